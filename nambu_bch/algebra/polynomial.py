@@ -1,0 +1,133 @@
+"""Exact sparse polynomials in the phase-space coordinates.
+
+Coefficients live in the field of rational functions of the parameters
+(``QQ(m, omega)``, so ``1/m`` is exact), optionally extended by algebraic
+numbers such as ``2**(1/3)`` for triple-jump coefficients.  The ring may carry
+extra *constant* generators (the step ``h``, the family parameter ``alpha``)
+that are never differentiated.  Polynomials are sympy ``PolyElement``s: dicts
+from exponent tuples to coefficients, as in ``sympy/polys/rings.py``.
+
+Anything that is not a polynomial in this ring (``sin(x1)``, ``exp(h*x1)``)
+stays a general sympy expression; :class:`PolynomialAlgebra` offers the same
+operations (``diff``, ``is_zero``, ``to_sympy``) on both kinds so that callers
+never need to ask which one they hold.
+"""
+
+from __future__ import annotations
+
+from functools import cached_property
+
+import sympy
+from sympy.polys.domains import QQ
+from sympy.polys.polyerrors import CoercionFailed, GeneratorsError, PolynomialError
+from sympy.polys.rings import PolyElement, ring
+
+from ..errors import InvalidSystemError
+
+_CONVERSION_ERRORS = (CoercionFailed, GeneratorsError, PolynomialError, ValueError, TypeError)
+
+
+def _symbols(names) -> tuple[sympy.Symbol, ...]:
+    return tuple(sympy.Symbol(n) if isinstance(n, str) else n for n in names)
+
+
+class PolynomialAlgebra:
+    """Polynomials in ``coordinates`` (and ``constants``) over ``QQ(parameters)``.
+
+    Parameters
+    ----------
+    coordinates : sequence of sympy Symbols
+        The phase-space variables, the only ones :meth:`diff` differentiates by.
+    parameters : sequence of sympy Symbols
+        Symbols allowed in denominators (``m``, ``omega``, ``I1`` ...).
+    constants : sequence of sympy Symbols
+        Extra polynomial generators that are never differentiated (``h``).
+    extension : sequence of sympy numbers
+        Algebraic numbers adjoined to QQ (e.g. ``cbrt(2)``).
+
+    Examples
+    --------
+    >>> import sympy
+    >>> x1, x2, m = sympy.symbols("x1 x2 m")
+    >>> A = PolynomialAlgebra([x1, x2], [m])
+    >>> A.to_sympy(A.diff(A.convert(x2**2 / (2*m)), 1))
+    x2/m
+    """
+
+    def __init__(self, coordinates, parameters=(), constants=(), extension=()):
+        self.coordinates = _symbols(coordinates)
+        self.parameters = _symbols(parameters)
+        self.constants = _symbols(constants)
+        self.extension = tuple(sympy.sympify(e) for e in extension)
+        clash = set(self.coordinates) & (set(self.parameters) | set(self.constants))
+        if clash:
+            raise InvalidSystemError(
+                f"symbols {sorted(map(str, clash))} are used both as coordinates and as parameters/constants"
+            )
+        domain = QQ.algebraic_field(*self.extension) if self.extension else QQ
+        if self.parameters:
+            domain = domain.frac_field(*self.parameters)
+        self.domain = domain
+        self.ring, *gens = ring(list(self.coordinates + self.constants), domain)
+        self.gens = tuple(gens)
+        self.n = len(self.coordinates)
+
+    def __repr__(self):
+        return f"PolynomialAlgebra(coordinates={self.coordinates}, parameters={self.parameters}, constants={self.constants})"
+
+    def with_constants(self, *constants, extension=()) -> "PolynomialAlgebra":
+        """The same algebra with more constant generators / algebraic numbers."""
+        new = tuple(c for c in _symbols(constants) if c not in self.constants)
+        ext = self.extension + tuple(e for e in extension if e not in self.extension)
+        if not new and ext == self.extension:
+            return self
+        return PolynomialAlgebra(self.coordinates, self.parameters, self.constants + new, ext)
+
+    # -- conversion -------------------------------------------------------------
+    def convert(self, expr):
+        """``expr`` as a ring element when it is a polynomial here, else a sympy expression."""
+        if isinstance(expr, PolyElement) and expr.ring == self.ring:
+            return expr
+        expr = sympy.sympify(expr)
+        try:
+            return self.ring.from_expr(expr) if expr.free_symbols else self.ring(self.domain.from_sympy(expr))
+        except _CONVERSION_ERRORS:
+            return expr
+
+    def is_polynomial(self, value) -> bool:
+        return isinstance(value, PolyElement) and value.ring == self.ring
+
+    def to_sympy(self, value) -> sympy.Expr:
+        """A sympy expression (polynomials are expanded, coefficients as rational functions)."""
+        if isinstance(value, PolyElement):
+            return value.as_expr()
+        return sympy.sympify(value)
+
+    def to_general(self, value) -> sympy.Expr:
+        return self.to_sympy(value)
+
+    @cached_property
+    def zero(self):
+        return self.ring.zero
+
+    # -- calculus ---------------------------------------------------------------
+    def diff(self, value, index: int):
+        """Partial derivative by coordinate number ``index`` (0-based)."""
+        if isinstance(value, PolyElement):
+            return value.diff(self.gens[index])
+        return sympy.diff(value, self.coordinates[index])
+
+    def is_zero(self, value) -> bool:
+        """Exact zero test: structural for polynomials, ``simplify`` for the rest."""
+        if isinstance(value, PolyElement):
+            return not value
+        value = sympy.sympify(value)
+        if value == 0:
+            return True
+        return sympy.expand(value) == 0 or sympy.simplify(value) == 0
+
+    def common(self, *values):
+        """The values in one representation: all ring elements if possible, else all sympy."""
+        if all(isinstance(v, PolyElement) for v in values):
+            return values
+        return tuple(self.to_sympy(v) for v in values)

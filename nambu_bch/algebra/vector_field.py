@@ -1,0 +1,141 @@
+"""Vector fields as first-order differential operators X = X^i d/dx_i.
+
+Convention (the paper's, Eqs. CL1 and CL2): the Lie bracket of two fields is
+their commutator *as operators*, ``[X, Y] f = X(Y f) - Y(X f)``, so that
+``[X, Y]^i = X(Y^i) - Y(X^i)`` and, for Hamiltonian fields,
+``[X_A, X_B] = X_{{B,A}}`` (Eq. CL1).
+
+Components are exact ring elements when the field is polynomial
+(see :mod:`nambu_bch.algebra.polynomial`) and general sympy expressions
+otherwise; the operations are the same for both.
+"""
+
+from __future__ import annotations
+
+import sympy
+
+from ..errors import NambuBCHError
+from .polynomial import PolynomialAlgebra
+
+
+class VectorField:
+    """A vector field on the coordinates of ``algebra``.
+
+    Parameters
+    ----------
+    algebra : PolynomialAlgebra
+    components : sequence
+        ``X^i``, one per coordinate, as sympy expressions or ring elements.
+
+    Examples
+    --------
+    >>> import sympy
+    >>> x1, x2 = sympy.symbols("x1 x2")
+    >>> A = PolynomialAlgebra([x1, x2])
+    >>> X = VectorField(A, [x2, 0]); Y = VectorField(A, [0, -x1])
+    >>> X.bracket(Y).to_sympy()
+    (x1, x2)
+    """
+
+    __slots__ = ("algebra", "components")
+
+    def __init__(self, algebra: PolynomialAlgebra, components):
+        components = tuple(components)
+        if len(components) != algebra.n:
+            raise NambuBCHError(
+                f"a vector field on {algebra.n} coordinates needs {algebra.n} components, got {len(components)}"
+            )
+        self.algebra = algebra
+        self.components = algebra.common(*(algebra.convert(c) for c in components))
+
+    @classmethod
+    def zero(cls, algebra: PolynomialAlgebra) -> "VectorField":
+        return cls(algebra, [algebra.zero] * algebra.n)
+
+    # -- action ---------------------------------------------------------------------
+    def apply(self, f):
+        """``X f = sum_i X^i df/dx_i`` (``f`` a sympy expression or ring element)."""
+        A = self.algebra
+        f, *components = A.common(A.convert(f), *self.components)
+        total = A.zero if A.is_polynomial(f) else sympy.Integer(0)
+        for i, c in enumerate(components):
+            if not A.is_zero(c):
+                total = total + c * A.diff(f, i)
+        return total if A.is_polynomial(total) else sympy.expand(total)
+
+    __call__ = apply
+
+    def bracket(self, other: "VectorField") -> "VectorField":
+        """The commutator ``[self, other]`` as differential operators."""
+        self._check(other)
+        A = self.algebra
+        comps = [
+            u - v for u, v in (A.common(self.apply(b), other.apply(a)) for a, b in zip(self.components, other.components))
+        ]
+        return VectorField(self.algebra, comps)
+
+    def divergence(self):
+        """``div X = sum_i dX^i/dx_i`` (zero for every Liouville field)."""
+        A = self.algebra
+        total = A.zero if all(A.is_polynomial(c) for c in self.components) else sympy.Integer(0)
+        for i, c in enumerate(self.components):
+            total = total + A.diff(c, i)
+        return total
+
+    # -- linear structure -------------------------------------------------------------
+    def _check(self, other):
+        if not isinstance(other, VectorField) or other.algebra.coordinates != self.algebra.coordinates:
+            raise NambuBCHError("vector fields on different coordinates cannot be combined")
+
+    def __add__(self, other):
+        self._check(other)
+        pairs = (self.algebra.common(a, b) for a, b in zip(self.components, other.components))
+        return VectorField(self.algebra, [a + b for a, b in pairs])
+
+    def __neg__(self):
+        return VectorField(self.algebra, [-c for c in self.components])
+
+    def __sub__(self, other):
+        return self + (-other)
+
+    def scale(self, factor) -> "VectorField":
+        """``factor * X`` for a constant factor (number, parameter or ring constant)."""
+        A = self.algebra
+        factor = A.convert(factor)
+        return VectorField(self.algebra, [a * b for a, b in (A.common(factor, c) for c in self.components)])
+
+    __rmul__ = scale
+    __mul__ = scale
+
+    # -- tests and output ---------------------------------------------------------------
+    def is_zero(self) -> bool:
+        return all(self.algebra.is_zero(c) for c in self.components)
+
+    def __eq__(self, other):
+        if not isinstance(other, VectorField) or other.algebra.coordinates != self.algebra.coordinates:
+            return NotImplemented
+        return (self - other).is_zero()
+
+    def __hash__(self):
+        return hash(self.to_sympy())
+
+    def to_sympy(self) -> tuple:
+        return tuple(self.algebra.to_sympy(c) for c in self.components)
+
+    def to_latex(self) -> str:
+        parts = []
+        for x, c in zip(self.algebra.coordinates, self.to_sympy()):
+            if c != 0:
+                parts.append(rf"\left({sympy.latex(sympy.factor(c))}\right)\frac{{\partial}}{{\partial {sympy.latex(x)}}}")
+        return " + ".join(parts) if parts else "0"
+
+    def _repr_latex_(self):
+        return f"${self.to_latex()}$"
+
+    def __repr__(self):
+        return f"VectorField({self.to_sympy()})"
+
+
+def lie_bracket(X: VectorField, Y: VectorField) -> VectorField:
+    """``[X, Y] = XY - YX`` as differential operators (Eq. CL1 convention)."""
+    return X.bracket(Y)

@@ -1,0 +1,54 @@
+"""The one exception family of nambu_bch.
+
+Every error raised on bad input derives from :class:`NambuBCHError` (itself a
+``ValueError``), and its message names the offending input and what would be
+accepted.  The CLI turns any of them into one line on stderr and exit code 2.
+"""
+
+
+class NambuBCHError(ValueError):
+    """Base class of every error nambu_bch raises on bad input."""
+
+
+class InvalidSystemError(NambuBCHError):
+    """A system whose coordinates, Hamiltonians or parameters do not fit together."""
+
+
+class NotSeparableError(InvalidSystemError):
+    """A Hamiltonian that must be split per coordinate contains a coupling term."""
+
+
+class UnknownModelError(NambuBCHError):
+    """A built-in model name that does not exist."""
+
+
+class InvalidCompositionError(NambuBCHError):
+    """A composition (word or coefficient list) that is malformed."""
+
+
+class UnknownPieceError(InvalidCompositionError):
+    """A word names a piece that the splitting does not have."""
+
+
+class InconsistentCoefficientsError(InvalidCompositionError):
+    """The coefficients of some piece do not sum to one (the scheme is inconsistent)."""
+
+
+class NoExactFlowError(NambuBCHError):
+    """A piece of a splitting whose flow cannot be written in closed form."""
+
+
+class InvalidOrderError(NambuBCHError):
+    """A truncation order that is negative, not an integer, or too high to finish."""
+
+
+class ExpressionParseError(NambuBCHError):
+    """A user expression that is not accepted by the safe parser."""
+
+
+class UnstableStepError(NambuBCHError):
+    """A step size outside the stability interval of the integrator (e.g. |omega h| >= 2)."""
+
+
+class NumericalRangeError(NambuBCHError):
+    """A numeric input or result that is not finite (overflow, NaN input)."""

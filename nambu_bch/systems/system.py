@@ -1,0 +1,165 @@
+"""A Nambu (N >= 3) or Hamiltonian (N = 2) system: coordinates, Hamiltonians, parameters."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from functools import cached_property
+
+import sympy
+
+from ..algebra import PolynomialAlgebra, VectorField, liouville_field
+from ..errors import InvalidSystemError
+
+#: Symbols reserved by the package: the step and the family parameter.
+RESERVED_SYMBOLS = ("h", "alpha")
+
+
+def _as_symbols(names, what):
+    if isinstance(names, str):
+        names = names.replace(",", " ").split()
+    out = []
+    for n in names:
+        if isinstance(n, str):
+            if not n.isidentifier():
+                raise InvalidSystemError(f"{what} name {n!r} is not a valid symbol name")
+            n = sympy.Symbol(n)
+        if not isinstance(n, sympy.Symbol):
+            raise InvalidSystemError(f"{what} must be symbols or names, got {n!r}")
+        out.append(n)
+    return tuple(out)
+
+
+@dataclass(frozen=True, eq=False)
+class System:
+    """Coordinates ``x_1..x_N`` driven by ``N - 1`` Hamiltonians (one for N = 2).
+
+    The equations of motion are ``df/dt = {f, H_1, ..., H_{N-1}}`` (Eq. NambuEq;
+    Eq. HamiltonEq for N = 2), i.e. ``dx/dt = X_{H_1..H_{N-1}}``.
+
+    Parameters
+    ----------
+    coordinates : str or sequence of Symbols/names, e.g. ``"x1 x2 x3"``
+    hamiltonians : sequence of sympy expressions (or strings parsed safely)
+    parameters : str or sequence of Symbols/names, e.g. ``"m omega"``
+    name : str, optional
+    split : ``"full"`` to split every Hamiltonian per coordinate (Eqs. X1-X3),
+        or ``"single"`` to split only the first one (the paper's footnote).
+    description, citation : str, optional
+
+    Examples
+    --------
+    >>> S = System("x1 x2 x3", ["x2**2/(2*m) + m*omega**2*x3/2", "x3 - x1**2"], "m omega")
+    >>> S.N, S.H
+    (3, m*omega**2*x3/2 + x2**2/(2*m))
+    """
+
+    coordinates: tuple
+    hamiltonians: tuple
+    parameters: tuple = ()
+    name: str = "custom"
+    split: str = "full"
+    description: str = ""
+    citation: str = ""
+    piece_labels: tuple = field(default=(), compare=False)
+
+    def __post_init__(self):
+        coords = _as_symbols(self.coordinates, "coordinate")
+        params = _as_symbols(self.parameters, "parameter")
+        object.__setattr__(self, "coordinates", coords)
+        object.__setattr__(self, "parameters", params)
+        if len(coords) < 2:
+            raise InvalidSystemError(f"a system needs at least 2 coordinates, got {len(coords)}")
+        if len(set(coords)) != len(coords) or set(coords) & set(params):
+            raise InvalidSystemError(f"coordinates {coords} and parameters {params} must be distinct symbols")
+        for s in coords + params:
+            if s.name in RESERVED_SYMBOLS:
+                raise InvalidSystemError(f"the symbol {s.name!r} is reserved (step / family parameter); rename it")
+        hams = self.hamiltonians
+        if isinstance(hams, (str, sympy.Basic)):
+            hams = (hams,)
+        hams = tuple(self._parse(H) for H in hams)
+        expected = 1 if len(coords) == 2 else len(coords) - 1
+        if len(hams) != expected:
+            raise InvalidSystemError(
+                f"a system on {len(coords)} coordinates needs {expected} Hamiltonian(s), got {len(hams)}"
+            )
+        allowed = set(coords) | set(params)
+        for k, H in enumerate(hams):
+            stray = H.free_symbols - allowed
+            if stray:
+                raise InvalidSystemError(
+                    f"Hamiltonian {self._ham_name(k, len(hams))} = {H} uses {sorted(map(str, stray))}, "
+                    f"which are neither coordinates {[str(c) for c in coords]} nor parameters {[str(p) for p in params]}"
+                )
+            if not H.free_symbols & set(coords):
+                raise InvalidSystemError(f"Hamiltonian {self._ham_name(k, len(hams))} = {H} does not depend on any coordinate")
+        object.__setattr__(self, "hamiltonians", hams)
+        if self.split not in ("full", "single"):
+            raise InvalidSystemError(f"split must be 'full' or 'single', got {self.split!r}")
+
+    def _parse(self, H):
+        if isinstance(H, str):
+            from ..parsing import parse_expression
+
+            return parse_expression(H, symbols=(*self.coordinates, *self.parameters))
+        try:
+            return sympy.sympify(H, strict=True)
+        except (sympy.SympifyError, TypeError) as exc:
+            raise InvalidSystemError(f"Hamiltonian {H!r} is not a sympy expression") from exc
+
+    @staticmethod
+    def _ham_name(k, count):
+        return "H" if k == 0 else ("G" if count == 2 else f"H{k + 1}")
+
+    # -- views --------------------------------------------------------------------
+    @property
+    def N(self) -> int:
+        return len(self.coordinates)
+
+    @property
+    def H(self) -> sympy.Expr:
+        return self.hamiltonians[0]
+
+    @property
+    def G(self):
+        """The second Hamiltonian (``None`` for N = 2)."""
+        return self.hamiltonians[1] if len(self.hamiltonians) > 1 else None
+
+    @cached_property
+    def algebra(self) -> PolynomialAlgebra:
+        """Polynomials in the coordinates and the step ``h`` over ``QQ(parameters)``."""
+        return PolynomialAlgebra(self.coordinates, self.parameters, constants=(sympy.Symbol("h"),))
+
+    @cached_property
+    def vector_field(self) -> VectorField:
+        """``X_{H,G}`` (Eq. gLiouville), or ``X_H`` for N = 2."""
+        return liouville_field(self.algebra, *self.hamiltonians)
+
+    @cached_property
+    def splitting(self):
+        """The default splitting of this system (see :mod:`nambu_bch.systems.splitting`)."""
+        from .splitting import full_split, single_split
+
+        return full_split(self) if self.split == "full" else single_split(self)
+
+    def equations_of_motion(self) -> tuple:
+        """``dx_i/dt`` as sympy expressions (e.g. Eq. NambuOHeqs for ``ho3``)."""
+        return self.vector_field.to_sympy()
+
+    def symbols(self) -> dict:
+        """Name -> Symbol for every symbol a user expression may use (plus ``h``, ``alpha``)."""
+        names = {s.name: s for s in (*self.coordinates, *self.parameters)}
+        names.update({n: sympy.Symbol(n) for n in RESERVED_SYMBOLS})
+        return names
+
+    def to_latex(self) -> str:
+        labels = ["H", "G"] if len(self.hamiltonians) == 2 else [f"H_{{{k + 1}}}" for k in range(len(self.hamiltonians))]
+        if len(self.hamiltonians) == 1:
+            labels = ["H"]
+        return ",\\quad ".join(f"{lab} = {sympy.latex(H)}" for lab, H in zip(labels, self.hamiltonians))
+
+    def _repr_latex_(self):
+        return f"${self.to_latex()}$"
+
+    def __repr__(self):
+        return f"System(name={self.name!r}, coordinates={self.coordinates}, hamiltonians={self.hamiltonians}, parameters={self.parameters})"
