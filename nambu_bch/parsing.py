@@ -36,7 +36,6 @@ _BINARY = {
     ast.Mult: lambda a, b: a * b,
     ast.Div: lambda a, b: a / b,
     ast.Pow: lambda a, b: a**b,
-    ast.BitXor: lambda a, b: a**b,
 }
 
 
@@ -64,6 +63,8 @@ def parse_expression(text: str, symbols, what: str = "expression") -> sympy.Expr
     if not text.strip():
         raise ExpressionParseError(f"{what} is empty")
     names = dict(symbols) if isinstance(symbols, dict) else {s.name: s for s in symbols}
+    # '^' means power to physicists; Python would parse it as xor with the wrong precedence
+    text = text.replace("^", "**")
     try:
         tree = ast.parse(text.strip(), mode="eval")
     except (SyntaxError, ValueError) as exc:
@@ -106,7 +107,7 @@ class _Builder:
             return -value if isinstance(node.op, ast.USub) else value
         if isinstance(node, ast.BinOp) and type(node.op) in _BINARY:
             left, right = self.visit(node.left, depth + 1), self.visit(node.right, depth + 1)
-            if isinstance(node.op, (ast.Pow, ast.BitXor)) and right.is_number and abs(right) > MAX_EXPONENT:
+            if isinstance(node.op, ast.Pow) and right.is_number and abs(right) > MAX_EXPONENT:
                 self.fail(f"the exponent {right} is larger than {MAX_EXPONENT}")
             if isinstance(node.op, ast.Div) and right == 0:
                 self.fail("it divides by zero")

@@ -34,7 +34,7 @@ class VectorField:
     >>> A = PolynomialAlgebra([x1, x2])
     >>> X = VectorField(A, [x2, 0]); Y = VectorField(A, [0, -x1])
     >>> X.bracket(Y).to_sympy()
-    (x1, x2)
+    (x1, -x2)
     """
 
     __slots__ = ("algebra", "components")

@@ -49,8 +49,8 @@ def step_function(splitting, comp, params=None):
     --------
     >>> from nambu_bch import model
     >>> step = step_function(model("ho").splitting, "121")
-    >>> [round(v, 6) for v in step([1.0, 0.0], 0.1)]
-    [0.995, -0.09975]
+    >>> [round(float(v), 6) for v in step([1.0, 0.0], 0.1)]
+    [0.995, -0.1]
     """
     flows = subflow_functions(splitting, comp, params)
 
