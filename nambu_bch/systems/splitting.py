@@ -95,7 +95,7 @@ def _moving(field: VectorField) -> tuple:
 def full_split(system) -> Splitting:
     """Split every Hamiltonian per coordinate; piece ``i`` moves ``x_i`` (Eqs. X1-X3)."""
     coords = system.coordinates
-    names = ["H", "G"] if len(system.hamiltonians) == 2 else [f"H{k + 1}" for k in range(len(system.hamiltonians))]
+    names = [system._ham_name(k, len(system.hamiltonians)) for k in range(len(system.hamiltonians))]
     parts = [separate(H, coords, name) for H, name in zip(system.hamiltonians, names)]
     pieces = []
     for i in range(system.N):
