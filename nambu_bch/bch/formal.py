@@ -1,0 +1,313 @@
+"""The formal BCH series: log of a product of exponentials in the Lyndon basis.
+
+For a composition ``Phi = exp(c_1 X_{k_1}) ... exp(c_s X_{k_s})`` (operator
+order, :mod:`nambu_bch.integrators.composition`) with the pieces as free
+generators, ``log Phi = sum_d L_d``, ``L_d`` a homogeneous Lie polynomial of
+degree ``d``.  With the step, ``Phi_h = exp(h X_eff)`` and
+``X_eff = sum_d h^(d-1) L_d``, so ``L_{j+1}`` is the coefficient ``Z_j``
+(Eqs. eL1, eL2).
+
+Algorithm (exact, no floats).  The product is expanded in the free associative
+algebra truncated at ``max_degree``, homogeneous part ``d`` stored as a dense
+vector over the ``g^d`` words (``g`` generators).  Clearing the common
+denominator ``q`` of the ``c_i`` and storing ``d! * (part d)`` keeps every
+product integral (``d!/(a! b!)`` is a binomial coefficient), and
+``log(1 + Q) = sum_k (-1)^(k+1) Q^k / k`` adds one factor ``lcm(1..n)``.  Each
+``L_d`` is then written in the Lyndon basis ``P_w`` by a triangular solve
+(``P_w = w + larger words``, :mod:`nambu_bch.bch.lyndon`); the residual after
+the solve must vanish, which checks on every call that the logarithm is a Lie
+element.  Algebraic coefficients (triple jump, ``2**(1/3)``) run the same code
+with elements of ``QQ(2**(1/3))``.
+
+References
+----------
+Horikoshi, Eqs. (eL1), (BCH1), (eL2), (BCH2); Hairer, Lubich, Wanner,
+*Geometric Numerical Integration*, Sect. III.4 (BCH formula) and Sect. III.5
+(symmetric compositions have odd-degree series); Reutenauer, *Free Lie
+Algebras*, Thm. 5.1 (Lyndon basis); Casas & Murua, J. Math. Phys. 50 (2009)
+033513 (BCH series in a Hall-Lyndon basis).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from math import comb, factorial, lcm
+
+import numpy as np
+import sympy
+from sympy.polys.constructor import construct_domain
+
+from ..errors import InvalidCompositionError, InvalidOrderError
+from ..integrators.composition import Composition
+from ..integrators.composition import composition as make_composition
+from .lyndon import lyndon_expansion, lyndon_words, standard_bracketing, tree_to_latex, witt_dimension, word_index
+
+#: Largest number of words ``g^max_degree`` of the top degree that the engine accepts.
+MAX_WORDS = 600_000
+
+
+def estimate_size(n_generators: int, max_degree: int) -> dict:
+    """Sizes of the BCH computation: Lyndon basis elements (Witt) and associative words.
+
+    >>> estimate_size(3, 7)["lyndon"]
+    508
+    """
+    g = n_generators
+    return {
+        "lyndon": sum(witt_dimension(g, d) for d in range(1, max_degree + 1)),
+        "words": sum(g**d for d in range(1, max_degree + 1)),
+        "top_words": g**max_degree,
+    }
+
+
+def check_degree(max_degree, n_generators: int, limit: int = MAX_WORDS) -> int:
+    """``max_degree`` as an int ``>= 1`` whose computation fits the size limit, else :class:`InvalidOrderError`."""
+    if isinstance(max_degree, bool) or not isinstance(max_degree, (int, np.integer)):
+        try:
+            if isinstance(max_degree, bool) or float(max_degree) != int(max_degree):
+                raise ValueError
+            max_degree = int(max_degree)
+        except (TypeError, ValueError, OverflowError):
+            raise InvalidOrderError(f"BCH degree must be a positive integer, got {max_degree!r}") from None
+    max_degree = int(max_degree)
+    if max_degree < 1:
+        raise InvalidOrderError(f"BCH degree must be a positive integer (1 = X_1 + X_2 + ...), got {max_degree}")
+    if n_generators > 1 and max_degree * np.log(n_generators) > np.log(limit) + 1e-9:
+        size = estimate_size(n_generators, max_degree) if max_degree < 64 else None
+        detail = (
+            f"{size['lyndon']} Lyndon basis elements (Witt's formula) and {size['top_words']} words of top degree"
+            if size else f"more than {limit} words of top degree"
+        )
+        raise InvalidOrderError(
+            f"BCH to degree {max_degree} in {n_generators} generators needs {detail}; the limit is "
+            f"{limit} words (degree <= {_max_degree(n_generators, limit)} for {n_generators} generators)"
+        )
+    return max_degree
+
+
+def _max_degree(g: int, limit: int) -> int:
+    d = 1
+    while g ** (d + 1) <= limit:
+        d += 1
+    return d
+
+
+class _Scalars:
+    """Coefficient arithmetic: python ints (rational compositions) or a sympy algebraic field."""
+
+    def __init__(self, coefficients):
+        K, elems = construct_domain([sympy.nsimplify(c) if not c.is_Rational else c for c in coefficients], extension=True)
+        if K.is_ZZ or K.is_QQ:
+            fracs = [sympy.Rational(c) for c in coefficients]
+            self.q = lcm(*(int(f.q) for f in fracs))
+            self.values = [int(f.p) * (self.q // int(f.q)) for f in fracs]
+            self.K = None
+            self.zero, self.one = 0, 1
+        else:
+            self.q = 1
+            self.values = list(elems)
+            self.K = K
+            self.zero, self.one = K.zero, K.one
+
+    def zeros(self, n):
+        a = np.empty(n, dtype=object)
+        a.fill(self.zero)
+        return a
+
+    def is_zero(self, x) -> bool:
+        return not x
+
+    def to_sympy(self, numerator, denominator: int):
+        if self.K is None:
+            return sympy.Rational(int(numerator), denominator)
+        return self.K.to_sympy(numerator * self.K.convert(sympy.Rational(1, denominator)))
+
+
+def _log_of_product(letters, scalars: _Scalars, g: int, n: int):
+    """Numerators ``N_d`` (arrays over the ``g^d`` words) and denominators of ``log prod exp``."""
+    # P_d scaled by d!; degree 0 is the unit
+    P = [scalars.zeros(g**d) for d in range(n + 1)]
+    P[0][0] = scalars.one
+    for a, c in zip(letters, scalars.values):
+        new = [scalars.zeros(g**d) for d in range(n + 1)]
+        powers = [scalars.one]
+        for _ in range(n):
+            powers.append(powers[-1] * c)
+        for d in range(n + 1):
+            for b in range(d + 1):
+                col = word_index((a,) * b, g)
+                view = new[d].reshape(g ** (d - b), g**b)
+                view[:, col] += P[d - b] * (comb(d, b) * powers[b])
+        P = new
+    Q = P
+    Q[0] = scalars.zeros(1)
+    L = [scalars.zeros(g**d) for d in range(n + 1)]
+    big = lcm(*range(1, n + 1))
+    R = Q
+    for k in range(1, n + 1):
+        if k > 1:
+            R = [
+                _graded_product_part(R, Q, d, k, g, scalars) if d >= k else scalars.zeros(g**d)
+                for d in range(n + 1)
+            ]
+        sign = 1 if k % 2 else -1
+        for d in range(k, n + 1):
+            L[d] += R[d] * (sign * (big // k))
+    dens = [factorial(d) * big * scalars.q**d for d in range(n + 1)]
+    return L, dens
+
+
+def _graded_product_part(R, Q, d, k, g, scalars):
+    """Part ``d`` of ``R * Q`` (both scaled by degree factorials), ``R`` of min degree ``k - 1``."""
+    out = scalars.zeros(g**d)
+    for a in range(k - 1, d):
+        b = d - a
+        out += np.multiply.outer(R[a], Q[b]).ravel() * comb(d, a)
+    return out
+
+
+def _lyndon_coordinates(vector, d: int, g: int):
+    """Coordinates of a homogeneous Lie element of degree ``d`` in the Lyndon basis."""
+    residual = vector.copy()
+    coords = []
+    for w in lyndon_words(g, d):
+        c = residual[word_index(w, g)]
+        if not c:
+            continue
+        coords.append((w, c))
+        idx, coef = lyndon_expansion(w, g)
+        residual[idx] -= coef.astype(object) * c
+    if any(residual):
+        raise ArithmeticError(f"internal error: the degree-{d} part of the BCH logarithm is not a Lie element")
+    return coords
+
+
+@dataclass(frozen=True, eq=False)
+class FormalBCH:
+    """``log(exp(c_1 X_{k_1}) ... exp(c_s X_{k_s}))`` through ``max_degree`` in the Lyndon basis.
+
+    Attributes
+    ----------
+    composition : Composition
+    generators : tuple of int
+        The distinct piece numbers, in increasing order: the ordered alphabet of
+        the Lyndon basis (piece ``k`` is the generator ``X_k``).
+    max_degree : int
+    """
+
+    composition: Composition
+    generators: tuple
+    max_degree: int
+    _terms: dict
+    _words: dict
+
+    def terms(self, degree: int) -> list:
+        """``[(coefficient, tree), ...]`` of the degree-``degree`` part, Lyndon words in lexicographic order.
+
+        ``coefficient`` is an exact sympy number; ``tree`` a generator (piece
+        number) or a 2-tuple ``(left, right)`` = ``[left, right]``.
+        """
+        if not isinstance(degree, int) or degree < 1 or degree > self.max_degree:
+            raise InvalidOrderError(f"degree must be an integer in 1..{self.max_degree} (the computed range), got {degree!r}")
+        return list(self._terms.get(degree, ()))
+
+    def words(self, degree: int) -> list:
+        """``[(coefficient, lyndon_word), ...]`` with words as tuples of piece numbers."""
+        self.terms(degree)
+        return list(self._words.get(degree, ()))
+
+    @property
+    def degrees(self) -> tuple:
+        """Degrees ``1..max_degree`` whose part is non-zero (odd only for a symmetric composition)."""
+        return tuple(d for d in range(1, self.max_degree + 1) if self._terms.get(d))
+
+    def all_terms(self) -> list:
+        """``[(coefficient, tree), ...]`` over all degrees, lowest first."""
+        return [t for d in range(1, self.max_degree + 1) for t in self._terms.get(d, ())]
+
+    def __len__(self):
+        return sum(len(v) for v in self._terms.values())
+
+    def to_latex(self, names=None, step="h") -> str:
+        r"""The series term by term, e.g. ``X_{\rm eff} = X_{1} + X_{2} - \frac{h^{2}}{24}[...] ...``.
+
+        Parameters
+        ----------
+        names : dict or callable, optional
+            LaTeX name of each generator (default ``X_{k}``).
+        step : str or None
+            With a step symbol the series is printed as ``X_eff`` (degree ``d`` carries
+            ``step^(d-1)``, Eq. BCH2); with ``None`` as ``log Phi`` of the bare generators.
+        """
+        pieces = []
+        for d in range(1, self.max_degree + 1):
+            power = sympy.Symbol(step) ** (d - 1) if step else sympy.Integer(1)
+            for c, tree in self._terms.get(d, ()):
+                pieces.append(_term_latex(c, power, tree_to_latex(tree, names)))
+        series = " ".join(pieces).lstrip("+ ") if pieces else "0"
+        lhs = r"X_{\rm eff}" if step else r"\log \Phi"
+        tail = f" + O({sympy.latex(sympy.Symbol(step) ** self.max_degree)})" if step else ""
+        return f"{lhs} = {series}{tail}"
+
+    def _repr_latex_(self):
+        return f"${self.to_latex()}$"
+
+    def __repr__(self):
+        return f"FormalBCH({self.composition.name!r}, max_degree={self.max_degree}, terms={len(self)})"
+
+
+def _term_latex(c, power, body: str) -> str:
+    """`` + \\frac{h^{2}}{12} [X_1,[X_1,X_2]]``: sign, then magnitude (rational) or parenthesised coefficient."""
+    if c.is_Rational:
+        sign = "-" if c < 0 else "+"
+        magnitude = abs(c) * power
+        text = "" if magnitude == 1 else sympy.latex(magnitude) + " "
+        return f"{sign} {text}{body}"
+    factor = "" if power == 1 else " " + sympy.latex(power)
+    return rf"+ \left({sympy.latex(c)}\right){factor} {body}"
+
+
+def formal_bch(comp, max_degree: int, n_pieces: int | None = None) -> FormalBCH:
+    """The BCH series ``log(prod_j exp(c_j X_{k_j}))`` through ``max_degree``, exact, in the Lyndon basis.
+
+    Parameters
+    ----------
+    comp : Composition, word, alias or ``"k:c,..."`` spec
+        The pieces act as free generators, named by their 1-based numbers.
+    max_degree : int
+        Highest degree kept (``X_eff`` through ``h^(max_degree - 1)``).
+    n_pieces : int, optional
+        Needed only by ``lie-trotter`` / ``strang`` specs.
+
+    Returns
+    -------
+    FormalBCH
+
+    Examples
+    --------
+    Eq. (BCH1) for position Verlet ``e^{hX_T/2} e^{hX_V} e^{hX_T/2}`` (T = 1, V = 2):
+
+    >>> B = formal_bch("121", 3)
+    >>> B.degrees
+    (1, 3)
+    >>> B.terms(3)
+    [(-1/24, (1, (1, 2))), (1/12, ((1, 2), 2))]
+    >>> formal_bch("12", 2).terms(2)     # Lie-Trotter: X_1 + X_2 + [X_1, X_2]/2
+    [(1/2, (1, 2))]
+    """
+    comp = make_composition(comp, n_pieces)
+    if not isinstance(comp, Composition) or not comp.pieces:
+        raise InvalidCompositionError(f"formal_bch needs a composition with at least one factor, got {comp!r}")
+    generators = tuple(sorted(set(comp.pieces)))
+    g = len(generators)
+    n = check_degree(max_degree, g)
+    letter = {k: i for i, k in enumerate(generators)}
+    scalars = _Scalars(comp.coefficients)
+    L, dens = _log_of_product([letter[k] for k in comp.pieces], scalars, g, n)
+    terms, words = {}, {}
+    for d in range(1, n + 1):
+        coords = _lyndon_coordinates(L[d], d, g)
+        if coords:
+            words[d] = tuple((scalars.to_sympy(c, dens[d]), tuple(generators[a] for a in w)) for w, c in coords)
+            terms[d] = tuple((c, standard_bracketing(w, generators)) for (c, _), (w, _) in zip(words[d], coords))
+    return FormalBCH(comp, generators, n, terms, words)

@@ -1,0 +1,237 @@
+"""The free Lie algebra: Lyndon words, their standard bracketing, bracket trees.
+
+Basis.  Over an ordered alphabet ``a_0 < a_1 < ...`` a *Lyndon word* is a
+non-empty word strictly smaller (lexicographically) than each of its proper
+suffixes.  Its *standard factorisation* is ``w = u v`` with ``v`` the longest
+proper suffix of ``w`` that is itself Lyndon (then ``u`` is Lyndon too), and
+its *standard bracketing* is ``P_a = a`` for a letter and
+``P_w = [P_u, P_v]``.  The ``P_w`` over all Lyndon words form a basis of the
+free Lie algebra (Chen-Fox-Lyndon), and expanded in the free associative
+algebra ``P_w = w + sum_{v > w} alpha_v v`` (all ``v`` rearrangements of
+``w``; Reutenauer, Thm. 5.1), which makes coordinates in this basis a
+triangular solve.  The number of Lyndon words of length ``d`` over ``g``
+letters is Witt's formula ``(1/d) sum_{e | d} mu(e) g^(d/e)``.
+
+Trees.  A bracket tree is a leaf or a 2-tuple ``(left, right)`` meaning the
+commutator ``[left, right] = left right - right left``.  A leaf is an
+``int`` (a piece / generator number), or a tuple of sympy expressions (a
+Liouville term ``X_{A,B}`` as in ``Piece.terms``); :func:`is_bracket` tells
+the two tuple kinds apart by their entries.
+
+References
+----------
+Reutenauer, *Free Lie Algebras* (1993), Sect. 5.1 and Thm. 5.1 (Lyndon basis),
+Cor. 4.14 (Witt's formula); Duval, J. Algorithms 4 (1983) 363 (generation);
+Horikoshi, Eq. (BCH2) (nested commutators written as trees).
+"""
+
+from __future__ import annotations
+
+from functools import lru_cache
+
+import numpy as np
+import sympy
+
+
+def is_bracket(tree) -> bool:
+    """``True`` for a bracket node ``(left, right)``, ``False`` for a leaf.
+
+    >>> is_bracket((1, (2, 3))), is_bracket(1), is_bracket((sympy.Symbol("A"), sympy.Symbol("C")))
+    (True, False, False)
+    """
+    return isinstance(tree, tuple) and len(tree) == 2 and not any(isinstance(e, sympy.Basic) for e in tree)
+
+
+def tree_degree(tree) -> int:
+    """Number of leaves of a bracket tree (its degree in the free Lie algebra).
+
+    >>> tree_degree((1, (1, 2)))
+    3
+    """
+    if is_bracket(tree):
+        return tree_degree(tree[0]) + tree_degree(tree[1])
+    return 1
+
+
+def tree_leaves(tree) -> tuple:
+    """The leaves of a tree, left to right.
+
+    >>> tree_leaves(((1, 2), (1, 3)))
+    (1, 2, 1, 3)
+    """
+    if is_bracket(tree):
+        return tree_leaves(tree[0]) + tree_leaves(tree[1])
+    return (tree,)
+
+
+def map_leaves(tree, function):
+    """The same tree with every leaf replaced by ``function(leaf)``."""
+    if is_bracket(tree):
+        return (map_leaves(tree[0], function), map_leaves(tree[1], function))
+    return function(tree)
+
+
+def witt_dimension(n_letters: int, degree: int) -> int:
+    """Number of Lyndon words of length ``degree`` over ``n_letters`` letters (Witt's formula).
+
+    ``dim L_d = (1/d) sum_{e | d} mu(e) g^(d/e)``: the dimension of the degree-``d``
+    part of the free Lie algebra on ``g`` generators (Reutenauer, Cor. 4.14).
+
+    >>> [witt_dimension(3, d) for d in range(1, 10)]
+    [3, 3, 8, 18, 48, 116, 312, 810, 2184]
+    """
+    if degree < 1:
+        return 0
+    total = sum(sympy.mobius(e) * n_letters ** (degree // e) for e in sympy.divisors(degree))
+    return int(total) // degree
+
+
+def lyndon_words(n_letters: int, degree: int) -> list:
+    """All Lyndon words of length ``degree`` over letters ``0..n_letters-1``, in lexicographic order.
+
+    Duval's algorithm generates every Lyndon word of length ``<= degree`` in order.
+
+    >>> lyndon_words(2, 3)
+    [(0, 0, 1), (0, 1, 1)]
+    """
+    return list(_lyndon_words(n_letters, degree))
+
+
+@lru_cache(maxsize=None)
+def _lyndon_words(n_letters: int, degree: int) -> tuple:
+    if n_letters < 1 or degree < 1:
+        return ()
+    out = []
+    w = [-1]
+    while w:
+        w[-1] += 1
+        if len(w) == degree:
+            out.append(tuple(w))
+        m = len(w)
+        while len(w) < degree:
+            w.append(w[len(w) - m])
+        while w and w[-1] == n_letters - 1:
+            w.pop()
+    return tuple(out)
+
+
+def is_lyndon(word) -> bool:
+    """``word`` is strictly smaller than all its proper suffixes.
+
+    >>> is_lyndon((0, 1)), is_lyndon((1, 0)), is_lyndon((0, 0))
+    (True, False, False)
+    """
+    word = tuple(word)
+    return bool(word) and all(word < word[i:] for i in range(1, len(word)))
+
+
+@lru_cache(maxsize=None)
+def standard_factorization(word: tuple) -> tuple:
+    """``(u, v)`` with ``v`` the longest proper Lyndon suffix of the Lyndon word ``word``.
+
+    >>> standard_factorization((0, 0, 1, 0, 1))
+    ((0, 0, 1), (0, 1))
+    """
+    for i in range(1, len(word)):
+        if is_lyndon(word[i:]):
+            return word[:i], word[i:]
+    raise ValueError(f"{word!r} is a letter or not a Lyndon word; standard factorisation needs a Lyndon word of length >= 2")
+
+
+def standard_bracketing(word, letters=None):
+    """The bracket tree ``P_w`` of a Lyndon word; leaves are ``letters[a]`` (default: the letters).
+
+    >>> standard_bracketing((0, 0, 1), letters=(1, 2))
+    (1, (1, 2))
+    """
+    word = tuple(word)
+    if len(word) == 1:
+        return word[0] if letters is None else letters[word[0]]
+    u, v = standard_factorization(word)
+    return (standard_bracketing(u, letters), standard_bracketing(v, letters))
+
+
+@lru_cache(maxsize=None)
+def lyndon_expansion(word: tuple, n_letters: int) -> tuple:
+    """``P_w`` in the free associative algebra as ``(indices, coefficients)`` numpy int64 arrays.
+
+    A word ``a_1 .. a_d`` has index ``sum a_i g^(d-i)`` (base-``g`` digits), so that
+    lexicographic order of equal-length words is numeric order of indices.
+    """
+    g = n_letters
+    if len(word) == 1:
+        return np.array([word[0]], dtype=np.int64), np.array([1], dtype=np.int64)
+    u, v = standard_factorization(word)
+    iu, cu = lyndon_expansion(u, g)
+    iv, cv = lyndon_expansion(v, g)
+    su, sv = g ** len(u), g ** len(v)
+    idx = np.concatenate([(iu[:, None] * sv + iv[None, :]).ravel(), (iv[:, None] * su + iu[None, :]).ravel()])
+    coef = np.concatenate([(cu[:, None] * cv[None, :]).ravel(), -(cv[:, None] * cu[None, :]).ravel()])
+    keys, inverse = np.unique(idx, return_inverse=True)
+    summed = np.zeros(len(keys), dtype=np.int64)
+    np.add.at(summed, inverse, coef)
+    keep = summed != 0
+    return keys[keep], summed[keep]
+
+
+def word_index(word, n_letters: int) -> int:
+    """Base-``g`` index of a word (see :func:`lyndon_expansion`)."""
+    index = 0
+    for a in word:
+        index = index * n_letters + a
+    return index
+
+
+def tree_to_associative(tree) -> dict:
+    """A bracket tree expanded in the free associative algebra: ``{word: integer}``.
+
+    Words are tuples of leaves; ``[x, y] = xy - yx``.
+
+    >>> sorted(tree_to_associative((1, 2)).items())
+    [((1, 2), 1), ((2, 1), -1)]
+    """
+    if not is_bracket(tree):
+        return {(tree,): 1}
+    left, right = tree_to_associative(tree[0]), tree_to_associative(tree[1])
+    out: dict = {}
+    for a, ca in left.items():
+        for b, cb in right.items():
+            out[a + b] = out.get(a + b, 0) + ca * cb
+            out[b + a] = out.get(b + a, 0) - ca * cb
+    return {w: c for w, c in out.items() if c != 0}
+
+
+def lie_to_associative(terms) -> dict:
+    """``sum c * tree`` over ``(c, tree)`` pairs, in the free associative algebra: ``{word: c}``.
+
+    Two Lie polynomials are equal iff these dicts are equal (the free Lie algebra
+    embeds in the free associative algebra, Reutenauer Thm. 0.5); this is how the
+    paper's nine-term Eq. (BCH2), which is not written in a basis, is compared
+    with the Lyndon-basis series.
+
+    >>> lie_to_associative([(1, (1, (2, 3))), (1, (2, (3, 1))), (1, (3, (1, 2)))])    # Jacobi
+    {}
+    """
+    out: dict = {}
+    for c, tree in terms:
+        for w, k in tree_to_associative(tree).items():
+            out[w] = out.get(w, 0) + c * k
+    return {w: c for w, c in out.items() if c != 0}
+
+
+def tree_to_latex(tree, names=None) -> str:
+    """LaTeX of a bracket tree, ``[X_{1},[X_{1},X_{2}]]``; ``names`` maps leaves to LaTeX.
+
+    ``names`` is a dict or a callable; the default writes ``X_{k}`` for an integer
+    leaf ``k`` and ``X_{A,B}`` for a Liouville term ``(A, B)``.
+
+    >>> tree_to_latex((1, (1, 2)))
+    '[X_{1},[X_{1},X_{2}]]'
+    """
+    if is_bracket(tree):
+        return f"[{tree_to_latex(tree[0], names)},{tree_to_latex(tree[1], names)}]"
+    if names is not None:
+        return names(tree) if callable(names) else names[tree]
+    if isinstance(tree, tuple):
+        return "X_{" + ",".join(sympy.latex(e) for e in tree) + "}"
+    return f"X_{{{tree}}}"
