@@ -1,0 +1,218 @@
+"""The safe expression parser (nambu_bch.parsing): exact numbers, whitelist, hostile input.
+
+Property: for *any* text, ``parse_expression`` either returns an exact sympy
+expression in the declared symbols or raises ``ExpressionParseError`` -- never
+another exception, never a Float, never an undeclared symbol, never a side effect.
+"""
+
+from __future__ import annotations
+
+import os
+
+import pytest
+import sympy
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+
+from nambu_bch.errors import ExpressionParseError, NambuBCHError
+from nambu_bch.parsing import MAX_LENGTH, parse_expression
+
+x1, x2, x3, m, omega = sympy.symbols("x1 x2 x3 m omega")
+SYMBOLS = [x1, x2, x3, m, omega]
+
+FAST = settings(max_examples=300, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+
+
+def _ok_or_parse_error(text):
+    try:
+        result = parse_expression(text, SYMBOLS, what="--H")
+    except ExpressionParseError as exc:
+        message = str(exc)
+        assert "\n" not in message and message.startswith("--H"), message
+        return None
+    assert isinstance(result, sympy.Expr)
+    assert not result.has(sympy.Float), result
+    assert result.free_symbols <= set(SYMBOLS), result
+    return result
+
+
+# -------------------------------------------------------------------------------------------
+# accepted input
+# -------------------------------------------------------------------------------------------
+@pytest.mark.parametrize(
+    "text, expected",
+    [
+        ("x2^2/(2*m) + m*omega^2*x1^2/2", x2**2 / (2 * m) + m * omega**2 * x1**2 / 2),  # Eq. (HO1)
+        ("x3 - x1**2", x3 - x1**2),  # Eq. (G)
+        ("0.1*x1", x1 / 10),
+        ("1e-3 + 2.5E2 + 1_000.5", sympy.Rational(1, 1000) + 250 + sympy.Rational(2001, 2)),
+        ("-(+x1)", -x1),
+        ("2^-1", sympy.Rational(1, 2)),
+        ("x1^0.5", sympy.sqrt(x1)),
+        ("Rational(1, 3)*x1", x1 / 3),
+        ("sin(x1)*cos(x2) + exp(-x3) + sqrt(2) + abs(m) + cbrt(8)", sympy.sin(x1) * sympy.cos(x2) + sympy.exp(-x3) + sympy.sqrt(2) + abs(m) + 2),
+        ("pi*E", sympy.pi * sympy.E),
+        (" x1 ", x1),
+        ("+".join(f"x1**{k}" for k in range(1, 200)), sum(x1**k for k in range(1, 200))),
+        ("*".join(["x1"] * 400), x1**400),
+    ],
+)
+def test_accepted(text, expected):
+    assert sympy.simplify(parse_expression(text, SYMBOLS) - expected) == 0
+
+
+def test_declared_symbol_shadows_constant():
+    E = sympy.Symbol("E")
+    assert parse_expression("E + 1", [E]) == E + 1
+
+
+def test_floats_stay_exact():
+    value = parse_expression("0.1 + 0.2", [])
+    assert value == sympy.Rational(3, 10) and value.is_Rational
+
+
+# -------------------------------------------------------------------------------------------
+# rejected input
+# -------------------------------------------------------------------------------------------
+REJECTED = {
+    "__import__('os').system('touch /tmp/pwned')": "__import__",
+    "().__class__.__bases__[0].__subclasses__()": "whitelisted",
+    "x1.__class__": "attribute",
+    "x1[0]": "subscript",
+    "(lambda: 1)()": "call",
+    "lambda: 1": "lambda",
+    "eval('1')": "eval",
+    "exec('1')": "exec",
+    "open('/etc/passwd').read()": "whitelisted",
+    "open('/etc/passwd')": "'open' is not allowed",
+    "getattr(x1, 'real')": "getattr",
+    "globals()": "globals",
+    "sympify('x1')": "sympify",
+    "Symbol('y')": "Symbol",
+    "y + x1": "'y' is not declared",
+    "__builtins__": "not declared",
+    "'abc'": "not a number",
+    "b'abc'": "not a number",
+    "1j": "not a number",
+    "True": "not a number",
+    "None": "not a number",
+    "[x1]": "List",
+    "(x1, x2)": "Tuple",
+    "{x1: 1}": "Dict",
+    "x1 if x1 else 0": "IfExp",
+    "x1 < 2": "Compare",
+    "x1 and x2": "BoolOp",
+    "x1 % 2": "'%'",
+    "x1 // 2": "'//'",
+    "x1 @ x2": "'@'",
+    "~x1": "'~'",
+    "x1 << 2": "'<<'",
+    "sin(x=x1)": "keyword",
+    "sin(*[x1])": "Starred",
+    "sin": "must be called",
+    "sin(x1, x2)": "invalid",
+    "Rational(x1, 2)": "invalid",
+    "[x for x in ()]": "ListComp",
+    "f'{x1}'": "JoinedStr",
+    "(y := 1)": "NamedExpr",
+    "x1 +": "not a valid expression",
+    "x1 = 1": "not a valid expression",
+    "import os": "not a valid expression",
+    "x1; x2": "not a valid expression",
+    "x1\x00": "not a valid expression",
+    "": "empty",
+    "   ": "empty",
+    "x1 ** 100000": "exponent",
+    "9**9**9**9": "exponent",
+    "((9**999)**999)**999": "bits",
+    "x1**(10**1001)": "exponent",
+    "(10**999)**50": "bits",
+    "1e400": "out of range",
+    "1e-400": "out of range",
+    "1/0": "divides by zero",
+    "x1/(x2-x2)": "divides by zero",
+    "0**-1": "divides by zero",
+    "log(0)": "not finite",
+    "Rational(1, 0)": "not finite",
+    "x1**(2*I)": "not declared",
+    "sin(" * 100 + "x1" + ")" * 100: "nested",
+    "-" * 1500 + "x1": "nested",
+    "(" * 300 + "x1" + ")" * 300: "not a valid expression",
+    "x1+" * 700 + "x1": "characters long",
+}
+
+
+@pytest.mark.parametrize("text", list(REJECTED))
+def test_rejected_with_message(text):
+    with pytest.raises(ExpressionParseError) as info:
+        parse_expression(text, SYMBOLS, what="--H")
+    message = str(info.value)
+    assert "\n" not in message and len(message) < 600, message
+    assert message.startswith("--H"), message
+    assert REJECTED[text].lower() in message.lower(), message
+
+
+def test_injection_has_no_side_effect(tmp_path):
+    target = tmp_path / "pwned"
+    for text in (
+        f"__import__('os').system('touch {target}')",
+        f"open('{target}', 'w')",
+        f"().__class__.__base__.__subclasses__()[0]('{target}')",
+    ):
+        with pytest.raises(ExpressionParseError):
+            parse_expression(text, SYMBOLS, what="--H")
+    assert not target.exists()
+    assert not os.path.exists("/tmp/pwned")
+
+
+def test_non_string_and_error_family():
+    with pytest.raises(ExpressionParseError, match="must be a string"):
+        parse_expression(3, SYMBOLS)
+    assert issubclass(ExpressionParseError, NambuBCHError) and issubclass(ExpressionParseError, ValueError)
+
+
+def test_too_long():
+    with pytest.raises(ExpressionParseError, match=str(MAX_LENGTH)):
+        parse_expression("x1+" * MAX_LENGTH, SYMBOLS, what="--H")
+
+
+# -------------------------------------------------------------------------------------------
+# hypothesis: garbage never escapes as another exception
+# -------------------------------------------------------------------------------------------
+ALPHABET = st.sampled_from(list("x123mog+-*/^().,e_ ijE'\"[]{}:;=<>!%&|~@#\\") + ["**", "sin(", "__", "lambda", "\n"])
+
+
+@FAST
+@given(st.text(max_size=80))
+def test_arbitrary_unicode_text(text):
+    _ok_or_parse_error(text)
+
+
+@FAST
+@given(st.lists(ALPHABET, max_size=40).map("".join))
+def test_expression_like_garbage(text):
+    _ok_or_parse_error(text)
+
+
+# well-formed random expressions: the parse agrees with sympy's own arithmetic
+_atoms = st.one_of(
+    st.sampled_from(["x1", "x2", "x3", "m", "omega"]),
+    st.integers(0, 50).map(str),
+    st.fractions(min_value=-5, max_value=5, max_denominator=9).map(lambda f: f"({f.numerator}/{f.denominator})"),
+)
+
+
+def _combine(children):
+    return st.one_of(
+        st.tuples(children, st.sampled_from(["+", "-", "*"]), children).map(lambda t: f"({t[0]} {t[1]} {t[2]})"),
+        st.tuples(children, st.integers(0, 4)).map(lambda t: f"({t[0]})^{t[1]}"),
+        children.map(lambda c: f"-({c})"),
+    )
+
+
+@FAST
+@given(st.recursive(_atoms, _combine, max_leaves=12))
+def test_wellformed_expressions_match_sympy(text):
+    result = parse_expression(text, SYMBOLS)
+    names = {s.name: s for s in SYMBOLS}
+    assert sympy.expand(result - sympy.sympify(text.replace("^", "**"), locals=names)) == 0
