@@ -52,3 +52,7 @@ class UnstableStepError(NambuBCHError):
 
 class NumericalRangeError(NambuBCHError):
     """A numeric input or result that is not finite (overflow, NaN input)."""
+
+
+class NoExactResultError(NambuBCHError):
+    """An exact result (polynomial invariant, exact factor form F(omega h), closed-form solution) that this system and word do not have."""
