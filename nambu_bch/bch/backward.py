@@ -26,6 +26,7 @@ import sympy
 from ..algebra import VectorField
 from ..errors import InvalidOrderError
 from ..integrators.composition import composition as make_composition
+from .fast import FastFields
 
 H = sympy.Symbol("h")
 MAX_ORDER = 16
@@ -122,7 +123,7 @@ class EffectiveField:
         return f"${self.to_latex()}$"
 
 
-def effective_field(splitting, comp, order: int = 2) -> EffectiveField:
+def effective_field(splitting, comp, order: int = 2, fast: bool = True) -> EffectiveField:
     """``X_eff`` of ``comp`` on ``splitting`` through ``h**order`` by backward error analysis.
 
     Parameters
@@ -131,6 +132,11 @@ def effective_field(splitting, comp, order: int = 2) -> EffectiveField:
     comp : Composition or word (``"12321"``)
     order : int
         Highest power of ``h`` kept in ``X_eff``.
+    fast : bool
+        Run the series in Laurent polynomials of the parameters over QQ
+        (:mod:`nambu_bch.bch.fast`, no rational-function gcds) when the fields
+        allow it; ``False`` keeps the system's ring over ``QQ(parameters)``.
+        The result is the same exact field either way.
 
     Examples
     --------
@@ -143,6 +149,9 @@ def effective_field(splitting, comp, order: int = 2) -> EffectiveField:
     comp = make_composition(comp, len(splitting)).check(splitting)
     algebra = splitting.system.algebra.with_constants(H, extension=comp.extension)
     fields = [VectorField(algebra, p.field.to_sympy()) if comp.extension else p.field for p in splitting.pieces]
+    engine = FastFields.build(algebra, dict(enumerate(fields, 1))) if fast else None
+    if engine is not None:
+        return EffectiveField(_backward_laurent(engine, comp, order), order, comp, splitting)
     series = _HSeries(algebra)
     h = algebra.convert(H)
     top = order + 1
@@ -164,3 +173,53 @@ def effective_field(splitting, comp, order: int = 2) -> EffectiveField:
             comps.append(series.coefficient(target - current, j + 1))
         Z.append(VectorField(algebra, comps))
     return EffectiveField(tuple(Z), order, comp, splitting)
+
+
+def _backward_laurent(engine, comp, order) -> tuple:
+    """The same recursion as :func:`effective_field`, on raw Laurent-ring elements (``engine.ring``)."""
+    algebra, R = engine.algebra, engine.ring
+    n = algebra.n
+    hidx = n + algebra.constants.index(H)
+    h = R.gens[hidx]
+    coords = R.gens[:n]
+
+    def truncate(p, degree):
+        if all(m[hidx] <= degree for m in p.keys()):
+            return p
+        return R.from_dict({m: c for m, c in p.items() if m[hidx] <= degree})
+
+    def coefficient(p, degree):
+        return R.from_dict({m[:hidx] + (0,) + m[hidx + 1:]: c for m, c in p.items() if m[hidx] == degree})
+
+    def apply(components, f):
+        total = R.zero
+        for c, x in zip(components, coords):
+            if c:
+                d = f.diff(x)
+                if d:
+                    total = total + c * d
+        return engine._reduce(total)
+
+    def exp_apply(components, scale, value, degree):
+        total = term = value
+        for k in range(1, degree + 1):
+            term = truncate(apply(components, term) * scale, degree) * R.domain.convert(sympy.Rational(1, k))
+            if not term:
+                break
+            total = total + term
+        return total
+
+    top = order + 1
+    pulled = []
+    for x in coords:
+        value = x
+        for k, c in reversed(comp.factors()):
+            value = exp_apply(engine.fields[k].components, h * engine._coefficient(c), value, top)
+        pulled.append(value)
+    Z = []
+    for j in range(order + 1):
+        partial = [R.zero] * n
+        for l, Zl in enumerate(Z):
+            partial = [p + z * h**l for p, z in zip(partial, Zl)]
+        Z.append([coefficient(target - exp_apply(partial, h, x, j + 1), j + 1) for x, target in zip(coords, pulled)])
+    return tuple(VectorField(algebra, [engine.to_algebra(engine._reduce(c)) for c in comps]) for comps in Z)

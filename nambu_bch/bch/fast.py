@@ -1,0 +1,191 @@
+"""A faster exact representation for brackets: Laurent polynomials in the parameters over QQ.
+
+The system's ring has coefficients in the rational-function field
+``QQ(m, omega, ...)``; every coefficient operation there normalises a fraction
+with a polynomial gcd, which dominates the cost of nested brackets (the rigid
+body, ``QQ(I1, I2, I3)``).  The fields of the built-in models only ever divide
+by *monomials* in the parameters (``1/m``, ``1/I2 - 1/I3``), i.e. their
+coefficients are Laurent polynomials.  Here a parameter ``p`` becomes two
+ordinary ring generators ``p`` and ``p_inv`` over QQ (or QQ(2^(1/3))), and every
+product is brought back to the canonical form in which no monomial contains
+both (``p^a p_inv^b -> p^(a-b)`` or ``p_inv^(b-a)``).  Laurent monomials are a
+basis, so the canonical form is unique and zero tests stay structural and
+exact; the coefficient arithmetic is plain rationals, no gcds.  Derivatives are
+taken only by coordinates, where ``p``, ``p_inv`` are constants.
+
+A field with a non-monomial denominator (``1/(m + 1)``) or a non-polynomial
+component is not representable: :meth:`FastFields.build` returns ``None`` and
+the caller keeps the system's own ring.
+
+References
+----------
+Laurent polynomial rings as localisations ``QQ[p, 1/p]``: Cox, Little, O'Shea,
+*Ideals, Varieties, and Algorithms*, Sect. 3.2 (the ``p y - 1`` trick, here
+reduced explicitly); Horikoshi, Eq. (CL1) (bracket convention).
+"""
+
+from __future__ import annotations
+
+import sympy
+from sympy.polys.rings import PolyElement, ring
+
+from ..algebra import VectorField
+
+
+class _Field:
+    """Components in the Laurent ring plus their coordinate derivatives (computed once)."""
+
+    __slots__ = ("components", "_derivatives")
+
+    def __init__(self, components):
+        self.components = tuple(components)
+        self._derivatives = None
+
+    def derivatives(self, gens):
+        if self._derivatives is None:
+            self._derivatives = tuple(tuple(c.diff(x) for x in gens) for c in self.components)
+        return self._derivatives
+
+
+class FastFields:
+    """Vector fields on ``algebra``'s coordinates with Laurent-polynomial coefficients.
+
+    Use :meth:`build`; then ``fields`` (piece number -> internal field),
+    ``bracket``, ``is_zero`` and ``combination`` plug into
+    :class:`~nambu_bch.bch.evaluation.BracketEvaluator`.
+
+    Examples
+    --------
+    >>> from nambu_bch import model
+    >>> S = model("rigid-body").splitting
+    >>> F = FastFields.build(S.system.algebra, {p.number: p.field for p in S.pieces})
+    >>> F.ring.symbols[3:]
+    (h, I1, I1_inv, I2, I2_inv, I3, I3_inv)
+    >>> Z = F.combination([(1, F.bracket(F.fields[1], F.fields[2]))])
+    >>> Z == S[1].field.bracket(S[2].field)
+    True
+    """
+
+    def __init__(self, algebra, ring_, laurent, fields):
+        self.algebra = algebra
+        self.ring = ring_
+        self._laurent = laurent  # [(index of p, index of p_inv)] in the ring's generators
+        self.fields = fields
+        self._coords = ring_.gens[: algebra.n]
+
+    # -- construction -------------------------------------------------------------
+    @classmethod
+    def build(cls, algebra, fields: dict):
+        """Convert ``{key: VectorField}``; ``None`` if some coefficient is not Laurent."""
+        comps = [c for X in fields.values() for c in X.components]
+        if not all(isinstance(c, PolyElement) and c.ring == algebra.ring for c in comps):
+            return None
+        params = algebra.parameters
+        base = algebra.domain.field.domain if params else algebra.domain
+        names = [str(s) for s in algebra.coordinates + algebra.constants]
+        for p in params:
+            names += [str(p), f"{p}_inv"]
+        if len(set(names)) != len(names):
+            return None
+        ring_, *_ = ring(names, base)
+        first = algebra.n + len(algebra.constants)
+        laurent = [(first + 2 * k, first + 2 * k + 1) for k in range(len(params))]
+        self = cls(algebra, ring_, laurent, {})
+        converted = {}
+        for key, X in fields.items():
+            parts = [self._from_algebra(c) for c in X.components]
+            if any(p is None for p in parts):
+                return None
+            converted[key] = _Field(parts)
+        self.fields = converted
+        return self
+
+    def _from_algebra(self, poly):
+        params = self.algebra.parameters
+        out = {}
+        for monom, coeff in poly.items():
+            if not params:
+                out[monom] = coeff
+                continue
+            numer, denom = coeff.numer, coeff.denom
+            if len(denom) != 1:
+                return None
+            [(dexp, dcoeff)] = denom.items()
+            for nexp, ncoeff in numer.items():
+                lexp = []
+                for a, b in zip(nexp, dexp):
+                    k = a - b
+                    lexp += [k, 0] if k >= 0 else [0, -k]
+                key = monom + tuple(lexp)
+                out[key] = out.get(key, 0) + ncoeff / dcoeff
+        return self.ring.from_dict({k: v for k, v in out.items() if v})
+
+    # -- operations ---------------------------------------------------------------
+    def _reduce(self, poly):
+        """Canonical Laurent form: no monomial holds both ``p`` and ``p_inv``."""
+        pairs = self._laurent
+        if not pairs or not any(m[i] and m[j] for m in poly.keys() for i, j in pairs):
+            return poly
+        out = {}
+        for m, c in poly.items():
+            m = list(m)
+            for i, j in pairs:
+                k = m[i] - m[j]
+                m[i], m[j] = (k, 0) if k >= 0 else (0, -k)
+            key = tuple(m)
+            out[key] = out.get(key, 0) + c
+        return self.ring.from_dict({k: v for k, v in out.items() if v})
+
+    def bracket(self, X: _Field, Y: _Field) -> _Field:
+        """``[X, Y]^i = X^j d_j Y^i - Y^j d_j X^i`` (operator commutator, Eq. CL1)."""
+        gens = self._coords
+        dX, dY = X.derivatives(gens), Y.derivatives(gens)
+        zero = self.ring.zero
+        comps = []
+        for i in range(len(gens)):
+            total = zero
+            for j in range(len(gens)):
+                if X.components[j] and dY[i][j]:
+                    total = total + X.components[j] * dY[i][j]
+                if Y.components[j] and dX[i][j]:
+                    total = total - Y.components[j] * dX[i][j]
+            comps.append(self._reduce(total))
+        return _Field(comps)
+
+    @staticmethod
+    def is_zero(X: _Field) -> bool:
+        return not any(X.components)
+
+    def _coefficient(self, c):
+        return self.ring.domain.from_sympy(sympy.sympify(c))
+
+    def combination(self, pairs) -> VectorField:
+        """``sum c X`` (``c`` exact sympy numbers) as a :class:`VectorField` of the original algebra."""
+        totals = [self.ring.zero] * self.algebra.n
+        for c, X in pairs:
+            k = self._coefficient(c)
+            totals = [t + comp * k for t, comp in zip(totals, X.components)]
+        return VectorField(self.algebra, [self.to_algebra(self._reduce(t)) for t in totals])
+
+    def to_algebra(self, poly):
+        """A Laurent-ring element back in the algebra's ring over ``QQ(parameters)``."""
+        algebra = self.algebra
+        split = algebra.n + len(algebra.constants)
+        if not algebra.parameters:
+            return algebra.ring.from_dict(dict(poly.items())) if poly else algebra.ring.zero
+        field = algebra.domain.field
+        pring = field.ring
+        groups: dict = {}
+        for m, c in poly.items():
+            groups.setdefault(m[:split], []).append((m[split:], c))
+        out = {}
+        for head, items in groups.items():
+            shift = [max((lexp[2 * k + 1] for lexp, _ in items), default=0) for k in range(len(algebra.parameters))]
+            numer = {}
+            for lexp, c in items:
+                e = tuple(lexp[2 * k] - lexp[2 * k + 1] + shift[k] for k in range(len(shift)))
+                numer[e] = numer.get(e, 0) + c
+            num = pring.from_dict(numer)
+            den = pring.from_dict({tuple(shift): pring.domain.one})
+            out[head] = field.new(num, den)
+        return algebra.ring.from_dict(out)
