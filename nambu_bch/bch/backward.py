@@ -73,9 +73,12 @@ def _exp_apply(series, field, scale, value, degree):
     algebra = series.algebra
     total, term = value, value
     for n in range(1, degree + 1):
-        term = series.truncate(algebra.convert(scale) * field.apply(term) * algebra.convert(sympy.Rational(1, n)), degree)
+        # non-polynomial fields (sin, H1(x1)) give sympy values: bring the factors to one kind
+        s, applied, r = algebra.common(algebra.convert(scale), field.apply(term), algebra.convert(sympy.Rational(1, n)))
+        term = series.truncate(s * applied * r, degree)
         if algebra.is_zero(term):
             break
+        total, term = algebra.common(total, term)
         total = total + term
     return total
 
@@ -170,6 +173,7 @@ def effective_field(splitting, comp, order: int = 2, fast: bool = True) -> Effec
         comps = []
         for x, target in zip(coords, pulled):
             current = _exp_apply(series, partial, h, x, j + 1)
+            target, current = algebra.common(target, current)
             comps.append(series.coefficient(target - current, j + 1))
         Z.append(VectorField(algebra, comps))
     return EffectiveField(tuple(Z), order, comp, splitting)

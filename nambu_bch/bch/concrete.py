@@ -22,7 +22,7 @@ from ..algebra import VectorField
 from ..integrators.composition import composition as make_composition
 from .backward import H, EffectiveField, check_order
 from .evaluation import BracketEvaluator
-from .fast import FastFields
+from .fast import field_backend
 from .formal import formal_bch
 
 
@@ -37,8 +37,9 @@ def effective_field_bch(splitting, comp, order: int = 2, fast: bool = True) -> E
         Highest power of ``h`` kept (``Z_0 .. Z_order``; the series is needed to degree ``order + 1``).
     fast : bool
         Evaluate brackets in the fastest exact representation available
-        (:mod:`nambu_bch.bch.fast`: Laurent polynomials in the parameters over QQ);
-        ``False`` uses the system's own ring over ``QQ(parameters)``.
+        (:func:`nambu_bch.bch.fast.field_backend`: Laurent polynomials in the
+        parameters over QQ, or expanded sympy expressions for non-polynomial
+        fields); ``False`` uses the :class:`VectorField` methods on the system's ring.
 
     Returns
     -------
@@ -59,7 +60,7 @@ def effective_field_bch(splitting, comp, order: int = 2, fast: bool = True) -> E
     pieces = {p.number: p.field for p in splitting.pieces}
     if comp.extension:
         pieces = {k: VectorField(algebra, X.to_sympy()) for k, X in pieces.items()}
-    engine = FastFields.build(algebra, pieces) if fast else None
+    engine = field_backend(algebra, pieces, fast)
     if engine is not None:
         evaluator = BracketEvaluator(engine.fields, engine.bracket, engine.is_zero)
         combine = engine.combination

@@ -25,6 +25,7 @@ from itertools import product
 from ..algebra import liouville_field
 from ..errors import UnknownPieceError
 from .evaluation import BracketEvaluator
+from .fast import field_backend
 from .lyndon import is_bracket
 
 
@@ -38,22 +39,23 @@ def _expand_tree(tree, splitting):
     return list(splitting[tree].terms)
 
 
+def _evaluator(algebra, fields: dict) -> BracketEvaluator:
+    backend = field_backend(algebra, fields)
+    if backend is None:
+        return BracketEvaluator(fields)
+    return BracketEvaluator(backend.fields, backend.bracket, backend.is_zero)
+
+
 def piece_evaluator(splitting) -> BracketEvaluator:
     """A :class:`BracketEvaluator` whose leaves are the piece numbers of ``splitting``."""
-    return BracketEvaluator({p.number: p.field for p in splitting.pieces})
+    return _evaluator(splitting.system.algebra, {p.number: p.field for p in splitting.pieces})
 
 
 def term_evaluator(splitting) -> BracketEvaluator:
-    """A :class:`BracketEvaluator` whose leaves are Liouville terms ``(H_a, G_b, ...)``."""
+    """A :class:`BracketEvaluator` whose leaves are the Liouville terms ``(H_a, G_b, ...)`` of ``splitting``."""
     algebra = splitting.system.algebra
-    cache: dict = {}
-
-    def leaf(term):
-        if term not in cache:
-            cache[term] = liouville_field(algebra, *term)
-        return cache[term]
-
-    return BracketEvaluator(leaf)
+    terms = {t for p in splitting.pieces for t in p.terms}
+    return _evaluator(algebra, {t: liouville_field(algebra, *t) for t in terms})
 
 
 def expand_terms(terms, splitting, prune: bool = True, evaluators=None) -> list:

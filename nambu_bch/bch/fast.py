@@ -189,3 +189,56 @@ class FastFields:
             den = pring.from_dict({tuple(shift): pring.domain.one})
             out[head] = field.new(num, den)
         return algebra.ring.from_dict(out)
+
+
+class SympyFields:
+    """Fallback for non-polynomial fields (``sin``, undefined functions ``H1(x1)``): expanded sympy expressions.
+
+    Brackets are ``diff`` + ``expand``; the zero test is structural after
+    ``expand`` (no ``simplify``).  It never calls a non-zero field zero; an
+    exotic zero that only ``simplify`` would see (``sin^2 + cos^2 - 1``) is kept,
+    which costs a term but never changes a value.
+    """
+
+    def __init__(self, algebra, fields: dict):
+        self.algebra = algebra
+        self.fields = {k: tuple(sympy.expand(algebra.to_sympy(c)) for c in X.components) for k, X in fields.items()}
+
+    def bracket(self, X, Y):
+        coords = self.algebra.coordinates
+        out = []
+        for i in range(len(coords)):
+            total = sympy.Integer(0)
+            for j, x in enumerate(coords):
+                if X[j] != 0:
+                    total += X[j] * sympy.diff(Y[i], x)
+                if Y[j] != 0:
+                    total -= Y[j] * sympy.diff(X[i], x)
+            out.append(sympy.expand(total))
+        return tuple(out)
+
+    @staticmethod
+    def is_zero(X) -> bool:
+        return all(c == 0 for c in X)
+
+    def combination(self, pairs) -> VectorField:
+        totals = [sympy.Integer(0)] * self.algebra.n
+        for c, X in pairs:
+            totals = [t + sympy.sympify(c) * comp for t, comp in zip(totals, X)]
+        return VectorField(self.algebra, [sympy.expand(t) for t in totals])
+
+
+def field_backend(algebra, fields: dict, fast: bool = True):
+    """The fastest exact backend for ``{key: VectorField}``: :class:`FastFields`, else :class:`SympyFields`.
+
+    With ``fast=False`` (or when neither applies) ``None``: use the :class:`VectorField` methods.
+    """
+    if not fast:
+        return None
+    backend = FastFields.build(algebra, fields)
+    if backend is not None:
+        return backend
+    comps = [c for X in fields.values() for c in X.components]
+    if any(not isinstance(c, PolyElement) for c in comps):
+        return SympyFields(algebra, fields)
+    return None
