@@ -56,3 +56,7 @@ class NumericalRangeError(NambuBCHError):
 
 class NoExactResultError(NambuBCHError):
     """An exact result (polynomial invariant, exact factor form F(omega h), closed-form solution) that this system and word do not have."""
+
+
+class InvalidRunError(NambuBCHError):
+    """An argument of a numeric run (step count, sampling, initial-state shape, backend, precision) that is not accepted."""
