@@ -1,34 +1,253 @@
-"""pytest helpers and plugin (entry point ``pytest11``): fixtures for the built-in models."""
+"""pytest helpers and plugin: assertions for one's own test suite, and fixtures for the built-in models.
+
+The plugin is registered through the ``pytest11`` entry point ``nambu_bch``
+(pyproject.toml), so installing the package makes the fixtures available in
+any pytest run; ``pytest -p nambu_bch.testing`` loads it explicitly.
+
+Fixtures: ``ho``, ``ho3``, ``rigid_body``, ``lotka_volterra``,
+``ho3_composite`` (the built-in :func:`~nambu_bch.model` systems),
+``paper_words`` (the six second-order words of Sect. 5.1) and ``symbols``
+(name -> Symbol for ``x1..x3``, ``m``, ``omega``, ``h``, ``alpha``, ...).
+
+Assertions (each raises ``AssertionError`` with the residual spelled out):
+
+* :func:`assert_fields_equal` -- two vector fields agree component by component;
+* :func:`assert_shadow_pair` -- ``X_{H_S, G_S} = X_eff + O(h^(order+1))``
+  (Eq. L2 for N = 3, Eq. L1 for N = 2), checked against
+  :func:`~nambu_bch.bch.effective_field` (backward error analysis);
+* :func:`assert_invariant` -- ``I(Phi_h(x)) = I(x)`` exactly for the composed
+  map (:func:`~nambu_bch.integrators.composed_map`), e.g. Eqs. (CQ12321H),
+  (CQ12321G) and Table (table).
+
+Example (``examples/test_paper_results.py`` has more)::
+
+    from nambu_bch.testing import assert_invariant
+
+    def test_table_row_12321(ho3):
+        assert_invariant(ho3, "12321", "x3 - x1**2 + h**2*x2**2/(4*m**2)")  # G_c, Eq. (CQ12321G)
+"""
 
 from __future__ import annotations
 
 import pytest
+import sympy
 
 from .systems import model
 
+__all__ = [
+    "assert_fields_equal",
+    "assert_invariant",
+    "assert_shadow_pair",
+    "liouville_components",
+]
 
+H = sympy.Symbol("h")
+ALPHA = sympy.Symbol("alpha")
+
+
+# --------------------------------------------------------------------------------------------
+# helpers
+# --------------------------------------------------------------------------------------------
+def _as_expr(value, system, what):
+    """A sympy expression from a sympy object or a string (parsed safely with the system's symbols)."""
+    if value is None:
+        return None
+    if isinstance(value, str):
+        from .parsing import parse_expression
+
+        return parse_expression(value, system.symbols(), what=what)
+    return sympy.sympify(value)
+
+
+def _components(field):
+    """Components of a VectorField, EffectiveField or sequence, as sympy expressions."""
+    if hasattr(field, "to_sympy"):
+        return tuple(sympy.sympify(c) for c in field.to_sympy())
+    return tuple(sympy.sympify(c) for c in field)
+
+
+def liouville_components(coordinates, *hamiltonians) -> tuple:
+    """``X_{H_1..H_{N-1}}^i = {x_i, H_1, ..., H_{N-1}}`` as sympy expressions (any ``h``, ``alpha`` allowed).
+
+    The Nambu bracket is the Jacobian determinant ``det d(f, H_1..H_{N-1})/d(x_1..x_N)``
+    (Eq. NB; Eq. Poisson for N = 2), so ``X_H = (dH/dx2, -dH/dx1)`` for N = 2.
+
+    >>> x1, x2 = sympy.symbols("x1 x2")
+    >>> liouville_components((x1, x2), (x1**2 + x2**2) / 2)
+    (x2, -x1)
+    """
+    coords = tuple(coordinates)
+    grads = [[sympy.diff(Hk, x) for x in coords] for Hk in hamiltonians]
+    out = []
+    for i in range(len(coords)):
+        row = [sympy.Integer(1 if j == i else 0) for j in range(len(coords))]
+        out.append(sympy.expand(sympy.Matrix([row, *grads]).det(method="berkowitz")))
+    return tuple(out)
+
+
+def _truncate(expr, order):
+    """Coefficients of ``h^0 .. h^order`` of ``expr`` (a polynomial in ``h`` or a series)."""
+    expr = sympy.expand(expr)
+    if expr.is_polynomial(H):
+        poly = sympy.Poly(expr, H)
+        return [sympy.simplify(poly.coeff_monomial(H**k)) for k in range(order + 1)]
+    series = sympy.series(expr, H, 0, order + 1).removeO()
+    return [sympy.simplify(sympy.expand(series).coeff(H, k)) for k in range(order + 1)]
+
+
+def _residual_report(coordinates, residuals, header):
+    lines = [header]
+    for x, r in zip(coordinates, residuals):
+        if r != 0:
+            lines.append(f"    d/d{x}: {r}")
+    return "\n".join(lines)
+
+
+# --------------------------------------------------------------------------------------------
+# assertions
+# --------------------------------------------------------------------------------------------
+def assert_fields_equal(X, Y, coordinates=None, msg: str = ""):
+    """Assert ``X == Y`` component by component (exactly, after ``simplify``).
+
+    Parameters
+    ----------
+    X, Y : VectorField, EffectiveField or sequence of sympy expressions
+    coordinates : sequence of Symbols, optional
+        Names for the failure message (default: taken from ``X`` or ``x1..xN``).
+    msg : str
+        Prefix of the failure message.
+    """
+    __tracebackhide__ = True
+    a, b = _components(X), _components(Y)
+    if len(a) != len(b):
+        raise AssertionError(f"{msg}fields on {len(a)} and {len(b)} coordinates cannot be equal")
+    if coordinates is None:
+        algebra = getattr(X, "algebra", None) or getattr(Y, "algebra", None)
+        coordinates = algebra.coordinates if algebra is not None else sympy.symbols(f"x1:{len(a) + 1}")
+    residuals = [sympy.simplify(u - v) for u, v in zip(a, b)]
+    if any(r != 0 for r in residuals):
+        raise AssertionError(_residual_report(coordinates, residuals, f"{msg}fields differ; residual X - Y:"))
+
+
+def assert_shadow_pair(system, word, H_S, G_S=None, order: int = 2):
+    """Assert that ``(H_S, G_S)`` are shadow Hamiltonians of ``word`` through ``h^order``.
+
+    Checks ``X_{H_S, G_S} - X_eff = O(h^(order+1))`` coefficient by coefficient,
+    ``X_eff`` from :func:`~nambu_bch.bch.effective_field` (backward error
+    analysis of the composed map, Eqs. eL1/eL2).  Any free family parameter
+    (``alpha``) must drop out, i.e. the identity must hold for every value
+    (the paper's Eqs. SH12321c/SG12321c hold for all ``alpha``).
+
+    Parameters
+    ----------
+    system : System
+    word : str or Composition
+    H_S, G_S : sympy expressions or strings in the system's symbols, ``h`` and
+        ``alpha``; ``G_S`` is ``None`` for N = 2 (for N >= 4 pass a sequence
+        ``[H_S2, H_S3, ...]`` as ``G_S``).  Truncation terms ``O(h**k)`` are dropped.
+    order : int
+        Highest power of ``h`` compared.
+    """
+    __tracebackhide__ = True
+    from .bch import effective_field
+
+    hams = [_as_expr(H_S, system, "H_S")]
+    if isinstance(G_S, (list, tuple)):
+        hams += [_as_expr(G, system, "G_S") for G in G_S]
+    elif G_S is not None:
+        hams.append(_as_expr(G_S, system, "G_S"))
+    hams = [H.removeO() if isinstance(H, sympy.Basic) and H.has(sympy.Order) else H for H in hams]
+    expected = len(system.hamiltonians)
+    if len(hams) != expected:
+        raise AssertionError(
+            f"{system.name} has {expected} Hamiltonian(s); got {len(hams)} shadow Hamiltonian(s) "
+            f"({'give G_S' if expected > len(hams) else 'G_S must be None for N = 2'})"
+        )
+    X_eff = effective_field(system.splitting, word, order)
+    lhs = liouville_components(system.coordinates, *hams)
+    rhs = X_eff.to_sympy()
+    failures = []
+    for k in range(order + 1):
+        residuals = [c[k] for c in (_truncate(a - b, order) for a, b in zip(lhs, rhs))]
+        if any(r != 0 for r in residuals):
+            failures.append(_residual_report(system.coordinates, residuals, f"  at h^{k}:"))
+    if failures:
+        raise AssertionError(
+            f"X_{{H_S,G_S}} != X_eff + O(h^{order + 1}) for {system.name}, word {word}; "
+            "residual X_{H_S,G_S} - X_eff:\n" + "\n".join(failures)
+        )
+
+
+def assert_invariant(system, word, I, h=H):
+    """Assert that ``I`` is an exact invariant of the composed map: ``I(Phi_h(x)) - I(x) = 0``.
+
+    ``Phi_h`` is :func:`~nambu_bch.integrators.composed_map` (exact in ``h``,
+    all orders), so this checks e.g. the conserved quantities of Table (table)
+    with no truncation.
+
+    Parameters
+    ----------
+    system : System
+    word : str or Composition
+    I : sympy expression or string in the system's symbols and ``h``
+    """
+    __tracebackhide__ = True
+    from .integrators import composed_map
+
+    expr = _as_expr(I, system, "I")
+    image = composed_map(system.splitting, word, h)
+    moved = expr.subs(dict(zip(system.coordinates, image)), simultaneous=True)
+    residual = sympy.factor(sympy.simplify(sympy.expand(moved - expr)))
+    if residual != 0:
+        raise AssertionError(
+            f"{expr} is not invariant under Phi_h = {word} for {system.name}; "
+            f"residual I(Phi_h(x)) - I(x) = {residual}"
+        )
+
+
+# --------------------------------------------------------------------------------------------
+# fixtures (the plugin)
+# --------------------------------------------------------------------------------------------
 @pytest.fixture
 def ho():
-    """The harmonic oscillator, Eq. (HO1)."""
+    """The harmonic oscillator, Eq. (HO1); pieces 1 = T, 2 = V."""
     return model("ho")
 
 
 @pytest.fixture
 def ho3():
-    """The paper's N = 3 oscillator (q, p, q^2), Eqs. (Ex1), (H), (G)."""
+    """The paper's N = 3 oscillator (q, p, q^2), Eqs. (Ex1), (H), (G); pieces Eqs. (hX1)-(hX3)."""
     return model("ho3")
 
 
 @pytest.fixture
 def rigid_body():
+    """The free rigid body, H = sum x_i^2/(2 I_i), G = |x|^2/2, full split."""
     return model("rigid-body")
 
 
 @pytest.fixture
 def lotka_volterra():
+    """Cyclic Lotka-Volterra, H = x1 + x2 + x3, G = x1 x2 x3, only H split."""
     return model("lotka-volterra")
 
 
 @pytest.fixture
 def ho3_composite():
+    """The (q^2, p^2, qp) oscillator of the conclusions, only H split."""
     return model("ho3-composite")
+
+
+@pytest.fixture
+def paper_words():
+    """The six symmetric second-order words of the paper's Sect. 5.1 / Table (table)."""
+    from .integrators import PAPER_WORDS
+
+    return PAPER_WORDS
+
+
+@pytest.fixture
+def symbols():
+    """Name -> Symbol for the built-in models' symbols, the step ``h`` and ``alpha``."""
+    names = "x1 x2 x3 m omega I1 I2 I3 h alpha"
+    return {s.name: s for s in sympy.symbols(names)}

@@ -1,0 +1,720 @@
+"""The ``nambu-bch`` command line (also ``python -m nambu_bch``): a thin layer over the library.
+
+Synopsis::
+
+    nambu-bch models   [--model NAME] [--format text|latex|json]
+    nambu-bch bch      [SYSTEM] [--integrator WORD] [--order K] [--field] [--terms]
+    nambu-bch fi       [SYSTEM] [--integrator WORD]
+    nambu-bch shadow   [SYSTEM] [--integrator WORD] [--order K] [--route direct|fi] [--degree D]
+    nambu-bch conserved [SYSTEM] [--integrator WORD]
+    nambu-bch exact    [SYSTEM] [--integrator WORD]
+    nambu-bch check    [SYSTEM] [--integrator WORD] [--h H] [--steps N] [--x0 X] [--every K]
+    nambu-bch plot     [--outdir DIR] [--h H] [--steps N] [--x0 X] [--every K]
+
+    SYSTEM is one of   --model NAME                         (built-in; default ho3)
+                       --system FILE.toml                   (see nambu_bch.model_file)
+                       --H EXPR [--G EXPR ...] [--coords "x1 x2 x3"] [--param NAME ...] [--split full|single]
+    --param NAME=VALUE sets a parameter's value: numeric subcommands use it (default 1 for
+                       every parameter), symbolic ones substitute it exactly before the analysis.
+    --format latex|text|json (default latex for symbolic results, text for models/check/plot),
+    --output FILE      (written atomically: temporary file in the same directory + os.replace).
+
+With no options ``nambu-bch shadow`` prints the alpha-family of shadow
+Hamiltonians of Phi^{12321} for the paper's N = 3 oscillator at order 2
+(Horikoshi, Eqs. SH12321c, SG12321c) as LaTeX.
+
+Bad input (an unknown model, a malformed word or expression, a missing file,
+an invalid flag) prints one line on stderr naming the input and what is
+accepted, and exits with status 2; user expressions are parsed by
+:func:`nambu_bch.parsing.parse_expression`, never evaluated.  Any other
+exception is a bug and propagates with its traceback (exit status 1).
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import sys
+
+import sympy
+
+from . import render
+from .errors import NambuBCHError
+
+PROG = "nambu-bch"
+DEFAULT_MODEL = "ho3"
+MAX_STEPS = 100_000_000
+MAX_CLI_ORDER = 12
+_SYMBOLIC = ("latex", "text", "json")
+
+
+class UsageError(Exception):
+    """An argparse error, reported on one line by :func:`main`."""
+
+    def __init__(self, prog, message):
+        super().__init__(message)
+        self.prog = prog
+
+
+class _Parser(argparse.ArgumentParser):
+    def error(self, message):  # one line, no usage block
+        raise UsageError(self.prog, message)
+
+
+class _Formatter(argparse.RawDescriptionHelpFormatter):
+    pass
+
+
+# --------------------------------------------------------------------------------------------
+# input conversion (each raises NambuBCHError naming the flag)
+# --------------------------------------------------------------------------------------------
+def _number(text, flag):
+    from .model_file import parse_value
+
+    return parse_value(text, flag)
+
+
+def positive_float(text, flag="--h"):
+    value = _number(text, flag)
+    if not value.is_positive:
+        raise NambuBCHError(f"{flag} {text!r} must be a positive number such as 0.1")
+    out = float(value)
+    if not 0.0 < out < float("inf"):
+        raise NambuBCHError(f"{flag} {text!r} is out of range; give a positive finite number such as 0.1")
+    return out
+
+
+def positive_int(text, flag, limit):
+    try:
+        value = int(text, 10)
+    except (TypeError, ValueError):
+        raise NambuBCHError(f"{flag} {text!r} must be a positive integer such as 1000") from None
+    if not 1 <= value <= limit:
+        raise NambuBCHError(f"{flag} {value} must be between 1 and {limit}")
+    return value
+
+
+def order_value(text, flag="--order", limit=MAX_CLI_ORDER, low=0):
+    try:
+        value = int(text, 10)
+    except (TypeError, ValueError):
+        raise NambuBCHError(f"{flag} {text!r} must be an integer between {low} and {limit}") from None
+    if not low <= value <= limit:
+        raise NambuBCHError(f"{flag} {value} must be between {low} and {limit}")
+    return value
+
+
+def parse_params(items):
+    """``--param NAME`` / ``--param NAME=VALUE`` -> ``(names in order, {name: exact value})``."""
+    names, values = [], {}
+    for item in items or ():
+        name, sep, value = item.partition("=")
+        name = name.strip()
+        if not name.isidentifier() or name.startswith("_"):
+            raise NambuBCHError(
+                f"--param {item!r}: {name!r} is not a parameter name; write --param m (declare) or --param m=1 (value)"
+            )
+        if name in ("h", "alpha"):
+            raise NambuBCHError(f"--param {item!r}: {name!r} is reserved (the step is --h, alpha is the family parameter)")
+        if name not in names:
+            names.append(name)
+        if sep:
+            values[name] = _number(value.strip(), f"--param {name}")
+    return names, values
+
+
+def parse_x0(text, n):
+    parts = [p for p in text.replace(",", " ").split()]
+    if len(parts) != n:
+        raise NambuBCHError(f"--x0 {text!r} gives {len(parts)} value(s); the system has {n} coordinates (e.g. --x0 {','.join(['1'] * n)})")
+    out = []
+    for p in parts:
+        value = float(_number(p, "--x0"))
+        if value != value or value in (float("inf"), float("-inf")):
+            raise NambuBCHError(f"--x0 {text!r}: {p!r} is not finite")
+        out.append(value)
+    return out
+
+
+# --------------------------------------------------------------------------------------------
+# the system and the integrator from the flags
+# --------------------------------------------------------------------------------------------
+def system_from_args(args):
+    """``(system, values)``: the built-in model, TOML file or flag-defined system, and parameter values."""
+    from .model_file import load_system
+    from .parsing import parse_expression
+    from .systems import System, model
+
+    names, values = parse_params(getattr(args, "param", None))
+    user_flags = [f for f, v in (("--H", args.H), ("--G", args.G), ("--coords", args.coords)) if v]
+    chosen = [f for f, v in (("--model", args.model), ("--system", args.system)) if v] + (["--H"] if user_flags else [])
+    if len(chosen) > 1:
+        raise NambuBCHError(f"{' and '.join(chosen)} both choose the system; give only one of --model, --system, --H/--G")
+    if user_flags and not args.H:
+        raise NambuBCHError(f"{user_flags[0]} needs --H EXPR (the first Hamiltonian)")
+    if args.H:
+        hams = [args.H] + list(args.G or [])
+        if args.coords:
+            coords = args.coords.replace(",", " ").split()
+        else:
+            coords = [f"x{i}" for i in range(1, (len(hams) + 1 if len(hams) > 1 else 2) + 1)]
+        for c in coords:
+            if not c.isidentifier() or c.startswith("_"):
+                raise NambuBCHError(f"--coords {args.coords!r}: {c!r} is not a symbol name; write e.g. --coords 'x1 x2 x3'")
+        symbols = [sympy.Symbol(s) for s in (*coords, *names)]
+        flags = ["--H"] + ["--G"] * (len(hams) - 1)
+        parsed = [parse_expression(text, symbols, what=flag) for text, flag in zip(hams, flags)]
+        system = System(coords, parsed, names, name=args.name or "custom", split=args.split or "full")
+        return system, values
+    if args.system:
+        file_values: dict = {}
+        system = load_system(args.system, file_values)
+        extra = [n for n in names if n not in {p.name for p in system.parameters}]
+        if extra:
+            raise NambuBCHError(f"--param {extra[0]}: the system of {args.system} has parameters {_list(system.parameters)}")
+        if args.split and args.split != system.split:
+            system = _with(system, split=args.split)
+        return system, {**file_values, **values}
+    system = model(args.model or DEFAULT_MODEL)
+    extra = [n for n in names if n not in {p.name for p in system.parameters}]
+    if extra:
+        raise NambuBCHError(f"--param {extra[0]}: model {system.name} has parameters {_list(system.parameters)}")
+    if args.split and args.split != system.split:
+        system = _with(system, split=args.split)
+    return system, values
+
+
+def _list(symbols):
+    return ", ".join(str(s) for s in symbols) or "none"
+
+
+def _with(system, **changes):
+    from .systems import System
+
+    fields = dict(
+        coordinates=system.coordinates, hamiltonians=system.hamiltonians, parameters=system.parameters,
+        name=system.name, split=system.split, description=system.description, citation=system.citation,
+    )
+    fields.update(changes)
+    return System(**fields)
+
+
+def substituted(system, values):
+    """The system with the given parameter values substituted exactly (symbolic subcommands)."""
+    if not values:
+        return system
+    subs = {p: values[p.name] for p in system.parameters if p.name in values}
+    rest = tuple(p for p in system.parameters if p.name not in values)
+    hams = tuple(sympy.sympify(H).subs(subs) for H in system.hamiltonians)
+    label = ",".join(f"{k}={v}" for k, v in values.items())
+    return _with(system, hamiltonians=hams, parameters=rest, name=f"{system.name}[{label}]")
+
+
+def default_word(system) -> str:
+    """The Strang word ``12..n..21`` of the system's splitting (``12321`` for ho3, ``121`` for ho)."""
+    n = len(system.splitting)
+    word = "".join(str(k) for k in range(1, n + 1))
+    return word + word[-2::-1] if n > 1 else "1"
+
+
+def integrator_from_args(args, system):
+    """``(word, Composition)`` checked against the system's splitting."""
+    from .integrators import composition
+
+    word = args.integrator or default_word(system)
+    comp = composition(word, len(system.splitting)).check(system.splitting)
+    return word, comp
+
+
+# --------------------------------------------------------------------------------------------
+# output
+# --------------------------------------------------------------------------------------------
+def emit(args, *, latex=None, text=None, data=None):
+    """Print (or write to ``--output``) the result in the chosen ``--format``.
+
+    ``latex`` / ``text`` are callables returning strings, ``data`` a callable
+    returning the JSON-able dict; only the one needed is computed.
+    """
+    fmt = args.format
+    if fmt == "json":
+        out = render.to_json(data())
+    elif fmt == "latex" and latex is not None:
+        out = render.latex_document(latex())
+    elif text is not None:
+        out = text()
+        out = out if out.endswith("\n") else out + "\n"
+    else:
+        out = render.to_text(data())
+    if args.output:
+        try:
+            render.write_output(out, args.output)
+        except OSError as exc:
+            raise NambuBCHError(f"--output {args.output}: cannot write the file ({exc.strerror or exc})") from None
+        print(f"wrote {args.output}", file=sys.stderr)
+    else:
+        sys.stdout.write(out)
+        sys.stdout.flush()
+
+
+def _base(system, word, **extra):
+    data = render.system_dict(system)
+    data["integrator"] = word
+    data.update(extra)
+    return data
+
+
+# --------------------------------------------------------------------------------------------
+# subcommands
+# --------------------------------------------------------------------------------------------
+def cmd_models(args):
+    from .systems import model, model_names
+
+    if args.model or args.system or args.H:
+        systems = [system_from_args(args)[0]]
+    else:
+        systems = [model(name) for name in model_names()]
+
+    def piece_dict(system, piece):
+        return {
+            "number": piece.number,
+            "label": piece.label(),
+            "moves": [str(system.coordinates[i]) for i in piece.moving],
+            "field": [render.expression(c) for c in piece.field.to_sympy()],
+        }
+
+    def data():
+        out = []
+        for s in systems:
+            d = render.system_dict(s)
+            d.update(N=s.N, split=s.split, description=s.description, citation=s.citation,
+                     pieces=[piece_dict(s, p) for p in s.splitting.pieces], default_integrator=default_word(s))
+            out.append(d)
+        return {"models": out}
+
+    def text():
+        lines = []
+        for s in systems:
+            lines.append(f"{s.name}  (N = {s.N}, split = {s.split}, default integrator {default_word(s)})")
+            if s.description:
+                lines.append(f"  {s.description}")
+            lines.append(f"  coordinates: {_list(s.coordinates)};  parameters: {_list(s.parameters)}")
+            for lab, H in zip(("H", "G", "H3", "H4"), s.hamiltonians):
+                lines.append(f"  {lab} = {H}")
+            for p in s.splitting.pieces:
+                moves = ", ".join(str(s.coordinates[i]) for i in p.moving)
+                comps = ", ".join(f"d{s.coordinates[i]}/dt = {p.field.to_sympy()[i]}" for i in p.moving)
+                lines.append(f"  piece {p.number}: moves {moves}: {comps}")
+            if s.citation:
+                lines.append(f"  ref: {s.citation}")
+        return "\n".join(lines)
+
+    def latex():
+        blocks = []
+        for s in systems:
+            rows = [rf"\text{{{s.name}}}:\quad {s.to_latex()}"]
+            rows += [rf"X_{{{p.number}}} = {p.label()} = {p.field.to_latex()}" for p in s.splitting.pieces]
+            blocks.append(" \\\\\n".join(rows))
+        return "\\begin{gathered}\n" + " \\\\[1ex]\n".join(blocks) + "\n\\end{gathered}"
+
+    emit(args, latex=latex, text=text, data=data)
+
+
+def cmd_bch(args):
+    from .bch import effective_field, formal_bch
+    from .bch.lyndon import tree_to_latex
+
+    system, values = system_from_args(args)
+    system = substituted(system, values)
+    word, comp = integrator_from_args(args, system)
+    order = args.order if args.order is not None else 2
+    series = formal_bch(comp, order + 1)
+
+    def tree_text(tree):
+        return tree_to_latex(tree).replace("X_{", "X").replace("}", "")
+
+    def tree_json(tree):
+        return list(map(tree_json, tree)) if isinstance(tree, tuple) else tree
+
+    field = effective_field(system.splitting, comp, order) if args.field else None
+    expanded = None
+    if args.terms:
+        from .bch import expand_terms
+
+        expanded = {d: expand_terms(series.terms(d), system.splitting) for d in series.degrees}
+
+    def data():
+        terms = [
+            {"degree": d, "power_of_h": d - 1, "coefficient": render.expression(c), "bracket": tree_text(t), "tree": tree_json(t)}
+            for d in range(1, series.max_degree + 1) for c, t in series.terms(d)
+        ]
+        out = _base(system, word, order=order, max_degree=series.max_degree,
+                    coefficients=[render.expression(c) for c in comp.coefficients],
+                    pieces=list(comp.pieces), terms=terms)
+        if field is not None:
+            out["X_eff"] = [[render.expression(c) for c in Z.to_sympy()] for Z in field.coefficients]
+        if expanded is not None:
+            out["liouville_terms"] = [
+                {"degree": d, "coefficient": render.expression(c), "bracket": tree_to_latex(t)}
+                for d, items in expanded.items() for c, t in items
+            ]
+        return out
+
+    def text():
+        lines = [f"{comp.name}: Phi_h = " + " ".join(f"exp({'' if c == 1 else f'({c})*'}h*X{k})" for k, c in comp.factors())]
+        lines.append(f"X_eff through h^{order} (formal BCH in the Lyndon basis):")
+        for d in range(1, series.max_degree + 1):
+            for c, t in series.terms(d):
+                lines.append(f"  h^{d - 1}  {c}  {tree_text(t)}")
+        if field is not None:
+            for j, Z in enumerate(field.coefficients):
+                comps = ", ".join(str(c) for c in Z.to_sympy())
+                lines.append(f"Z_{j} = ({comps})")
+        if expanded is not None:
+            lines.append("Liouville terms (zero brackets pruned):")
+            for d, items in expanded.items():
+                for c, t in items:
+                    lines.append(f"  h^{d - 1}  {c}  {tree_to_latex(t)}")
+        return "\n".join(lines)
+
+    def latex():
+        rows = [comp.to_latex(), series.to_latex()]
+        if field is not None:
+            rows.append(field.to_latex())
+        if expanded is not None:
+            for d, items in expanded.items():
+                body = " ".join(_signed_latex(c * sympy.Symbol("h") ** (d - 1)) + " " + tree_to_latex(t) for c, t in items)
+                rows.append(rf"X_{{\rm eff}}\big|_{{h^{{{d - 1}}}}} = {body.lstrip('+ ') or '0'}")
+        return " \\\\\n".join(rows)
+
+    emit(args, latex=latex, text=text, data=data)
+
+
+def _signed_latex(term) -> str:
+    """``+ \\frac{h^{2}}{12}`` / ``- \\frac{h^{2}}{24}`` / ``+`` for a unit coefficient."""
+    if term == 1:
+        return "+"
+    if term == -1:
+        return "-"
+    if term.could_extract_minus_sign():
+        return "- " + sympy.latex(-term)
+    return "+ " + sympy.latex(term)
+
+
+def cmd_shadow(args):
+    from .shadow import shadow_hamiltonians
+
+    system, values = system_from_args(args)
+    system = substituted(system, values)
+    word, comp = integrator_from_args(args, system)
+    order = args.order if args.order is not None else 2
+    kwargs = {"order": order, "route": args.route}
+    if args.degree is not None:
+        kwargs["degree"] = args.degree
+    family = shadow_hamiltonians(system, comp, **kwargs)
+
+    def data():
+        out = _base(system, word, order=order, route=args.route)
+        out.update(family.to_dict())
+        out["model"], out["integrator"] = system.name, word
+        return out
+
+    emit(args, latex=family.to_latex, data=data)
+
+
+def cmd_conserved(args):
+    from .exact import conserved_quantities
+
+    system, values = system_from_args(args)
+    system = substituted(system, values)
+    word, comp = integrator_from_args(args, system)
+    result = conserved_quantities(system, comp)
+
+    def data():
+        out = _base(system, word)
+        out.update(result.to_dict())
+        out["model"], out["integrator"] = system.name, word
+        return out
+
+    emit(args, latex=result.to_latex, data=data)
+
+
+def cmd_exact(args):
+    from .exact import exact_shadow_hamiltonians
+
+    system, values = system_from_args(args)
+    system = substituted(system, values)
+    word, comp = integrator_from_args(args, system)
+    result = exact_shadow_hamiltonians(system, comp)
+
+    def data():
+        out = _base(system, word)
+        if hasattr(result, "to_dict"):
+            out.update(result.to_dict())
+        else:
+            out.update(H_S=render.expression(result.H_S), G_S=render.expression(getattr(result, "G_S", None)))
+        out["model"], out["integrator"] = system.name, word
+        return out
+
+    emit(args, latex=result.to_latex, data=data)
+
+
+def cmd_fi(args):
+    from . import shadow
+
+    system, values = system_from_args(args)
+    system = substituted(system, values)
+    word, comp = integrator_from_args(args, system)
+    forms = shadow.fi_forms()
+    reps = shadow.fi_representations(system, comp) if args.model or args.system or args.H else None
+
+    def data():
+        out = {"forms": shadow.fi_forms_dict(forms)}
+        if reps is not None:
+            out = {**_base(system, word), **out, "representations": reps.to_dict()}
+        return out
+
+    def latex():
+        text = shadow.fi_forms_latex(forms)
+        return text if reps is None else text + " \\\\\n" + reps.to_latex()
+
+    emit(args, latex=latex, data=data)
+
+
+def numeric_inputs(args, system, values):
+    from .integrators import parameter_values
+
+    params = {k: float(v) for k, v in values.items()}
+    parameter_values(system, params)  # raises naming an unknown parameter
+    x0 = parse_x0(args.x0, system.N) if args.x0 else [1.0] * system.N
+    return params, x0
+
+
+def cmd_check(args):
+    from .numeric import check
+
+    system, values = system_from_args(args)
+    word, comp = integrator_from_args(args, system)
+    params, x0 = numeric_inputs(args, system, values)
+    report = check(system, comp, args.h, args.steps, x0, params=params, every=args.every)
+
+    def data():
+        out = _base(system, word, h=args.h, steps=args.steps, x0=x0, params=params)
+        out.update(report.to_dict())
+        out["model"], out["integrator"] = system.name, word
+        return out
+
+    text = getattr(report, "to_text", None)
+    emit(args, text=text, data=data)
+
+
+def cmd_plot(args):
+    from .numeric import paper_figures
+
+    outdir = args.outdir
+    if not os.path.isdir(outdir):
+        try:
+            os.makedirs(outdir, exist_ok=True)
+        except OSError as exc:
+            raise NambuBCHError(f"--outdir {outdir}: cannot create the directory ({exc.strerror or exc})") from None
+    kwargs = {}
+    if args.h is not None:
+        kwargs["h"] = args.h
+    if args.steps is not None:
+        kwargs["steps"] = args.steps
+    if args.x0:
+        kwargs["x0"] = parse_x0(args.x0, 3)
+    if args.every is not None:
+        kwargs["every"] = args.every
+    files = paper_figures(outdir, **kwargs)
+    files = [os.fspath(f) for f in (files.values() if isinstance(files, dict) else files)]
+
+    emit(args, text=lambda: "\n".join(files), data=lambda: {"outdir": outdir, "files": files})
+
+
+# --------------------------------------------------------------------------------------------
+# the parser
+# --------------------------------------------------------------------------------------------
+def _system_options(parser):
+    group = parser.add_argument_group("system (one of --model, --system, --H)")
+    group.add_argument("--model", metavar="NAME", help=f"built-in model: ho, ho3, rigid-body, lotka-volterra, ho3-composite (default {DEFAULT_MODEL})")
+    group.add_argument("--system", metavar="FILE", help="a TOML file defining the system (keys: coordinates, H, G, parameters, split)")
+    group.add_argument("--H", metavar="EXPR", help="first Hamiltonian of a user system, e.g. 'x2^2/2 + x1^2/2'")
+    group.add_argument("--G", metavar="EXPR", action="append", help="second Hamiltonian (N = 3); repeat for N >= 4")
+    group.add_argument("--coords", metavar="NAMES", help="coordinates of a user system, e.g. 'x1 x2 x3' (default x1..xN)")
+    group.add_argument("--param", metavar="NAME[=VALUE]", action="append",
+                       help="declare a parameter (user system) and/or set its value, e.g. --param m=1; repeatable")
+    group.add_argument("--split", choices=("full", "single"), help="split every Hamiltonian (full) or only H (single)")
+    group.add_argument("--name", metavar="NAME", help="name of a user system in the output (default custom)")
+
+
+def _integrator_options(parser, order=False):
+    parser.add_argument("--integrator", metavar="WORD",
+                        help="word such as 12321, alias (TVT, VTV, lie-trotter, strang, forest-ruth, yoshida:WORD) "
+                             "or 'piece:coeff,...' (default: the Strang word 12..n..21)")
+    if order:
+        parser.add_argument("--order", metavar="K", type=str, help=f"highest power of h kept (default 2, at most {MAX_CLI_ORDER})")
+
+
+def _output_options(parser, default, choices=_SYMBOLIC):
+    parser.add_argument("--format", choices=choices, default=default, help=f"output format (default {default})")
+    parser.add_argument("--output", metavar="FILE", help="write the result to FILE (atomically) instead of stdout")
+
+
+def _numeric_options(parser, defaults):
+    parser.add_argument("--h", metavar="H", type=str, help=f"step size (default {defaults['h']})")
+    parser.add_argument("--steps", metavar="N", type=str, help=f"number of steps (default {defaults['steps']})")
+    parser.add_argument("--x0", metavar="X", help="initial state, comma separated (default 1,1,...,1)")
+    parser.add_argument("--every", metavar="K", type=str, help="sample every K steps (default 1)")
+
+
+EXAMPLES = {
+    "models": "examples:\n  nambu-bch models\n  nambu-bch models --model ho3 --format latex\n  nambu-bch models --H 'x2^2/2 + x1^4/4' --format json",
+    "bch": "examples:\n  nambu-bch bch                          # Phi^{12321}, X_eff through h^2 (Eq. BCH2)\n"
+           "  nambu-bch bch --model ho --integrator TVT --format text     # Eq. (BCH1)\n"
+           "  nambu-bch bch --field --terms          # also Z_j on ho3 and the Liouville terms (Eq. BCH4)",
+    "fi": "examples:\n  nambu-bch fi                           # the eight forms 1AX..2BY\n"
+          "  nambu-bch fi --model ho3 --integrator 12321   # each double commutator of Eq. (BCH4)",
+    "shadow": "examples:\n  nambu-bch shadow                       # alpha-family of Phi^{12321}, ho3, order 2 (Eqs. SH12321c, SG12321c)\n"
+              "  nambu-bch shadow --integrator 32123 --format json\n"
+              "  nambu-bch shadow --model ho --integrator TVT --order 4\n"
+              "  nambu-bch shadow --H 'x2^2/(2*m) + m*x3/2' --G 'x3 - x1^2' --param m --route fi",
+    "conserved": "examples:\n  nambu-bch conserved --integrator 31213   # a row of Table (table)\n  nambu-bch conserved --format json",
+    "exact": "examples:\n  nambu-bch exact                        # F(omega h)^alpha H_c, F^(1-alpha) G_c (Eqs. ESH12321, ESG12321)\n"
+             "  nambu-bch exact --model ho --integrator TVT",
+    "check": "examples:\n  nambu-bch check --integrator 32123 --h 0.1 --steps 100000 --x0 1,1,1\n"
+             "  nambu-bch check --model rigid-body --param I1=1 --param I2=2 --param I3=3 --format json",
+    "plot": "examples:\n  nambu-bch plot --outdir figures       # Figs. 1-4 of the paper (Phi^{32123}, h = 0.1)\n"
+            "  nambu-bch plot --outdir /tmp/figs --steps 20000",
+}
+
+HELP = {
+    "models": "list the built-in systems and the pieces of their splittings",
+    "bch": "the formal BCH series of a word, term by term (optionally evaluated on a system)",
+    "fi": "the eight fundamental-identity forms of [X_AB,[X_CD,X_EF]] and their use on a system",
+    "shadow": "the shadow-Hamiltonian family of a word at an order, or the obstruction",
+    "conserved": "exact conserved quantities H_c, G_c of the integrator (Table (table))",
+    "exact": "exact shadow Hamiltonians F^alpha H_c, F^(1-alpha) G_c (Eq. Xeff2)",
+    "check": "iterate the integrator and report the conservation diagnostics",
+    "plot": "regenerate the paper's Figs. 1-4 as PNG files",
+}
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = _Parser(
+        prog=PROG, formatter_class=_Formatter,
+        description="Shadow Hamiltonians of splitting integrators in Nambu mechanics (Horikoshi).",
+        epilog="examples:\n  nambu-bch shadow            # the paper's alpha-family, LaTeX\n"
+               "  nambu-bch models\n  nambu-bch SUBCOMMAND --help",
+    )
+    from . import __version__
+
+    parser.add_argument("--version", action="version", version=f"%(prog)s {__version__}")
+    sub = parser.add_subparsers(dest="command", metavar="SUBCOMMAND", parser_class=_Parser)
+    sub.required = True
+
+    def add(name, func):
+        p = sub.add_parser(name, help=HELP[name], description=HELP[name], epilog=EXAMPLES[name], formatter_class=_Formatter)
+        p.set_defaults(func=func)
+        return p
+
+    p = add("models", cmd_models)
+    _system_options(p)
+    _output_options(p, "text")
+
+    p = add("bch", cmd_bch)
+    _system_options(p)
+    _integrator_options(p, order=True)
+    p.add_argument("--field", action="store_true", help="also evaluate X_eff = Z_0 + h Z_1 + ... on the system")
+    p.add_argument("--terms", action="store_true", help="also expand into Liouville terms, zero brackets pruned (Eq. BCH4)")
+    _output_options(p, "latex")
+
+    p = add("fi", cmd_fi)
+    _system_options(p)
+    _integrator_options(p)
+    _output_options(p, "latex")
+
+    p = add("shadow", cmd_shadow)
+    _system_options(p)
+    _integrator_options(p, order=True)
+    p.add_argument("--route", choices=("direct", "fi"), default="direct",
+                   help="direct: order-by-order linear solve; fi: fundamental-identity representations (default direct)")
+    p.add_argument("--degree", metavar="D", type=str, help="polynomial degree of the ansatz for H_S, G_S (default: the library's)")
+    _output_options(p, "latex")
+
+    for name, func in (("conserved", cmd_conserved), ("exact", cmd_exact)):
+        p = add(name, func)
+        _system_options(p)
+        _integrator_options(p)
+        _output_options(p, "latex")
+
+    p = add("check", cmd_check)
+    _system_options(p)
+    _integrator_options(p)
+    _numeric_options(p, {"h": 0.1, "steps": 1000})
+    _output_options(p, "text", choices=("text", "json"))
+
+    p = add("plot", cmd_plot)
+    p.add_argument("--outdir", metavar="DIR", default=".", help="directory for fig1.png .. fig4.png (default .)")
+    _numeric_options(p, {"h": 0.1, "steps": "the paper's"})
+    _output_options(p, "text", choices=("text", "json"))
+    return parser
+
+
+def _normalise(args):
+    """Convert the numeric string flags, each error naming its flag."""
+    if getattr(args, "order", None) is not None:
+        args.order = order_value(args.order)
+    if getattr(args, "degree", None) is not None:
+        args.degree = order_value(args.degree, "--degree", limit=20, low=1)
+    if hasattr(args, "h"):
+        default_h = 0.1 if args.command == "check" else None
+        args.h = positive_float(args.h, "--h") if args.h is not None else default_h
+    if hasattr(args, "steps"):
+        default_steps = 1000 if args.command == "check" else None
+        args.steps = positive_int(args.steps, "--steps", MAX_STEPS) if args.steps is not None else default_steps
+    if hasattr(args, "every"):
+        default_every = 1 if args.command == "check" else None
+        args.every = positive_int(args.every, "--every", MAX_STEPS) if args.every is not None else default_every
+    for flag in ("integrator", "coords", "name", "model"):
+        value = getattr(args, flag, None)
+        if value is not None and (not value.strip() or len(value) > 200):
+            raise NambuBCHError(f"--{flag} {value[:40]!r} must be a non-empty string of at most 200 characters")
+    return args
+
+
+def main(argv=None) -> int:
+    """Run the CLI on ``argv`` (default ``sys.argv[1:]``); returns the exit status.
+
+    0 on success, 2 on bad input (one line on stderr), 130 on Ctrl-C.
+    """
+    parser = build_parser()
+    prog = PROG
+    try:
+        args = parser.parse_args(argv)
+        prog = f"{PROG} {args.command}"
+        _normalise(args)
+        args.func(args)
+    except SystemExit as exc:  # --help, --version
+        return exc.code if isinstance(exc.code, int) else 0
+    except UsageError as exc:
+        hint = exc.prog if exc.prog != PROG else PROG
+        print(f"{exc.prog}: error: {exc}; see '{hint} --help'", file=sys.stderr)
+        return 2
+    except NambuBCHError as exc:
+        message = " ".join(str(exc).split())
+        print(f"{prog}: error: {message}", file=sys.stderr)
+        return 2
+    except KeyboardInterrupt:
+        print(f"{prog}: interrupted", file=sys.stderr)
+        return 130
+    except BrokenPipeError:
+        try:
+            sys.stdout = open(os.devnull, "w")
+        except OSError:
+            pass
+        return 0
+    return 0
+
+
+if __name__ == "__main__":  # pragma: no cover
+    sys.exit(main())

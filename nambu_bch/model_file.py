@@ -1,0 +1,151 @@
+"""User systems from TOML files (``nambu-bch ... --system FILE``).
+
+Format (every expression is parsed by the safe parser, never evaluated)::
+
+    # my_oscillator.toml
+    name = "my-ho3"                                   # optional
+    coordinates = ["x1", "x2", "x3"]                  # or "x1 x2 x3"
+    H = "x2^2/(2*m) + m*omega^2*x3/2"                 # first Hamiltonian
+    G = "x3 - x1^2"                                   # second (N = 3); omit for N = 2
+    # hamiltonians = ["...", "...", "..."]            # instead of H/G, e.g. for N >= 4
+    parameters = ["m", "omega"]                       # symbolic parameters, or a table
+    # [parameters]                                    # with numeric values used by
+    # m = 1                                           # 'check' and 'plot'
+    # omega = "1/2"
+    split = "full"                                    # or "single" (split only H)
+    description = "..."                               # optional
+    citation = "..."                                  # optional
+
+Unknown keys are an error naming the accepted ones, so typos do not pass
+silently.
+"""
+
+from __future__ import annotations
+
+import os
+
+from .errors import InvalidSystemError
+from .parsing import parse_expression
+
+try:  # Python >= 3.11
+    import tomllib
+except ModuleNotFoundError:  # pragma: no cover - Python 3.10 with tomli installed
+    try:
+        import tomli as tomllib
+    except ModuleNotFoundError:
+        tomllib = None
+
+#: Largest accepted model file, in bytes.
+MAX_FILE_SIZE = 64 * 1024
+KEYS = ("name", "coordinates", "H", "G", "hamiltonians", "parameters", "split", "description", "citation")
+
+
+def parse_value(text, what: str):
+    """An exact real number from ``text`` (``"1"``, ``"0.1"``, ``"1/2"``, ``"sqrt(2)"``) or from a TOML number."""
+    if isinstance(text, bool):
+        raise InvalidSystemError(f"{what} must be a number, got {text!r}")
+    if isinstance(text, int):
+        text = str(text)
+    elif isinstance(text, float):
+        text = repr(text)
+    value = parse_expression(text, [], what=what)
+    if not value.is_number or value.is_real is False or value.free_symbols:
+        raise InvalidSystemError(f"{what} = {text!r} is not a real number; give e.g. 1, 0.5 or 1/2")
+    return value
+
+
+def load_system(path, values: dict | None = None):
+    """``(System, {name: value})`` read from the TOML file at ``path``.
+
+    Parameters
+    ----------
+    path : str or path-like
+    values : dict, optional
+        Filled with the numeric parameter values the file gives (exact sympy numbers).
+
+    Raises
+    ------
+    InvalidSystemError
+        On a missing / unreadable / oversized file, TOML syntax errors, unknown
+        keys or a malformed entry; :class:`ExpressionParseError` on a bad expression.
+    """
+    from .systems import System
+
+    shown = os.fspath(path)
+    if tomllib is None:  # pragma: no cover
+        raise InvalidSystemError("--system needs Python >= 3.11 (tomllib) or the 'tomli' package")
+    try:
+        size = os.path.getsize(shown)
+        if size > MAX_FILE_SIZE:
+            raise InvalidSystemError(f"--system {shown}: file is {size} bytes; at most {MAX_FILE_SIZE} are accepted")
+        with open(shown, "rb") as handle:
+            data = tomllib.load(handle)
+    except OSError as exc:
+        raise InvalidSystemError(f"--system {shown}: cannot read the file ({exc.strerror or exc})") from None
+    except tomllib.TOMLDecodeError as exc:
+        raise InvalidSystemError(f"--system {shown}: not valid TOML ({exc})") from None
+    except UnicodeDecodeError:
+        raise InvalidSystemError(f"--system {shown}: not valid TOML (not UTF-8 text)") from None
+    unknown = sorted(set(data) - set(KEYS))
+    if unknown:
+        raise InvalidSystemError(f"--system {shown}: unknown key(s) {', '.join(unknown)}; accepted keys are {', '.join(KEYS)}")
+
+    def text_list(key, value):
+        if isinstance(value, str):
+            value = value.replace(",", " ").split()
+        if not isinstance(value, list) or not all(isinstance(v, str) for v in value):
+            raise InvalidSystemError(f"--system {shown}: {key} must be a list of strings or one string, got {value!r}")
+        return value
+
+    if "coordinates" not in data:
+        raise InvalidSystemError(f"--system {shown}: the key 'coordinates' is missing (e.g. coordinates = [\"x1\", \"x2\"])")
+    coordinates = text_list("coordinates", data["coordinates"])
+    if "hamiltonians" in data:
+        if "H" in data or "G" in data:
+            raise InvalidSystemError(f"--system {shown}: give either 'hamiltonians' or 'H'/'G', not both")
+        hams = data["hamiltonians"]
+        if not isinstance(hams, list) or not all(isinstance(v, str) for v in hams):
+            raise InvalidSystemError(f"--system {shown}: hamiltonians must be a list of strings")
+    else:
+        if "H" not in data:
+            raise InvalidSystemError(f"--system {shown}: the key 'H' (or 'hamiltonians') is missing")
+        hams = [data["H"]] + ([data["G"]] if "G" in data else [])
+        if not all(isinstance(v, str) for v in hams):
+            raise InvalidSystemError(f"--system {shown}: H and G must be strings such as \"x2^2/2 + x1^2/2\"")
+    params = data.get("parameters", [])
+    names = []
+    if isinstance(params, dict):
+        for key, value in params.items():
+            names.append(key)
+            if values is not None:
+                values[key] = parse_value(value, f"--system {shown}: parameter {key}")
+    else:
+        names = text_list("parameters", params)
+    for key in ("name", "split", "description", "citation"):
+        if key in data and not isinstance(data[key], str):
+            raise InvalidSystemError(f"--system {shown}: {key} must be a string, got {data[key]!r}")
+    name = data.get("name", os.path.splitext(os.path.basename(shown))[0])
+    symbols = _symbols(coordinates, names, shown)
+    parsed = [parse_expression(H, symbols, what=f"--system {shown}: {label}") for H, label in zip(hams, _labels(len(hams)))]
+    system = System(
+        coordinates, parsed, names, name=name, split=data.get("split", "full"),
+        description=data.get("description", ""), citation=data.get("citation", ""),
+    )
+    return system
+
+
+def _labels(count):
+    if count == 2:
+        return ["H", "G"]
+    return ["H"] + [f"hamiltonians[{k}]" for k in range(1, count)]
+
+
+def _symbols(coordinates, parameters, shown):
+    import sympy
+
+    out = []
+    for n in list(coordinates) + list(parameters):
+        if not isinstance(n, str) or not n.isidentifier():
+            raise InvalidSystemError(f"--system {shown}: {n!r} is not a valid symbol name")
+        out.append(sympy.Symbol(n))
+    return out
