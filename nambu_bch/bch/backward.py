@@ -180,23 +180,26 @@ def effective_field(splitting, comp, order: int = 2, fast: bool = True) -> Effec
 
 
 def _backward_laurent(engine, comp, order) -> tuple:
-    """The same recursion as :func:`effective_field`, on raw Laurent-ring elements (``engine.ring``)."""
+    """The same recursion as :func:`effective_field`, graded by powers of ``h``, in the Laurent ring.
+
+    Series in ``h`` are lists ``[f_0, ..., f_top]`` of ``h``-free ring elements, so
+    no product ever produces a power of ``h`` that is thrown away.  The pull-back
+    is ``[h^n] exp(c h X) f = sum_k c^k/k! X^k f_{n-k}``.  For the modified field,
+    with ``U_k = (h Y)^k x`` and ``Y = sum_l h^l Z_l``,
+    ``[h^n] U_k = sum_l Z_l [h^(n-1-l)] U_{k-1}`` involves only ``Z_l`` with
+    ``l <= n - k``; so ``Z_j^i = [h^(j+1)] Phi^* x_i - sum_{k >= 2} [h^(j+1)] U_k / k!``
+    and every ``[h^n] U_k`` is computed once (Hairer-Lubich-Wanner IX.1).
+    """
     algebra, R = engine.algebra, engine.ring
     n = algebra.n
-    hidx = n + algebra.constants.index(H)
-    h = R.gens[hidx]
     coords = R.gens[:n]
-
-    def truncate(p, degree):
-        if all(m[hidx] <= degree for m in p.keys()):
-            return p
-        return R.from_dict({m: c for m, c in p.items() if m[hidx] <= degree})
-
-    def coefficient(p, degree):
-        return R.from_dict({m[:hidx] + (0,) + m[hidx + 1:]: c for m, c in p.items() if m[hidx] == degree})
+    top = order + 1
+    zero = R.zero
 
     def apply(components, f):
-        total = R.zero
+        total = zero
+        if not f:
+            return total
         for c, x in zip(components, coords):
             if c:
                 d = f.diff(x)
@@ -204,26 +207,43 @@ def _backward_laurent(engine, comp, order) -> tuple:
                     total = total + c * d
         return engine._reduce(total)
 
-    def exp_apply(components, scale, value, degree):
-        total = term = value
-        for k in range(1, degree + 1):
-            term = truncate(apply(components, term) * scale, degree) * R.domain.convert(sympy.Rational(1, k))
-            if not term:
-                break
-            total = total + term
-        return total
+    def exp_pullback(components, c, series):
+        out = [zero] * (top + 1)
+        for m, f in enumerate(series):
+            term, scale = f, R.domain.one
+            for k in range(0, top - m + 1):
+                if k:
+                    term = apply(components, term)
+                    scale = scale * c * R.domain.convert(sympy.Rational(1, k))
+                if not term:
+                    break
+                out[m + k] = out[m + k] + term * scale
+        return out
 
-    top = order + 1
     pulled = []
     for x in coords:
-        value = x
+        series = [x] + [zero] * top
         for k, c in reversed(comp.factors()):
-            value = exp_apply(engine.fields[k].components, h * engine._coefficient(c), value, top)
-        pulled.append(value)
+            series = exp_pullback(engine.fields[k].components, engine._coefficient(c), series)
+        pulled.append(series)
     Z = []
+    # U[i][k][m] = [h^m] (hY)^k x_i
+    U = [[[x] + [zero] * top] + [[zero] * (top + 1) for _ in range(top)] for x in coords]
+    inverse_factorial = [R.domain.convert(1 / sympy.factorial(k)) for k in range(top + 1)]
     for j in range(order + 1):
-        partial = [R.zero] * n
-        for l, Zl in enumerate(Z):
-            partial = [p + z * h**l for p, z in zip(partial, Zl)]
-        Z.append([coefficient(target - exp_apply(partial, h, x, j + 1), j + 1) for x, target in zip(coords, pulled)])
-    return tuple(VectorField(algebra, [engine.to_algebra(engine._reduce(c)) for c in comps]) for comps in Z)
+        m = j + 1
+        comps = []
+        for i in range(n):
+            Ui = U[i]
+            rest = zero
+            for k in range(2, m + 1):
+                value = zero
+                for l in range(0, m - k + 1):
+                    value = value + apply(Z[l], Ui[k - 1][m - 1 - l])
+                Ui[k][m] = value
+                rest = rest + value * inverse_factorial[k]
+            comps.append(engine._reduce(pulled[i][m] - rest))
+        Z.append(comps)
+        for i in range(n):
+            U[i][1][m] = comps[i]
+    return tuple(VectorField(algebra, [engine.to_algebra(c) for c in comps]) for comps in Z)
