@@ -1,0 +1,192 @@
+"""Exact shadow Hamiltonians ``H_S^e = F(omega h)^alpha H_c``, ``G_S^e = F(omega h)^(1-alpha) G_c``.
+
+For the oscillators the composed map is linear in ``(x1, x2)`` (position or
+velocity Verlet, Eqs. equiv1, equiv2), a rotation by ``theta = 2 asin(omega h/2)``
+in scaled variables, so its effective field is the field of the conserved
+quantities stretched by ``F(omega h)`` (Eqs. Xeff1, Xeff2):
+
+    X_eff = F(omega h) X_{H_c}            (N = 2),    H_S^e = F(omega h) H_c,
+    X_eff = F(omega h) X_{H_c, G_c}       (N = 3).
+
+The Nambu bracket is linear in each slot, so every split of the factor,
+``X_{F^alpha H_c, F^(1-alpha) G_c} = F X_{H_c,G_c}``, gives shadow Hamiltonians:
+the alpha-family of Eqs. (ESH12321), (ESG12321) and Table (table).
+
+Which systems qualify.  The form is *checked*, never assumed: the system must
+have a parameter ``omega``, polynomial conserved quantities
+(:func:`~nambu_bch.exact.conserved_quantities`), and the BCH effective field
+(:func:`~nambu_bch.bch.effective_field`) must equal ``F(omega h) X_{H_c,G_c}``
+through ``h^CHECK_ORDER``; otherwise :class:`~nambu_bch.errors.NoExactResultError`
+is raised.  (Exactness to all orders for ``ho``/``ho3``: the time-``h`` flow of
+``F X_{H_c,G_c}`` reproduces ``Phi_h`` exactly, see
+:mod:`nambu_bch.exact.solutions` and ``tests/test_exact_solutions.py``.)
+
+References
+----------
+Horikoshi, Eqs. (Xeff1), (SHPV2), (Xeff2), (ESH12321), (ESG12321), Table (table).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from functools import lru_cache
+
+import sympy
+
+from ..algebra import liouville_field
+from ..bch import effective_field
+from ..errors import NoExactResultError
+from .factor import F, F_series
+from .invariants import ConservedQuantities, conserved_quantities
+
+H_STEP = sympy.Symbol("h")
+ALPHA = sympy.Symbol("alpha")
+OMEGA = sympy.Symbol("omega")
+#: Order in h through which X_eff = F(omega h) X_{H_c,G_c} is verified before an ExactShadow is returned.
+CHECK_ORDER = 8
+
+
+def truncate_h(expr, order: int, h=H_STEP):
+    """``expr`` (a polynomial in ``h``) without the powers of ``h`` above ``order``."""
+    expr = sympy.expand(expr)
+    return sympy.Add(*[t for t in sympy.Add.make_args(expr) if sympy.degree(t, h) <= order])
+
+
+def factor_power_series(exponent, order: int, x=None):
+    """``F(omega h)^exponent`` expanded through ``h^order`` (binomial series of ``(1 + u)^a``).
+
+    Examples
+    --------
+    >>> factor_power_series(ALPHA, 2)
+    alpha*h**2*omega**2/6 + 1
+    """
+    x = OMEGA * H_STEP if x is None else x
+    u = F_series(x, order) - 1
+    total, term = sympy.Integer(1), sympy.Integer(1)
+    for k in range(1, order // 2 + 1):
+        term = truncate_h(term * u * (exponent - k + 1) / k, order)
+        total += term
+    return sympy.expand(total)
+
+
+@dataclass(frozen=True, eq=False)
+class ExactShadow:
+    """The alpha-family of exact shadow Hamiltonians of a linear oscillator.
+
+    Attributes
+    ----------
+    H_S, G_S : sympy expressions containing ``F(omega h)`` exactly and ``alpha``
+        (``G_S`` is ``None`` and ``H_S = F H_c`` for N = 2)
+    factor : sympy expression, ``F(omega h)`` in closed form
+    alpha : Symbol("alpha")
+    conserved : ConservedQuantities (``H_c``, ``G_c``)
+    verified_order : int, ``X_eff = F X_{H_c,G_c}`` was checked through this power of ``h``
+    """
+
+    H_S: object
+    G_S: object
+    factor: object
+    conserved: ConservedQuantities = field(repr=False)
+    verified_order: int = CHECK_ORDER
+    alpha: sympy.Symbol = ALPHA
+
+    @property
+    def H_c(self):
+        return self.conserved.H_c
+
+    @property
+    def G_c(self):
+        return self.conserved.G_c
+
+    def series(self, order: int) -> tuple:
+        """``(H_S, G_S)`` expanded through ``h^order`` (``G_S`` is ``None`` for N = 2).
+
+        Eqs. (ESH12321), (ESG12321) are ``series(2)`` for ``ho3`` and ``12321``.
+        """
+        if self.G_S is None:
+            return (truncate_h(factor_power_series(1, order) * self.H_c, order), None)
+        H = truncate_h(factor_power_series(ALPHA, order) * self.H_c, order)
+        G = truncate_h(factor_power_series(1 - ALPHA, order) * self.G_c, order)
+        return (sympy.collect(H, H_STEP), sympy.collect(G, H_STEP))
+
+    def field_series(self, order: int) -> tuple:
+        """The components of ``X_eff = F(omega h) X_{H_c,G_c}`` through ``h^order`` (sympy)."""
+        system = self.conserved.system
+        Xc = liouville_field(system.algebra, *self.conserved.hamiltonians_c).to_sympy()
+        Fs = F_series(OMEGA * H_STEP, order)
+        return tuple(truncate_h(Fs * c, order) for c in Xc)
+
+    def to_latex(self) -> str:
+        Fx = r"F(x) = \frac{2\arcsin(x/2)}{x\sqrt{1 - x^2/4}}"
+        if self.G_S is None:
+            return rf"H_S^e = F(\omega h)\Big({sympy.latex(self.H_c)}\Big),\quad {Fx}"
+        return (rf"H_S^e = F(\omega h)^{{\alpha}}\Big({sympy.latex(self.H_c)}\Big),\quad "
+                rf"G_S^e = F(\omega h)^{{1-\alpha}}\Big({sympy.latex(self.G_c)}\Big),\quad {Fx}")
+
+    def _repr_latex_(self):
+        return f"${self.to_latex()}$"
+
+    def to_dict(self) -> dict:
+        return {"H_S": str(self.H_S), "G_S": None if self.G_S is None else str(self.G_S),
+                "H_c": str(self.H_c), "G_c": None if self.G_c is None else str(self.G_c),
+                "free_parameters": [] if self.G_S is None else ["alpha"]}
+
+
+def exact_shadow_hamiltonians(system, word) -> ExactShadow:
+    """The exact shadow Hamiltonians ``F^alpha H_c``, ``F^(1-alpha) G_c`` of ``word`` on ``system``.
+
+    Parameters
+    ----------
+    system : System with a parameter ``omega`` (``ho``, ``ho3`` or a user-defined oscillator like them)
+    word : str or Composition
+
+    Returns
+    -------
+    ExactShadow
+
+    Raises
+    ------
+    NoExactResultError if the system has no ``omega``, no polynomial conserved
+    quantities, or its effective field is not ``F(omega h) X_{H_c,G_c}``
+    (e.g. ``rigid-body``, ``lotka-volterra``, ``ho3-composite``).
+
+    References
+    ----------
+    Horikoshi, Eqs. (Xeff1), (SHPV2), (Xeff2), (ESH12321), (ESG12321), Table (table).
+
+    Examples
+    --------
+    >>> from nambu_bch import model
+    >>> exact_shadow_hamiltonians(model("ho3"), "12321").series(2)[0]     # Eq. (ESH12321)
+    h**2*(alpha*m*omega**4*x3/12 + alpha*omega**2*x2**2/(12*m)) + m*omega**2*x3/2 + x2**2/(2*m)
+    """
+    cq = conserved_quantities(system, word)
+    return _exact_shadow(system, cq.word, cq)
+
+
+@lru_cache(maxsize=64)
+def _exact_shadow(system, word, cq):
+    what = f"{word!r} on {system.name}"
+    if OMEGA not in system.parameters:
+        raise NoExactResultError(
+            f"no exact factor form F(omega h) for {what}: the system has no parameter 'omega' "
+            "(exact shadow Hamiltonians exist here only for linear oscillators such as ho and ho3)"
+        )
+    if system.N > 3 or any(Ic is None for Ic in cq.hamiltonians_c):
+        raise NoExactResultError(
+            f"no exact factor form F(omega h) for {what}: no polynomial conserved quantity tends to each Hamiltonian"
+        )
+    X = effective_field(system.splitting, word, CHECK_ORDER)
+    Xc = liouville_field(system.algebra, *cq.hamiltonians_c).to_sympy()
+    Fs = F_series(OMEGA * H_STEP, CHECK_ORDER)
+    for j, Z in enumerate(X.coefficients):
+        for zc, xc in zip(Z.to_sympy(), Xc):
+            if sympy.expand(sympy.expand(Fs * xc).coeff(H_STEP, j) - zc) != 0:
+                raise NoExactResultError(
+                    f"no exact factor form for {what}: X_eff differs from F(omega h) X_(H_c,G_c) at order h^{j} "
+                    "(exact shadow Hamiltonians exist here only for linear oscillators such as ho and ho3)"
+                )
+    Fx = F(OMEGA * H_STEP)
+    if system.N == 2:
+        return ExactShadow(Fx * cq.H_c, None, Fx, cq)
+    return ExactShadow(Fx**ALPHA * cq.H_c, Fx ** (1 - ALPHA) * cq.G_c, Fx, cq)

@@ -1,0 +1,304 @@
+"""The modified Nambu equations and their exact solutions x^o, x^c, x^s.
+
+Three vector fields are compared with the integrator (Sect. 5.5):
+
+* ``kind="o"`` -- the original Hamiltonians, ``dx/dt = X_{H,G}`` (Eq. NambuOHeqs);
+* ``kind="c"`` -- the conserved quantities, ``dx/dt = X_{H_c,G_c}`` (Eq. NambuCQeqs;
+  for ``32123`` on ``ho3``: ``x1' = x2/m``, ``x2' = -m omega^2 a^2 x1``,
+  ``x3' = 2 b^2 x1 x2/m`` with ``a = sqrt(1 - omega^2 h^2/4)``, ``b = sqrt(1 - omega^2 h^2/2)``);
+* ``kind="s"`` -- the exact shadow Hamiltonians, ``dx/dt = F(omega h) X_{H_c,G_c}`` (Eq. NambuSHeqs).
+
+Closed-form solution.  Each field has a *linear core*: two coordinates
+``y = (x1, x2)`` with ``y' = A y``, ``tr A = 0``, ``det A = Omega^2 > 0``
+(``Omega = omega`` for "o", ``tilde omega = a omega`` for "c"), so
+
+    y(t) = cos(Omega t) y0 + sin(Omega t)/Omega A y0,
+
+and the remaining coordinates are *driven*, ``x_k' = q_k(y)`` with ``q_k`` a
+polynomial of degree <= 2, integrated in closed form (the ``cos 2 Omega t``,
+``sin 2 Omega t`` terms of Eqs. OHsol, CQsol).  The shadow solution is the
+conserved-quantity solution at the stretched time ``tilde t = F(omega h) t``
+(Eq. SHsol).  At ``t = h`` the shadow solution *is* the map:
+``tilde omega tilde t = 2 asin(omega h / 2)`` (tested exactly).
+
+Parameters are taken positive (``m, omega > 0``) when ``Omega`` is extracted
+from ``Omega^2``.
+
+References
+----------
+Horikoshi, Eqs. (NambuOHeqs), (NambuCQeqs), (NambuSHeqs), (OHsol), (CQsol), (SHsol), Figs. 3-4.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from functools import lru_cache
+
+import numpy as np
+import sympy
+
+from ..algebra import liouville_field
+from ..errors import NambuBCHError, NoExactResultError, UnstableStepError
+from ..integrators import composition
+from ..integrators.step import parameter_values
+from .exact_shadow import OMEGA, exact_shadow_hamiltonians
+from .factor import F
+from .invariants import conserved_quantities
+
+H_STEP = sympy.Symbol("h")
+TIME = sympy.Symbol("t")
+KINDS = ("o", "c", "s")
+
+
+def _check_kind(kind):
+    if kind not in KINDS:
+        raise NambuBCHError(f"kind must be one of 'o' (original), 'c' (conserved), 's' (exact shadow), got {kind!r}")
+
+
+def _word(system, word) -> str:
+    comp = composition(word, len(system.splitting)).check(system.splitting)
+    return word if isinstance(word, str) else (comp.name or "".join(map(str, comp.pieces)))
+
+
+def _conserved_field(system, word) -> tuple:
+    cq = conserved_quantities(system, word)
+    if any(Ic is None for Ic in cq.hamiltonians_c):
+        raise NoExactResultError(
+            f"{word!r} on {system.name} has no polynomial conserved quantity for each Hamiltonian, "
+            "so the equations with the conserved quantities (Eq. NambuCQeqs) are not defined"
+        )
+    return liouville_field(system.algebra, *cq.hamiltonians_c).to_sympy()
+
+
+def modified_equations(system, word, kind) -> tuple:
+    """Right-hand sides ``dx_i/dt`` of the Nambu equations with H,G / H_c,G_c / H_S^e,G_S^e.
+
+    Parameters
+    ----------
+    system : System
+    word : str or Composition
+    kind : ``"o"`` (Eq. NambuOHeqs), ``"c"`` (Eq. NambuCQeqs) or ``"s"`` (Eq. NambuSHeqs)
+
+    Returns
+    -------
+    tuple of sympy expressions, one per coordinate (``"s"`` contains ``F(omega h)`` exactly).
+
+    Examples
+    --------
+    >>> from nambu_bch import model
+    >>> modified_equations(model("ho3"), "32123", "c")          # Eq. (NambuCQeqs)
+    (x2/m, h**2*m*omega**4*x1/4 - m*omega**2*x1, -h**2*omega**2*x1*x2/m + 2*x1*x2/m)
+    """
+    _check_kind(kind)
+    word = _word(system, word)
+    if kind == "o":
+        return tuple(system.vector_field.to_sympy())
+    if kind == "c":
+        return tuple(_conserved_field(system, word))
+    shadow = exact_shadow_hamiltonians(system, word)
+    return tuple(shadow.factor * c for c in _conserved_field(system, word))
+
+
+def _positive_sqrt(expr):
+    """``sqrt(expr)`` for a rational function positive near ``h = 0``, parameters assumed positive.
+
+    Monomial square factors come out of the root and the rest is scaled to
+    constant term 1 in ``h``: ``omega**2*(4 - h**2*omega**2)/4 -> omega*sqrt(1 - h**2*omega**2/4)``.
+    """
+    num, den = sympy.fraction(sympy.cancel(sympy.together(expr)))
+    out, inside = sympy.Integer(1), sympy.Integer(1)
+    for part, power in ((num, 1), (den, -1)):
+        gens = sorted(part.free_symbols, key=str)
+        if not gens:
+            out *= sympy.sqrt(part) ** power
+            continue
+        poly = sympy.Poly(part, *gens)
+        (mono, prim) = poly.terms_gcd()
+        for g, e in zip(gens, mono):
+            out *= g ** sympy.Rational(e * power, 2)
+        prim_expr = prim.as_expr()
+        const = prim_expr.subs(H_STEP, 0)
+        if const == 0:
+            const = sympy.Integer(1)
+        out *= sympy.sqrt(const) ** power
+        inside *= sympy.expand(prim_expr / const) ** power
+    return out * sympy.sqrt(inside)
+
+
+def _tidy(expr, atoms, W, det):
+    """Collect over the trig atoms and ``t``; each coefficient as ``a + b W`` (``W**2 = det``), factored."""
+    parts = sympy.collect(sympy.expand(expr), atoms, evaluate=False)
+
+    def reduce(v):
+        num, den = sympy.fraction(sympy.cancel(sympy.together(v)))
+        rem = lambda p: sympy.Poly(p, W).rem(sympy.Poly(W**2 - det, W)).all_coeffs()[::-1] + [0]  # noqa: E731
+        p0, p1 = rem(num)[:2]
+        q0, q1 = rem(den)[:2]
+        # (p0 + p1 W) / (q0 + q1 W) with one of q0, q1 zero (den is a monomial in W times a rational function)
+        if q1 == 0:
+            a, b = p0 / q0, p1 / q0
+        else:
+            a, b = p1 / q1, p0 / (q1 * det)
+        return sympy.factor(a) + sympy.factor(b) * W
+
+    return sympy.Add(*[reduce(v) * k for k, v in parts.items()])
+
+
+def _closed_form(system, rhs, t):
+    """Closed-form solution of ``x' = rhs(x)`` with a 2-d linear core and driven coordinates."""
+    coords = system.coordinates
+    x0 = tuple(sympy.Symbol(f"{c.name}_0") for c in coords)
+    rhs = [sympy.expand(r) for r in rhs]
+    polys = []
+    for r in rhs:
+        try:
+            polys.append(sympy.Poly(r, *coords))
+        except sympy.PolynomialError:
+            polys = None
+            break
+    fail = NoExactResultError(
+        f"no closed-form solution for {system.name}: the equations {tuple(rhs)} do not have a linear "
+        "two-coordinate core y' = A y (trace 0, det > 0) with the other coordinates driven by a quadratic in y"
+    )
+    if polys is None:
+        raise fail
+    linear = [i for i, p in enumerate(polys)
+              if p.is_zero or (p.total_degree() == 1 and all(sum(m) == 1 for m in p.monoms()))]
+    core = [i for i in linear if all(polys[i].degree(coords[j]) <= 0 for j in range(len(coords)) if j not in linear)]
+    # the core: linear equations that only involve each other
+    while True:
+        keep = [i for i in core if all(polys[i].degree(coords[j]) <= 0 for j in range(len(coords)) if j not in core)]
+        if keep == core:
+            break
+        core = keep
+    driven = [i for i in range(len(coords)) if i not in core]
+    if len(core) != 2 or any(any(polys[k].degree(coords[j]) > 0 for j in driven) or polys[k].total_degree() > 2
+                             for k in driven):
+        raise fail
+    i1, i2 = core
+    y = (coords[i1], coords[i2])
+    A = sympy.Matrix([[sympy.expand(rhs[i]).coeff(yj) for yj in y] for i in core])
+    if sympy.simplify(A.trace()) != 0:
+        raise fail
+    det = sympy.factor(A.det())
+    Omega = _positive_sqrt(det)
+    if Omega.is_zero or det.is_negative:
+        raise fail
+    # work with a placeholder W for Omega so that coefficients factor cleanly, substitute at the end
+    W = sympy.Dummy("Omega", positive=True)
+    C = sympy.Matrix([x0[i1], x0[i2]])
+    S = A * C / W
+    c1, s1 = sympy.cos(W * t), sympy.sin(W * t)
+    c2, s2 = sympy.cos(2 * W * t), sympy.sin(2 * W * t)
+    out = [None] * len(coords)
+    yt = C * c1 + S * s1
+    out[i1], out[i2] = yt[0], yt[1]
+    for k in driven:
+        q = sympy.Poly(rhs[k], *y)
+        Q = sympy.Matrix(2, 2, lambda a, b: q.coeff_monomial(y[a] ** 2) if a == b else q.coeff_monomial(y[0] * y[1]) / 2)
+        lvec = sympy.Matrix([[q.coeff_monomial(y[0]), q.coeff_monomial(y[1])]])
+        c0 = q.coeff_monomial(1)
+        CQC, SQS, CQS = (C.T * Q * C)[0], (S.T * Q * S)[0], (C.T * Q * S)[0]
+        integral = ((CQC + SQS) / 2 * t + (CQC - SQS) / (4 * W) * s2 + CQS / (2 * W) * (1 - c2)
+                    + (lvec * C)[0] * s1 / W + (lvec * S)[0] * (1 - c1) / W + c0 * t)
+        out[k] = x0[k] + integral
+    return tuple(_tidy(e, [c1, s1, c2, s2, t], W, det).subs(W, Omega) for e in out), x0, Omega
+
+
+@dataclass(frozen=True, eq=False)
+class ModifiedSolution:
+    """The exact solution of the modified Nambu equations of one ``kind``.
+
+    Attributes
+    ----------
+    expressions : tuple of sympy expressions in ``t``, the initial values ``x1_0, x2_0, ...``,
+        the parameters and ``h``
+    initial_symbols : tuple of Symbols ``x1_0, x2_0, ...``
+    frequency : sympy expression, ``Omega`` of the linear core in ``t`` (``omega``,
+        ``tilde omega = a omega``, or ``F(omega h) tilde omega``)
+    equations : the right-hand sides it solves (:func:`modified_equations`)
+    kind, word, system
+    """
+
+    expressions: tuple
+    initial_symbols: tuple
+    frequency: object
+    equations: tuple
+    kind: str
+    word: str
+    system: object = field(repr=False)
+    time: sympy.Symbol = TIME
+
+    def numeric(self, params=None, h=0.1):
+        """``f(t, x0) -> array (N, len(t))``, the solution lambdified once for float ``t`` arrays.
+
+        Raises UnstableStepError if ``|omega h| >= 2`` (kinds "c", "s": ``a`` would be imaginary).
+        """
+        values = parameter_values(self.system, params)
+        h = float(h)
+        if self.kind != "o" and OMEGA in values and abs(values[OMEGA] * h) >= 2:
+            raise UnstableStepError(f"the modified solution needs |omega h| < 2, got omega h = {values[OMEGA] * h!r}")
+        args = (self.time, *self.initial_symbols, *values, H_STEP)
+        fn = _lambdify(args, self.expressions)
+        pvals = tuple(values.values())
+        n = len(self.initial_symbols)
+
+        def solution(t, x0):
+            t = np.asarray(t, dtype=float)
+            x0 = np.asarray(x0, dtype=float).reshape(-1)
+            if x0.shape != (n,):
+                raise NambuBCHError(f"initial state must have {n} components, got shape {x0.shape}")
+            res = fn(t, *x0, *pvals, h)
+            return np.array([np.broadcast_to(np.asarray(r, dtype=float), t.shape) for r in res])
+
+        return solution
+
+    def at(self, x0=None, t=None):
+        """The expressions with the initial values (and optionally ``t``) substituted."""
+        subs = {} if x0 is None else dict(zip(self.initial_symbols, x0))
+        if t is not None:
+            subs[self.time] = t
+        return tuple(sympy.sympify(e).subs(subs) for e in self.expressions)
+
+
+def _lambdify(args, expressions):
+    return sympy.lambdify(args, list(expressions), modules="numpy", cse=True)
+
+
+def modified_solution(system, word, kind) -> ModifiedSolution:
+    """The exact solution ``x^o``, ``x^c`` or ``x^s`` of the modified Nambu equations, for any initial state.
+
+    Parameters
+    ----------
+    system : System (``ho``, ``ho3`` or another linear oscillator)
+    word : str or Composition
+    kind : ``"o"`` (Eq. OHsol), ``"c"`` (Eq. CQsol) or ``"s"`` (Eq. SHsol)
+
+    Returns
+    -------
+    ModifiedSolution
+
+    References
+    ----------
+    Horikoshi, Eqs. (OHsol), (CQsol), (SHsol).
+
+    Examples
+    --------
+    >>> from nambu_bch import model
+    >>> modified_solution(model("ho"), "121", "o").expressions[0]
+    x1_0*cos(omega*t) + x2_0*sin(omega*t)/(m*omega)
+    """
+    _check_kind(kind)
+    return _solution(system, _word(system, word), kind)
+
+
+@lru_cache(maxsize=64)
+def _solution(system, word, kind):
+    eqs = modified_equations(system, word, kind)
+    if kind == "s":
+        base, x0, Omega = _closed_form(system, modified_equations(system, word, "c"), TIME)
+        Fx = F(OMEGA * H_STEP)
+        exprs = tuple(e.subs(TIME, Fx * TIME) for e in base)
+        return ModifiedSolution(exprs, x0, Fx * Omega, eqs, kind, word, system)
+    exprs, x0, Omega = _closed_form(system, eqs, TIME)
+    return ModifiedSolution(exprs, x0, Omega, eqs, kind, word, system)
