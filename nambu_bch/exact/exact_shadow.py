@@ -13,7 +13,7 @@ The Nambu bracket is linear in each slot, so every split of the factor,
 the alpha-family of Eqs. (ESH12321), (ESG12321) and Table (table).
 
 Which systems qualify.  The form is *checked*, never assumed: the system must
-have a parameter ``omega``, polynomial conserved quantities
+have a parameter ``omega`` (or a harmonic core whose frequency plays its part), polynomial conserved quantities
 (:func:`~nambu_bch.exact.conserved_quantities`), and the BCH effective field
 (:func:`~nambu_bch.bch.effective_field`) must equal ``F(omega h) X_{H_c,G_c}``
 through ``h^CHECK_ORDER``; otherwise :class:`~nambu_bch.errors.NoExactResultError`
@@ -38,6 +38,7 @@ from ..bch import effective_field
 from ..errors import NoExactResultError
 from .factor import F, F_series
 from .invariants import ConservedQuantities, conserved_quantities
+from .linear_core import linear_core
 
 H_STEP = sympy.Symbol("h")
 ALPHA = sympy.Symbol("alpha")
@@ -53,7 +54,7 @@ def truncate_h(expr, order: int, h=H_STEP):
 
 
 def factor_power_series(exponent, order: int, x=None):
-    """``F(omega h)^exponent`` expanded through ``h^order`` (binomial series of ``(1 + u)^a``).
+    """``F(x)^exponent`` expanded through ``h^order``, ``x = omega h`` by default (binomial series of ``(1 + u)^a``).
 
     Examples
     --------
@@ -78,6 +79,8 @@ class ExactShadow:
     H_S, G_S : sympy expressions containing ``F(omega h)`` exactly and ``alpha``
         (``G_S`` is ``None`` and ``H_S = F H_c`` for N = 2)
     factor : sympy expression, ``F(omega h)`` in closed form
+    frequency : sympy expression, the ``omega`` of ``F(omega h)`` (the frequency of the
+        harmonic core of ``X_{H,G}``; the parameter ``omega`` for ``ho``, ``ho3``)
     alpha : Symbol("alpha")
     conserved : ConservedQuantities (``H_c``, ``G_c``)
     verified_order : int, ``X_eff = F X_{H_c,G_c}`` was checked through this power of ``h``
@@ -88,6 +91,7 @@ class ExactShadow:
     factor: object
     conserved: ConservedQuantities = field(repr=False)
     verified_order: int = CHECK_ORDER
+    frequency: object = OMEGA
     alpha: sympy.Symbol = ALPHA
 
     @property
@@ -103,17 +107,18 @@ class ExactShadow:
 
         Eqs. (ESH12321), (ESG12321) are ``series(2)`` for ``ho3`` and ``12321``.
         """
+        x = self.frequency * H_STEP
         if self.G_S is None:
-            return (truncate_h(factor_power_series(1, order) * self.H_c, order), None)
-        H = truncate_h(factor_power_series(ALPHA, order) * self.H_c, order)
-        G = truncate_h(factor_power_series(1 - ALPHA, order) * self.G_c, order)
+            return (truncate_h(factor_power_series(1, order, x) * self.H_c, order), None)
+        H = truncate_h(factor_power_series(ALPHA, order, x) * self.H_c, order)
+        G = truncate_h(factor_power_series(1 - ALPHA, order, x) * self.G_c, order)
         return (sympy.collect(H, H_STEP), sympy.collect(G, H_STEP))
 
     def field_series(self, order: int) -> tuple:
         """The components of ``X_eff = F(omega h) X_{H_c,G_c}`` through ``h^order`` (sympy)."""
         system = self.conserved.system
         Xc = liouville_field(system.algebra, *self.conserved.hamiltonians_c).to_sympy()
-        Fs = F_series(OMEGA * H_STEP, order)
+        Fs = F_series(self.frequency * H_STEP, order)
         return tuple(truncate_h(Fs * c, order) for c in Xc)
 
     def to_latex(self) -> str:
@@ -167,18 +172,14 @@ def exact_shadow_hamiltonians(system, word) -> ExactShadow:
 @lru_cache(maxsize=64)
 def _exact_shadow(system, word, cq):
     what = f"{word!r} on {system.name}"
-    if OMEGA not in system.parameters:
-        raise NoExactResultError(
-            f"no exact factor form F(omega h) for {what}: the system has no parameter 'omega' "
-            "(exact shadow Hamiltonians exist here only for linear oscillators such as ho and ho3)"
-        )
+    omega = frequency(system)
     if system.N > 3 or any(Ic is None for Ic in cq.hamiltonians_c):
         raise NoExactResultError(
             f"no exact factor form F(omega h) for {what}: no polynomial conserved quantity tends to each Hamiltonian"
         )
     X = effective_field(system.splitting, word, CHECK_ORDER)
     Xc = liouville_field(system.algebra, *cq.hamiltonians_c).to_sympy()
-    Fs = F_series(OMEGA * H_STEP, CHECK_ORDER)
+    Fs = F_series(omega * H_STEP, CHECK_ORDER)
     for j, Z in enumerate(X.coefficients):
         for zc, xc in zip(Z.to_sympy(), Xc):
             if sympy.expand(sympy.expand(Fs * xc).coeff(H_STEP, j) - zc) != 0:
@@ -186,7 +187,21 @@ def _exact_shadow(system, word, cq):
                     f"no exact factor form for {what}: X_eff differs from F(omega h) X_(H_c,G_c) at order h^{j} "
                     "(exact shadow Hamiltonians exist here only for linear oscillators such as ho and ho3)"
                 )
-    Fx = F(OMEGA * H_STEP)
+    Fx = F(omega * H_STEP)
     if system.N == 2:
-        return ExactShadow(Fx * cq.H_c, None, Fx, cq)
-    return ExactShadow(Fx**ALPHA * cq.H_c, Fx ** (1 - ALPHA) * cq.G_c, Fx, cq)
+        return ExactShadow(Fx * cq.H_c, None, Fx, cq, frequency=omega)
+    return ExactShadow(Fx**ALPHA * cq.H_c, Fx ** (1 - ALPHA) * cq.G_c, Fx, cq, frequency=omega)
+
+
+def frequency(system):
+    """The ``omega`` of ``F(omega h)``: the parameter ``omega`` if the system has one, else the
+    frequency of the harmonic core of ``X_{H,G}`` (:func:`~nambu_bch.exact.linear_core.linear_core`)."""
+    if OMEGA in system.parameters:
+        return OMEGA
+    try:
+        return linear_core(system.coordinates, system.vector_field.to_sympy(), system.name).Omega
+    except NoExactResultError:
+        raise NoExactResultError(
+            f"no exact factor form F(omega h) for {system.name}: it has no parameter 'omega' and its equations "
+            "have no harmonic core (exact shadow Hamiltonians exist here only for linear oscillators such as ho and ho3)"
+        ) from None

@@ -41,8 +41,8 @@ from ..algebra import liouville_field
 from ..errors import NambuBCHError, NoExactResultError, UnstableStepError
 from ..integrators import composition
 from ..integrators.step import parameter_values
-from .exact_shadow import OMEGA, exact_shadow_hamiltonians
-from .factor import F
+from .exact_shadow import OMEGA, exact_shadow_hamiltonians, frequency
+from .linear_core import linear_core
 from .invariants import conserved_quantities
 
 H_STEP = sympy.Symbol("h")
@@ -99,32 +99,6 @@ def modified_equations(system, word, kind) -> tuple:
     return tuple(shadow.factor * c for c in _conserved_field(system, word))
 
 
-def _positive_sqrt(expr):
-    """``sqrt(expr)`` for a rational function positive near ``h = 0``, parameters assumed positive.
-
-    Monomial square factors come out of the root and the rest is scaled to
-    constant term 1 in ``h``: ``omega**2*(4 - h**2*omega**2)/4 -> omega*sqrt(1 - h**2*omega**2/4)``.
-    """
-    num, den = sympy.fraction(sympy.cancel(sympy.together(expr)))
-    out, inside = sympy.Integer(1), sympy.Integer(1)
-    for part, power in ((num, 1), (den, -1)):
-        gens = sorted(part.free_symbols, key=str)
-        if not gens:
-            out *= sympy.sqrt(part) ** power
-            continue
-        poly = sympy.Poly(part, *gens)
-        (mono, prim) = poly.terms_gcd()
-        for g, e in zip(gens, mono):
-            out *= g ** sympy.Rational(e * power, 2)
-        prim_expr = prim.as_expr()
-        const = prim_expr.subs(H_STEP, 0)
-        if const == 0:
-            const = sympy.Integer(1)
-        out *= sympy.sqrt(const) ** power
-        inside *= sympy.expand(prim_expr / const) ** power
-    return out * sympy.sqrt(inside)
-
-
 def _tidy(expr, atoms, W, det):
     """Collect over the trig atoms and ``t``; each coefficient as ``a + b W`` (``W**2 = det``), factored."""
     parts = sympy.collect(sympy.expand(expr), atoms, evaluate=False)
@@ -149,41 +123,9 @@ def _closed_form(system, rhs, t):
     coords = system.coordinates
     x0 = tuple(sympy.Symbol(f"{c.name}_0") for c in coords)
     rhs = [sympy.expand(r) for r in rhs]
-    polys = []
-    for r in rhs:
-        try:
-            polys.append(sympy.Poly(r, *coords))
-        except sympy.PolynomialError:
-            polys = None
-            break
-    fail = NoExactResultError(
-        f"no closed-form solution for {system.name}: the equations {tuple(rhs)} do not have a linear "
-        "two-coordinate core y' = A y (trace 0, det > 0) with the other coordinates driven by a quadratic in y"
-    )
-    if polys is None:
-        raise fail
-    linear = [i for i, p in enumerate(polys)
-              if p.is_zero or (p.total_degree() == 1 and all(sum(m) == 1 for m in p.monoms()))]
-    core = [i for i in linear if all(polys[i].degree(coords[j]) <= 0 for j in range(len(coords)) if j not in linear)]
-    # the core: linear equations that only involve each other
-    while True:
-        keep = [i for i in core if all(polys[i].degree(coords[j]) <= 0 for j in range(len(coords)) if j not in core)]
-        if keep == core:
-            break
-        core = keep
-    driven = [i for i in range(len(coords)) if i not in core]
-    if len(core) != 2 or any(any(polys[k].degree(coords[j]) > 0 for j in driven) or polys[k].total_degree() > 2
-                             for k in driven):
-        raise fail
-    i1, i2 = core
+    lc = linear_core(coords, rhs, system.name)
+    (i1, i2), driven, A, det, Omega = lc.core, lc.driven, lc.A, lc.det, lc.Omega
     y = (coords[i1], coords[i2])
-    A = sympy.Matrix([[sympy.expand(rhs[i]).coeff(yj) for yj in y] for i in core])
-    if sympy.simplify(A.trace()) != 0:
-        raise fail
-    det = sympy.factor(A.det())
-    Omega = _positive_sqrt(det)
-    if Omega.is_zero or det.is_negative:
-        raise fail
     # work with a placeholder W for Omega so that coefficients factor cleanly, substitute at the end
     W = sympy.Dummy("Omega", positive=True)
     C = sympy.Matrix([x0[i1], x0[i2]])
@@ -228,6 +170,7 @@ class ModifiedSolution:
     word: str
     system: object = field(repr=False)
     time: sympy.Symbol = TIME
+    step_frequency: object = OMEGA
 
     def numeric(self, params=None, h=0.1):
         """``f(t, x0) -> array (N, len(t))``, the solution lambdified once for float ``t`` arrays.
@@ -236,8 +179,10 @@ class ModifiedSolution:
         """
         values = parameter_values(self.system, params)
         h = float(h)
-        if self.kind != "o" and OMEGA in values and abs(values[OMEGA] * h) >= 2:
-            raise UnstableStepError(f"the modified solution needs |omega h| < 2, got omega h = {values[OMEGA] * h!r}")
+        if self.kind != "o":
+            x = complex(sympy.sympify(self.step_frequency).subs(values)) * h
+            if abs(x.imag) > 0 or abs(x.real) >= 2:
+                raise UnstableStepError(f"the modified solution {self.kind!r} needs |omega h| < 2, got omega h = {x.real!r}")
         args = (self.time, *self.initial_symbols, *values, H_STEP)
         fn = _lambdify(args, self.expressions)
         pvals = tuple(values.values())
@@ -297,8 +242,10 @@ def _solution(system, word, kind):
     eqs = modified_equations(system, word, kind)
     if kind == "s":
         base, x0, Omega = _closed_form(system, modified_equations(system, word, "c"), TIME)
-        Fx = F(OMEGA * H_STEP)
-        exprs = tuple(e.subs(TIME, Fx * TIME) for e in base)
-        return ModifiedSolution(exprs, x0, Fx * Omega, eqs, kind, word, system)
+        shadow = exact_shadow_hamiltonians(system, word)
+        exprs = tuple(e.subs(TIME, shadow.factor * TIME) for e in base)
+        return ModifiedSolution(exprs, x0, shadow.factor * Omega, eqs, kind, word, system,
+                                step_frequency=shadow.frequency)
     exprs, x0, Omega = _closed_form(system, eqs, TIME)
-    return ModifiedSolution(exprs, x0, Omega, eqs, kind, word, system)
+    omega = frequency(system) if kind == "c" else Omega
+    return ModifiedSolution(exprs, x0, Omega, eqs, kind, word, system, step_frequency=omega)
