@@ -1,0 +1,520 @@
+"""Code generation: the composed step as a straight-line program, printed once per backend.
+
+The numeric backends never call sympy per step.  Instead, once per
+``(system, word)``, the exact sub-flows (:func:`nambu_bch.integrators.exact_flow`)
+are turned into a :class:`StepProgram`:
+
+* every sub-flow ``phi^{k_j}_{c_j h}`` becomes an *update* ``x_i <- x_i + d_i``
+  for each coordinate it moves, with the increment ``d_i = phi_i(x) - x_i``
+  (``x_i (e^u - 1)`` is written ``x_i expm1(u)`` so small steps lose nothing);
+  all increments of one sub-flow are computed from the state before it;
+* every coordinate-free sub-expression of the increments (products of
+  parameters, exact coefficients and ``h``) is *hoisted* into a constant
+  ``k_j(h, params)``, evaluated once per run, so the loop body only multiplies
+  and adds state values and constants (e.g. ``s0 += k0*s1`` for Eq. hX1e).
+
+The program is then printed with sympy's code printers -- Python for numba and
+the pure-Python / numpy / mpmath fallbacks, C (``ccode``) for the reference loop
+of ``benchmarks/bench_iterate.py``.  Every printer emits the same operations in
+the same order, so the backends agree bit for bit on polynomial flows (on
+``exp`` flows up to the last bits of the libraries' ``expm1``).
+
+Operator order: the updates run in word order, left to right, exactly as the
+sub-flows act on a state (:mod:`nambu_bch.integrators.composition`).
+
+Compensated (Kahan) summation -- Higham, *Accuracy and Stability of Numerical
+Algorithms*, Sect. 4.3; Hairer, Lubich, Wanner, *Geometric Numerical
+Integration*, Sect. VIII.5 -- replaces ``s += d`` by::
+
+    y = d - c;  t = s + y;  c = (t - s) - y;  s = t
+
+with one compensation ``c`` per coordinate carried across all steps.
+
+References
+----------
+Horikoshi, Sect. 5.5 (numerical results) and Eqs. (hX1e)-(hX3e), (12321).
+"""
+
+from __future__ import annotations
+
+import hashlib
+from dataclasses import dataclass
+from functools import lru_cache
+
+import sympy
+from sympy.codegen.cfunctions import expm1
+from sympy.printing.c import C99CodePrinter
+from sympy.printing.pycode import PythonCodePrinter
+
+from ..errors import InvalidSystemError
+from ..integrators.composition import composition as make_composition
+from ..integrators.flows import TIME, exact_flow
+
+#: The step symbol of the constants (same name as in the rest of the package).
+STEP = sympy.Symbol("h")
+
+#: Bump when the generated source changes meaning (part of the cache key).
+TEMPLATE_VERSION = "1"
+
+_FUNCTIONS = ("exp", "expm1", "log", "sin", "cos", "tan", "sinh", "cosh", "tanh", "sqrt", "atan", "asin", "acos")
+
+
+@dataclass(frozen=True)
+class Update:
+    """One sub-flow ``exp(c h X_k)`` as increments ``((i, d_i), ...)`` in the state symbols and constants."""
+
+    piece: int
+    coefficient: sympy.Expr
+    increments: tuple
+
+
+@dataclass(frozen=True, eq=False)
+class StepProgram:
+    """The composed step ``Phi_h`` as hoisted constants plus an ordered list of updates.
+
+    Attributes
+    ----------
+    system_name, word : str
+    N : int
+    coordinates, parameters : tuple of Symbols of the system
+    state : tuple of Symbols ``s0 .. s{N-1}`` used in the increments
+    constants : tuple of ``(k_j, expression in the parameters and h)``
+    updates : tuple of :class:`Update` in the order they act on the state
+    """
+
+    system_name: str
+    word: str
+    N: int
+    coordinates: tuple
+    parameters: tuple
+    state: tuple
+    constants: tuple
+    updates: tuple
+
+    def constant_function(self, modules="math"):
+        """``f(h, *params) -> [k_0, k_1, ...]`` (lambdified once; ``modules="mpmath"`` for mpf)."""
+        exprs = [e for _, e in self.constants] or [sympy.Integer(0)]
+        return sympy.lambdify((STEP, *self.parameters), exprs, modules=modules)
+
+    @property
+    def n_operations(self) -> int:
+        """Floating-point operations per step (adds, multiplies, calls), a rough cost measure."""
+        count = 0
+        for u in self.updates:
+            for _, d in u.increments:
+                count += 1 + sympy.count_ops(d)
+        return count
+
+    def __repr__(self):
+        return (f"StepProgram({self.system_name!r}, {self.word!r}: {len(self.updates)} sub-flows, "
+                f"{len(self.constants)} constants, ~{self.n_operations} flops/step)")
+
+
+def step_program(system, word) -> StepProgram:
+    """The :class:`StepProgram` of ``word`` on ``system`` (memoised per system and word).
+
+    Examples
+    --------
+    >>> from nambu_bch import model
+    >>> prog = step_program(model("ho3"), "12321")
+    >>> [(u.piece, u.increments) for u in prog.updates][:3]
+    [(1, ((0, k0*s1),)), (2, ((1, k1*s0),)), (3, ((2, k2*s0*s1),))]
+    >>> prog.constants[:3]
+    ((k0, h/(2*m)), (k1, -h*m*omega**2/2), (k2, 2*h/m))
+    """
+    comp = make_composition(word, len(system.splitting)).check(system.splitting)
+    return _step_program(system, comp)
+
+
+@lru_cache(maxsize=128)
+def _step_program(system, comp) -> StepProgram:
+    coords = system.coordinates
+    state = tuple(sympy.Symbol(f"s{i}") for i in range(len(coords)))
+    to_state = dict(zip(coords, state))
+    hoister = _Hoister(state)
+    updates = []
+    for k, c in comp.factors():
+        flow = exact_flow(system.splitting[k], coords)
+        incs = []
+        for i, (x, e) in enumerate(zip(coords, flow.expressions)):
+            d = sympy.sympify(e) - x
+            if d == 0:
+                continue
+            d = _with_expm1(sympy.factor_terms(d.subs(TIME, c * STEP)))
+            stray = d.free_symbols - set(coords) - set(system.parameters) - {STEP}
+            if stray:
+                raise InvalidSystemError(f"the flow of piece {k} of {system.name} uses unknown symbols {sorted(map(str, stray))}")
+            incs.append((i, hoister.polynomial(d.xreplace(to_state))))
+        if incs:
+            updates.append(Update(k, c, tuple(incs)))
+    return StepProgram(system.name, str(comp), len(coords), coords, tuple(system.parameters), state,
+                       tuple(hoister.constants), tuple(updates))
+
+
+def _with_expm1(expr):
+    """Rewrite ``exp(u) - 1`` (inside any sum) as ``expm1(u)``."""
+    def is_target(e):
+        return e.is_Add and any(isinstance(a, sympy.exp) for a in e.args) and -1 in e.args
+
+    def rewrite(e):
+        exps = [a for a in e.args if isinstance(a, sympy.exp)]
+        rest = [a for a in e.args if a is not exps[0] and a != -1]
+        return sympy.Add(expm1(exps[0].args[0]), *rest, evaluate=False) if rest else expm1(exps[0].args[0])
+
+    return expr.replace(is_target, rewrite)
+
+
+class _Hoister:
+    """Replace maximal coordinate-free sub-expressions by constants ``k0, k1, ...`` (deduplicated)."""
+
+    def __init__(self, state):
+        self.state = set(state)
+        self.constants = []
+        self._index = {}
+
+    def constant(self, expr):
+        expr = sympy.nsimplify(expr) if expr.has(sympy.Float) else expr
+        if expr not in self._index:
+            sym = sympy.Symbol(f"k{len(self.constants)}")
+            self._index[expr] = sym
+            self.constants.append((sym, expr))
+        return self._index[expr]
+
+    def polynomial(self, expr):
+        """A polynomial increment as ``sum_j k_j * monomial_j``; anything else via :meth:`__call__`."""
+        state = sorted(self.state, key=str)
+        if not expr.is_polynomial(*state):
+            return self(expr)
+        terms = []
+        for powers, coeff in sympy.Poly(sympy.expand(expr), *state).terms():
+            mono = sympy.Mul(*[s**e for s, e in zip(state, powers)])
+            if mono == 1:
+                terms.append(self.constant(coeff))
+            elif coeff in (1, -1):
+                terms.append(coeff * mono)
+            else:
+                terms.append(self.constant(coeff) * mono)
+        return sympy.Add(*terms)
+
+    def __call__(self, expr):
+        if not (expr.free_symbols & self.state):
+            return self.constant(expr)
+        if expr.is_Symbol:
+            return expr
+        if expr.is_Add or expr.is_Mul:
+            free = [a for a in expr.args if not (a.free_symbols & self.state)]
+            dep = [self(a) for a in expr.args if a.free_symbols & self.state]
+            if free:
+                dep.insert(0, self.constant(expr.func(*free)))
+            return expr.func(*dep)
+        if expr.is_Pow:
+            base, ex = expr.args
+            if ex.free_symbols & self.state:
+                return sympy.Pow(self(base), self(ex))
+            return sympy.Pow(self(base), ex if ex.is_Integer else self.constant(ex))
+        if isinstance(expr, sympy.Function):
+            return expr.func(*[self(a) for a in expr.args])
+        raise InvalidSystemError(f"cannot generate numeric code for the sub-expression {expr}")
+
+
+# -- printers -------------------------------------------------------------------------------------------
+
+
+class _PowMixin:
+    """Small integer powers as explicit products, so every backend rounds them identically."""
+
+    def _print_Pow(self, expr, *args, **kwargs):
+        base, ex = expr.args
+        if ex.is_Integer and 2 <= int(ex) <= 8:
+            b = self.parenthesize(base, 100)
+            return "(" + "*".join([b] * int(ex)) + ")"
+        if ex.is_Integer and -8 <= int(ex) <= -1:
+            b = self.parenthesize(base, 100)
+            return "(1.0/(" + "*".join([b] * -int(ex)) + "))"
+        return super()._print_Pow(expr, *args, **kwargs)
+
+
+class _KernelPrinter(_PowMixin, PythonCodePrinter):
+    """Python printer whose functions are module globals ``<prefix>exp`` etc. (``_exp``, ``_np_exp``, ``_mp_exp``)."""
+
+    def __init__(self, prefix="_"):
+        funcs = {f: f"{prefix}{f}" for f in _FUNCTIONS}
+        super().__init__({"user_functions": funcs, "fully_qualified_modules": False})
+
+
+class _CPrinter(_PowMixin, C99CodePrinter):
+    pass
+
+
+def print_python(expr, prefix="_") -> str:
+    """``expr`` as Python source with functions named ``prefix + name`` (e.g. ``_expm1``)."""
+    return _KernelPrinter(prefix).doprint(expr)
+
+
+def print_c(expr) -> str:
+    """``expr`` as C99 source (sympy's ``ccode`` with small powers expanded)."""
+    return _CPrinter().doprint(expr)
+
+
+# -- loop bodies ----------------------------------------------------------------------------------------
+
+
+def body_lines(program: StepProgram, printer, kahan=False, c_syntax=False):
+    """Statements of one step, ``s_i`` / ``k_j`` / ``d_j`` / ``c_i`` named as in the generated kernels."""
+    end = ";" if c_syntax else ""
+    decl = "double " if c_syntax else ""
+    lines = []
+    for u in program.updates:
+        names = []
+        for j, (i, d) in enumerate(u.increments):
+            lines.append(f"{decl}d{j} = {printer(d)}{end}")
+            names.append((i, f"d{j}"))
+        for i, d in names:
+            if kahan:
+                lines += [f"{decl}y{i} = {d} - c{i}{end}", f"{decl}t{i} = s{i} + y{i}{end}",
+                          f"c{i} = (t{i} - s{i}) - y{i}{end}", f"s{i} = t{i}{end}"]
+            else:
+                lines.append(f"s{i} += {d}{end}")
+    if c_syntax:  # C declares each temporary once per scope: one brace block per update
+        return _c_scoped(program, lines, kahan)
+    return lines
+
+
+def _c_scoped(program, lines, kahan):
+    out = []
+    it = iter(lines)
+    for u in program.updates:
+        n = len(u.increments)
+        count = n + n * (4 if kahan else 1)
+        block = [next(it) for _ in range(count)]
+        out.append("{ " + " ".join(block) + " }")
+    return out
+
+
+# -- module source --------------------------------------------------------------------------------------
+
+_HEADER = '''"""Generated by nambu_bch.numeric.codegen from the exact sub-flows of {name!r}, word {word!r}.
+
+Do not edit: the file name is a hash of this source; delete the directory to clear the cache.
+{program}
+"""
+import math
+import numpy as np
+
+_exp, _expm1, _log, _sqrt = math.exp, math.expm1, math.log, math.sqrt
+_sin, _cos, _tan, _sinh, _cosh, _tanh = math.sin, math.cos, math.tan, math.sinh, math.cosh, math.tanh
+_atan, _asin, _acos, _isfinite = math.atan, math.asin, math.acos, math.isfinite
+_np_exp, _np_expm1, _np_log, _np_sqrt = np.exp, np.expm1, np.log, np.sqrt
+_np_sin, _np_cos, _np_tan, _np_sinh, _np_cosh, _np_tanh = np.sin, np.cos, np.tan, np.sinh, np.cosh, np.tanh
+_np_atan, _np_asin, _np_acos = np.arctan, np.arcsin, np.arccos
+'''
+
+
+def _indent(lines, n):
+    pad = " " * n
+    return "\n".join(pad + line for line in lines)
+
+
+def python_source(program: StepProgram) -> str:
+    """The generated kernel module (numba-compatible Python; see :mod:`nambu_bch.numeric.kernels`).
+
+    Functions (``x``/``X`` are updated in place to the final state, ``out[0]`` must hold
+    the initial state; they return the number of steps done, fewer than ``steps``
+    only when a sample was not finite):
+
+    * ``run(x, K, steps, every, out)`` and ``run_kahan(x, c, K, steps, every, out)`` --
+      one trajectory, ``x`` of shape (N,), ``out`` of shape (n_samples, N);
+    * ``run_batch(X, K, steps, every, out, chunk)`` and ``run_batch_kahan(X, C, ...)`` --
+      ``X`` of shape (N, batch), ``out`` of shape (n_samples, N, batch); the batch is
+      processed in chunks that stay in cache, the inner loop runs over the chunk;
+    * ``run_numpy(X, K, steps, every, out, chunk)`` and ``run_numpy_kahan(X, C, ...)`` --
+      the vectorised numpy fallback for batches (same operations, same order).
+    """
+    N = program.N
+    s = [f"s{i}" for i in range(N)]
+    consts = [f"k{j} = K[{j}]" for j in range(len(program.constants))] or ["pass"]
+    scalar = lambda e: print_python(e, "_")  # noqa: E731
+    vector = lambda e: print_python(e, "_np_")  # noqa: E731
+    load = "; ".join(f"{v} = x[{i}]" for i, v in enumerate(s))
+    store = "; ".join(f"x[{i}] = {v}" for i, v in enumerate(s))
+    finite = " and ".join(f"_isfinite({v})" for v in s)
+    sample = "; ".join(f"out[j, {i}] = {v}" for i, v in enumerate(s))
+    src = [_HEADER.format(name=program.system_name, word=program.word, program=_describe(program))]
+
+    for kahan in (False, True):
+        body = body_lines(program, scalar, kahan)
+        name = "run_kahan" if kahan else "run"
+        args = "x, c, K, steps, every, out" if kahan else "x, K, steps, every, out"
+        comp_load = "; ".join(f"c{i} = c[{i}]" for i in range(N))
+        comp_store = "; ".join(f"c[{i}] = c{i}" for i in range(N))
+        src.append(f"""
+def {name}({args}):
+{_indent(consts, 4)}
+    {load}
+    {comp_load if kahan else ''}
+    n = 0
+    j = 1
+    while n < steps:
+        m = every if steps - n >= every else steps - n
+        for _ in range(m):
+{_indent(body, 12)}
+        n += m
+        {sample}
+        j += 1
+        if not ({finite}):
+            break
+    {store}
+    {comp_store if kahan else ''}
+    return n
+""")
+        # batch: chunks of states kept in small contiguous arrays, inner loop over the chunk
+        name = "run_batch_kahan" if kahan else "run_batch"
+        args = "X, C, K, steps, every, out, chunk" if kahan else "X, K, steps, every, out, chunk"
+        alloc = [f"S{i} = np.empty(chunk)" for i in range(N)] + ([f"Q{i} = np.empty(chunk)" for i in range(N)] if kahan else [])
+        gather = [f"S{i}[b] = X[{i}, b0 + b]" for i in range(N)] + ([f"Q{i}[b] = C[{i}, b0 + b]" for i in range(N)] if kahan else [])
+        scatter = [f"X[{i}, b0 + b] = S{i}[b]" for i in range(N)] + ([f"C[{i}, b0 + b] = Q{i}[b]" for i in range(N)] if kahan else [])
+        inner_load = [f"s{i} = S{i}[b]" for i in range(N)] + ([f"c{i} = Q{i}[b]" for i in range(N)] if kahan else [])
+        inner_store = [f"S{i}[b] = s{i}" for i in range(N)] + ([f"Q{i}[b] = c{i}" for i in range(N)] if kahan else [])
+        src.append(f"""
+def {name}({args}):
+{_indent(consts, 4)}
+    B = X.shape[1]
+{_indent(alloc, 4)}
+    for b0 in range(0, B, chunk):
+        nb = min(chunk, B - b0)
+        for b in range(nb):
+{_indent(gather, 12)}
+        n = 0
+        j = 1
+        while n < steps:
+            m = every if steps - n >= every else steps - n
+            for _ in range(m):
+                for b in range(nb):
+{_indent(inner_load, 20)}
+{_indent(body, 20)}
+{_indent(inner_store, 20)}
+            n += m
+            for b in range(nb):
+{_indent([f"out[j, {i}, b0 + b] = S{i}[b]" for i in range(N)], 16)}
+            j += 1
+        for b in range(nb):
+{_indent(scatter, 12)}
+    return steps
+""")
+        # numpy fallback: the same statements on chunk arrays
+        name = "run_numpy_kahan" if kahan else "run_numpy"
+        vbody = body_lines(program, vector, kahan)
+        vload = [f"s{i} = X[{i}, b0:b1].copy()" for i in range(N)] + ([f"c{i} = C[{i}, b0:b1].copy()" for i in range(N)] if kahan else [])
+        vstore = [f"X[{i}, b0:b1] = s{i}" for i in range(N)] + ([f"C[{i}, b0:b1] = c{i}" for i in range(N)] if kahan else [])
+        src.append(f"""
+def {name}({args}):
+{_indent(consts, 4)}
+    B = X.shape[1]
+    for b0 in range(0, B, chunk):
+        b1 = min(b0 + chunk, B)
+{_indent(vload, 8)}
+        n = 0
+        j = 1
+        while n < steps:
+            m = every if steps - n >= every else steps - n
+            for _ in range(m):
+{_indent(vbody, 16)}
+            n += m
+{_indent([f"out[j, {i}, b0:b1] = s{i}" for i in range(N)], 12)}
+            j += 1
+{_indent(vstore, 8)}
+    return steps
+""")
+    return "\n".join(src)
+
+
+def mpmath_source(program: StepProgram) -> str:
+    """``run(x, K, steps, every, out)`` for mpmath numbers (functions ``_mp_exp`` etc. from the namespace)."""
+    N = program.N
+    s = [f"s{i}" for i in range(N)]
+    consts = [f"k{j} = K[{j}]" for j in range(len(program.constants))] or ["pass"]
+    body = body_lines(program, lambda e: print_python(e, "_mp_"))
+    return f"""
+def run(x, K, steps, every, out, progress=None):
+{_indent(consts, 4)}
+    {"; ".join(f"{v} = x[{i}]" for i, v in enumerate(s))}
+    n = 0
+    j = 1
+    while n < steps:
+        m = every if steps - n >= every else steps - n
+        for _ in range(m):
+{_indent(body, 12)}
+        n += m
+        {"; ".join(f"out[j, {i}] = {v}" for i, v in enumerate(s))}
+        j += 1
+        if progress is not None:
+            progress(n)
+        if not ({" and ".join(f"_mp_isfinite({v})" for v in s)}):
+            break
+    {"; ".join(f"x[{i}] = {v}" for i, v in enumerate(s))}
+    return n
+"""
+
+
+def c_source(program: StepProgram) -> str:
+    """A C99 translation unit with the same loop: ``run`` and ``run_batch`` (for the benchmark's reference).
+
+    ``long run(double *x, const double *K, long steps)`` advances one state in place;
+    ``void run_batch(double *X, const double *K, long steps, long B, long chunk)``
+    advances ``X`` of shape (N, B) (row-major) chunk by chunk, inner loop over the chunk,
+    exactly like the numba batch kernel (without sampling).
+    """
+    N = program.N
+    body = body_lines(program, print_c, c_syntax=True)
+    consts = " ".join(f"const double k{j} = K[{j}];" for j in range(len(program.constants)))
+    decl = " ".join(f"double s{i} = x[{i}];" for i in range(N))
+    store = " ".join(f"x[{i}] = s{i};" for i in range(N))
+    arrays = " ".join(f"double S{i}[chunk];" for i in range(N))
+    gather = " ".join(f"S{i}[b] = X[{i} * B + b0 + b];" for i in range(N))
+    scatter = " ".join(f"X[{i} * B + b0 + b] = S{i}[b];" for i in range(N))
+    inner_load = " ".join(f"double s{i} = S{i}[b];" for i in range(N))
+    inner_store = " ".join(f"S{i}[b] = s{i};" for i in range(N))
+    return f"""/* Generated by nambu_bch.numeric.codegen: {program.system_name} {program.word} */
+#include <math.h>
+
+long run(double *restrict x, const double *restrict K, long steps) {{
+    {consts}
+    {decl}
+    for (long n = 0; n < steps; ++n) {{
+        {chr(10).join('        ' + b for b in body).strip()}
+    }}
+    {store}
+    return steps;
+}}
+
+void run_batch(double *restrict X, const double *restrict K, long steps, long B, long chunk) {{
+    {consts}
+    {arrays}
+    for (long b0 = 0; b0 < B; b0 += chunk) {{
+        long nb = chunk < B - b0 ? chunk : B - b0;
+        for (long b = 0; b < nb; ++b) {{ {gather} }}
+        for (long n = 0; n < steps; ++n) {{
+            for (long b = 0; b < nb; ++b) {{
+                {inner_load}
+                {chr(10).join('                ' + b for b in body).strip()}
+                {inner_store}
+            }}
+        }}
+        for (long b = 0; b < nb; ++b) {{ {scatter} }}
+    }}
+}}
+"""
+
+
+def _describe(program):
+    lines = [f"state {', '.join(f's{i} = {c}' for i, c in enumerate(program.coordinates))}"]
+    lines += [f"{k} = {e}" for k, e in program.constants]
+    for u in program.updates:
+        lines.append(f"piece {u.piece} (coefficient {u.coefficient}): " +
+                     ", ".join(f"s{i} += {d}" for i, d in u.increments))
+    return "\n".join(lines)
+
+
+def source_hash(source: str) -> str:
+    """A short stable key of a generated source (the kernel cache file name)."""
+    return hashlib.sha256((TEMPLATE_VERSION + source).encode()).hexdigest()[:20]

@@ -1,0 +1,279 @@
+"""Guards of a numeric run: accepted inputs, the stability interval, the float64 range.
+
+Checks made before any step is taken, each raising one
+:class:`~nambu_bch.errors.NambuBCHError` subclass with a one-line message:
+
+* :func:`check_inputs` -- ``h``, ``steps``, ``every``, ``x0`` and the parameters
+  are finite real numbers of the accepted shapes (``NumericalRangeError`` for
+  NaN/inf, ``InvalidRunError`` for the rest);
+* :func:`check_stability` -- the *linear part* of the step: the largest set of
+  coordinates ``S`` whose increments are affine in ``x_S`` alone (``(x1, x2)``
+  of ``ho`` and ``ho3``, all three of ``ho3-composite``).  Its matrix ``M(h)`` is
+  formed numerically; the step is unstable (``UnstableStepError``) if an
+  eigenvalue has ``|lambda| > 1`` or an eigenvalue on the unit circle is
+  defective (a Jordan block: linear growth, the boundary ``omega h = 2`` where
+  ``tr M = -2``).  For the oscillators this is exactly ``|omega h| < 2``
+  (position/velocity Verlet: ``tr M = 2 - omega^2 h^2``, Hairer-Lubich-Wanner
+  Sect. I.5);
+* :func:`check_range` -- one step in extended precision (``numpy.longdouble``,
+  exponent range 10^4932 on x86; mpmath elsewhere) against float64: if they
+  differ by more than ``1e-6`` relative to the state's scale, float64 over- or
+  underflows for this initial state (``NumericalRangeError``).
+
+:func:`check_result` turns non-finite samples after a run into a
+``NumericalRangeError`` naming the step.
+
+References
+----------
+Horikoshi, Sect. 5.5; Hairer, Lubich, Wanner, *Geometric Numerical Integration*, Sect. I.5.
+"""
+
+from __future__ import annotations
+
+import math
+import numbers
+
+import numpy as np
+
+from ..errors import InvalidRunError, NumericalRangeError, UnstableStepError
+from ..integrators.step import parameter_values
+
+#: Smallest positive normal float64.
+TINY = np.finfo(np.float64).tiny
+#: Relative disagreement with the extended-precision step that counts as over/underflow.
+RANGE_RTOL = 1e-6
+
+
+def _real(value, what):
+    if isinstance(value, bool) or not isinstance(value, (numbers.Real, np.floating, np.integer, str)):
+        if hasattr(value, "_mpf_"):  # mpmath.mpf
+            return value
+        raise InvalidRunError(f"{what} must be a real number, got {value!r}")
+    if isinstance(value, str):
+        try:
+            float(value)
+        except ValueError:
+            raise InvalidRunError(f"{what} must be a real number, got {value!r}") from None
+        value_f = float(value)
+    else:
+        value_f = float(value)
+    if not math.isfinite(value_f):
+        raise NumericalRangeError(f"{what} = {value!r} is not finite; give a finite real number")
+    return value
+
+
+def check_count(value, what, minimum):
+    """``value`` as an int ``>= minimum`` (integral floats such as ``1e5`` accepted)."""
+    if isinstance(value, bool):
+        raise InvalidRunError(f"{what} must be an integer >= {minimum}, got {value!r}")
+    if isinstance(value, (float, np.floating)):
+        if not math.isfinite(value) or value != int(value):
+            raise InvalidRunError(f"{what} must be an integer >= {minimum}, got {value!r}")
+        value = int(value)
+    if not isinstance(value, (int, np.integer)) or value < minimum:
+        raise InvalidRunError(f"{what} must be an integer >= {minimum}, got {value!r}")
+    return int(value)
+
+
+def check_inputs(system, h, steps, every, x0, params=None, exact=False):
+    """Validate a run's arguments; returns ``(h, steps, every, x0 array, params dict)``.
+
+    ``x0`` must have shape ``(N,)`` or ``(N, batch)``; with ``exact=True`` (the mpmath
+    path) strings and mpf values are kept as they are (object array).
+    """
+    h = _real(h, "step h")
+    steps = check_count(steps, "steps", 0)
+    every = check_count(every, "every", 1)
+    if params is not None and not isinstance(params, dict):
+        raise InvalidRunError(f"params must be a dict such as {{'omega': 1.0}}, got {params!r}")
+    for k, v in (params or {}).items():
+        _real(v, f"parameter {k}")
+    values = parameter_values(system, params)  # unknown names -> InvalidSystemError
+    try:
+        arr = np.array(x0, dtype=object if exact else np.float64)
+    except (TypeError, ValueError):
+        raise InvalidRunError(f"x0 must be an array of {system.N} real numbers (or shape ({system.N}, batch)), got {x0!r}") from None
+    if arr.ndim not in (1, 2) or arr.shape[0] != system.N or (arr.ndim == 2 and arr.shape[1] == 0):
+        raise InvalidRunError(
+            f"x0 has shape {arr.shape}, but {system.name} has {system.N} coordinates "
+            f"{tuple(str(c) for c in system.coordinates)}: give shape ({system.N},) or ({system.N}, batch)"
+        )
+    floats = np.array([float(v) for v in arr.ravel()]).reshape(arr.shape) if exact else arr
+    if not np.all(np.isfinite(floats)):
+        bad = floats[~np.isfinite(floats)].ravel()[0]
+        raise NumericalRangeError(f"x0 contains the non-finite value {bad}; initial states must be finite")
+    if not exact:
+        sub = (floats != 0) & (np.abs(floats) < TINY)
+        if np.any(sub):
+            raise NumericalRangeError(
+                f"x0 contains {floats[sub].ravel()[0]:.3g}, below the smallest normal float64 ({TINY:.3g}): it underflows; "
+                "rescale the initial state or use dps=... (mpmath)"
+            )
+    return h, steps, every, arr, values
+
+
+# -- stability --------------------------------------------------------------------------------------------
+
+
+def linear_part(program):
+    """``(S, maps)``: the coordinates ``S`` whose increments are affine in ``x_S`` alone, and per update
+    the list ``(i, {j: constant or 1/-1 coefficient}, additive constant)`` restricted to ``S``."""
+    import sympy
+
+    state = program.state
+    S = set(range(program.N))
+    changed = True
+    while changed:
+        changed = False
+        for u in program.updates:
+            for i, d in u.increments:
+                if i not in S:
+                    continue
+                used = {state.index(s) for s in d.free_symbols & set(state)}
+                ok = used <= S and d.is_polynomial(*state) and sympy.Poly(d, *state).total_degree() <= 1
+                if not ok:
+                    S.discard(i)
+                    changed = True
+    return tuple(sorted(S))
+
+
+def step_matrix(kernel, K, S):
+    """The matrix of the (affine) step restricted to the coordinates ``S`` (the constant part dropped)."""
+    import sympy
+
+    program = kernel.program
+    ks = [k for k, _ in program.constants]
+    subs = dict(zip(ks, [float(v) for v in K]))
+    index = {s: n for n, s in enumerate(S)}
+    M = np.eye(len(S))
+    for u in program.updates:
+        U = np.eye(len(S))
+        touched = False
+        for i, d in u.increments:
+            if i not in index:
+                continue
+            touched = True
+            for j in S:
+                coeff = float(sympy.diff(d, program.state[j]).xreplace(subs))
+                U[index[i], index[j]] += coeff
+        if touched:
+            M = U @ M
+    return M
+
+
+def check_stability(kernel, h, K, params=None):
+    """Raise :class:`UnstableStepError` if the linear part of the step is not power-bounded.
+
+    Examples
+    --------
+    >>> from nambu_bch import model
+    >>> from nambu_bch.numeric.kernels import kernel
+    >>> k = kernel(model("ho3"), "32123")
+    >>> check_stability(k, 1.9, k.constants(1.9))
+    >>> check_stability(k, 2.0, k.constants(2.0))  # doctest: +ELLIPSIS
+    Traceback (most recent call last):
+    ...
+    nambu_bch.errors.UnstableStepError: h = 2.0 is outside the stability interval of 32123 on ho3 (omega*h = 2, must be < 2): ...
+    """
+    S = linear_part(kernel.program)
+    if not S:
+        return
+    M = step_matrix(kernel, K, S)
+    if not np.all(np.isfinite(M)):
+        raise NumericalRangeError(f"h = {h!r}: the step's coefficients overflow float64")
+    lam = np.linalg.eigvals(M)
+    radius = float(np.max(np.abs(lam)))
+    reason = None
+    if radius > 1 + 1e-9:
+        reason = f"the linear part on {_names(kernel, S)} has spectral radius {radius:.6g} > 1 (exponential growth)"
+    else:
+        scale = max(1.0, float(np.linalg.norm(M)))
+        for lam0 in lam:
+            if abs(abs(lam0) - 1) > 1e-6:
+                continue
+            cluster = np.abs(lam - lam0) < 1e-6
+            if cluster.sum() < 2:
+                continue
+            centre = lam[cluster].mean()
+            sv = np.linalg.svd(M - centre * np.eye(len(S)), compute_uv=False)
+            geometric = int(np.sum(sv < 1e-6 * scale))
+            if geometric < cluster.sum():
+                reason = (f"the linear part on {_names(kernel, S)} has a defective eigenvalue {complex(centre).real:.6g} "
+                          "on the unit circle (the stability boundary: linear growth)")
+                break
+    if reason:
+        values = parameter_values(kernel.system, params)
+        omega = {p.name: v for p, v in values.items()}.get("omega")
+        hint = f" (omega*h = {omega * float(h):.6g}, must be < 2)" if omega is not None else ""
+        raise UnstableStepError(f"h = {h!r} is outside the stability interval of {kernel.program.word} on "
+                                f"{kernel.program.system_name}{hint}: {reason}; take a smaller step")
+
+
+def _names(kernel, S):
+    return "(" + ", ".join(str(kernel.program.coordinates[i]) for i in S) + ")"
+
+
+# -- float64 range -----------------------------------------------------------------------------------------
+
+
+def check_range(kernel, x0, K, max_mpmath=64):
+    """Raise :class:`NumericalRangeError` if one float64 step over- or underflows from ``x0`` (shape (N,) or (N, B))."""
+    X = np.asarray(x0, dtype=np.float64)
+    X = X.reshape(X.shape[0], -1)
+    N, B = X.shape
+    out = np.zeros((2, N, B))
+    f64 = X.copy()
+    with np.errstate(all="ignore"):
+        kernel.run_batch(f64, K, 1, 1, out, backend="numpy")
+        if np.finfo(np.longdouble).maxexp > 1024:
+            ref = X.astype(np.longdouble)
+            kernel.run_batch(ref, K, 1, 1, np.zeros((2, N, B), dtype=np.longdouble), backend="numpy")
+        else:  # no extended exponent range: mpmath on (a sample of) the states
+            import mpmath
+
+            cols = np.unique(np.linspace(0, B - 1, min(B, max_mpmath)).astype(int))
+            X, f64 = X[:, cols], f64[:, cols]
+            ref = np.empty(X.shape, dtype=object)
+            src = kernel.module
+            for c in range(X.shape[1]):
+                xs = [mpmath.mpf(float(v)) for v in X[:, c]]
+                src.run(xs, [mpmath.mpf(float(k)) for k in K], 1, 1, np.zeros((2, N), dtype=object))
+                ref[:, c] = xs
+        scale = np.maximum(np.abs(X).astype(ref.dtype), np.abs(ref))
+        diff = np.abs(f64.astype(ref.dtype) - ref)
+        bad = ~(diff <= RANGE_RTOL * scale)
+    if np.any(bad):
+        i, b = [int(v[0]) for v in np.nonzero(bad)]
+        value = ref[i, b]
+        big = abs(float(value)) > 1 or not np.isfinite(f64[i, b])
+        kind = "overflows" if big else "underflows"
+        limit = f"the largest float64 is {np.finfo(np.float64).max:.3g}" if big else f"the smallest normal float64 is {TINY:.3g}"
+        where = f"from x0 = {X[:, b].tolist()}" if B > 1 else f"from x0 = {X[:, 0].tolist()}"
+        raise NumericalRangeError(
+            f"one step of {kernel.program.word} on {kernel.program.system_name} {where} {kind} float64 in "
+            f"{kernel.program.coordinates[i]} (about {_fmt(value)}; {limit}); rescale the initial state or use dps=... (mpmath)"
+        )
+
+
+def _fmt(value):
+    try:
+        import mpmath
+
+        return mpmath.nstr(mpmath.mpf(str(value)) if not hasattr(value, "_mpf_") else value, 3)
+    except Exception:  # pragma: no cover - formatting only
+        return str(value)
+
+
+def check_result(samples, steps_of_samples, what="the state"):
+    """Raise :class:`NumericalRangeError` at the first non-finite sample (overflow during the run)."""
+    finite = np.isfinite(samples)
+    if finite.all():
+        return
+    axes = tuple(range(1, samples.ndim))
+    first = int(np.argmin(finite.all(axis=axes)))
+    lo = int(steps_of_samples[first - 1]) if first > 0 else 0
+    hi = int(steps_of_samples[first])
+    raise NumericalRangeError(
+        f"{what} overflowed float64 (became inf/nan) between steps {lo} and {hi}; the initial state is too large "
+        "for float64 or the step is unstable for it; rescale, take a smaller h, or use dps=... (mpmath)"
+    )

@@ -1,0 +1,192 @@
+"""Iterating a splitting integrator: ``x_n = (Phi_h)^n x_0``, sampled every ``every`` steps.
+
+:func:`iterate` is the one driver of the numeric backend.  It validates the
+input (:mod:`~nambu_bch.numeric.guards`), fetches the compiled kernel of the
+``(system, word)`` (:mod:`~nambu_bch.numeric.kernels`, generated once from the
+exact sub-flows and cached on disk), and runs it for one trajectory or a batch
+of initial states, in float64, float64 with compensated summation, or mpmath
+(:mod:`~nambu_bch.numeric.precision`).
+
+Shape convention (stable): the state index comes first, as in
+:func:`nambu_bch.integrators.step_function` -- ``x0`` of shape ``(N,)`` gives
+samples of shape ``(n_samples, N)``, ``x0`` of shape ``(N, batch)`` gives
+``(n_samples, N, batch)``.  Sample ``j`` is the state after
+``sample_steps(steps, every)[j]`` steps: ``0, every, 2 every, ...`` and, if
+``every`` does not divide ``steps``, the final step ``steps`` as the last sample.
+So ``samples[0]`` is ``x0`` and ``samples[-1]`` the final state, always.
+
+References
+----------
+Horikoshi, Sect. 5.5: ``x^{32123}(t) = (Phi^{32123}_h)^n x(0)``, ``t = n h``.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..errors import InvalidRunError, InvalidSystemError, NumericalRangeError
+from ..systems import System, model
+from .guards import check_inputs, check_range, check_result, check_stability
+from .kernels import kernel, resolve_backend
+from .precision import check_dps, run_mpmath
+from .progress import Progress, progress_wanted
+
+#: Largest sample array accepted (bytes); beyond it, sample less often (larger ``every``).
+MAX_SAMPLE_BYTES = 16 * 2**30
+#: Trajectory-steps per kernel call when progress is reported (a few tenths of a second compiled).
+_SEGMENT_WORK = 20_000_000
+
+
+def as_system(system) -> System:
+    """A :class:`~nambu_bch.systems.System` from a System or a built-in model name."""
+    if isinstance(system, System):
+        return system
+    if isinstance(system, str):
+        return model(system)
+    raise InvalidSystemError(f"system must be a nambu_bch System or a built-in model name, got {system!r}")
+
+
+def n_samples(steps: int, every: int) -> int:
+    """Number of samples of a run: ``ceil(steps / every) + 1``.
+
+    >>> n_samples(10, 5), n_samples(10, 3), n_samples(0, 4)
+    (3, 5, 1)
+    """
+    return -(-int(steps) // int(every)) + 1
+
+
+def sample_steps(steps: int, every: int = 1) -> np.ndarray:
+    """The step number of every sample: ``0, every, 2 every, ...``, ending at ``steps``.
+
+    >>> sample_steps(10, 3).tolist()
+    [0, 3, 6, 9, 10]
+    """
+    grid = np.arange(0, int(steps) + 1, int(every), dtype=np.int64)
+    if grid[-1] != steps:
+        grid = np.append(grid, np.int64(steps))
+    return grid
+
+
+def sample_times(h, steps: int, every: int = 1) -> np.ndarray:
+    """Times ``t = n h`` of the samples (float64)."""
+    return float(h) * sample_steps(steps, every).astype(np.float64)
+
+
+def iterate(system, word, h, steps, x0, params=None, every=1, *, kahan=False, dps=None,
+            backend="auto", progress=None, chunk=None, check_stable=True):
+    """Iterate ``Phi_h`` of ``word`` on ``system`` ``steps`` times from ``x0``; the samples every ``every`` steps.
+
+    The step is generated once from the exact sub-flows (Eqs. hX1e-hX3e for ``ho3``)
+    and applied in word order (left to right, :mod:`nambu_bch.integrators.composition`),
+    compiled with numba; the numpy fallback runs the same generated operations.
+
+    Parameters
+    ----------
+    system : System or str -- e.g. ``"ho3"``
+    word : str or Composition -- e.g. ``"32123"``, ``"TVT"``, ``"forest-ruth"``
+    h : float -- the step (negative steps run backwards; str or mpf accepted with ``dps``)
+    steps : int >= 0
+    x0 : array of shape (N,) -- one trajectory -- or (N, batch) -- a batch of initial states
+    params : dict, optional -- e.g. ``{"m": 1, "omega": 1}``; missing parameters are 1
+    every : int >= 1 -- keep every ``every``-th state (long runs need not fill memory)
+    kahan : bool -- compensated summation of the increments (float64 only)
+    dps : int, optional -- decimal digits of an mpmath run (a reference; ~10^3x slower)
+    backend : ``"auto"`` | ``"numba"`` | ``"numpy"``
+    progress : bool or None -- a progress line on stderr; None: only on a terminal and for long runs
+    chunk : int, optional -- states per cache block of a batch (tuning only)
+    check_stable : bool -- refuse steps outside the stability interval (:func:`~nambu_bch.numeric.guards.check_stability`)
+
+    Returns
+    -------
+    numpy.ndarray
+        ``(n_samples, N)`` for one trajectory, ``(n_samples, N, batch)`` for a batch, with
+        ``n_samples = ceil(steps / every) + 1`` at the steps :func:`sample_steps` lists
+        (``samples[0] == x0``); float64, or ``object`` (``mpmath.mpf``) with ``dps``.
+
+    Raises
+    ------
+    InvalidRunError, InvalidSystemError, InvalidCompositionError -- bad arguments
+    NumericalRangeError -- non-finite input, or float64 overflow/underflow (before or during the run)
+    UnstableStepError -- ``h`` outside the stability interval (``|omega h| >= 2`` for the oscillators)
+
+    Examples
+    --------
+    >>> x = iterate("ho3", "32123", 0.1, 1000, [1.0, 1.0, 1.0], every=500)
+    >>> x.shape
+    (3, 3)
+    >>> H = x[:, 1]**2 / 2 + x[:, 2] / 2          # H of Eq. (H), m = omega = 1: not conserved ...
+    >>> Hc = H + 0.1**2 * x[:, 0]**2 / 8          # ... but H_c of Table (table) is, to round-off
+    >>> bool(abs(Hc - Hc[0]).max() < 1e-13), bool(abs(H - H[0]).max() > 1e-4)
+    (True, True)
+    >>> iterate("ho", "TVT", 0.1, 4, [[1.0, 0.0], [0.0, 1.0]]).shape     # a batch of two states
+    (5, 2, 2)
+    """
+    system = as_system(system)
+    kern = kernel(system, word)
+    if dps is not None:
+        dps = check_dps(dps)
+        if kahan:
+            raise InvalidRunError("kahan=True applies to float64 runs; an mpmath run (dps=...) needs no compensation")
+        h, steps, every, X, _ = check_inputs(system, h, steps, every, x0, params, exact=True)
+        if check_stable:
+            check_stability(kern, h, kern.constants(float(h), params), params)
+        batch = 1 if X.ndim == 1 else X.shape[1]
+        reporter = Progress(steps * batch, f"iterate {system.name} {kern.program.word} (mpmath, dps={dps})",
+                            enabled=_enabled(progress, steps * batch * 1000))
+        with reporter:
+            return run_mpmath(kern, X, h, steps, every, params, dps, reporter.update if reporter.enabled else None)
+
+    h, steps, every, X, _ = check_inputs(system, h, steps, every, x0, params)
+    be = resolve_backend(backend)
+    if chunk is not None:
+        from .guards import check_count
+
+        chunk = check_count(chunk, "chunk", 1)
+    with np.errstate(over="ignore", invalid="ignore"):
+        K = kern.constants(float(h), params)
+    if not np.all(np.isfinite(K)):
+        raise NumericalRangeError(f"h = {h!r} with params {params or {}} makes the step's coefficients overflow float64")
+    if check_stable:
+        check_stability(kern, h, K, params)
+    check_range(kern, X, K)
+
+    single = X.ndim == 1
+    batch = 1 if single else X.shape[1]
+    count = n_samples(steps, every)
+    nbytes = count * system.N * batch * 8
+    if nbytes > MAX_SAMPLE_BYTES:
+        raise InvalidRunError(f"{count} samples of {system.N} x {batch} states need {nbytes / 2**30:.1f} GiB "
+                              f"(limit {MAX_SAMPLE_BYTES / 2**30:.0f} GiB); sample less often (larger every)")
+    out = np.empty((count, system.N) if single else (count, system.N, batch), dtype=np.float64)
+    state = np.ascontiguousarray(X, dtype=np.float64).copy()
+    out[0] = state
+    comp = np.zeros_like(state) if kahan else None
+
+    reporter = Progress(steps * batch, f"iterate {system.name} {kern.program.word}",
+                        enabled=_enabled(progress, steps * batch * (30 if be == "numpy" and single else 1)))
+    segment = steps if not reporter.enabled else max(every, (_SEGMENT_WORK // batch) // every * every)
+    done, j = 0, 0
+    with reporter, np.errstate(over="ignore", invalid="ignore"):
+        while done < steps or (steps == 0 and j < 0):
+            seg = min(segment, steps - done)
+            nseg = n_samples(seg, every)
+            view = out[j:j + nseg]
+            if single:
+                n = kern.run(state, K, seg, every, view, kahan=kahan, comp=comp, backend=be)
+            else:
+                n = kern.run_batch(state, K, seg, every, view, kahan=kahan, comp=comp, backend=be, chunk=chunk)
+            if n < seg:  # stopped at a non-finite sample: the rest is undefined
+                out[j + n_samples(n, every):] = np.nan
+                break
+            done += seg
+            j += nseg - 1
+            reporter.update(done * batch)
+    check_result(out, sample_steps(steps, every), f"{system.name} under {kern.program.word} with h = {h!r}")
+    return out
+
+
+def _enabled(progress, work):
+    """Explicit choice, else automatic: a terminal and enough work (trajectory-steps, ~1 ns each compiled)."""
+    if progress is not None:
+        return bool(progress)
+    return work >= 5e8 and progress_wanted()
