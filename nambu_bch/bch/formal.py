@@ -62,13 +62,10 @@ def estimate_size(n_generators: int, max_degree: int) -> dict:
 
 def check_degree(max_degree, n_generators: int, limit: int = MAX_WORDS) -> int:
     """``max_degree`` as an int ``>= 1`` whose computation fits the size limit, else :class:`InvalidOrderError`."""
+    if isinstance(max_degree, sympy.Integer):
+        max_degree = int(max_degree)
     if isinstance(max_degree, bool) or not isinstance(max_degree, (int, np.integer)):
-        try:
-            if isinstance(max_degree, bool) or float(max_degree) != int(max_degree):
-                raise ValueError
-            max_degree = int(max_degree)
-        except (TypeError, ValueError, OverflowError):
-            raise InvalidOrderError(f"BCH degree must be a positive integer, got {max_degree!r}") from None
+        raise InvalidOrderError(f"BCH degree must be a positive integer, got {max_degree!r}")
     max_degree = int(max_degree)
     if max_degree < 1:
         raise InvalidOrderError(f"BCH degree must be a positive integer (1 = X_1 + X_2 + ...), got {max_degree}")
@@ -96,7 +93,7 @@ class _Scalars:
     """Coefficient arithmetic: python ints (rational compositions) or a sympy algebraic field."""
 
     def __init__(self, coefficients):
-        K, elems = construct_domain([sympy.nsimplify(c) if not c.is_Rational else c for c in coefficients], extension=True)
+        K, elems = construct_domain(list(coefficients), extension=True)
         if K.is_ZZ or K.is_QQ:
             fracs = [sympy.Rational(c) for c in coefficients]
             self.q = lcm(*(int(f.q) for f in fracs))
