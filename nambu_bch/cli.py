@@ -161,6 +161,14 @@ def system_from_args(args):
         for c in coords:
             if not c.isidentifier() or c.startswith("_"):
                 raise NambuBCHError(f"--coords {args.coords!r}: {c!r} is not a symbol name; write e.g. --coords 'x1 x2 x3'")
+            if c in ("h", "alpha"):
+                raise NambuBCHError(f"--coords {args.coords!r}: {c!r} is reserved (the step h, the family parameter alpha)")
+        expected = 1 if len(coords) == 2 else len(coords) - 1
+        if len(coords) >= 2 and len(hams) != expected:
+            raise NambuBCHError(
+                f"--coords {' '.join(coords)!r}: a system on {len(coords)} coordinates needs {expected} Hamiltonian(s) "
+                f"(--H and {expected - 1} --G), got {len(hams)}"
+            )
         symbols = [sympy.Symbol(s) for s in (*coords, *names)]
         flags = ["--H"] + ["--G"] * (len(hams) - 1)
         parsed = [parse_expression(text, symbols, what=flag) for text, flag in zip(hams, flags)]
@@ -269,8 +277,9 @@ def _base(system, word, **extra):
 def cmd_models(args):
     from .systems import model, model_names
 
-    if args.model or args.system or args.H:
-        systems = [system_from_args(args)[0]]
+    if any((args.model, args.system, args.H, args.G, args.coords, args.param, args.split, args.name)):
+        system, values = system_from_args(args)
+        systems = [substituted(system, values)]
     else:
         systems = [model(name) for name in model_names()]
 
@@ -427,7 +436,7 @@ def cmd_conserved(args):
     system, values = system_from_args(args)
     system = substituted(system, values)
     word, comp = integrator_from_args(args, system)
-    result = conserved_quantities(system, comp)
+    result = conserved_quantities(system, comp, **({"degree": args.degree} if args.degree is not None else {}))
 
     def data():
         out = _base(system, word)
@@ -445,17 +454,26 @@ def cmd_exact(args):
     system = substituted(system, values)
     word, comp = integrator_from_args(args, system)
     result = exact_shadow_hamiltonians(system, comp)
+    series = result.series(args.order) if args.order is not None else None
 
     def data():
         out = _base(system, word)
-        if hasattr(result, "to_dict"):
-            out.update(result.to_dict())
-        else:
-            out.update(H_S=render.expression(result.H_S), G_S=render.expression(getattr(result, "G_S", None)))
+        out.update(result.to_dict())
         out["model"], out["integrator"] = system.name, word
+        if series is not None:
+            out.update(order=args.order, H_S_series=render.expression(series[0]), G_S_series=render.expression(series[1]))
         return out
 
-    emit(args, latex=result.to_latex, data=data)
+    def latex():
+        text = result.to_latex()
+        if series is not None:
+            O = sympy.latex(sympy.Symbol("h") ** (args.order + 1))
+            text += rf" \\" + "\n" + rf"H_S^e = {sympy.latex(series[0])} + O({O})"
+            if series[1] is not None:
+                text += rf",\quad G_S^e = {sympy.latex(series[1])} + O({O})"
+        return text
+
+    emit(args, latex=latex, data=data)
 
 
 def cmd_fi(args):
@@ -508,8 +526,6 @@ def cmd_check(args):
 
 
 def cmd_plot(args):
-    from .numeric import paper_figures
-
     outdir = args.outdir
     if not os.path.isdir(outdir):
         try:
@@ -525,6 +541,8 @@ def cmd_plot(args):
         kwargs["x0"] = parse_x0(args.x0, 3)
     if args.every is not None:
         kwargs["every"] = args.every
+    from .numeric import paper_figures
+
     files = paper_figures(outdir, **kwargs)
     files = [os.fspath(f) for f in (files.values() if isinstance(files, dict) else files)]
 
@@ -641,11 +659,19 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--degree", metavar="D", type=str, help="polynomial degree of the ansatz for H_S, G_S (default: the library's)")
     _output_options(p, "latex")
 
-    for name, func in (("conserved", cmd_conserved), ("exact", cmd_exact)):
-        p = add(name, func)
-        _system_options(p)
-        _integrator_options(p)
-        _output_options(p, "latex")
+    p = add("conserved", cmd_conserved)
+    _system_options(p)
+    _integrator_options(p)
+    p.add_argument("--degree", metavar="D", type=str,
+                   help="total degree of the polynomial ansatz for invariants (default: that of the Hamiltonians)")
+    _output_options(p, "latex")
+
+    p = add("exact", cmd_exact)
+    _system_options(p)
+    _integrator_options(p)
+    p.add_argument("--order", metavar="K", type=str,
+                   help="also expand H_S^e, G_S^e through h^K (Eqs. ESH12321, ESG12321)")
+    _output_options(p, "latex")
 
     p = add("check", cmd_check)
     _system_options(p)
@@ -665,7 +691,7 @@ def _normalise(args):
     if getattr(args, "order", None) is not None:
         args.order = order_value(args.order)
     if getattr(args, "degree", None) is not None:
-        args.degree = order_value(args.degree, "--degree", limit=20, low=1)
+        args.degree = order_value(args.degree, "--degree", limit=12, low=1)
     if hasattr(args, "h"):
         default_h = 0.1 if args.command == "check" else None
         args.h = positive_float(args.h, "--h") if args.h is not None else default_h
