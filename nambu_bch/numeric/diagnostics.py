@@ -1,0 +1,404 @@
+"""Diagnostics along a run: errors of H, G, H_c, G_c, H_S; x^o, x^c, x^s - x; order and drift fits.
+
+The numerical proof of the symbolic results (Sect. 5.5 of the paper):
+
+* the original Hamiltonians ``H``, ``G`` oscillate with ``O(h^2)`` amplitude;
+* the exact conserved quantities ``H_c``, ``G_c`` (Table (table)) stay at round-off;
+* the truncated BCH shadow Hamiltonians of order ``k`` oscillate with
+  ``O(h^{k+2})`` amplitude for a symmetric scheme (:func:`nambu_bch.shadow.shadow_hamiltonians`);
+* the exact shadow Hamiltonians ``F^alpha H_c``, ``F^(1-alpha) G_c`` stay at round-off;
+* ``x^o - x`` beats (Fig. 3), ``x^c - x`` beats (Fig. 4, solid), ``x^s - x`` stays at
+  round-off (Fig. 4, dashed): Eqs. (OHsol), (CQsol), (SHsol).
+
+:func:`check` runs all of these and returns a :class:`CheckResult` whose
+``to_dict()`` is what ``nambu-bch check`` prints.  :func:`observed_order`
+fits ``log(error) = p log(h) + c``; :func:`drift_rate` fits a straight line
+``Q(t) - Q(0) = r t + c`` (a secular drift has ``r != 0`` beyond its error).
+
+Every quantity is a sympy expression lambdified *once* (numpy) and evaluated
+on the whole sample array.  Quantities that a system and word do not have
+(no polynomial invariant, no closed-form solution, no shadow Hamiltonian at
+this order) are left out, never guessed.
+
+References
+----------
+Horikoshi, Sect. 5.5, Figs. 1-4, Eqs. (OHsol), (CQsol), (SHsol), Table (table).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+import sympy
+
+from ..errors import InvalidRunError, NambuBCHError
+from ..integrators.composition import composition as make_composition
+from ..integrators.step import parameter_values
+from .iterate import as_system, iterate, sample_times
+
+H_STEP = sympy.Symbol("h")
+ALPHA = sympy.Symbol("alpha")
+
+#: The quantities :func:`quantities` can provide, in display order.
+QUANTITY_NAMES = ("H", "G", "H_c", "G_c", "H_S", "G_S", "H_S_exact", "G_S_exact")
+
+
+# -- the quantities ---------------------------------------------------------------------------------------
+
+
+def quantities(system, word, h, params=None, order=2, alpha=0.5, which=QUANTITY_NAMES) -> dict:
+    """``{name: sympy expression in the coordinates}`` with ``h``, the parameters and ``alpha`` substituted.
+
+    ``H``, ``G`` (the system), ``H_c``, ``G_c`` (:func:`nambu_bch.exact.conserved_quantities`),
+    ``H_S``, ``G_S`` (truncated BCH shadow Hamiltonians of ``order``, family parameters set to
+    ``alpha``), ``H_S_exact``, ``G_S_exact`` (:func:`nambu_bch.exact.exact_shadow_hamiltonians`).
+    Names a system or word does not have are absent.
+
+    Examples
+    --------
+    >>> from nambu_bch import model
+    >>> q = quantities(model("ho3"), "32123", 0.1, which=("H", "H_c"))
+    >>> sorted(q), sorted(map(str, q["H_c"].free_symbols))
+    (['H', 'H_c'], ['x1', 'x2', 'x3'])
+    """
+    system = as_system(system)
+    values = parameter_values(system, params)
+    subs = {**values, H_STEP: sympy.Float(float(h), 17), ALPHA: sympy.Float(float(alpha), 17)}
+    out = {}
+
+    def put(name, expr):
+        if name in which and expr is not None:
+            out[name] = sympy.sympify(expr).xreplace(subs)
+
+    put("H", system.H)
+    put("G", system.G)
+    if {"H_c", "G_c"} & set(which):
+        cq = _try(lambda: _exact().conserved_quantities(system, word))
+        if cq is not None:
+            put("H_c", cq.H_c)
+            put("G_c", cq.G_c)
+    if {"H_S", "G_S"} & set(which):
+        fam = _try(lambda: _shadow(system, word, order))
+        if fam is not None and getattr(fam, "exists", True):
+            free = [s for s in getattr(fam, "free_parameters", ()) or ()]
+            extra = {sympy.Symbol(str(s)) if not isinstance(s, sympy.Symbol) else s: sympy.Float(float(alpha), 17) for s in free}
+            put("H_S", None if fam.H_S is None else sympy.sympify(fam.H_S).xreplace(extra))
+            put("G_S", None if getattr(fam, "G_S", None) is None else sympy.sympify(fam.G_S).xreplace(extra))
+    if {"H_S_exact", "G_S_exact"} & set(which):
+        es = _try(lambda: _exact().exact_shadow_hamiltonians(system, word))
+        if es is not None:
+            put("H_S_exact", es.H_S)
+            put("G_S_exact", es.G_S)
+    return out
+
+
+def _exact():
+    from .. import exact
+
+    return exact
+
+
+def _shadow(system, word, order):
+    from ..shadow import shadow_hamiltonians
+
+    return shadow_hamiltonians(system, word, order=order)
+
+
+def _try(fn):
+    """The result, or None when the package says the result does not exist (or is not built yet)."""
+    try:
+        return fn()
+    except (NambuBCHError, ImportError, AttributeError, NotImplementedError):
+        return None
+
+
+def evaluate(expr, coordinates, samples, dps=None) -> np.ndarray:
+    """``expr`` on every sample (rows of ``samples``, shape (n, N) or (n, N, batch)); float64 out.
+
+    With ``dps`` (object samples from an mpmath run) the evaluation is done in mpmath.
+    """
+    if dps is None:
+        fn = sympy.lambdify(coordinates, expr, modules="numpy")
+        cols = [np.asarray(samples[:, i], dtype=np.float64) for i in range(len(coordinates))]
+        value = fn(*cols)
+        return np.broadcast_to(np.asarray(value, dtype=np.float64), cols[0].shape).copy()
+    import mpmath
+
+    fn = sympy.lambdify(coordinates, expr, modules="mpmath")
+    with mpmath.workdps(dps):
+        flat = samples.reshape(samples.shape[0], samples.shape[1], -1)
+        res = np.empty((flat.shape[0], flat.shape[2]), dtype=object)
+        for n in range(flat.shape[0]):
+            for b in range(flat.shape[2]):
+                res[n, b] = fn(*flat[n, :, b])
+        return res.reshape((samples.shape[0],) + samples.shape[2:])
+
+
+def errors_along(samples, exprs: dict, coordinates, dps=None) -> dict:
+    """``{name: Q(x_n) - Q(x_0)}`` for each expression (float64 arrays; differences taken before rounding)."""
+    out = {}
+    for name, expr in exprs.items():
+        v = evaluate(expr, coordinates, samples, dps)
+        if dps is None:
+            out[name] = v - v[0]
+        else:
+            import mpmath
+
+            with mpmath.workdps(dps):
+                out[name] = np.array([float(a - v[0]) for a in v.ravel()]).reshape(v.shape)
+    return out
+
+
+def solution_differences(system, word, h, steps, every, x0, samples, params=None, kinds="ocs") -> dict:
+    """``{"x3_o": x3^o(t_n) - x3_n, ...}`` for every coordinate and kind with a closed-form solution.
+
+    Eqs. (OHsol), (CQsol), (SHsol); Figs. 3 and 4 plot ``x3_o``, ``x3_c``, ``x3_s``.
+    """
+    system = as_system(system)
+    t = sample_times(h, steps, every)
+    out = {}
+    for kind in kinds:
+        sol = _try(lambda k=kind: _exact().modified_solution(system, word, k).numeric(params=params, h=float(h)))
+        if sol is None:
+            continue
+        ref = sol(t, np.asarray(x0, dtype=float))
+        for i, c in enumerate(system.coordinates):
+            out[f"{c}_{kind}"] = ref[i] - samples[:, i]
+    return out
+
+
+# -- check --------------------------------------------------------------------------------------------------
+
+
+@dataclass
+class CheckResult:
+    """The errors of one run (``nambu-bch check``).
+
+    Attributes
+    ----------
+    model, integrator : str
+    h : float
+    steps, every : int
+    x0 : list of float
+    params : dict
+    order : int -- truncation order of ``H_S``, ``G_S``
+    alpha : float -- value given to the family parameter(s)
+    max_abs_error : dict -- ``max_n |Q(x_n) - Q(x_0)|`` per quantity, ``max_n |x_i^k(t_n) - x_{i,n}|``
+        per ``x{i}_{k}`` (k = o, c, s)
+    drift_rate : dict -- slope of a straight-line fit of ``Q(t) - Q(0)`` (per unit time)
+    seconds : float -- wall time of the run and its diagnostics
+    """
+
+    model: str
+    integrator: str
+    h: float
+    steps: int
+    every: int
+    x0: list
+    params: dict
+    order: int
+    alpha: float
+    max_abs_error: dict = field(default_factory=dict)
+    drift_rate: dict = field(default_factory=dict)
+    seconds: float = 0.0
+
+    def to_dict(self) -> dict:
+        """JSON-ready: ``{"model", "integrator", "h", "steps", ..., "max_abs_error": {...}, "drift_rate": {...}}``."""
+        return {
+            "model": self.model, "integrator": self.integrator, "h": float(self.h), "steps": int(self.steps),
+            "every": int(self.every), "x0": [float(v) for v in self.x0],
+            "params": {k: float(v) for k, v in self.params.items()}, "order": int(self.order),
+            "alpha": float(self.alpha),
+            "max_abs_error": {k: _json_float(v) for k, v in self.max_abs_error.items()},
+            "drift_rate": {k: _json_float(v) for k, v in self.drift_rate.items()},
+        }
+
+    def __str__(self):
+        lines = [f"{self.model} {self.integrator}: h = {self.h}, {self.steps} steps"]
+        lines += [f"  max |{k}(t) - {k}(0)| = {v:.3e}" if not k.startswith("x") else f"  max |{k}| = {v:.3e}"
+                  for k, v in self.max_abs_error.items()]
+        return "\n".join(lines)
+
+
+def _json_float(v):
+    v = float(v)
+    return v if math.isfinite(v) else None
+
+
+def check(system, word, h, steps, x0, params=None, *, order=2, alpha=0.5, every=1, kahan=False,
+          backend="auto", include=None) -> CheckResult:
+    """Run ``word`` on ``system`` and measure every error the package can predict.
+
+    Parameters
+    ----------
+    system : System or model name; word : str or Composition
+    h : float; steps : int; x0 : array of shape (N,)
+    params : dict, optional
+    order : int -- truncation order ``k`` of the BCH shadow Hamiltonians ``H_S``, ``G_S``
+    alpha : float -- the value of the family parameter(s) of ``H_S``, ``G_S`` and the exact ones
+    every : int -- sample (and measure) every ``every`` steps
+    kahan, backend : as for :func:`~nambu_bch.numeric.iterate`
+    include : iterable of names, optional -- restrict to these quantities (default: all of
+        :data:`QUANTITY_NAMES`) -- and solution kinds ``"o"``, ``"c"``, ``"s"``
+
+    Returns
+    -------
+    CheckResult -- ``.to_dict()["max_abs_error"]`` has ``H, G, H_c, G_c, H_S, G_S, H_S_exact,
+    G_S_exact`` and ``x1_o .. xN_s`` where they are defined.
+
+    References
+    ----------
+    Horikoshi, Sect. 5.5, Figs. 1-4.
+
+    Examples
+    --------
+    >>> r = check("ho3", "32123", 0.1, 2000, [1.0, 1.0, 1.0], include=("H", "H_c", "s"))
+    >>> sorted(r.max_abs_error)
+    ['H', 'H_c', 'x1_s', 'x2_s', 'x3_s']
+    >>> r.max_abs_error["H_c"] < 1e-13 < 1e-4 < r.max_abs_error["H"], r.max_abs_error["x3_s"] < 1e-10
+    (True, True)
+    """
+    import time
+
+    start = time.perf_counter()
+    system = as_system(system)
+    comp = make_composition(word, len(system.splitting))
+    name = word if isinstance(word, str) else str(comp)
+    if np.ndim(x0) != 1:
+        raise InvalidRunError(f"check takes one initial state of shape ({system.N},), got shape {np.shape(x0)}")
+    samples = iterate(system, word, h, steps, x0, params, every, kahan=kahan, backend=backend)
+    include = tuple(include) if include is not None else QUANTITY_NAMES + tuple("ocs")
+    exprs = quantities(system, word, h, params, order, alpha, which=[q for q in include if q in QUANTITY_NAMES])
+    errs = errors_along(samples, exprs, system.coordinates)
+    kinds = "".join(k for k in "ocs" if k in include)
+    diffs = solution_differences(system, word, h, steps, every, x0, samples, params, kinds) if kinds else {}
+    t = sample_times(h, steps, every)
+    result = CheckResult(system.name, name, float(h), int(steps), int(every), [float(v) for v in x0],
+                         {p.name: v for p, v in parameter_values(system, params).items()}, int(order), float(alpha))
+    for key, series in {**errs, **diffs}.items():
+        result.max_abs_error[key] = float(np.max(np.abs(series)))
+    for key, series in errs.items():
+        result.drift_rate[key] = drift_rate(t, series).rate if len(t) > 2 else 0.0
+    result.seconds = time.perf_counter() - start
+    return result
+
+
+# -- fits ---------------------------------------------------------------------------------------------------
+
+
+@dataclass
+class DriftFit:
+    """``Q(t) - Q(0) ~ rate * t + intercept``; ``stderr`` is the standard error of ``rate``."""
+
+    rate: float
+    stderr: float
+    intercept: float
+    span: float
+
+    @property
+    def drift(self) -> float:
+        """``rate * span``: the secular change over the fitted time span."""
+        return self.rate * self.span
+
+    def to_dict(self) -> dict:
+        return {"rate": self.rate, "stderr": self.stderr, "intercept": self.intercept, "span": self.span,
+                "drift": self.drift}
+
+
+def drift_rate(t, values) -> DriftFit:
+    """Least-squares straight line through ``(t, values - values[0])``: the secular drift rate.
+
+    Examples
+    --------
+    >>> t = np.linspace(0, 10, 101)
+    >>> fit = drift_rate(t, 3e-12 * t + 1e-3 * np.sin(40 * t))
+    >>> abs(fit.rate - 3e-12) < 2e-5, fit.span
+    (True, 10.0)
+    """
+    t = np.asarray(t, dtype=np.float64).ravel()
+    y = np.asarray(values, dtype=np.float64).ravel()
+    if t.shape != y.shape or t.size < 3:
+        raise InvalidRunError(f"drift_rate needs matching t and values with at least 3 points, got {t.shape} and {y.shape}")
+    y = y - y[0]
+    tm = t.mean()
+    dt = t - tm
+    sxx = float(dt @ dt)
+    if sxx == 0:
+        raise InvalidRunError("drift_rate needs at least two distinct times")
+    rate = float(dt @ (y - y.mean())) / sxx
+    intercept = float(y.mean() - rate * tm)
+    resid = y - (rate * t + intercept)
+    stderr = math.sqrt(float(resid @ resid) / max(t.size - 2, 1) / sxx)
+    return DriftFit(rate, stderr, intercept, float(t[-1] - t[0]))
+
+
+@dataclass
+class OrderFit:
+    """``error ~ C h^order`` fitted on ``log error = order log h + log C``."""
+
+    order: float
+    intercept: float
+    hs: np.ndarray
+    errors: np.ndarray
+    quantity: str
+
+    def to_dict(self) -> dict:
+        return {"order": self.order, "intercept": self.intercept, "hs": [float(v) for v in self.hs],
+                "errors": [float(v) for v in self.errors], "quantity": self.quantity}
+
+
+def fit_order(hs, errors, quantity="error") -> OrderFit:
+    """Slope of ``log(errors)`` against ``log(hs)`` (least squares).
+
+    >>> round(fit_order([0.1, 0.05, 0.025], [2e-2, 5e-3, 1.25e-3]).order, 6)
+    2.0
+    """
+    hs = np.asarray(hs, dtype=np.float64)
+    errors = np.asarray(errors, dtype=np.float64)
+    if hs.size < 2 or np.any(hs <= 0) or np.any(errors <= 0) or hs.shape != errors.shape:
+        raise InvalidRunError(f"an order fit needs >= 2 positive steps and positive errors, got hs={hs}, errors={errors}")
+    slope, intercept = np.polyfit(np.log(hs), np.log(errors), 1)
+    return OrderFit(float(slope), float(intercept), hs, errors, quantity)
+
+
+def observed_order(system, word, hs, T, x0, params=None, quantity="x", backend="auto") -> OrderFit:
+    """The observed order of convergence of ``word`` by a log-log fit over the steps ``hs``.
+
+    ``quantity="x"``: the global error ``max_i |x_i(T) - x_i^ref(T)|`` against the exact
+    solution ``x^o`` (Eq. OHsol) when the system has one, else against a run of
+    the same scheme with step ``min(hs)/64`` (whose error is ``64^p`` times smaller).
+    ``quantity="H"`` (or ``"G"``, ...): ``max_{t <= T} |Q(x(t)) - Q(x(0))|``.
+    Each ``h`` is adjusted to ``T / round(T / h)`` so the runs end exactly at ``T``.
+
+    Examples
+    --------
+    >>> fit = observed_order("ho3", "32123", [0.1, 0.05, 0.025], 5.0, [1.0, 1.0, 1.0])
+    >>> round(fit.order, 1)
+    2.0
+    """
+    system = as_system(system)
+    x0 = np.asarray(x0, dtype=float)
+    steps_list = [max(1, int(round(T / float(h)))) for h in hs]
+    hs_eff = np.array([T / n for n in steps_list])
+    errors = []
+    if quantity == "x":
+        sol = _try(lambda: _exact().modified_solution(system, word, "o").numeric(params=params, h=float(hs_eff[0])))
+        if sol is not None:
+            ref = sol(np.array([T]), x0)[:, 0]
+        else:
+            n_ref = steps_list[int(np.argmin(hs_eff))] * 64
+            ref = iterate(system, word, T / n_ref, n_ref, x0, params, n_ref, backend=backend)[-1]
+        for h, n in zip(hs_eff, steps_list):
+            final = iterate(system, word, h, n, x0, params, n, backend=backend)[-1]
+            errors.append(float(np.max(np.abs(final - ref))))
+    else:
+        for h, n in zip(hs_eff, steps_list):
+            exprs = quantities(system, word, h, params, which=(quantity,))
+            if quantity not in exprs:
+                raise InvalidRunError(f"quantity {quantity!r} is not defined for {system.name} with {word!r}; "
+                                      f"use 'x' or one of {', '.join(QUANTITY_NAMES)}")
+            samples = iterate(system, word, h, n, x0, params, 1, backend=backend)
+            errors.append(float(np.max(np.abs(errors_along(samples, exprs, system.coordinates)[quantity]))))
+    return fit_order(hs_eff, errors, quantity)
