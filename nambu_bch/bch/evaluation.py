@@ -30,6 +30,9 @@ class BracketEvaluator:
         ``bracket(X, Y)``; default ``X.bracket(Y)``.
     is_zero : callable, optional
         ``is_zero(X)``; default ``X.is_zero()``.
+    to_field : callable, optional
+        Internal value -> :class:`~nambu_bch.algebra.VectorField` (for fast backends);
+        default: values are fields already.
 
     Examples
     --------
@@ -38,12 +41,15 @@ class BracketEvaluator:
     >>> E = BracketEvaluator({p.number: p.field for p in S.pieces})
     >>> E.is_zero((1, (1, 3))), E.is_zero((1, (1, 2)))     # Eq. (BCH4)
     (True, False)
+    >>> E.field((1, (1, 2))).to_sympy()
+    (2*omega**2*x2/m, 0, 0)
     """
 
-    def __init__(self, leaf_value, bracket=None, is_zero=None):
+    def __init__(self, leaf_value, bracket=None, is_zero=None, to_field=None):
         self._leaf = leaf_value
         self._bracket = bracket or (lambda X, Y: X.bracket(Y))
         self._is_zero = is_zero or (lambda X: X.is_zero())
+        self._to_field = to_field
         self._cache: dict = {}
         self.brackets_computed = 0
 
@@ -79,6 +85,13 @@ class BracketEvaluator:
                 result = None
         self._cache[tree] = result
         return result
+
+    def field(self, tree, zero=None):
+        """The value of ``tree`` as a :class:`~nambu_bch.algebra.VectorField` (``zero`` when it vanishes)."""
+        value = self.value(tree)
+        if value is None:
+            return zero
+        return self._to_field(value) if self._to_field else value
 
     def is_zero(self, tree) -> bool:
         """``True`` when the concrete value of ``tree`` vanishes."""

@@ -43,11 +43,15 @@ def _evaluator(algebra, fields: dict) -> BracketEvaluator:
     backend = field_backend(algebra, fields)
     if backend is None:
         return BracketEvaluator(fields)
-    return BracketEvaluator(backend.fields, backend.bracket, backend.is_zero)
+    return BracketEvaluator(
+        backend.fields, backend.bracket, backend.is_zero, to_field=lambda X: backend.combination([(1, X)])
+    )
 
 
 def piece_evaluator(splitting) -> BracketEvaluator:
-    """A :class:`BracketEvaluator` whose leaves are the piece numbers of ``splitting``."""
+    """A :class:`BracketEvaluator` whose leaves are the piece numbers of ``splitting``.
+
+    Use ``.field(tree)`` for the :class:`~nambu_bch.algebra.VectorField` value (``.value`` is internal)."""
     return _evaluator(splitting.system.algebra, {p.number: p.field for p in splitting.pieces})
 
 
