@@ -65,7 +65,9 @@ def quantities(system, word, h, params=None, order=2, alpha=0.5, which=QUANTITY_
     """
     system = as_system(system)
     values = parameter_values(system, params)
-    subs = {**values, H_STEP: sympy.Float(float(h), 17), ALPHA: sympy.Float(float(alpha), 17)}
+    # exact binary values (60 digits), so mpmath evaluations see the same h as the run
+    subs = {**{p: sympy.Float(v, 60) for p, v in values.items()}, H_STEP: sympy.Float(float(h), 60),
+            ALPHA: sympy.Float(float(alpha), 60)}
     out = {}
 
     def put(name, expr):
@@ -83,7 +85,7 @@ def quantities(system, word, h, params=None, order=2, alpha=0.5, which=QUANTITY_
         fam = _try(lambda: _shadow(system, word, order))
         if fam is not None and getattr(fam, "exists", True):
             free = [s for s in getattr(fam, "free_parameters", ()) or ()]
-            extra = {sympy.Symbol(str(s)) if not isinstance(s, sympy.Symbol) else s: sympy.Float(float(alpha), 17) for s in free}
+            extra = {sympy.Symbol(str(s)) if not isinstance(s, sympy.Symbol) else s: sympy.Float(float(alpha), 60) for s in free}
             put("H_S", None if fam.H_S is None else sympy.sympify(fam.H_S).xreplace(extra))
             put("G_S", None if getattr(fam, "G_S", None) is None else sympy.sympify(fam.G_S).xreplace(extra))
     if {"H_S_exact", "G_S_exact"} & set(which):

@@ -230,8 +230,17 @@ def kernel(system, word) -> Kernel:
     >>> [float(v) for v in k.constants(0.1)]
     [0.05, -0.1]
     """
+    directory = str(cache_dir())
+    if isinstance(word, str):  # resolving a word can be slow (triple jumps: exact algebraic coefficients)
+        return _kernel_for_word(system, word, directory)
     comp = make_composition(word, len(system.splitting)).check(system.splitting)
-    return _kernel(system, comp, str(cache_dir()))
+    return _kernel(system, comp, directory)
+
+
+@lru_cache(maxsize=64)
+def _kernel_for_word(system, word, directory):
+    comp = make_composition(word, len(system.splitting)).check(system.splitting)
+    return _kernel(system, comp, directory)
 
 
 @lru_cache(maxsize=64)

@@ -1,0 +1,291 @@
+"""Tests of the numeric backend: generated kernels, backends, sampling, Kahan, mpmath, cache, progress (issue 6).
+
+Numerical tests carry explicit tolerances; the numba and numpy paths are compared bit for bit on
+polynomial flows (the generated code performs the same IEEE operations in the same order).
+References: Horikoshi, Sect. 5.5, Eqs. (hX1e)-(hX3e), (12321).
+"""
+
+from __future__ import annotations
+
+import io
+import os
+
+import numpy as np
+import pytest
+
+from nambu_bch import model
+from nambu_bch.errors import (
+    InvalidCompositionError,
+    InvalidRunError,
+    InvalidSystemError,
+    NambuBCHError,
+    NumericalRangeError,
+)
+from nambu_bch.integrators import step_function
+from nambu_bch.numeric import iterate, kernel, n_samples, sample_steps, sample_times, step_program
+from nambu_bch.numeric.codegen import c_source, python_source
+from nambu_bch.numeric.kernels import numba_available, resolve_backend
+from nambu_bch.numeric.progress import Progress
+
+numba_only = pytest.mark.skipif(not numba_available(), reason="numba not installed or disabled")
+
+POLY_CASES = [("ho", "TVT"), ("ho3", "32123"), ("ho3", "12321"), ("rigid-body", "forest-ruth"), ("ho3-composite", "121")]
+X0 = {"ho": [1.0, 0.5], "ho3": [1.0, 1.0, 1.0], "rigid-body": [0.3, 0.8, -0.5], "ho3-composite": [1.0, 1.0, 1.0],
+      "lotka-volterra": [0.9, 1.1, 1.0]}
+
+
+# -- shapes and sampling ----------------------------------------------------------------------------------
+
+
+def test_sampling_grid_includes_start_and_end():
+    assert sample_steps(10, 5).tolist() == [0, 5, 10]
+    assert sample_steps(10, 3).tolist() == [0, 3, 6, 9, 10]
+    assert n_samples(0, 7) == 1 and sample_steps(0, 7).tolist() == [0]
+    assert np.allclose(sample_times(0.1, 4, 2), [0.0, 0.2, 0.4])
+
+
+def test_shapes_single_and_batch():
+    x = iterate("ho3", "32123", 0.1, 10, [1.0, 1.0, 1.0], every=3)
+    assert x.shape == (5, 3) and x.dtype == np.float64
+    assert x[0].tolist() == [1.0, 1.0, 1.0]
+    X0 = np.array([[1.0, 1.0, 1.0], [0.2, -0.4, 0.5], [2.0, 0.0, 3.0]]).T      # (N, batch) = (3, 3)
+    xb = iterate("ho3", "32123", 0.1, 10, X0, every=3)
+    assert xb.shape == (5, 3, 3)
+    assert np.array_equal(xb[:, :, 0], x)                                       # batch member 0 == single run
+    assert np.array_equal(xb[0], X0)
+    assert iterate("ho3", "32123", 0.1, 0, [1.0, 2.0, 3.0]).tolist() == [[1.0, 2.0, 3.0]]
+
+
+def test_every_subsamples_the_same_trajectory():
+    full = iterate("ho3", "32123", 0.1, 100, [1.0, 1.0, 1.0])
+    sparse = iterate("ho3", "32123", 0.1, 100, [1.0, 1.0, 1.0], every=7)
+    assert np.array_equal(sparse, full[sample_steps(100, 7)])
+
+
+@pytest.mark.parametrize("name,word", POLY_CASES + [("lotka-volterra", "12321")])
+def test_matches_the_lambdified_step(name, word):
+    """The generated kernel iterates the same map as nambu_bch.integrators.step_function."""
+    system = model(name)
+    step = step_function(system.splitting, word)
+    x = np.array(X0[name])
+    for _ in range(50):
+        x = step(x, 0.05)
+    ours = iterate(system, word, 0.05, 50, X0[name], every=50)[-1]
+    assert np.allclose(ours, x, rtol=1e-13, atol=1e-13)
+
+
+def test_operator_order_on_a_non_palindromic_word():
+    """Word "123": piece 1 acts first, then 2, then 3 (left to right, Eqs. hX1e-hX3e)."""
+    h = 0.3
+    x1, x2, x3 = 1.0, 2.0, 0.5
+    x1 = x1 + h * x2                    # piece 1: x1 += h x2 / m
+    x2 = x2 - h * x1                    # piece 2: x2 -= h m omega^2 x1 (new x1)
+    x3 = x3 + 2 * h * x1 * x2           # piece 3: x3 += 2 h x1 x2 / m (new x1, x2)
+    got = iterate("ho3", "123", h, 1, [1.0, 2.0, 0.5])[-1]
+    assert np.allclose(got, [x1, x2, x3], rtol=1e-15, atol=1e-15)
+    other = iterate("ho3", "321", h, 1, [1.0, 2.0, 0.5])[-1]
+    assert not np.allclose(other, got)
+
+
+def test_parameters_enter_through_the_constants():
+    a = iterate("ho3", "32123", 0.1, 200, [1.0, 1.0, 1.0], params={"m": 2.0, "omega": 0.5})
+    step = step_function(model("ho3").splitting, "32123", {"m": 2.0, "omega": 0.5})
+    x = np.array([1.0, 1.0, 1.0])
+    for _ in range(200):
+        x = step(x, 0.1)
+    assert np.allclose(a[-1], x, rtol=1e-12)
+
+
+# -- generated code -----------------------------------------------------------------------------------------
+
+
+def test_step_program_hoists_constants():
+    prog = step_program(model("ho3"), "12321")
+    assert [u.piece for u in prog.updates] == [1, 2, 3, 2, 1]
+    assert str(prog.updates[2].increments[0][1]) == "k2*s0*s1"      # Eq. (hX3e): x3 += (2h/m) x1 x2
+    src = python_source(prog)
+    assert "sympy" not in src and "def run(" in src and "def run_batch(" in src and "def run_numpy(" in src
+    assert "s2 += d0" in src
+    csrc = c_source(prog)
+    assert "long run(" in csrc and "void run_batch(" in csrc
+
+
+def test_exponential_flows_use_expm1():
+    prog = step_program(model("lotka-volterra"), "12321")
+    assert all("expm1" in str(d) for u in prog.updates for _, d in u.increments)
+
+
+# -- backends -------------------------------------------------------------------------------------------------
+
+
+@numba_only
+@pytest.mark.parametrize("name,word", POLY_CASES)
+@pytest.mark.parametrize("kahan", [False, True])
+def test_numba_and_numpy_agree_bitwise(name, word, kahan):
+    x0 = X0[name]
+    a = iterate(name, word, 0.05, 300, x0, every=7, kahan=kahan, backend="numba")
+    b = iterate(name, word, 0.05, 300, x0, every=7, kahan=kahan, backend="numpy")
+    assert np.array_equal(a, b)
+
+
+@numba_only
+@pytest.mark.parametrize("kahan", [False, True])
+def test_batch_numba_numpy_and_single_agree_bitwise(kahan):
+    rng = np.random.default_rng(1)
+    X = rng.normal(size=(3, 301))                       # not a multiple of the chunk sizes
+    a = iterate("ho3", "32123", 0.1, 50, X, every=10, kahan=kahan, backend="numba")
+    b = iterate("ho3", "32123", 0.1, 50, X, every=10, kahan=kahan, backend="numpy", chunk=64)
+    assert np.array_equal(a, b)
+    single = iterate("ho3", "32123", 0.1, 50, X[:, 123], every=10, kahan=kahan)
+    assert np.array_equal(a[:, :, 123], single)
+
+
+def test_exponential_flows_agree_across_backends():
+    X = np.array([[0.9, 1.1, 1.0], [1.2, 0.7, 1.3]]).T
+    a = iterate("lotka-volterra", "12321", 0.05, 400, X, every=100)
+    b = iterate("lotka-volterra", "12321", 0.05, 400, X, every=100, backend="numpy")
+    assert np.allclose(a, b, rtol=1e-13, atol=0)
+    c = iterate("lotka-volterra", "12321", 0.05, 400, X[:, 0], every=100, backend="numpy")
+    assert np.allclose(a[:, :, 0], c, rtol=1e-13, atol=0)
+
+
+@numba_only
+def test_disable_numba_environment_variable(monkeypatch):
+    a = iterate("ho3", "32123", 0.1, 500, [1.0, 1.0, 1.0], every=50)
+    monkeypatch.setenv("NAMBU_BCH_DISABLE_NUMBA", "1")
+    assert resolve_backend("auto") == "numpy"
+    with pytest.raises(InvalidRunError, match="numba"):
+        resolve_backend("numba")
+    b = iterate("ho3", "32123", 0.1, 500, [1.0, 1.0, 1.0], every=50)
+    assert np.array_equal(a, b)
+
+
+def test_unknown_backend():
+    with pytest.raises(InvalidRunError, match="backend 'cuda'"):
+        iterate("ho", "TVT", 0.1, 10, [1.0, 0.0], backend="cuda")
+
+
+@numba_only
+def test_kernels_are_cached_on_disk(tmp_path, monkeypatch):
+    monkeypatch.setenv("NAMBU_BCH_CACHE", str(tmp_path))
+    k = kernel(model("ho"), "VTV")
+    assert k.path.parent == tmp_path / "kernels" and k.path.read_text() == k.source
+    k.compile()
+    cached = list((tmp_path / "kernels").rglob("*.nbi"))
+    assert cached, "numba wrote no cache index next to the generated module"
+    again = kernel(model("ho"), "VTV")
+    assert again is k
+
+
+# -- precision ---------------------------------------------------------------------------------------------------
+
+
+def test_kahan_removes_accumulated_round_off_at_tiny_steps():
+    """h = 1e-8: 10^4 increments of ~1e-8 lose ~1e-13 in plain float64; compensated sums stay at ~1e-16."""
+    n, h = 10_000, 1e-8
+    ref = iterate("ho3", "32123", h, n, [1.0, 1.0, 1.0], every=n, dps=40)[-1]
+    ref = np.array([float(v) for v in ref])
+    plain = iterate("ho3", "32123", h, n, [1.0, 1.0, 1.0], every=n)[-1]
+    kahan = iterate("ho3", "32123", h, n, [1.0, 1.0, 1.0], every=n, kahan=True)[-1]
+    err_plain, err_kahan = np.abs(plain - ref).max(), np.abs(kahan - ref).max()
+    assert err_kahan <= 4.5e-16
+    assert err_plain > 1e-14 > err_kahan
+
+
+def test_mpmath_path():
+    import mpmath
+
+    x = iterate("ho3", "32123", 0.1, 300, [1.0, 1.0, 1.0], every=100, dps=40)
+    assert x.shape == (4, 3) and x.dtype == object and isinstance(x[-1, 2], mpmath.mpf)
+    f = iterate("ho3", "32123", 0.1, 300, [1.0, 1.0, 1.0], every=100)
+    assert np.allclose(x.astype(float), f, rtol=0, atol=1e-13)
+    # H_c (Table (table), 32123) is conserved to the working precision
+    with mpmath.workdps(40):
+        h = mpmath.mpf(0.1)
+        Hc = [r[1] ** 2 / 2 + r[2] / 2 + h**2 * r[0] ** 2 / 8 for r in x]
+        assert max(abs(v - Hc[0]) for v in Hc) < mpmath.mpf(10) ** -36
+    # a decimal string step is read at dps digits (a slightly different map from float 0.1)
+    y = iterate("ho3", "32123", "0.1", 300, ["1", "1", "1"], every=300, dps=40)
+    assert abs(float(y[-1, 0] - x[-1, 0])) < 1e-12
+    batch = iterate("ho", "TVT", 0.1, 10, [[1.0, 0.0], [0.0, 1.0]], dps=20)
+    assert batch.shape == (11, 2, 2)
+
+
+def test_precision_argument_errors():
+    with pytest.raises(InvalidRunError, match="kahan"):
+        iterate("ho", "TVT", 0.1, 10, [1.0, 0.0], kahan=True, dps=30)
+    with pytest.raises(InvalidRunError, match="dps"):
+        iterate("ho", "TVT", 0.1, 10, [1.0, 0.0], dps=5)
+
+
+# -- progress -------------------------------------------------------------------------------------------------------
+
+
+def test_progress_is_off_in_pipes_and_on_when_asked():
+    stream = io.StringIO()
+    p = Progress(10, "x", stream=stream, delay=0, interval=0)
+    p.update(5)
+    p.close()
+    assert stream.getvalue() == ""                      # StringIO is not a TTY
+    p = Progress(10, "x", enabled=True, stream=stream, delay=0, interval=0)
+    p.update(5)
+    p.close()
+    assert "50%" in stream.getvalue() and stream.getvalue().endswith("\n")
+
+
+def test_segmented_runs_with_progress_give_the_same_samples(monkeypatch, capsys):
+    import importlib
+
+    it = importlib.import_module("nambu_bch.numeric.iterate")   # the module, not the re-exported function
+    monkeypatch.setattr(it, "_SEGMENT_WORK", 700)
+    plain = iterate("ho3", "32123", 0.1, 5000, [1.0, 1.0, 1.0], every=30)
+    segmented = iterate("ho3", "32123", 0.1, 5000, [1.0, 1.0, 1.0], every=30, progress=True)
+    assert np.array_equal(plain, segmented)
+    k1 = iterate("ho3", "32123", 0.1, 5000, [1.0, 1.0, 1.0], every=30, kahan=True)
+    k2 = iterate("ho3", "32123", 0.1, 5000, [1.0, 1.0, 1.0], every=30, kahan=True, progress=True)
+    assert np.array_equal(k1, k2)
+    X = np.ones((3, 4))
+    assert np.array_equal(iterate("ho3", "32123", 0.1, 999, X, every=10, progress=True),
+                          iterate("ho3", "32123", 0.1, 999, X, every=10))
+    capsys.readouterr()
+
+
+# -- bad input -----------------------------------------------------------------------------------------------------
+
+
+@pytest.mark.parametrize("kwargs,error,text", [
+    ({"steps": -1}, InvalidRunError, "steps"),
+    ({"steps": 2.5}, InvalidRunError, "steps"),
+    ({"steps": True}, InvalidRunError, "steps"),
+    ({"every": 0}, InvalidRunError, "every"),
+    ({"x0": [1.0, 1.0]}, InvalidRunError, "shape"),
+    ({"x0": [[1.0], [2.0]]}, InvalidRunError, "shape"),
+    ({"x0": "abc"}, InvalidRunError, "x0"),
+    ({"h": "fast"}, InvalidRunError, "step h"),
+    ({"h": 1j}, InvalidRunError, "step h"),
+    ({"params": {"mass": 1.0}}, InvalidSystemError, "mass"),
+    ({"params": [1.0]}, InvalidRunError, "params"),
+    ({"word": "1x2"}, InvalidCompositionError, "1x2"),
+    ({"word": "124"}, InvalidCompositionError, "4"),
+    ({"system": "pendulum"}, NambuBCHError, "pendulum"),
+    ({"system": 3}, InvalidSystemError, "system"),
+])
+def test_bad_arguments(kwargs, error, text):
+    args = {"system": "ho3", "word": "32123", "h": 0.1, "steps": 10, "x0": [1.0, 1.0, 1.0]}
+    args.update(kwargs)
+    with pytest.raises(error, match=text):
+        iterate(**args)
+
+
+def test_errors_are_value_errors_for_callers():
+    with pytest.raises(ValueError):
+        iterate("ho3", "32123", float("nan"), 10, [1.0, 1.0, 1.0])
+    with pytest.raises(NumericalRangeError):
+        iterate("ho3", "32123", 0.1, 10, [1.0, float("inf"), 1.0])
+
+
+def test_cache_dir_env(tmp_path, monkeypatch):
+    from nambu_bch.numeric.kernels import cache_dir
+
+    monkeypatch.setenv("NAMBU_BCH_CACHE", str(tmp_path / "c"))
+    assert cache_dir() == tmp_path / "c" / "kernels" and os.path.isdir(cache_dir())
