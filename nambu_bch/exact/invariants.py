@@ -119,8 +119,25 @@ def _invariant_basis(setup: _Setup, degree: int):
     for col, diff in enumerate(columns):
         for m, c in diff.items():
             mat[rows[m]][col] = c
-    null = DomainMatrix(mat, (len(rows), len(monos)), setup.K).nullspace().to_list()
-    return [R({mu: c for mu, c in zip(monos, vec) if c}) for vec in null]
+    return [R({mu: c for mu, c in zip(monos, vec) if c}) for vec in _nullspace(mat, len(monos), setup.K)]
+
+
+def _nullspace(mat, ncols, K):
+    """Rows spanning the nullspace, from a Gauss-Jordan rref over the field ``K``.
+
+    (``DomainMatrix.nullspace`` goes through the fraction-free ``rref_den``,
+    whose gcds in ``QQ(m, omega, h)`` are 100x slower here.)
+    """
+    rref, pivots = DomainMatrix(mat, (len(mat), ncols), K).rref(method="GJ")
+    rows = rref.to_list()
+    out = []
+    for free in (c for c in range(ncols) if c not in pivots):
+        vec = [K.zero] * ncols
+        vec[free] = K.one
+        for i, p in enumerate(pivots):
+            vec[p] = -rows[i][free]
+        out.append(vec)
+    return out
 
 
 def _h_regular_limit(K, c):
@@ -319,6 +336,14 @@ def _rank(setup, polys) -> int:
 
 
 def _primitive(p):
-    """``p`` scaled so that its leading coefficient (graded order) is 1."""
-    lead = max(p.keys(), key=lambda m: (sum(m), m))
-    return p * (p.ring.domain.one / p[lead])
+    """``p`` times the lcm of its coefficients' denominators, divided by their numerators' gcd."""
+    K = p.ring.domain
+    dom = K.get_ring()
+    den, num = dom.one, dom.zero
+    for c in p.values():
+        den = dom.lcm(den, c.denom)
+    for c in p.values():
+        num = dom.gcd(num, (c * den).numer)
+    scaled = p * K.convert(den) * (K.one / K.convert(num))
+    lead = max(scaled.keys(), key=lambda m: (sum(m), m))
+    return -scaled if K.numer(scaled[lead]).LC < 0 else scaled

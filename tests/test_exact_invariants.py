@@ -1,0 +1,156 @@
+"""Exact conserved quantities of the discrete maps: Eqs. (CQPV), (CQ12321H), (CQ12321G), Table (table),
+and Eqs. (XHc), (XHcGc): they are conserved but they are not the shadow Hamiltonians.
+
+Horikoshi, *Shadow Hamiltonians of structure-preserving integrators for Nambu mechanics*.
+"""
+
+from __future__ import annotations
+
+import pytest
+import sympy
+
+from nambu_bch import PAPER_WORDS, System, composed_map, liouville_field, model
+from nambu_bch.bch import effective_field
+from nambu_bch.errors import InvalidOrderError, NambuBCHError, NoExactResultError
+from nambu_bch.exact import conserved_quantities, is_invariant
+
+x1, x2, x3, m, omega, h = sympy.symbols("x1 x2 x3 m omega h")
+H2 = x2**2 / (2 * m) + m * omega**2 * x1**2 / 2  # Eq. (HO1)
+H = x2**2 / (2 * m) + m * omega**2 * x3 / 2  # Eq. (H)
+G = x3 - x1**2  # Eq. (G)
+
+# Table (table): (H_c, G_c) for the six second-order integrators of the N = 3 oscillator
+TABLE = {
+    "12321": (H, G + h**2 * x2**2 / (4 * m**2)),  # Eqs. (CQ12321H), (CQ12321G)
+    "13231": (H, G + h**2 * x2**2 / (4 * m**2)),
+    "31213": (H - omega**2 * h**2 * x2**2 / (4 * m), G - h**2 * x2**2 / (4 * m**2)),
+    "21312": (H - m * omega**4 * h**2 * x1**2 / 8, G),
+    "23132": (H - m * omega**4 * h**2 * x1**2 / 8, G),
+    "32123": (H + m * omega**4 * h**2 * x1**2 / 8, G + omega**2 * h**2 * x1**2 / 2),
+}
+
+
+def _invariant_by_substitution(system, word, quantity) -> bool:
+    phi = composed_map(system.splitting, word)
+    image = quantity.subs(dict(zip(system.coordinates, phi)), simultaneous=True)
+    return sympy.expand(image - quantity) == 0
+
+
+def test_position_verlet_CQPV():
+    """Eq. (CQPV): H_c = H - omega^2 h^2 x2^2 / (8m) for Phi^TVT on the oscillator."""
+    ho = model("ho")
+    cq = conserved_quantities(ho, "TVT")
+    assert sympy.expand(cq.H_c - (H2 - omega**2 * h**2 * x2**2 / (8 * m))) == 0
+    assert cq.G_c is None
+    assert _invariant_by_substitution(ho, "121", cq.H_c)
+    assert not _invariant_by_substitution(ho, "121", H2)
+
+
+def test_velocity_verlet_on_ho():
+    """VTV: the conserved quantity of Eq. (equiv2)'s 2-d map, H - m omega^4 h^2 x1^2 / 8 (Table (table), rows 21312)."""
+    cq = conserved_quantities(model("ho"), "VTV")
+    assert sympy.expand(cq.H_c - (H2 - m * omega**4 * h**2 * x1**2 / 8)) == 0
+    assert _invariant_by_substitution(model("ho"), "212", cq.H_c)
+
+
+@pytest.mark.parametrize("word", PAPER_WORDS)
+def test_table_rows(word):
+    """Every row of Table (table), checked as an exact invariant by substituting the composed map."""
+    ho3 = model("ho3")
+    cq = conserved_quantities(ho3, word)
+    H_c, G_c = TABLE[word]
+    assert sympy.expand(cq.H_c - H_c) == 0, cq.H_c
+    assert sympy.expand(cq.G_c - G_c) == 0, cq.G_c
+    assert _invariant_by_substitution(ho3, word, H_c)
+    assert _invariant_by_substitution(ho3, word, G_c)
+    assert is_invariant(ho3, word, cq.H_c) and is_invariant(ho3, word, cq.G_c)
+    assert len(cq.quantities) == 2  # all invariants of degree <= 2 modulo constants
+    assert cq.check()
+    # the normalisation: H_c -> H, G_c -> G as h -> 0
+    assert sympy.expand(cq.H_c.subs(h, 0) - H) == 0 and sympy.expand(cq.G_c.subs(h, 0) - G) == 0
+
+
+def test_original_hamiltonians_are_not_conserved():
+    ho3 = model("ho3")
+    assert not _invariant_by_substitution(ho3, "32123", H)
+    assert not _invariant_by_substitution(ho3, "32123", G)
+    assert _invariant_by_substitution(ho3, "12321", H)  # Eq. (CQ12321H): H itself is conserved
+
+
+def test_XHc_is_not_X_eff():
+    """Eq. (XHc): X_{H_c} = (1 - omega^2 h^2/4) x2/m d/dx1 - m omega^2 x1 d/dx2, which is not X_eff."""
+    ho = model("ho")
+    cq = conserved_quantities(ho, "121")
+    X = liouville_field(ho.algebra, cq.H_c).to_sympy()
+    assert sympy.expand(X[0] - (1 - omega**2 * h**2 / 4) * x2 / m) == 0
+    assert sympy.expand(X[1] + m * omega**2 * x1) == 0
+    Xeff = effective_field(ho.splitting, "121", 2).to_sympy()
+    assert any(sympy.expand(a - b) != 0 for a, b in zip(X, Xeff))
+
+
+def test_XHcGc_is_not_X_eff():
+    """Eq. (XHcGc) for Phi^12321, and X_{H_c,G_c} != X_eff already at h^2."""
+    ho3 = model("ho3")
+    cq = conserved_quantities(ho3, "12321")
+    X = liouville_field(ho3.algebra, cq.H_c, cq.G_c).to_sympy()
+    expected = ((1 - omega**2 * h**2 / 4) * x2 / m, -m * omega**2 * x1, 2 * x1 * x2 / m)
+    assert all(sympy.expand(a - b) == 0 for a, b in zip(X, expected))
+    Z = effective_field(ho3.splitting, "12321", 2)
+    diff = [sympy.expand(sympy.expand(a).coeff(h, 2) - b) for a, b in zip(X, Z[2].to_sympy())]
+    assert any(d != 0 for d in diff)
+
+
+def test_higher_degree_ansatz_contains_products():
+    """With degree 4 the invariants include products of H_c and G_c; H_c, G_c stay the paper's."""
+    ho3 = model("ho3")
+    cq = conserved_quantities(ho3, "32123", degree=4)
+    assert cq.degree == 4
+    H_c, G_c = TABLE["32123"]
+    assert sympy.expand(cq.H_c - H_c) == 0 and sympy.expand(cq.G_c - G_c) == 0
+    assert len(cq.quantities) == 5  # H_c, G_c, H_c^2, H_c G_c, G_c^2
+    for q in cq.quantities:
+        assert _invariant_by_substitution(ho3, "32123", q)
+
+
+def test_default_degree_and_output():
+    cq = conserved_quantities(model("ho3"), "12321")
+    assert cq.degree == 2
+    d = cq.to_dict()
+    names = model("ho3").symbols()
+    assert sympy.expand(sympy.sympify(d["H_c"], locals=names) - TABLE["12321"][0]) == 0
+    assert sympy.expand(sympy.sympify(d["G_c"], locals=names) - TABLE["12321"][1]) == 0
+    assert "H_c =" in cq.to_latex() and cq._repr_latex_().startswith("$")
+
+
+def test_no_invariant_near_H_for_rigid_body():
+    cq = conserved_quantities(model("rigid-body"), "12321")
+    assert cq.H_c is None and cq.G_c is None
+    assert cq.to_dict() == {"H_c": None, "G_c": None}
+
+
+def test_user_system_and_composition_object():
+    from nambu_bch import composition
+
+    ho3 = model("ho3")
+    comp = composition("32123", 3)
+    cq = conserved_quantities(ho3, comp)
+    assert sympy.expand(cq.H_c - TABLE["32123"][0]) == 0
+    S = System("x1 x2 x3", ["x2**2/2 + 2*x3", "x3 - x1**2"], (), name="ho3-numeric")  # m = 1, omega = 2
+    cq = conserved_quantities(S, "12321")
+    assert sympy.expand(cq.G_c - (x3 - x1**2 + h**2 * x2**2 / 4)) == 0
+
+
+@pytest.mark.parametrize("degree", [0, -1, 2.5, "2", True, 99])
+def test_bad_degree(degree):
+    with pytest.raises(InvalidOrderError, match="degree"):
+        conserved_quantities(model("ho3"), "12321", degree=degree)
+
+
+def test_non_polynomial_map():
+    with pytest.raises(NoExactResultError, match="not polynomial"):
+        conserved_quantities(model("lotka-volterra"), "121")
+
+
+def test_bad_word():
+    with pytest.raises(NambuBCHError):
+        conserved_quantities(model("ho3"), "12x21")
