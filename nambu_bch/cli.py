@@ -8,8 +8,9 @@ Synopsis::
     nambu-bch shadow   [SYSTEM] [--integrator WORD] [--order K] [--route direct|fi] [--degree D]
     nambu-bch conserved [SYSTEM] [--integrator WORD]
     nambu-bch exact    [SYSTEM] [--integrator WORD]
-    nambu-bch check    [SYSTEM] [--integrator WORD] [--h H] [--steps N] [--x0 X] [--every K]
-    nambu-bch plot     [--outdir DIR] [--h H] [--steps N] [--x0 X] [--every K]
+    nambu-bch check    [SYSTEM] [--integrator WORD] [--h H] [--steps N] [--x0 X] [--every K] [--order K] [--alpha A]
+    nambu-bch plot     [SYSTEM] [--integrator WORD] [--outdir DIR] [--h H] [--steps N] [--short-steps N]
+                       [--x0 X] [--every K] [--dpi DPI] [--fig-format png|pdf|svg]
 
     SYSTEM is one of   --model NAME                         (built-in; default ho3)
                        --system FILE.toml                   (see nambu_bch.model_file)
@@ -182,7 +183,8 @@ def system_from_args(args):
             raise NambuBCHError(f"--param {extra[0]}: the system of {args.system} has parameters {_list(system.parameters)}")
         if args.split and args.split != system.split:
             system = _with(system, split=args.split)
-        return system, {**file_values, **values}
+        args.file_values = file_values  # numeric defaults for check / plot; not substituted symbolically
+        return system, values
     system = model(args.model or DEFAULT_MODEL)
     extra = [n for n in names if n not in {p.name for p in system.parameters}]
     if extra:
@@ -501,28 +503,29 @@ def cmd_fi(args):
 def numeric_inputs(args, system, values):
     from .integrators import parameter_values
 
-    params = {k: float(v) for k, v in values.items()}
+    params = {k: float(v) for k, v in {**getattr(args, "file_values", {}), **values}.items()}
     parameter_values(system, params)  # raises naming an unknown parameter
     x0 = parse_x0(args.x0, system.N) if args.x0 else [1.0] * system.N
     return params, x0
 
 
 def cmd_check(args):
-    from .numeric import check
+    from .numeric.diagnostics import check
 
     system, values = system_from_args(args)
     word, comp = integrator_from_args(args, system)
     params, x0 = numeric_inputs(args, system, values)
-    report = check(system, comp, args.h, args.steps, x0, params=params, every=args.every)
+    order = args.order if args.order is not None else 2
+    alpha = float(_number(args.alpha, "--alpha")) if args.alpha is not None else 0.5
+    report = check(system, word, args.h, args.steps, x0, params=params, every=args.every, order=order, alpha=alpha)
 
     def data():
-        out = _base(system, word, h=args.h, steps=args.steps, x0=x0, params=params)
+        out = render.system_dict(system)
         out.update(report.to_dict())
         out["model"], out["integrator"] = system.name, word
         return out
 
-    text = getattr(report, "to_text", None)
-    emit(args, text=text, data=data)
+    emit(args, text=lambda: str(report), data=data)
 
 
 def cmd_plot(args):
@@ -532,21 +535,26 @@ def cmd_plot(args):
             os.makedirs(outdir, exist_ok=True)
         except OSError as exc:
             raise NambuBCHError(f"--outdir {outdir}: cannot create the directory ({exc.strerror or exc})") from None
-    kwargs = {}
-    if args.h is not None:
-        kwargs["h"] = args.h
+    system, values = system_from_args(args)
+    if args.integrator is None and system.name == "ho3":
+        args.integrator = "32123"  # the paper's Figs. 1-4
+    word, comp = integrator_from_args(args, system)
+    params, x0 = numeric_inputs(args, system, values)
+    kwargs = {"word": word, "h": args.h, "x0": tuple(x0), "params": params, "system": system, "fmt": args.fig_format}
     if args.steps is not None:
-        kwargs["steps"] = args.steps
-    if args.x0:
-        kwargs["x0"] = parse_x0(args.x0, 3)
+        kwargs["t_long"] = args.steps * args.h
+    if args.short_steps is not None:
+        kwargs["t_short"] = args.short_steps * args.h
     if args.every is not None:
-        kwargs["every"] = args.every
-    from .numeric import paper_figures
+        kwargs["every_long"] = args.every
+    if args.dpi is not None:
+        kwargs["dpi"] = args.dpi
+    from .numeric.figures import paper_figures
 
     files = paper_figures(outdir, **kwargs)
     files = [os.fspath(f) for f in (files.values() if isinstance(files, dict) else files)]
 
-    emit(args, text=lambda: "\n".join(files), data=lambda: {"outdir": outdir, "files": files})
+    emit(args, text=lambda: "\n".join(files), data=lambda: {"outdir": os.fspath(outdir), "files": files})
 
 
 # --------------------------------------------------------------------------------------------
@@ -579,10 +587,10 @@ def _output_options(parser, default, choices=_SYMBOLIC):
 
 
 def _numeric_options(parser, defaults):
-    parser.add_argument("--h", metavar="H", type=str, help=f"step size (default {defaults['h']})")
+    parser.add_argument("--h", metavar="H", type=str, help=f"step size, e.g. 0.1 or 1/20 (default {defaults['h']})")
     parser.add_argument("--steps", metavar="N", type=str, help=f"number of steps (default {defaults['steps']})")
-    parser.add_argument("--x0", metavar="X", help="initial state, comma separated (default 1,1,...,1)")
-    parser.add_argument("--every", metavar="K", type=str, help="sample every K steps (default 1)")
+    parser.add_argument("--x0", metavar="X", help="initial state, comma separated, e.g. 1,1,1 (default 1,...,1)")
+    parser.add_argument("--every", metavar="K", type=str, help=f"sample every K steps (default {defaults['every']})")
 
 
 EXAMPLES = {
@@ -601,8 +609,8 @@ EXAMPLES = {
              "  nambu-bch exact --model ho --integrator TVT",
     "check": "examples:\n  nambu-bch check --integrator 32123 --h 0.1 --steps 100000 --x0 1,1,1\n"
              "  nambu-bch check --model rigid-body --param I1=1 --param I2=2 --param I3=3 --format json",
-    "plot": "examples:\n  nambu-bch plot --outdir figures       # Figs. 1-4 of the paper (Phi^{32123}, h = 0.1)\n"
-            "  nambu-bch plot --outdir /tmp/figs --steps 20000",
+    "plot": "examples:\n  nambu-bch plot --integrator 32123 --outdir figures    # Figs. 1-4 of the paper (h = 0.1)\n"
+            "  nambu-bch plot --integrator 12321 --outdir /tmp/figs --steps 20000 --every 10",
 }
 
 HELP = {
@@ -675,13 +683,19 @@ def build_parser() -> argparse.ArgumentParser:
 
     p = add("check", cmd_check)
     _system_options(p)
-    _integrator_options(p)
-    _numeric_options(p, {"h": 0.1, "steps": 1000})
+    _integrator_options(p, order=True)
+    _numeric_options(p, {"h": 0.1, "steps": 1000, "every": 1})
+    p.add_argument("--alpha", metavar="A", help="value of the family parameter alpha in H_S, G_S (default 1/2)")
     _output_options(p, "text", choices=("text", "json"))
 
     p = add("plot", cmd_plot)
+    _system_options(p)
+    _integrator_options(p)
     p.add_argument("--outdir", metavar="DIR", default=".", help="directory for fig1.png .. fig4.png (default .)")
-    _numeric_options(p, {"h": 0.1, "steps": "the paper's"})
+    _numeric_options(p, {"h": 0.1, "steps": "200000 (t = 20000 at h = 0.1)", "every": 100})
+    p.add_argument("--short-steps", metavar="N", help="steps of the Figs. 1-2 run (default 1000, t = 100 at h = 0.1)")
+    p.add_argument("--dpi", metavar="DPI", help="resolution of the images (default 100)")
+    p.add_argument("--fig-format", choices=("png", "pdf", "svg"), default="png", help="image format (default png)")
     _output_options(p, "text", choices=("text", "json"))
     return parser
 
@@ -693,14 +707,19 @@ def _normalise(args):
     if getattr(args, "degree", None) is not None:
         args.degree = order_value(args.degree, "--degree", limit=12, low=1)
     if hasattr(args, "h"):
-        default_h = 0.1 if args.command == "check" else None
-        args.h = positive_float(args.h, "--h") if args.h is not None else default_h
+        args.h = positive_float(args.h, "--h") if args.h is not None else 0.1
     if hasattr(args, "steps"):
         default_steps = 1000 if args.command == "check" else None
         args.steps = positive_int(args.steps, "--steps", MAX_STEPS) if args.steps is not None else default_steps
     if hasattr(args, "every"):
         default_every = 1 if args.command == "check" else None
         args.every = positive_int(args.every, "--every", MAX_STEPS) if args.every is not None else default_every
+    if getattr(args, "short_steps", None) is not None:
+        args.short_steps = positive_int(args.short_steps, "--short-steps", MAX_STEPS)
+    if getattr(args, "dpi", None) is not None:
+        args.dpi = positive_int(args.dpi, "--dpi", 1200)
+    if getattr(args, "every", None) and getattr(args, "steps", None) and args.every > args.steps:
+        raise NambuBCHError(f"--every {args.every} is larger than --steps {args.steps}")
     for flag in ("integrator", "coords", "name", "model"):
         value = getattr(args, flag, None)
         if value is not None and (not value.strip() or len(value) > 200):
