@@ -220,11 +220,12 @@ def _backward_laurent(engine, comp, order) -> tuple:
                 out[m + k] = out[m + k] + term * scale
         return out
 
+    coefficients = engine.coefficients(comp.coefficients)
     pulled = []
     for x in coords:
         series = [x] + [zero] * top
-        for k, c in reversed(comp.factors()):
-            series = exp_pullback(engine.fields[k].components, engine._coefficient(c), series)
+        for k, c in reversed(list(zip(comp.pieces, coefficients))):
+            series = exp_pullback(engine.fields[k].components, c, series)
         pulled.append(series)
     Z = []
     # U[i][k][m] = [h^m] (hY)^k x_i

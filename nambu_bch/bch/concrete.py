@@ -69,7 +69,11 @@ def effective_field_bch(splitting, comp, order: int = 2, fast: bool = True) -> E
         combine = _combination(algebra)
     Z = []
     for j in range(order + 1):
-        terms = [(c, evaluator.value(tree)) for c, tree in series._terms.get(j + 1, ())]
+        if engine is not None and hasattr(engine, "ring"):
+            pairs = series.domain_terms(j + 1, engine.ring.domain)
+        else:
+            pairs = series.terms(j + 1)
+        terms = [(c, evaluator.value(tree)) for c, tree in pairs]
         Z.append(combine([(c, X) for c, X in terms if X is not None]))
     return EffectiveField(tuple(Z), order, comp, splitting)
 

@@ -27,6 +27,7 @@ reduced explicitly); Horikoshi, Eq. (CL1) (bracket convention).
 from __future__ import annotations
 
 import sympy
+from sympy.polys.constructor import construct_domain
 from sympy.polys.rings import PolyElement, ring
 
 from ..algebra import VectorField
@@ -152,15 +153,27 @@ class FastFields:
             comps.append(self._reduce(total))
         return _Field(comps)
 
+    def coefficients(self, numbers) -> list:
+        """Exact sympy numbers as elements of the ring's domain (algebraic ones via one primitive element)."""
+        K, elems = construct_domain(list(numbers), extension=True)
+        domain = self.ring.domain
+        if K == domain:
+            return list(elems)
+        if K.is_ZZ or K.is_QQ:
+            return [domain.convert_from(e, K) for e in elems]
+        return [self._coefficient(c) for c in numbers]
+
     @staticmethod
     def is_zero(X: _Field) -> bool:
         return not any(X.components)
 
     def _coefficient(self, c):
-        return self.ring.domain.from_sympy(sympy.sympify(c))
+        if isinstance(c, (int, sympy.Basic)):
+            return self.ring.domain.from_sympy(sympy.sympify(c))
+        return c  # already an element of the ring's domain
 
     def combination(self, pairs) -> VectorField:
-        """``sum c X`` (``c`` exact sympy numbers) as a :class:`VectorField` of the original algebra."""
+        """``sum c X`` (``c`` exact sympy numbers or domain elements) as a :class:`VectorField` of the algebra."""
         totals = [self.ring.zero] * self.algebra.n
         for c, X in pairs:
             k = self._coefficient(c)

@@ -36,6 +36,7 @@ from math import comb, factorial, lcm
 import numpy as np
 import sympy
 from sympy.polys.constructor import construct_domain
+from sympy.polys.domains import QQ
 
 from ..errors import InvalidCompositionError, InvalidOrderError
 from ..integrators.composition import Composition
@@ -114,10 +115,16 @@ class _Scalars:
     def is_zero(self, x) -> bool:
         return not x
 
-    def to_sympy(self, numerator, denominator: int):
+    def element(self, numerator, denominator: int):
+        """``numerator / denominator`` in the coefficient field (``QQ`` or the algebraic field ``K``)."""
         if self.K is None:
-            return sympy.Rational(int(numerator), denominator)
-        return self.K.to_sympy(numerator * self.K.convert(sympy.Rational(1, denominator)))
+            return QQ(int(numerator), denominator)
+        return numerator * self.K.convert(sympy.Rational(1, denominator))
+
+    def to_sympy(self, element):
+        if self.K is None:
+            return sympy.Rational(int(element.numerator), int(element.denominator))
+        return self.K.to_sympy(element)
 
 
 def _log_of_product(letters, scalars: _Scalars, g: int, n: int):
@@ -197,6 +204,21 @@ class FormalBCH:
     max_degree: int
     _terms: dict
     _words: dict
+    _domain: object = None
+    _elements: dict = None
+
+    def domain_terms(self, degree: int, domain):
+        """``[(c, tree)]`` with ``c`` an element of the sympy ``domain`` (QQ or an algebraic field).
+
+        Avoids re-deriving algebraic numbers from sympy expressions (a minimal-polynomial
+        computation per coefficient) when the caller works in the same field.
+        """
+        raw = self._elements.get(degree, ()) if self._elements else ()
+        if self._domain is not None and domain == self._domain:
+            return list(raw)
+        if self._domain is None:
+            return [(domain.convert_from(c, QQ), t) for c, t in raw]
+        return [(domain.from_sympy(c), t) for c, t in self.terms(degree)]
 
     def terms(self, degree: int) -> list:
         """``[(coefficient, tree), ...]`` of the degree-``degree`` part, Lyndon words in lexicographic order.
@@ -301,10 +323,11 @@ def formal_bch(comp, max_degree: int, n_pieces: int | None = None) -> FormalBCH:
     letter = {k: i for i, k in enumerate(generators)}
     scalars = _Scalars(comp.coefficients)
     L, dens = _log_of_product([letter[k] for k in comp.pieces], scalars, g, n)
-    terms, words = {}, {}
+    terms, words, elements = {}, {}, {}
     for d in range(1, n + 1):
         coords = _lyndon_coordinates(L[d], d, g)
         if coords:
-            words[d] = tuple((scalars.to_sympy(c, dens[d]), tuple(generators[a] for a in w)) for w, c in coords)
-            terms[d] = tuple((c, standard_bracketing(w, generators)) for (c, _), (w, _) in zip(words[d], coords))
-    return FormalBCH(comp, generators, n, terms, words)
+            elements[d] = tuple((scalars.element(c, dens[d]), standard_bracketing(w, generators)) for w, c in coords)
+            terms[d] = tuple((scalars.to_sympy(c), tree) for c, tree in elements[d])
+            words[d] = tuple((c, tuple(generators[a] for a in w)) for (c, _), (w, _) in zip(terms[d], coords))
+    return FormalBCH(comp, generators, n, terms, words, scalars.K, elements)
