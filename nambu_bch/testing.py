@@ -85,14 +85,22 @@ def liouville_components(coordinates, *hamiltonians) -> tuple:
     return tuple(out)
 
 
+def _zero_or_simplified(expr):
+    """``0`` if ``expr`` vanishes identically, else its simplified form (cheap test first)."""
+    expr = sympy.expand(expr)
+    if expr == 0:
+        return sympy.Integer(0)
+    return sympy.simplify(expr)
+
+
 def _truncate(expr, order):
     """Coefficients of ``h^0 .. h^order`` of ``expr`` (a polynomial in ``h`` or a series)."""
     expr = sympy.expand(expr)
     if expr.is_polynomial(H):
         poly = sympy.Poly(expr, H)
-        return [sympy.simplify(poly.coeff_monomial(H**k)) for k in range(order + 1)]
+        return [_zero_or_simplified(poly.coeff_monomial(H**k)) for k in range(order + 1)]
     series = sympy.series(expr, H, 0, order + 1).removeO()
-    return [sympy.simplify(sympy.expand(series).coeff(H, k)) for k in range(order + 1)]
+    return [_zero_or_simplified(sympy.expand(series).coeff(H, k)) for k in range(order + 1)]
 
 
 def _residual_report(coordinates, residuals, header):
@@ -124,7 +132,7 @@ def assert_fields_equal(X, Y, coordinates=None, msg: str = ""):
     if coordinates is None:
         algebra = getattr(X, "algebra", None) or getattr(Y, "algebra", None)
         coordinates = algebra.coordinates if algebra is not None else sympy.symbols(f"x1:{len(a) + 1}")
-    residuals = [sympy.simplify(u - v) for u, v in zip(a, b)]
+    residuals = [_zero_or_simplified(u - v) for u, v in zip(a, b)]
     if any(r != 0 for r in residuals):
         raise AssertionError(_residual_report(coordinates, residuals, f"{msg}fields differ; residual X - Y:"))
 
