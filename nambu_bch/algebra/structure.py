@@ -30,8 +30,49 @@ def _is_zero(expr) -> bool:
     return expr == 0 or sympy.simplify(expr) == 0
 
 
+def _ring_condition(map_components, coordinates):
+    """Eq. (Condition1) exactly in sparse polynomial rings; ``None`` unless every ``y_i`` is polynomial.
+
+    With ``y_i = P_i / D_i`` (``D_i`` free of the coordinates), ``det dy/dx = {P_1, ..., P_N} / prod D_i``
+    (Eq. NB), so the condition is ``{P_1, ..., P_N} = prod D_i`` in ``QQ[x, parameters]`` -- no rational
+    function arithmetic, which is what makes the sympy determinant slow.
+    """
+    from .brackets import nambu_bracket
+    from .polynomial import PolynomialAlgebra
+
+    ys = [sympy.sympify(y) for y in map_components]
+    others = sorted(set().union(*(y.free_symbols for y in ys)) - set(coordinates), key=str)
+    try:
+        fractions = PolynomialAlgebra(coordinates, parameters=others)
+        flat = PolynomialAlgebra(coordinates, constants=others)
+    except Exception:  # coordinates that are not plain symbols: use the sympy route
+        return None
+    values = [fractions.convert(y) for y in ys]
+    if not all(fractions.is_polynomial(v) for v in values):
+        return None
+    numerators, denominator = [], flat.ring.one
+    for v in values:
+        den = sympy.Integer(1)
+        for c in v.values():
+            den = sympy.lcm(den, sympy.denom(fractions.domain.to_sympy(c)))
+        numerators.append(flat.convert(sympy.expand(fractions.to_sympy(v) * den)))
+        denominator = denominator * flat.convert(den)
+    if not all(flat.is_polynomial(p) for p in numerators + [denominator]):
+        return None
+    return not (nambu_bracket(flat, *numerators) - denominator)
+
+
 def satisfies_nambu_condition(map_components, coordinates) -> bool:
-    """Eq. (Condition1): the map preserves the Nambu bracket (``det dy/dx = 1``)."""
+    """Eq. (Condition1): the map preserves the Nambu bracket (``det dy/dx = 1``).
+
+    Polynomial maps (coefficients rational in the parameters) are checked exactly in a sparse
+    polynomial ring, where the determinant is the Nambu bracket ``{y_1, ..., y_N}``; other maps by sympy.
+    """
+    if len(map_components) != len(coordinates):
+        jacobian(map_components, coordinates)  # raises, naming the mismatch
+    result = _ring_condition(map_components, coordinates)
+    if result is not None:
+        return result
     return _is_zero(jacobian(map_components, coordinates).det(method="berkowitz") - 1)
 
 
