@@ -539,6 +539,20 @@ class TestStructureConditions:
         assert condition1_literal(ys, C3) is expected
         assert satisfies_nambu_condition(ys, C3) is expected
 
+    @pytest.mark.parametrize(
+        "ys, expected",
+        [
+            ([x1 * (m + omega) / m, x2 * m / (m + omega), x3 + h * x1 * x2 / omega], True),
+            ([x1 / m, x2, x3], False),
+            ([x1 + h * x2**2 * x3 / (m * omega), x2 - h * x3 / m**2, x3 + x1 * x2 * omega], False),
+            ([x1 + h * x2**2 * x3 / (m * omega), x2 - h * x3**3 / m**2, x3], True),
+        ],
+    )
+    def test_condition1_parameters_in_denominators(self, ys, expected):
+        """Eq. (Condition1) for maps with rational parameter coefficients (the exact ring route)."""
+        assert satisfies_nambu_condition(ys, C3) is expected
+        assert condition1_literal(ys, C3) is expected
+
     def test_condition1_for_n4(self):
         """det J = 1 in four dimensions: shears pass, a scaling fails."""
         assert satisfies_nambu_condition([x1 + x2 * x3 * x4, x2, x3 + x4**2, x4], X)
