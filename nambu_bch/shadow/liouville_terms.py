@@ -1,0 +1,262 @@
+"""Unevaluated Liouville terms ``c X_{P_1, ..., P_{N-1}}`` and their formal sums.
+
+Two levels:
+
+* :class:`LiouvilleTerm` -- one term ``c X_{P,Q}`` with arbitrary functions in
+  the ``N - 1`` slots (polynomials or any sympy expressions, e.g. generic
+  ``Function`` s), kept unevaluated: antisymmetry (:meth:`canonical` orders the
+  slots, with the sign of the permutation), the vanishing rule
+  (:meth:`vanishes`: ``X_{P,Q} = 0`` iff ``grad P x grad Q = 0``, i.e. iff all
+  ``(N-1)``-minors of the gradients vanish), evaluation on demand
+  (:meth:`field`).
+* :class:`LiouvilleSum` -- a formal sum of terms with *monomial* slots, i.e.
+  the quotient of the span of symbols ``X_{m_1..m_{N-1}}`` by multilinearity
+  (slots are expanded into monomials), antisymmetry and the vanishing rule.
+  For monomials ``m_j = x^{a_j}`` one has ``grad m_j = m_j (a_j / x)``, so the
+  gradients are dependent exactly when the exponent vectors ``a_j`` are
+  linearly dependent: the vanishing rule is a rank test on integer vectors
+  (``X_{A, -2 x_2^2/m^2} = 0`` in Eq. BCH5 because ``A ~ x_2^2``).  This is the
+  bookkeeping of the paper's FI calculation (Eqs. CL5-CL8, BCH5): two formal
+  sums are equal when they are equal *as the paper manipulates them*; equal
+  formal sums give equal fields, not necessarily conversely.
+
+References
+----------
+Horikoshi, Eqs. (gLiouville), (L2), (BCH5) (the rule ``X_{A,-2x_2^2/m^2} = 0``).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from fractions import Fraction
+from functools import lru_cache
+
+import sympy
+from sympy.core.sorting import default_sort_key
+
+from ..algebra import VectorField, liouville_field
+from ..errors import NambuBCHError
+
+
+def _perm_sign(order) -> int:
+    sign, seen = 1, list(order)
+    for i in range(len(seen)):
+        while seen[i] != i:
+            j = seen[i]
+            seen[i], seen[j] = seen[j], seen[i]
+            sign = -sign
+    return sign
+
+
+@dataclass(frozen=True)
+class LiouvilleTerm:
+    """``coefficient * X_{slots}`` kept unevaluated.
+
+    Examples
+    --------
+    >>> import sympy
+    >>> x1, x2, x3, m = sympy.symbols("x1 x2 x3 m")
+    >>> t = LiouvilleTerm((x3, x2**2), 2)
+    >>> t.canonical()
+    LiouvilleTerm(slots=(x2**2, x3), coefficient=-2)
+    >>> LiouvilleTerm((x2**2/(2*m), -2*x2**2/m**2)).vanishes((x1, x2, x3))   # Eq. BCH5
+    True
+    """
+
+    slots: tuple
+    coefficient: object = sympy.Integer(1)
+
+    def __post_init__(self):
+        object.__setattr__(self, "slots", tuple(sympy.sympify(s) for s in self.slots))
+        object.__setattr__(self, "coefficient", sympy.sympify(self.coefficient))
+
+    def __neg__(self):
+        return LiouvilleTerm(self.slots, -self.coefficient)
+
+    def scale(self, c) -> "LiouvilleTerm":
+        return LiouvilleTerm(self.slots, self.coefficient * sympy.sympify(c))
+
+    def canonical(self) -> "LiouvilleTerm":
+        """Slots in sympy's canonical order, the coefficient times the permutation's sign (antisymmetry)."""
+        order = sorted(range(len(self.slots)), key=lambda i: default_sort_key(self.slots[i]))
+        return LiouvilleTerm(tuple(self.slots[i] for i in order), _perm_sign(order) * self.coefficient)
+
+    def vanishes(self, coordinates) -> bool:
+        """``X_{slots} = 0``: every ``(N-1)``-minor of the slots' gradients is zero (exact, sympy)."""
+        if self.coefficient == 0:
+            return True
+        J = sympy.Matrix([[sympy.diff(P, x) for x in coordinates] for P in self.slots])
+        n = len(coordinates)
+        for skip in range(n):
+            cols = [j for j in range(n) if j != skip]
+            if sympy.expand(J[:, cols].det(method="berkowitz")) != 0:
+                return False
+        return True
+
+    def field(self, algebra) -> VectorField:
+        """The concrete field ``coefficient * X_{slots}`` (Eq. gLiouville)."""
+        return liouville_field(algebra, *self.slots).scale(self.coefficient)
+
+    def expand(self, algebra) -> "LiouvilleSum":
+        """The formal monomial sum (polynomial slots only)."""
+        return LiouvilleSum.from_slots(algebra, self.slots, self.coefficient)
+
+    def to_latex(self) -> str:
+        body = "X_{" + ", ".join(sympy.latex(sympy.factor(s)) for s in self.slots) + "}"
+        c = self.coefficient
+        return body if c == 1 else (f"-{body}" if c == -1 else rf"\left({sympy.latex(c)}\right){body}")
+
+    def __str__(self):
+        body = "X_{" + ", ".join(str(sympy.factor(s)) for s in self.slots) + "}"
+        return body if self.coefficient == 1 else f"({self.coefficient})*{body}"
+
+
+@lru_cache(maxsize=None)
+def _dependent(exponents: tuple) -> bool:
+    """Are the integer vectors linearly dependent (exact Gaussian elimination over QQ)?"""
+    rows = [[Fraction(v) for v in e] for e in exponents]
+    r = 0
+    ncols = len(rows[0]) if rows else 0
+    for c in range(ncols):
+        pivot = next((i for i in range(r, len(rows)) if rows[i][c] != 0), None)
+        if pivot is None:
+            continue
+        rows[r], rows[pivot] = rows[pivot], rows[r]
+        for i in range(r + 1, len(rows)):
+            if rows[i][c]:
+                f = rows[i][c] / rows[r][c]
+                rows[i] = [a - f * b for a, b in zip(rows[i], rows[r])]
+        r += 1
+    return r < len(rows)
+
+
+@lru_cache(maxsize=None)
+def canonical_key(monomials: tuple):
+    """``(sign, key)`` of ``X_{x^{a_1}, ..., x^{a_{N-1}}}``: sorted exponents and the sign; ``(0, None)`` if it vanishes."""
+    if len(set(monomials)) < len(monomials) or _dependent(monomials):
+        return 0, None
+    order = sorted(range(len(monomials)), key=lambda i: monomials[i])
+    return _perm_sign(order), tuple(monomials[i] for i in order)
+
+
+def _to_domain(algebra, c):
+    """A number / sympy constant / domain element as an element of the algebra's coefficient domain."""
+    if isinstance(c, (int, sympy.Basic, Fraction)):
+        return algebra.domain.from_sympy(sympy.sympify(c))
+    return algebra.domain.convert(c)
+
+
+class LiouvilleSum:
+    """A formal sum ``sum_k c_k X_{x^{a_k1}, ..., x^{a_k(N-1)}}`` modulo multilinearity, antisymmetry, vanishing.
+
+    Keys are tuples of coordinate exponent vectors in increasing order;
+    coefficients live in the algebra's coefficient domain.
+
+    Examples
+    --------
+    >>> from nambu_bch import model
+    >>> S = model("ho3"); alg = S.algebra
+    >>> (A, C), (B, D) = S.splitting[1].terms[0], S.splitting[2].terms[0]   # Eqs. (hX1), (hX2)
+    >>> LiouvilleSum.from_slots(alg, (A, -2*A)).is_zero()        # antisymmetric part / vanishing
+    True
+    >>> lhs = LiouvilleSum.from_slots(alg, (B + A, C + D))          # X_{H,G}
+    >>> lhs == sum((LiouvilleSum.from_slots(alg, t) for p in S.splitting.pieces for t in p.terms), LiouvilleSum.zero(alg))
+    True
+    """
+
+    __slots__ = ("algebra", "terms")
+
+    def __init__(self, algebra, terms=None):
+        self.algebra = algebra
+        self.terms = {k: v for k, v in (terms or {}).items() if v}
+
+    @classmethod
+    def zero(cls, algebra) -> "LiouvilleSum":
+        return cls(algebra)
+
+    @classmethod
+    def from_slots(cls, algebra, slots, coefficient=1) -> "LiouvilleSum":
+        """Expand ``coefficient * X_{slots}`` multilinearly into canonical monomial terms."""
+        n = algebra.n
+        polys = []
+        for s in slots:
+            p = algebra.convert(s)
+            if not algebra.is_polynomial(p):
+                raise NambuBCHError(f"formal Liouville sums need polynomial slots, got {s}")
+            items = []
+            for mon, c in p.items():
+                if any(mon[n:]):
+                    raise NambuBCHError(f"formal Liouville sums need slots free of {algebra.constants}, got {s}")
+                items.append((mon[:n], c))
+            polys.append(items)
+        coeff = _to_domain(algebra, coefficient)
+        terms: dict = {}
+        cls._expand(polys, 0, (), coeff, terms)
+        return cls(algebra, terms)
+
+    @staticmethod
+    def _expand(polys, i, mons, coeff, out):
+        if i == len(polys):
+            sign, key = canonical_key(mons)
+            if sign:
+                out[key] = out.get(key, 0) + sign * coeff
+            return
+        for mon, c in polys[i]:
+            LiouvilleSum._expand(polys, i + 1, mons + (mon,), coeff * c, out)
+
+    # -- linear structure ---------------------------------------------------------
+    def __add__(self, other):
+        out = dict(self.terms)
+        for k, v in other.terms.items():
+            out[k] = out.get(k, 0) + v
+        return LiouvilleSum(self.algebra, out)
+
+    __radd__ = lambda self, other: self if other == 0 else self.__add__(other)  # noqa: E731  (sum())
+
+    def __neg__(self):
+        return LiouvilleSum(self.algebra, {k: -v for k, v in self.terms.items()})
+
+    def __sub__(self, other):
+        return self + (-other)
+
+    def scale(self, c) -> "LiouvilleSum":
+        c = _to_domain(self.algebra, c)
+        return LiouvilleSum(self.algebra, {k: c * v for k, v in self.terms.items()})
+
+    def is_zero(self) -> bool:
+        return not self.terms
+
+    def __eq__(self, other):
+        if not isinstance(other, LiouvilleSum):
+            return NotImplemented
+        return (self - other).is_zero()
+
+    def __hash__(self):
+        return hash(frozenset(self.terms))
+
+    # -- evaluation and output --------------------------------------------------------
+    def monomial(self, exponents) -> sympy.Expr:
+        return sympy.Mul(*(x**e for x, e in zip(self.algebra.coordinates, exponents)))
+
+    def field(self) -> VectorField:
+        """Evaluate: the concrete vector field ``sum_k c_k X_{...}``."""
+        A = self.algebra
+        total = VectorField.zero(A)
+        for key, c in self.terms.items():
+            total = total + liouville_field(A, *(self.monomial(e) for e in key)).scale(A.domain.to_sympy(c))
+        return total
+
+    def items(self):
+        """``[(sympy coefficient, (sympy monomials...)), ...]`` in canonical order."""
+        to = self.algebra.domain.to_sympy
+        return [(to(self.terms[k]), tuple(self.monomial(e) for e in k)) for k in sorted(self.terms)]
+
+    def to_latex(self) -> str:
+        parts = []
+        for c, mons in self.items():
+            body = "X_{" + ", ".join(sympy.latex(mo) for mo in mons) + "}"
+            parts.append(rf"\left({sympy.latex(c)}\right){body}")
+        return " + ".join(parts) if parts else "0"
+
+    def __repr__(self):
+        return "LiouvilleSum(" + " + ".join(f"({c})*X_{{{', '.join(map(str, mons))}}}" for c, mons in self.items()) + ")"
