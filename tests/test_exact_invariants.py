@@ -11,7 +11,7 @@ import sympy
 
 from nambu_bch import PAPER_WORDS, System, composed_map, liouville_field, model
 from nambu_bch.bch import effective_field
-from nambu_bch.errors import InvalidOrderError, NambuBCHError, NoExactResultError
+from nambu_bch.errors import InvalidOrderError, NambuBCHError
 from nambu_bch.exact import conserved_quantities, is_invariant
 
 x1, x2, x3, m, omega, h = sympy.symbols("x1 x2 x3 m omega h")
@@ -146,9 +146,14 @@ def test_bad_degree(degree):
         conserved_quantities(model("ho3"), "12321", degree=degree)
 
 
-def test_non_polynomial_map():
-    with pytest.raises(NoExactResultError, match="not polynomial"):
-        conserved_quantities(model("lotka-volterra"), "121")
+def test_exponential_map_lotka_volterra():
+    """The Lotka-Volterra pieces X_{x_i, G} conserve G = x1 x2 x3 exactly; no polynomial invariant tends to H."""
+    lv = model("lotka-volterra")
+    cq = conserved_quantities(lv, "121")
+    assert cq.H_c is None
+    assert sympy.expand(cq.G_c - x1 * x2 * x3) == 0
+    assert cq.quantities == (cq.G_c,)
+    assert is_invariant(lv, "121", cq.G_c)
 
 
 def test_bad_word():

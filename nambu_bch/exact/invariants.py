@@ -6,8 +6,11 @@ out), with unknown coefficients ``c_mu`` in the field ``K = QQ(parameters, h)``.
 Substituting the exact composed map (:func:`~nambu_bch.integrators.composed_map`)
 makes ``I(Phi_h(x)) - I(x)`` a polynomial in ``x`` whose coefficients are
 linear in the ``c_mu``; setting them to zero is a linear system over ``K``,
-solved exactly by a ``DomainMatrix`` nullspace.  Its rows span *all*
-invariants of degree ``<= d`` (modulo constants).
+solved exactly by a Gauss-Jordan nullspace over ``K`` (``DomainMatrix``).  Its
+rows span *all* invariants of degree ``<= d`` (modulo constants).  Maps with
+exponentials (Lotka-Volterra) are handled by treating the combined
+exponential of each term as one more generator, which finds ``G = x1 x2 x3``
+there (sound; identities between different exponentials are not used).
 
 Normalisation.  The invariants form a ``K``-vector space ``V`` of dimension
 ``r``, so "the" conserved quantity that tends to ``H`` as ``h -> 0`` is fixed
@@ -74,13 +77,11 @@ class _Setup:
         self.R, *gens = ring(list(self.coords), self.K)
         self.gens = tuple(gens)
         phi = composed_map(system.splitting, comp)
+        self.phi_exprs = tuple(sympy.sympify(e) for e in phi)
         try:
-            self.phi = tuple(self.R.from_expr(sympy.sympify(e)) for e in phi)
-        except Exception as exc:  # CoercionFailed & co: exp(...) flows
-            raise NoExactResultError(
-                f"the composed map of {_word_name(comp)!r} on {system.name} is not polynomial in "
-                f"{[str(c) for c in self.coords]}; polynomial invariants are searched only for polynomial maps"
-            ) from exc
+            self.phi = tuple(self.R.from_expr(e) for e in self.phi_exprs)
+        except Exception:  # CoercionFailed & co: exp(...) flows (Lotka-Volterra), see _exp_images
+            self.phi = None
 
     def monomials(self, degree):
         n = len(self.coords)
@@ -91,10 +92,9 @@ class _Setup:
         return out
 
 
-def _invariant_basis(setup: _Setup, degree: int):
-    """Polynomials (ring elements) spanning the invariants of degree ``1..degree``."""
+def _ring_images(setup: _Setup, monos):
+    """``{monomial: coefficient}`` of ``x^mu(Phi_h(x)) - x^mu`` for each ``mu``, in the sparse ring."""
     R, phi = setup.R, setup.phi
-    monos = setup.monomials(degree)
     powers = [[R.one] for _ in phi]
 
     def power(i, k):
@@ -103,22 +103,68 @@ def _invariant_basis(setup: _Setup, degree: int):
         return powers[i][k]
 
     columns = []
-    rows: dict = {}
-    for col, mu in enumerate(monos):
+    for mu in monos:
         image = R.one
         for i, k in enumerate(mu):
             if k:
                 image = image * power(i, k)
-        diff = image - R({mu: setup.K.one})
-        columns.append(diff)
+        columns.append(dict(image - R({mu: setup.K.one})))
+    return columns
+
+
+def _exp_images(setup: _Setup, monos):
+    """The same for a map with exponentials (Lotka-Volterra): exponential factors are combined per term
+    (``exp(a) exp(b) -> exp(a + b)``) and then treated as independent generators.  A vanishing result is
+    therefore an exact identity (the search is sound); an invariant that needs an identity between
+    different exponentials would be missed."""
+    coords = setup.coords
+    columns = []
+    for mu in monos:
+        image = sympy.Integer(1)
+        for e, k in zip(setup.phi_exprs, mu):
+            image *= e**k
+        diff = sympy.expand(sympy.powsimp(image, combine="exp"), power_exp=False) - sympy.Mul(
+            *[c**k for c, k in zip(coords, mu)])
+        column: dict = {}
+        for term in sympy.Add.make_args(sympy.expand(diff, power_exp=False)):
+            term = sympy.powsimp(term, combine="exp")
+            coeff, xs, exps = sympy.Integer(1), [0] * len(coords), sympy.Integer(1)
+            for f in sympy.Mul.make_args(term):
+                base, e = f.as_base_exp()
+                if base in coords and e.is_Integer:
+                    xs[coords.index(base)] += int(e)
+                elif f.has(*coords):
+                    exps *= f
+                else:
+                    coeff *= f
+            key = (tuple(xs), exps)
+            try:
+                value = setup.K.from_sympy(coeff)
+            except Exception as exc:  # noqa: BLE001 - an exotic coefficient: give up on this map
+                raise NoExactResultError(
+                    f"the composed map on {setup.system.name} is neither polynomial nor a product of "
+                    "exponentials; polynomial invariants are not searched for it"
+                ) from exc
+            column[key] = column.get(key, setup.K.zero) + value
+        columns.append({k: v for k, v in column.items() if v})
+    return columns
+
+
+def _invariant_basis(setup: _Setup, degree: int):
+    """Polynomials (ring elements) spanning the invariants of degree ``1..degree``."""
+    R, phi = setup.R, setup.phi
+    monos = setup.monomials(degree)
+    columns = _ring_images(setup, monos) if phi is not None else _exp_images(setup, monos)
+    rows: dict = {}
+    for diff in columns:
         for m in diff.keys():
             rows.setdefault(m, len(rows))
     if not rows:  # the map is the identity: every monomial is invariant
         return [R({mu: setup.K.one}) for mu in monos]
     mat = [[setup.K.zero] * len(monos) for _ in rows]
     for col, diff in enumerate(columns):
-        for m, c in diff.items():
-            mat[rows[m]][col] = c
+        for key, c in diff.items():
+            mat[rows[key]][col] = c
     return [R({mu: c for mu, c in zip(monos, vec) if c}) for vec in _nullspace(mat, len(monos), setup.K)]
 
 
