@@ -49,7 +49,7 @@ from ..errors import InvalidOrderError, InvalidSystemError, NoExactResultError
 from ..integrators import composed_map, composition
 
 H_STEP = sympy.Symbol("h")
-#: Most candidate pivot sets tried by the normalisation (beyond it only the lowest-degree invariants are used).
+#: Most candidate pivot sets (r-subsets of monomials, in graded order) tried by the normalisation.
 _MAX_CANDIDATES = 4000
 #: Largest ansatz degree accepted (the ansatz has C(N + d, d) unknowns).
 MAX_DEGREE = 8
@@ -186,16 +186,12 @@ def _nullspace(mat, ncols, K):
     return out
 
 
-def _h_regular_limit(K, c):
-    """``(limit at h = 0, ok)`` of an element of ``K = QQ(params, h)``."""
-    num, den = c.numer, c.denom
+def _vanishes_at_h0(K, c) -> bool:
+    """``c`` in ``K = QQ(params, h)`` is regular at ``h = 0`` and vanishes there (``h`` is the last generator)."""
     hidx = len(K.gens) - 1
-    ring_ = num.ring
-    num0 = ring_.from_dict({m: v for m, v in num.items() if m[hidx] == 0})
-    den0 = ring_.from_dict({m: v for m, v in den.items() if m[hidx] == 0})
-    if not den0:
-        return None, False
-    return (num0, den0), True
+    num_at_0 = any(m[hidx] == 0 for m in c.numer.keys())
+    den_at_0 = any(m[hidx] == 0 for m in c.denom.keys())
+    return den_at_0 and not num_at_0
 
 
 def _h_degrees(K, c):
@@ -230,13 +226,7 @@ def _normalise(setup: _Setup, basis, target):
         for c, b in zip(coeffs, basis):
             I = I + b * c
         D = I - T
-        ok = True
-        for c in D.values():
-            lim, regular = _h_regular_limit(K, c)
-            if not regular or lim[0]:
-                ok = False
-                break
-        if not ok or not I:
+        if not I or not all(_vanishes_at_h0(K, c) for c in D.values()):
             continue
         degs = [_h_degrees(K, c) for c in D.values()]
         score = (
@@ -252,7 +242,7 @@ def _normalise(setup: _Setup, basis, target):
 
 
 def _clean(expr):
-    """A readable sympy form: each coefficient factored, collected over monomials."""
+    """The expanded sympy form (what ``to_dict`` prints and ``sympify`` reads back)."""
     return sympy.expand(expr)
 
 

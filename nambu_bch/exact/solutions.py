@@ -42,8 +42,8 @@ from ..errors import NambuBCHError, NoExactResultError, UnstableStepError
 from ..integrators import composition
 from ..integrators.step import parameter_values
 from .exact_shadow import OMEGA, exact_shadow_hamiltonians, frequency
-from .linear_core import linear_core
 from .invariants import conserved_quantities
+from .linear_core import linear_core
 
 H_STEP = sympy.Symbol("h")
 TIME = sympy.Symbol("t")
@@ -206,7 +206,9 @@ class ModifiedSolution:
         return tuple(sympy.sympify(e).subs(subs) for e in self.expressions)
 
 
+@lru_cache(maxsize=64)
 def _lambdify(args, expressions):
+    """One numpy function per (arguments, expressions), reused by every ``numeric()`` call."""
     return sympy.lambdify(args, list(expressions), modules="numpy", cse=True)
 
 
