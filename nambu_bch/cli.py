@@ -478,26 +478,90 @@ def cmd_exact(args):
     emit(args, latex=latex, data=data)
 
 
-def cmd_fi(args):
-    from . import shadow
+FI_LABELS = ("1AX", "1AY", "1BX", "1BY", "2AX", "2AY", "2BX", "2BY")
 
+
+def _system_chosen(args) -> bool:
+    return any((args.model, args.system, args.H, args.G, args.coords, args.param, args.split, args.integrator))
+
+
+def fi_representations(system, comp):
+    """``[(coefficient, (a, b, c), {label: [LiouvilleTerm, ...]})]`` for each non-zero ``h^2`` double commutator.
+
+    The degree-3 part of the formal BCH series (Eq. BCH2) is expanded into Liouville
+    terms with vanishing brackets pruned (Eqs. BCH3, BCH4); each ``[[a, b], c]`` is
+    rewritten ``-[c, [a, b]]``, and each ``[X_a, [X_b, X_c]]`` is represented in the
+    eight ways of Eqs. (1AX)-(2BY), vanishing Liouville terms dropped (as in Eqs. CL5-CL8).
+    """
+    from .bch import expand_terms, formal_bch
+    from .bch.lyndon import is_bracket
+    from .shadow.fundamental_identity import double_commutator_terms, labels
+
+    series = formal_bch(comp, 3)
+    out = []
+    for c, tree in expand_terms(series.terms(3), system.splitting):
+        if is_bracket(tree[1]):
+            a, (b, d) = tree[0], tree[1]
+        else:  # [[a, b], d] = -[d, [a, b]]
+            (a, b), d, c = tree[0], tree[1], -c
+            a, b, d = d, a, b
+        reps = {}
+        for label in labels(len(a)):
+            terms = double_commutator_terms(system.algebra, a, b, d, label, c)
+            reps[label] = [t for t in terms if not t.vanishes(system.coordinates)]
+        out.append((c, (a, b, d), reps))
+    return out
+
+
+def cmd_fi(args):
     system, values = system_from_args(args)
     system = substituted(system, values)
     word, comp = integrator_from_args(args, system)
-    forms = shadow.fi_forms()
-    reps = shadow.fi_representations(system, comp) if args.model or args.system or args.H else None
+    reps = fi_representations(system, comp) if _system_chosen(args) else None
+
+    def slot_latex(slot):
+        return sympy.latex(sympy.factor(slot))
+
+    def commutator_latex(c, abd):
+        a, b, d = ("X_{" + ", ".join(slot_latex(s) for s in t) + "}" for t in abd)
+        return _signed_latex(c).lstrip("+ ") + rf" [{a}, [{b}, {d}]]"
+
+    def terms_latex(terms):
+        if not terms:
+            return "0"
+        return " ".join(("+ " + t.to_latex()) if not t.to_latex().startswith("-") else t.to_latex() for t in terms).lstrip("+ ")
 
     def data():
-        out = {"forms": shadow.fi_forms_dict(forms)}
+        out = {"forms": [{"label": lab, "text": render.fi_form_text(lab), "latex": render.fi_form_latex(lab)} for lab in FI_LABELS]}
         if reps is not None:
-            out = {**_base(system, word), **out, "representations": reps.to_dict()}
+            out = {**_base(system, word), **out}
+            out["representations"] = [
+                {
+                    "coefficient": render.expression(c),
+                    "commutator": [[render.expression(s) for s in t] for t in abd],
+                    "forms": {lab: [{"coefficient": render.expression(t.coefficient), "slots": [render.expression(s) for s in t.slots]}
+                                    for t in terms] for lab, terms in forms.items()},
+                }
+                for c, abd, forms in reps
+            ]
         return out
 
-    def latex():
-        text = shadow.fi_forms_latex(forms)
-        return text if reps is None else text + " \\\\\n" + reps.to_latex()
+    def text():
+        lines = [f"{lab}: {render.fi_form_text(lab)}" for lab in FI_LABELS]
+        for c, abd, forms in reps or ():
+            a, b, d = ("X_{" + ", ".join(str(s) for s in t) + "}" for t in abd)
+            lines.append(f"{c} [{a}, [{b}, {d}]] (h^2 term of {word} on {system.name}):")
+            lines += [f"  {lab}: " + (" + ".join(str(t) for t in terms) or "0") for lab, terms in forms.items()]
+        return "\n".join(lines)
 
-    emit(args, latex=latex, data=data)
+    def latex():
+        rows = [render.fi_form_latex(lab) for lab in FI_LABELS]
+        for c, abd, forms in reps or ():
+            rows.append(r"\text{" + f"{word} on {system.name}" + r"}:\quad h^2\," + commutator_latex(c, abd))
+            rows += [rf"\quad \overset{{\rm {lab}}}{{=}} {terms_latex(terms)}" for lab, terms in forms.items()]
+        return " \\\\\n".join(rows)
+
+    emit(args, latex=latex, text=text, data=data)
 
 
 def numeric_inputs(args, system, values):
@@ -598,8 +662,9 @@ EXAMPLES = {
     "bch": "examples:\n  nambu-bch bch                          # Phi^{12321}, X_eff through h^2 (Eq. BCH2)\n"
            "  nambu-bch bch --model ho --integrator TVT --format text     # Eq. (BCH1)\n"
            "  nambu-bch bch --field --terms          # also Z_j on ho3 and the Liouville terms (Eq. BCH4)",
-    "fi": "examples:\n  nambu-bch fi                           # the eight forms 1AX..2BY\n"
-          "  nambu-bch fi --model ho3 --integrator 12321   # each double commutator of Eq. (BCH4)",
+    "fi": "examples:\n  nambu-bch fi                           # the eight forms 1AX..2BY of [X_AB,[X_CD,X_EF]]\n"
+          "  nambu-bch fi --model ho3 --integrator 12321   # + each h^2 double commutator of Eq. (BCH4) in the\n"
+          "                                                 #   eight forms, vanishing terms dropped (Eqs. CL5-CL8)",
     "shadow": "examples:\n  nambu-bch shadow                       # alpha-family of Phi^{12321}, ho3, order 2 (Eqs. SH12321c, SG12321c)\n"
               "  nambu-bch shadow --integrator 32123 --format json\n"
               "  nambu-bch shadow --model ho --integrator TVT --order 4\n"

@@ -124,3 +124,52 @@ def write_output(text: str, path) -> None:
         except OSError:
             pass
         raise
+
+
+# --------------------------------------------------------------------------------------------
+# the eight fundamental-identity forms, generically (Eqs. 1AX-2BY)
+# --------------------------------------------------------------------------------------------
+def _fi_commutator(left, right, way, sign):
+    """``sign * [X_left, X_right]`` as ``[(sign, slots)]`` with slots as bracket strings (Eqs. CL2a, CL2b)."""
+    base, other, s = (right, left, 1) if way == "a" else (left, right, -1)
+    out = []
+    for j in range(len(base)):
+        slots = list(base)
+        slots[j] = "{" + ",".join([base[j], *other]) + "}"
+        out.append((sign * s, tuple(slots)))
+    return out
+
+
+def fi_form(label: str) -> list:
+    """``[(sign, (slot1, slot2)), ...]`` of ``[X_{A,B}, [X_{C,D}, X_{E,F}]]`` in representation ``label``.
+
+    ``label[0]``: ``1`` uses the fundamental identity on the first term of Eq. (CL2) (Eq. CL2a),
+    ``2`` on the second (Eq. CL2b); ``label[1]`` (``A``/``B``) and ``label[2]`` (``X``/``Y``) make
+    the same choice for Eqs. (CL3) and (CL4).  Slots are strings in the paper's bracket notation.
+
+    >>> [(s, ",".join(t)) for s, t in fi_form("1AX")]     # Eq. (1AX)
+    [(1, '{{E,C,D},A,B},F'), (1, '{E,C,D},{F,A,B}'), (1, '{E,A,B},{F,C,D}'), (1, 'E,{{F,C,D},A,B}')]
+    """
+    if len(label) != 3 or label[0] not in "12" or label[1] not in "AB" or label[2] not in "XY":
+        raise ValueError(f"FI label must be one of 1AX..2BY, got {label!r}")
+    inner = "a" if label[0] == "1" else "b"
+    outer = ("a" if label[1] == "A" else "b", "a" if label[2] == "X" else "b")
+    out = []
+    for (sign, slots), way in zip(_fi_commutator(("C", "D"), ("E", "F"), inner, 1), outer):
+        out.extend(_fi_commutator(("A", "B"), slots, way, sign))
+    return out
+
+
+def fi_form_text(label: str) -> str:
+    terms = fi_form(label)
+    body = " ".join(("+ " if s > 0 else "- ") + "X_{" + ",".join(slots) + "}" for s, slots in terms)
+    return "[X_{A,B},[X_{C,D},X_{E,F}]] = " + body.lstrip("+ ")
+
+
+def fi_form_latex(label: str) -> str:
+    def lx(text):
+        return text.replace("{", r"\{").replace("}", r"\}")
+
+    terms = fi_form(label)
+    body = " ".join(("+ " if s > 0 else "- ") + "X_{" + ",".join(lx(t) for t in slots) + "}" for s, slots in terms)
+    return r"[X_{A,B},[X_{C,D},X_{E,F}]] \overset{\rm " + label + "}{=} " + body.lstrip("+ ")

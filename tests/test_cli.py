@@ -40,7 +40,6 @@ def _has(module, name):
 
 
 needs_shadow = pytest.mark.skipif(not _has("nambu_bch.shadow", "shadow_hamiltonians"), reason="nambu_bch.shadow not landed")
-needs_fi = pytest.mark.skipif(not _has("nambu_bch.shadow", "fi_forms"), reason="FI forms not landed")
 needs_numeric = pytest.mark.skipif(not _has("nambu_bch.numeric.diagnostics", "check"), reason="numeric check not landed")
 needs_plot = pytest.mark.skipif(not _has("nambu_bch.numeric.figures", "paper_figures"), reason="paper_figures not landed")
 
@@ -239,15 +238,45 @@ def test_shadow(tmp_path):
     assert "mine" in text and "H_S" in text
 
 
-@needs_fi
+# Eqs. (1AX)-(2BY), transcribed from the paper's LaTeX source ({} are Nambu brackets).
+PAPER_FI = {
+    "1AX": "+{{E,C,D},A,B},F +{E,C,D},{F,A,B} +{E,A,B},{F,C,D} +E,{{F,C,D},A,B}",
+    "1AY": "+{{E,C,D},A,B},F +{E,C,D},{F,A,B} -{A,E,{F,C,D}},B -A,{B,E,{F,C,D}}",
+    "1BX": "-{A,{E,C,D},F},B -A,{B,{E,C,D},F} +{E,A,B},{F,C,D} +E,{{F,C,D},A,B}",
+    "1BY": "-{A,{E,C,D},F},B -A,{B,{E,C,D},F} -{A,E,{F,C,D}},B -A,{B,E,{F,C,D}}",
+    "2AX": "-{{C,E,F},A,B},D -{C,E,F},{D,A,B} -{C,A,B},{D,E,F} -C,{{D,E,F},A,B}",
+    "2AY": "-{{C,E,F},A,B},D -{C,E,F},{D,A,B} +{A,C,{D,E,F}},B +A,{B,C,{D,E,F}}",
+    "2BX": "+{A,{C,E,F},D},B +A,{B,{C,E,F},D} -{C,A,B},{D,E,F} -C,{{D,E,F},A,B}",
+    "2BY": "+{A,{C,E,F},D},B +A,{B,{C,E,F},D} +{A,C,{D,E,F}},B +A,{B,C,{D,E,F}}",
+}
+
+
+def test_fi_forms_match_the_paper():
+    from nambu_bch.render import fi_form
+
+    for label, text in PAPER_FI.items():
+        got = " ".join(("+" if sign > 0 else "-") + ",".join(slots) for sign, slots in fi_form(label))
+        assert got == text, label
+
+
 def test_fi():
     runs = cli_many(("fi",), ("fi", "--model", "ho3", "--integrator", "12321", "--format", "json"), ("fi", "--format", "text"))
     latex = ok(runs[0])
-    for label in ("1AX", "1AY", "1BX", "1BY", "2AX", "2AY", "2BX", "2BY"):
-        assert label in latex
+    for label in PAPER_FI:
+        assert rf"\overset{{\rm {label}}}" in latex
+    assert "ho3" not in latex  # no system chosen: the generic forms only
     data = json.loads(ok(runs[1]))
-    assert data["model"] == "ho3" and len(data["forms"]) == 8 and data["representations"]
-    assert "2BY" in ok(runs[2])
+    assert data["model"] == "ho3" and [f["label"] for f in data["forms"]] == list(PAPER_FI)
+    assert len(data["representations"]) == 4  # Eq. (BCH4): the non-vanishing h^2 terms
+    names = symbols_of(data)
+    B = m * omega**2 * x3 / 2
+    rep = next(r for r in data["representations"] if r["coefficient"] == "-1/24")  # [X_AC,[X_AC,X_BD]]
+    (term,) = rep["forms"]["1AX"]  # Eq. (CL5), first form: X_{B, -2 x2^2/m^2}
+    assert sympy.sympify(term["coefficient"]) == sympy.Rational(-1, 24)
+    assert [sympy.sympify(s, locals=names) for s in term["slots"]] == [B, -2 * x2**2 / m**2]
+    (term,) = rep["forms"]["2BX"]  # Eq. (CL5), second form: X_{omega^2 x2^2/m, C}
+    assert [sympy.sympify(s, locals=names) for s in term["slots"]] == [omega**2 * x2**2 / m, x3]
+    assert "2BY: [X_{A,B},[X_{C,D},X_{E,F}]] = X_{{A,{C,E,F},D},B}" in ok(runs[2])
 
 
 # --------------------------------------------------------------------------------------------
