@@ -1,20 +1,43 @@
-"""Numeric backend: compiled iteration of splitting integrators, diagnostics, the paper's figures (Sect. 5.5)."""
+"""Numeric backend: compiled iteration of splitting integrators, diagnostics, the paper's figures (Sect. 5.5).
+
+``iterate`` runs a scheme (numba kernels generated once from the exact sub-flows, numpy and
+mpmath fallbacks, optional Kahan summation); ``check`` measures every error the package
+predicts; ``paper_figures`` redraws Figs. 1-4; the studies answer speed-versus-accuracy questions.
+"""
 
 from .codegen import StepProgram, step_program
+from .diagnostics import CheckResult, DriftFit, OrderFit, check, drift_rate, fit_order, observed_order, quantities
+from .figures import paper_figures
 from .iterate import iterate, n_samples, sample_steps, sample_times
 from .kernels import Kernel, cache_dir, kernel, numba_available
 from .progress import Progress
+from .studies import HScan, PrecisionStudy, TruncationStudy, h_scan, precision_study, truncation_study
 
 __all__ = [
+    "CheckResult",
+    "DriftFit",
+    "HScan",
     "Kernel",
+    "OrderFit",
+    "PrecisionStudy",
     "Progress",
     "StepProgram",
+    "TruncationStudy",
     "cache_dir",
+    "check",
+    "drift_rate",
+    "fit_order",
+    "h_scan",
     "iterate",
     "kernel",
     "n_samples",
     "numba_available",
+    "observed_order",
+    "paper_figures",
+    "precision_study",
+    "quantities",
     "sample_steps",
     "sample_times",
     "step_program",
+    "truncation_study",
 ]

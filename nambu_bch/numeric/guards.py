@@ -216,10 +216,34 @@ def _names(kernel, S):
 # -- float64 range -----------------------------------------------------------------------------------------
 
 
+#: States of a batch checked in extended precision (the most extreme ones, see :func:`extreme_states`).
+MAX_CHECKED = 64
+
+
+def extreme_states(X, k=MAX_CHECKED):
+    """Column indices of the most extreme states of ``X`` (N, B) (all of them if ``B <= k``), judged by
+    binary exponents: largest and smallest max-norm, largest and smallest product of magnitudes,
+    smallest non-zero component."""
+    B = X.shape[1]
+    if B <= k:
+        return np.arange(B)
+    E = np.frexp(X)[1]                                   # int32 exponents, 0 for zeros
+    maxe = E.max(axis=0)
+    sume = E.sum(axis=0, dtype=np.int64)
+    mine = np.where(X != 0, E, np.int32(1 << 20)).min(axis=0)
+    picks = [maxe.argmax(), maxe.argmin(), sume.argmax(), sume.argmin(), mine.argmin(), 0, B - 1]
+    return np.unique(np.array(picks, dtype=np.int64))
+
+
 def check_range(kernel, x0, K, max_mpmath=64):
-    """Raise :class:`NumericalRangeError` if one float64 step over- or underflows from ``x0`` (shape (N,) or (N, B))."""
+    """Raise :class:`NumericalRangeError` if one float64 step over- or underflows from ``x0`` (shape (N,) or (N, B)).
+
+    For a batch of more than 64 states only the :func:`extreme_states` are checked; an overflow of
+    any other state is still caught after the run (:func:`check_result`).
+    """
     X = np.asarray(x0, dtype=np.float64)
     X = X.reshape(X.shape[0], -1)
+    X = X[:, extreme_states(X)]
     N, B = X.shape
     out = np.zeros((2, N, B))
     f64 = X.copy()

@@ -45,7 +45,7 @@ from .codegen import python_source, source_hash, step_program
 BACKENDS = ("auto", "numba", "numpy")
 #: States per chunk of a batch: the chunk's arrays stay in L1/L2 while all steps run.
 NUMBA_CHUNK = 256
-NUMPY_CHUNK = 8192
+NUMPY_CHUNK = 16384
 
 
 def cache_dir() -> Path:

@@ -1,0 +1,231 @@
+"""Speed of nambu_bch.numeric.iterate against a C reference loop, measured in one run.
+
+Prints nanoseconds per trajectory-step (best of --repeats) for
+  C (gcc -O2, generated from the same step program)  -- single trajectory and batch,
+  our numba kernel                                   -- single trajectory and batch (--batch states),
+  our numpy fallback                                 -- batch (vectorised) and single (scalar Python loop),
+  a plain Python loop over nambu_bch.integrators.step_function,
+the ratios to C with the targets (single <= 1.5x, batch <= 2x, numpy fallback <= 20x), and the
+kernel compile time (cold: empty cache, in a subprocess) versus loading it from the disk cache.
+
+Usage (from the repository root):
+    python benchmarks/bench_iterate.py                       # ho3, 32123 (Sect. 5.5)
+    python benchmarks/bench_iterate.py --system lotka-volterra --word 12321 --steps 2000000
+    python benchmarks/bench_iterate.py --quick               # smaller sizes, a few seconds
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+
+import numpy as np  # noqa: E402
+
+from nambu_bch import model  # noqa: E402
+from nambu_bch.integrators import step_function  # noqa: E402
+from nambu_bch.numeric import iterate, kernel  # noqa: E402
+from nambu_bch.numeric.kernels import NUMBA_CHUNK, numba_available  # noqa: E402
+
+
+def best(fn, repeats):
+    times = []
+    for _ in range(repeats):
+        start = time.perf_counter()
+        fn()
+        times.append(time.perf_counter() - start)
+    return min(times)
+
+
+COMPILE_SNIPPET = """
+import json, sys, time
+t0 = time.perf_counter()
+from nambu_bch import model
+from nambu_bch.numeric import kernel
+t1 = time.perf_counter()
+k = kernel(model(sys.argv[1]), sys.argv[2])
+t2 = time.perf_counter()
+single = k.compile()
+batch = k.compile(batch=True)
+print(json.dumps({"import": t1 - t0, "generate": t2 - t1, "single": single, "batch": batch}))
+"""
+
+
+def compile_times(system, word):
+    """Cold (empty cache) and warm (cache filled by the cold run) kernel compile/load times, in subprocesses."""
+    root = Path(__file__).resolve().parents[1]
+    env = dict(os.environ, PYTHONPATH=str(root) + os.pathsep + os.environ.get("PYTHONPATH", ""))
+    with tempfile.TemporaryDirectory(prefix="nambu_bch_cache_") as cache:
+        env["NAMBU_BCH_CACHE"] = cache
+        env.pop("NAMBU_BCH_DISABLE_NUMBA", None)
+        out = []
+        for _ in range(2):
+            res = subprocess.run([sys.executable, "-c", COMPILE_SNIPPET, system, word], env=env,
+                                 capture_output=True, text=True, check=True)
+            out.append(json.loads(res.stdout.strip().splitlines()[-1]))
+    return out
+
+
+def main(argv=None):
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--system", default="ho3")
+    ap.add_argument("--word", default="32123")
+    ap.add_argument("--h", type=float, default=0.1)
+    ap.add_argument("--steps", type=int, default=10_000_000, help="steps of the single-trajectory runs")
+    ap.add_argument("--batch", type=int, default=1_000_000, help="states of the batch runs")
+    ap.add_argument("--batch-steps", type=int, default=50)
+    ap.add_argument("--numpy-steps", type=int, default=10, help="steps of the numpy batch run")
+    ap.add_argument("--python-steps", type=int, default=20_000)
+    ap.add_argument("--repeats", type=int, default=5)
+    ap.add_argument("--quick", action="store_true", help="1e6 steps, 1e5 states, 3 repeats")
+    ap.add_argument("--json", action="store_true", help="also print the numbers as one JSON line")
+    ap.add_argument("--no-compile-times", action="store_true")
+    args = ap.parse_args(argv)
+    if args.quick:
+        args.steps, args.batch, args.repeats, args.python_steps = 1_000_000, 100_000, 3, 5_000
+
+    system = model(args.system)
+    N = system.N
+    k = kernel(system, args.word)
+    K = k.constants(args.h)
+    x0 = np.full(N, 0.7)
+    X0 = np.random.default_rng(0).uniform(0.5, 1.5, size=(N, args.batch))
+    print(f"# {system.name} {args.word}: {len(k.program.updates)} sub-flows, ~{k.program.n_operations} flops/step; "
+          f"h = {args.h}; best of {args.repeats}")
+    results = {}
+
+    # -- compile times -------------------------------------------------------------------------------------
+    if numba_available() and not args.no_compile_times:
+        cold, warm = compile_times(args.system, args.word)
+        results["compile_cold_s"] = cold["single"] + cold["batch"]
+        results["compile_warm_s"] = warm["single"] + warm["batch"]
+        print(f"kernel compile (empty cache, single + batch):   {results['compile_cold_s']:.2f} s "
+              f"(code generation {cold['generate']:.2f} s, import {cold['import']:.2f} s)")
+        print(f"kernel load from disk cache (single + batch):   {results['compile_warm_s']:.3f} s")
+
+    # -- C reference ---------------------------------------------------------------------------------------
+    cref = None
+    try:
+        from bench_iterate_c import CReference, c_compiler
+
+        if c_compiler():
+            cref = CReference(k.program)
+    except Exception as exc:  # no compiler, or compilation failed: report and go on
+        print(f"(no C reference: {exc})")
+    if cref is not None:
+        x = x0.copy()
+        X = X0.copy()
+
+        def c_single():
+            x[:] = x0
+            cref.run(x, K, args.steps)
+
+        def c_batch():
+            np.copyto(X, X0)
+            cref.run_batch(X, K, args.batch_steps, NUMBA_CHUNK)
+
+        results["c_single"] = best(c_single, args.repeats) / args.steps
+        results["c_batch"] = best(c_batch, args.repeats) / (args.batch_steps * args.batch)
+        c_final, c_batch_final = x.copy(), X.copy()
+        try:  # the same source with the compiler's best effort, for context (not the target's reference)
+            native = CReference(k.program, flags=("-O3", "-march=native"))
+            results["c_native_single"] = best(lambda: native.run(x0.copy(), K, args.steps), args.repeats) / args.steps
+            results["c_native_batch"] = best(lambda: native.run_batch(X0.copy(), K, args.batch_steps, NUMBA_CHUNK),
+                                             args.repeats) / (args.batch_steps * args.batch)
+            native.close()
+        except Exception as exc:  # pragma: no cover - depends on the compiler
+            print(f"(no -O3 -march=native build: {exc})")
+
+    # -- numba -------------------------------------------------------------------------------------------------
+    if numba_available():
+        iterate(system, args.word, args.h, 10, x0)            # compile / load outside the timing
+        iterate(system, args.word, args.h, 10, X0[:, :10])
+        holder = {}
+        results["numba_single"] = best(lambda: holder.__setitem__(
+            "x", iterate(system, args.word, args.h, args.steps, x0, every=args.steps)), args.repeats) / args.steps
+        results["numba_batch"] = best(lambda: holder.__setitem__(
+            "X", iterate(system, args.word, args.h, args.batch_steps, X0, every=args.batch_steps)),
+            args.repeats) / (args.batch_steps * args.batch)
+        out = np.empty((2, N, args.batch))
+        X = X0.copy()
+
+        def kernel_batch():
+            np.copyto(X, X0)
+            k.run_batch(X, K, args.batch_steps, args.batch_steps, out)
+
+        results["numba_batch_kernel"] = best(kernel_batch, args.repeats) / (args.batch_steps * args.batch)
+        if cref is not None:
+            same_single = np.array_equal(holder["x"][-1], c_final)
+            same_batch = np.array_equal(holder["X"][-1], c_batch_final)
+            print(f"numba == C bit for bit: single {same_single}, batch {same_batch}")
+
+    # -- numpy fallback and plain Python ----------------------------------------------------------------------
+    results["numpy_batch"] = best(lambda: iterate(system, args.word, args.h, args.numpy_steps, X0,
+                                                  every=args.numpy_steps, backend="numpy"),
+                                  args.repeats) / (args.numpy_steps * args.batch)
+    X = X0.copy()
+    out = np.empty((2, N, args.batch))
+
+    def numpy_kernel():
+        np.copyto(X, X0)
+        k.run_batch(X, K, args.numpy_steps, args.numpy_steps, out, backend="numpy")
+
+    results["numpy_batch_kernel"] = best(numpy_kernel, args.repeats) / (args.numpy_steps * args.batch)
+    results["numpy_single_python"] = best(lambda: iterate(system, args.word, args.h, args.python_steps, x0,
+                                                          every=args.python_steps, backend="numpy"),
+                                          max(1, args.repeats // 2)) / args.python_steps
+    step = step_function(system.splitting, args.word)
+
+    def plain():
+        x = x0.copy()
+        for _ in range(args.python_steps // 4):
+            x = step(x, args.h)
+
+    results["plain_python_loop"] = best(plain, max(1, args.repeats // 2)) / (args.python_steps // 4)
+
+    # -- report --------------------------------------------------------------------------------------------------
+    ns = {key: v * 1e9 for key, v in results.items() if not key.startswith("compile")}
+    labels = {
+        "c_single": "C -O2, single trajectory",
+        "c_batch": f"C -O2, batch of {args.batch:.0e}",
+        "numba_single": "numba, single trajectory",
+        "c_native_single": "C -O3 -march=native, single (context)",
+        "c_native_batch": "C -O3 -march=native, batch (context)",
+        "numba_batch": f"numba, batch of {args.batch:.0e} via iterate()",
+        "numba_batch_kernel": f"numba, batch of {args.batch:.0e}, kernel only",
+        "numpy_batch": f"numpy fallback, batch of {args.batch:.0e} via iterate()",
+        "numpy_batch_kernel": f"numpy fallback, batch of {args.batch:.0e}, kernel only",
+        "numpy_single_python": "numpy fallback, single (scalar Python loop)",
+        "plain_python_loop": "plain Python loop over step_function",
+    }
+    print(f"{'':46s} {'ns / trajectory-step':>22s}")
+    for key, label in labels.items():
+        if key in ns:
+            print(f"{label:46s} {ns[key]:22.2f}")
+    print("ratios (target):")
+    checks = [("numba_single", "c_single", 1.5), ("numba_batch", "c_batch", 2.0), ("numba_batch_kernel", "c_batch", 2.0),
+              ("numpy_batch", "c_batch", 20.0), ("numpy_batch_kernel", "c_batch", 20.0),
+              ("numba_single", "c_native_single", None), ("numba_batch_kernel", "c_native_batch", None),
+              ("numpy_single_python", "c_single", None), ("plain_python_loop", "c_single", None)]
+    for a, b, target in checks:
+        if a in ns and b in ns:
+            r = ns[a] / ns[b]
+            verdict = "" if target is None else (f"  (target <= {target:g}: {'met' if r <= target else 'MISSED'})")
+            print(f"  {labels[a]} / {labels[b]}: {r:8.2f}{verdict}")
+    if args.json:
+        print(json.dumps({"system": system.name, "word": args.word, "ns_per_step": ns,
+                          **{k2: v for k2, v in results.items() if k2.startswith("compile")}}))
+    if cref is not None:
+        cref.close()
+
+
+if __name__ == "__main__":
+    main()
