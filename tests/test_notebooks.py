@@ -51,4 +51,4 @@ def test_notebook_executes(path, monkeypatch):
 
 def test_notebooks_present():
     names = {p.stem for p in NOTEBOOKS}
-    assert {"01_hamiltonian_warmup", "03_exact_and_figures", "05_speed_accuracy"} <= names
+    assert {"01_hamiltonian_warmup", "02_fi_route_ho3", "03_exact_and_figures", "04_beyond_the_paper", "05_speed_accuracy"} <= names
