@@ -115,6 +115,28 @@ def test_exponential_flows_use_expm1():
     assert all("expm1" in str(d) for u in prog.updates for _, d in u.increments)
 
 
+def test_generated_c_loop_gives_the_same_bits(tmp_path):
+    """The C reference of the benchmark performs the same operations: bit-identical to the kernels."""
+    import ctypes
+    import shutil
+    import subprocess
+
+    cc = shutil.which("gcc") or shutil.which("cc")
+    if cc is None:
+        pytest.skip("no C compiler")
+    k = kernel(model("ho3"), "32123")
+    (tmp_path / "step.c").write_text(c_source(k.program))
+    subprocess.run([cc, "-O2", "-std=c99", "-shared", "-fPIC", "-o", str(tmp_path / "step.so"), str(tmp_path / "step.c"),
+                    "-lm"], check=True, capture_output=True)
+    lib = ctypes.CDLL(str(tmp_path / "step.so"))
+    dp = ctypes.POINTER(ctypes.c_double)
+    lib.run.argtypes = [dp, dp, ctypes.c_long]
+    K = k.constants(0.1)
+    x = np.array([1.0, 1.0, 1.0])
+    lib.run(x.ctypes.data_as(dp), K.ctypes.data_as(dp), 10_000)
+    assert np.array_equal(x, iterate("ho3", "32123", 0.1, 10_000, [1.0, 1.0, 1.0], every=10_000)[-1])
+
+
 # -- backends -------------------------------------------------------------------------------------------------
 
 

@@ -167,7 +167,7 @@ def iterate(system, word, h, steps, x0, params=None, every=1, *, kahan=False, dp
     segment = steps if not reporter.enabled else max(every, (_SEGMENT_WORK // batch) // every * every)
     done, j = 0, 0
     with reporter, np.errstate(over="ignore", invalid="ignore"):
-        while done < steps or (steps == 0 and j < 0):
+        while done < steps:
             seg = min(segment, steps - done)
             nseg = n_samples(seg, every)
             view = out[j:j + nseg]
