@@ -1,0 +1,28 @@
+"""Shadow Hamiltonians: Liouville-term algebra, the fundamental identity, the FI and direct routes, ``ShadowFamily``."""
+
+from .api import shadow_hamiltonians
+from .direct_route import DirectResult, OrderSolution, direct_route
+from .family import ShadowFamily
+from .fi_route import FICommutator, FIRepresentation, FIResult, fi_route
+from .fundamental_identity import FI_LABELS, commutator_terms, double_commutator_terms, representations
+from .jets import JetAlgebra
+from .liouville_terms import LiouvilleSum, LiouvilleTerm
+
+__all__ = [
+    "FI_LABELS",
+    "DirectResult",
+    "FICommutator",
+    "FIRepresentation",
+    "FIResult",
+    "JetAlgebra",
+    "LiouvilleSum",
+    "LiouvilleTerm",
+    "OrderSolution",
+    "ShadowFamily",
+    "commutator_terms",
+    "direct_route",
+    "double_commutator_terms",
+    "fi_route",
+    "representations",
+    "shadow_hamiltonians",
+]

@@ -139,6 +139,43 @@ def canonical_key(monomials: tuple):
     return _perm_sign(order), tuple(monomials[i] for i in order)
 
 
+class _Context:
+    """Canonical keys (sorted entries, sign) and the vanishing rule for one algebra and atom list."""
+
+    def __init__(self, algebra, atoms):
+        self.algebra, self.atoms = algebra, atoms
+        self.cache: dict = {}
+
+    def key(self, entries):
+        if entries in self.cache:
+            return self.cache[entries]
+        if len(set(entries)) < len(entries):
+            out = (0, None)
+        elif all(kind == 0 for kind, _ in entries):
+            sign, key = canonical_key(tuple(v for _, v in entries))
+            out = (sign, None if key is None else tuple((0, v) for v in key))
+        else:
+            slots = [self.atoms[v] if kind == 1 else sympy.Mul(*(x**e for x, e in zip(self.algebra.coordinates, v)))
+                     for kind, v in entries]
+            if liouville_field(self.algebra, *slots).is_zero():
+                out = (0, None)
+            else:
+                order = sorted(range(len(entries)), key=lambda i: entries[i])
+                out = (_perm_sign(order), tuple(entries[i] for i in order))
+        self.cache[entries] = out
+        return out
+
+
+_CONTEXTS: dict = {}
+
+
+def _context(algebra, atoms) -> _Context:
+    key = (id(algebra), atoms)
+    if key not in _CONTEXTS:
+        _CONTEXTS[key] = _Context(algebra, atoms)
+    return _CONTEXTS[key]
+
+
 def _to_domain(algebra, c):
     """A number / sympy constant / domain element as an element of the algebra's coefficient domain."""
     if isinstance(c, (int, sympy.Basic, Fraction)):
@@ -147,14 +184,23 @@ def _to_domain(algebra, c):
 
 
 class LiouvilleSum:
-    """A formal sum ``sum_k c_k X_{x^{a_k1}, ..., x^{a_k(N-1)}}`` modulo multilinearity, antisymmetry, vanishing.
+    """A formal sum ``sum_k c_k X_{e_k1, ..., e_k(N-1)}`` modulo multilinearity, antisymmetry, vanishing.
 
-    Keys are tuples of coordinate exponent vectors in increasing order;
-    coefficients live in the algebra's coefficient domain.
+    Each slot entry ``e`` is a basis element: a coordinate monomial ``x^a``
+    (key ``(0, a)``) or, optionally, an *atom* -- a named function kept whole,
+    such as a separable piece ``A = x_2^2/(2m)`` of ``H`` (key ``(1, k)``).
+    Atoms keep the bookkeeping of the paper's FI calculation: ``X_{B, x_2^2}``
+    (a piece of ``H`` in the first slot, so it belongs to ``X_{H, dG}``) and
+    ``X_{x_2^2, C}`` (a piece of ``G`` in the second slot) are different formal
+    terms even though ``B`` and ``C`` are both multiples of ``x_3``.  Without
+    atoms every slot is expanded into monomials.  Keys are sorted tuples of
+    entries; coefficients live in the algebra's coefficient domain.
 
     Examples
     --------
+    >>> import sympy
     >>> from nambu_bch import model
+    >>> x2, m, omega = sympy.symbols("x2 m omega")
     >>> S = model("ho3"); alg = S.algebra
     >>> (A, C), (B, D) = S.splitting[1].terms[0], S.splitting[2].terms[0]   # Eqs. (hX1), (hX2)
     >>> LiouvilleSum.from_slots(alg, (A, -2*A)).is_zero()        # antisymmetric part / vanishing
@@ -162,24 +208,35 @@ class LiouvilleSum:
     >>> lhs = LiouvilleSum.from_slots(alg, (B + A, C + D))          # X_{H,G}
     >>> lhs == sum((LiouvilleSum.from_slots(alg, t) for p in S.splitting.pieces for t in p.terms), LiouvilleSum.zero(alg))
     True
+    >>> atoms = (A, B, C, D)
+    >>> LiouvilleSum.from_slots(alg, (B, x2**2), atoms=atoms) == LiouvilleSum.from_slots(alg, (-m*omega**2*x2**2/2, C), atoms=atoms)
+    False
+    >>> LiouvilleSum.from_slots(alg, (B, x2**2)) == LiouvilleSum.from_slots(alg, (-m*omega**2*x2**2/2, C))
+    True
     """
 
-    __slots__ = ("algebra", "terms")
+    __slots__ = ("algebra", "terms", "atoms")
 
-    def __init__(self, algebra, terms=None):
+    def __init__(self, algebra, terms=None, atoms=()):
         self.algebra = algebra
+        self.atoms = tuple(atoms)
         self.terms = {k: v for k, v in (terms or {}).items() if v}
 
     @classmethod
-    def zero(cls, algebra) -> "LiouvilleSum":
-        return cls(algebra)
+    def zero(cls, algebra, atoms=()) -> "LiouvilleSum":
+        return cls(algebra, None, atoms)
 
     @classmethod
-    def from_slots(cls, algebra, slots, coefficient=1) -> "LiouvilleSum":
-        """Expand ``coefficient * X_{slots}`` multilinearly into canonical monomial terms."""
+    def from_slots(cls, algebra, slots, coefficient=1, atoms=()) -> "LiouvilleSum":
+        """Expand ``coefficient * X_{slots}`` multilinearly into canonical terms (slots equal to an atom stay whole)."""
         n = algebra.n
+        atoms = tuple(sympy.sympify(a) for a in atoms)
         polys = []
         for s in slots:
+            s_expr = algebra.to_sympy(s) if algebra.is_polynomial(s) else sympy.sympify(s)
+            if atoms and s_expr in atoms:
+                polys.append([((1, atoms.index(s_expr)), algebra.domain.one)])
+                continue
             p = algebra.convert(s)
             if not algebra.is_polynomial(p):
                 raise NambuBCHError(f"formal Liouville sums need polynomial slots, got {s}")
@@ -187,41 +244,42 @@ class LiouvilleSum:
             for mon, c in p.items():
                 if any(mon[n:]):
                     raise NambuBCHError(f"formal Liouville sums need slots free of {algebra.constants}, got {s}")
-                items.append((mon[:n], c))
+                items.append(((0, mon[:n]), c))
             polys.append(items)
         coeff = _to_domain(algebra, coefficient)
         terms: dict = {}
-        cls._expand(polys, 0, (), coeff, terms)
-        return cls(algebra, terms)
+        context = _context(algebra, atoms)
+        cls._expand(polys, 0, (), coeff, terms, context)
+        return cls(algebra, terms, atoms)
 
     @staticmethod
-    def _expand(polys, i, mons, coeff, out):
+    def _expand(polys, i, entries, coeff, out, context):
         if i == len(polys):
-            sign, key = canonical_key(mons)
+            sign, key = context.key(entries)
             if sign:
                 out[key] = out.get(key, 0) + sign * coeff
             return
-        for mon, c in polys[i]:
-            LiouvilleSum._expand(polys, i + 1, mons + (mon,), coeff * c, out)
+        for entry, c in polys[i]:
+            LiouvilleSum._expand(polys, i + 1, entries + (entry,), coeff * c, out, context)
 
     # -- linear structure ---------------------------------------------------------
     def __add__(self, other):
         out = dict(self.terms)
         for k, v in other.terms.items():
             out[k] = out.get(k, 0) + v
-        return LiouvilleSum(self.algebra, out)
+        return LiouvilleSum(self.algebra, out, self.atoms or other.atoms)
 
     __radd__ = lambda self, other: self if other == 0 else self.__add__(other)  # noqa: E731  (sum())
 
     def __neg__(self):
-        return LiouvilleSum(self.algebra, {k: -v for k, v in self.terms.items()})
+        return LiouvilleSum(self.algebra, {k: -v for k, v in self.terms.items()}, self.atoms)
 
     def __sub__(self, other):
         return self + (-other)
 
     def scale(self, c) -> "LiouvilleSum":
         c = _to_domain(self.algebra, c)
-        return LiouvilleSum(self.algebra, {k: c * v for k, v in self.terms.items()})
+        return LiouvilleSum(self.algebra, {k: c * v for k, v in self.terms.items()}, self.atoms)
 
     def is_zero(self) -> bool:
         return not self.terms
@@ -235,8 +293,12 @@ class LiouvilleSum:
         return hash(frozenset(self.terms))
 
     # -- evaluation and output --------------------------------------------------------
-    def monomial(self, exponents) -> sympy.Expr:
-        return sympy.Mul(*(x**e for x, e in zip(self.algebra.coordinates, exponents)))
+    def monomial(self, entry) -> sympy.Expr:
+        """The function of a slot entry: ``x^a`` for ``(0, a)``, the atom for ``(1, k)``."""
+        kind, value = entry
+        if kind == 1:
+            return self.atoms[value]
+        return sympy.Mul(*(x**e for x, e in zip(self.algebra.coordinates, value)))
 
     def field(self) -> VectorField:
         """Evaluate: the concrete vector field ``sum_k c_k X_{...}``."""

@@ -1,0 +1,402 @@
+"""The direct route: shadow Hamiltonians by an exact linear solve, order by order.
+
+Write ``H_S^a = H^a + sum_{j>=1} h^j dH^a_j`` for the ``N - 1`` Hamiltonians
+(``H, G`` for N = 3; ``H`` alone for N = 2, where ``X_{H_S}`` is Eq. L1).  By
+multilinearity of ``X_{H^1..H^{N-1}}``, the ``h^j`` part of ``X_{H_S^1..}`` is
+
+    sum_a X_{H^1, .., dH^a_j, .., H^{N-1}}  +  (cross terms of lower orders),
+
+the cross terms being the products with two or more corrections, e.g.
+``X_{dH_1, dG_1}`` at ``h^2`` or ``X_{dH_2, dG_2}`` at ``h^4``.  Matching the
+effective field ``X_eff = sum_j h^j Z_j`` (Eq. L2) gives at each order the
+*linear* equation
+
+    L(dH_j, dG_j) := X_{dH_j, G} + X_{H, dG_j} = Z_j - (cross terms)      (*)
+
+for polynomial corrections of degree ``<= D`` (the ansatz degree, chosen from
+the degrees of the right-hand side and of the Hamiltonians, or given).  The
+unknowns are the monomial coefficients; (*) is solved exactly with
+``DomainMatrix`` over ``QQ(parameters)`` (:mod:`nambu_bch.shadow.linear`).
+
+The complete solution space at order ``j`` is a particular solution plus the
+kernel of ``L`` -- the *gauge*: it contains ``(d psi/dG, -d psi/dH)`` for every
+``psi(H, G)`` (and constants), plus whatever else the system allows; it is
+computed, not assumed, and compared with the ``psi`` directions.
+
+The alpha-family (the package's parametrisation, Eq. Xeff3 generalised).  Two
+canonical members are the normal forms of the solution modulo the kernel
+(:func:`~nambu_bch.shadow.linear.normal_form`):
+
+* ``alpha = 0``: the corrections of ``H`` cleared first (constants first, then
+  the monomials of ``H`` itself, lexicographic with ``x_N`` highest, then the
+  other monomials), then those of ``G`` -- the shadow pair with "everything in
+  ``G_S``";
+* ``alpha = 1``: the same with the roles of the slots exchanged (last
+  Hamiltonian cleared first).
+
+The family is ``(1 - alpha) * member_0 + alpha * member_1`` at every order
+(affine combinations of solutions are solutions), with the lower-order family
+fed into the cross terms, so higher orders are solved over ``QQ(params)[alpha]``
+(right-hand sides split by powers of ``alpha``).  For ``ho3`` and ``12321`` this
+is exactly Eqs. (SH12321c), (SG12321c); ``alpha = 0, 1`` give Eqs. (SH12321b),
+(SG12321b) and (SH12321a), (SG12321a).  For N = 2 the kernel is the constants
+and the solution is unique (Eq. SHPV, SHPV1).
+
+When (*) has no solution the result carries a certificate: a left null
+vector ``y`` of ``L`` (``y L = 0``) with ``y (RHS) != 0`` -- a functional on
+vector fields (a combination of monomial coefficients of the components) that
+vanishes on every ``X_{dH,G} + X_{H,dG}`` of the ansatz but not on the
+right-hand side.
+
+References
+----------
+Horikoshi, Eqs. (L1), (L2), (SHPV), (SHPV1), (BCH5), (SH12321a)-(SG12321c),
+(Xeff3); Hairer, Lubich, Wanner, *Geometric Numerical Integration*, Sect. IX.3
+(modified Hamiltonians order by order).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from itertools import product
+
+import sympy
+
+from ..algebra import liouville_field
+from ..bch.backward import check_order
+from ..bch.concrete import effective_field_bch
+from ..errors import InvalidOrderError, NambuBCHError
+from ..integrators.composition import composition as make_composition
+from .linear import kernel_rref, normal_form, rank, solve_affine
+
+H_STEP = sympy.Symbol("h")
+ALPHA = sympy.Symbol("alpha")
+
+
+@dataclass
+class OrderSolution:
+    """The solution of Eq. (*) at one power ``h^order``.
+
+    Attributes
+    ----------
+    order : int
+    status : ``"solved"``, ``"vanishes"`` (zero right-hand side, e.g. odd orders of a
+        symmetric word) or ``"obstructed"``
+    degree : int or None -- the ansatz degree used
+    corrections : tuple of sympy expressions -- the family's ``dH^a_order`` (in ``alpha``)
+    members : (tuple, tuple) -- the ``alpha = 0`` and ``alpha = 1`` members
+    gauge : list of tuples -- a basis of the kernel (one correction per slot), echelon form
+    kernel_dim, psi_dim : int -- dimension of the kernel, and of the part spanned by
+        ``(d psi/dG, -d psi/dH)`` for monomials ``psi = H^p G^q`` (N = 3; ``None`` otherwise)
+    certificate : dict ``{(component, monomial): coefficient}`` or None
+    obstruction_value : sympy expression -- the certificate applied to the right-hand side
+    rhs : VectorField or None -- the right-hand side of Eq. (*)
+    """
+
+    order: int
+    status: str
+    degree: int | None = None
+    corrections: tuple = ()
+    members: tuple = ()
+    gauge: list = field(default_factory=list)
+    kernel_dim: int = 0
+    psi_dim: int | None = None
+    certificate: dict | None = None
+    obstruction_value: object = None
+    rhs: object = None
+
+    @property
+    def extra_gauge_dim(self):
+        """Kernel directions not of the form ``(psi_G, -psi_H)`` (system-specific gauge)."""
+        return None if self.psi_dim is None else self.kernel_dim - self.psi_dim
+
+
+@dataclass
+class DirectResult:
+    """All orders of the direct route for one system and composition."""
+
+    system: object
+    composition: object
+    order: int
+    orders: list
+    hamiltonians: tuple  # ring elements of the Hamiltonians
+    algebra: object
+    effective: object
+    corrections: dict  # (slot, order) -> ring element in alpha
+
+    @property
+    def exists(self) -> bool:
+        return all(o.status != "obstructed" for o in self.orders)
+
+    @property
+    def failed_order(self):
+        return next((o.order for o in self.orders if o.status == "obstructed"), None)
+
+    def shadow(self, upto=None) -> tuple:
+        """``(H_S, G_S, ...)`` as sympy expressions in ``h`` and ``alpha`` through ``h^upto``."""
+        upto = self.order if upto is None else upto
+        out = []
+        for a, Ha in enumerate(self.hamiltonians):
+            total = self.algebra.to_sympy(Ha)
+            for j in range(1, upto + 1):
+                c = self.corrections.get((a, j))
+                if c:
+                    total += H_STEP**j * self.algebra.to_sympy(c)
+            out.append(sympy.expand(total))
+        return tuple(out)
+
+
+def _monomials(n, degree):
+    mons = [e for e in product(range(degree + 1), repeat=n) if sum(e) <= degree]
+    # lexicographic with x_N highest, highest degree first (the priority order of normal forms)
+    return sorted(mons, key=lambda e: (tuple(reversed(e))), reverse=True)
+
+
+def _lift(alg, value):
+    """A ring element of the effective field's algebra as an element of ``alg`` (which has the extra ``alpha``)."""
+    if not hasattr(value, "ring"):
+        raise NambuBCHError(f"the direct route needs a polynomial effective field, got the component {value}")
+    pad = (0,) * (len(alg.gens) - len(value.ring.gens))
+    return alg.ring.from_dict({m + pad: alg.domain.convert(c) for m, c in value.items()})
+
+
+def _total_degree(p, n):
+    return max((sum(m[:n]) for m in p.keys()), default=-1)
+
+
+class _Solver:
+    def __init__(self, system, comp, order, degree):
+        self.system = system
+        self.comp = comp
+        self.order = order
+        self.degree = degree
+        splitting = system.splitting
+        self.effective = effective_field_bch(splitting, comp, order)
+        alg0 = self.effective[0].algebra
+        self.alg = alg = alg0.with_constants(ALPHA)
+        self.n = alg.n
+        self.alpha_index = len(alg.gens) - 1
+        hams = []
+        for Hk in system.hamiltonians:
+            p = alg.convert(Hk)
+            if not alg.is_polynomial(p):
+                raise NambuBCHError(f"the direct route needs polynomial Hamiltonians, got {Hk}")
+            hams.append(p)
+        self.hams = tuple(hams)
+        self.slots = len(hams)
+        self.gdeg = [_total_degree(p, self.n) - 1 for p in hams]
+        self._columns: dict = {}
+
+    # -- fields ------------------------------------------------------------------
+    def _field(self, slots):
+        return liouville_field(self.alg, *slots)
+
+    def _column_field(self, a, mono):
+        key = (a, mono)
+        if key not in self._columns:
+            m = self.alg.ring.from_dict({mono + (0,) * (len(self.alg.gens) - self.n): self.alg.domain.one})
+            slots = list(self.hams)
+            slots[a] = m
+            self._columns[key] = self._field(slots).components
+        return self._columns[key]
+
+    def _cross(self, j, corrections):
+        """``sum`` over assignments of lower orders to two or more slots (the cross terms at ``h^j``)."""
+        total = None
+        for orders in product(range(j), repeat=self.slots):
+            if sum(orders) != j or sum(1 for o in orders if o) < 2:
+                continue
+            slots = []
+            for a, o in enumerate(orders):
+                if o == 0:
+                    slots.append(self.hams[a])
+                else:
+                    c = corrections.get((a, o))
+                    if not c:
+                        break
+                    slots.append(c)
+            else:
+                X = self._field(slots)
+                total = X if total is None else total + X
+        return total
+
+    def _needed_degree(self, rhs_deg):
+        sums = [sum(g for b, g in enumerate(self.gdeg) if b != a) for a in range(self.slots)]
+        return max(1, max(rhs_deg + 1 - s for s in sums)), max(sums)
+
+    def _priority(self, columns, slot_order):
+        index = {c: k for k, c in enumerate(columns)}
+        zero = tuple([0] * self.n)
+        out = [index[(a, zero)] for a in range(self.slots) if (a, zero) in index]
+        for a in slot_order:
+            own = [m[: self.n] for m in self.hams[a].keys()]
+            own = sorted(set(own), key=lambda e: tuple(reversed(e)), reverse=True)
+            out += [index[(a, e)] for e in own if (a, e) in index and index[(a, e)] not in out]
+            out += [index[c] for c in columns if c[0] == a and index[c] not in out]
+        return out
+
+    # -- one order -----------------------------------------------------------------
+    def solve_order(self, j, corrections) -> OrderSolution:
+        alg = self.alg
+        Z = self.effective[j]
+        comps = [_lift(alg, c) for c in Z.components]
+        cross = self._cross(j, corrections)
+        if cross is not None:
+            comps = [c - x for c, x in zip(comps, cross.components)]
+        from ..algebra import VectorField
+
+        rhs = VectorField(alg, comps)
+        if all(not c for c in comps):
+            return OrderSolution(j, "vanishes", corrections=(sympy.Integer(0),) * self.slots, rhs=rhs)
+        rhs_deg = max(_total_degree(c, self.n) for c in comps)
+        needed, reach = self._needed_degree(rhs_deg)
+        D = self.degree if self.degree is not None else needed
+        if D - 1 + reach < rhs_deg:
+            raise InvalidOrderError(
+                f"ansatz degree {D} cannot match the h^{j} field of degree {rhs_deg} "
+                f"(corrections need degree >= {needed}); pass degree >= {needed} or None"
+            )
+        monos = _monomials(self.n, D)
+        columns = [(a, e) for a in range(self.slots) for e in monos]
+        row_index: dict = {}
+
+        def row(i, mono):
+            key = (i, mono)
+            if key not in row_index:
+                row_index[key] = len(row_index)
+            return row_index[key]
+
+        col_vectors = []
+        for a, e in columns:
+            vec = {}
+            for i, comp in enumerate(self._column_field(a, e)):
+                for m, c in comp.items():
+                    vec[row(i, m[: self.n])] = c
+            col_vectors.append(vec)
+        by_power: dict = {}
+        for i, comp in enumerate(comps):
+            for m, c in comp.items():
+                k = m[self.alpha_index]
+                by_power.setdefault(k, {})
+                r = row(i, m[: self.n])
+                by_power[k][r] = by_power[k].get(r, alg.domain.zero) + c
+        powers = sorted(by_power)
+        domain = alg.domain
+        sol = solve_affine(col_vectors, [by_power[k] for k in powers], len(row_index), domain)
+        if not sol.consistent:
+            inverse = {v: k for k, v in row_index.items()}
+            cert = {}
+            for r, v in sol.certificate.items():
+                i, mono = inverse[r]
+                cert[(alg.coordinates[i], self._mono_expr(mono))] = domain.to_sympy(v)
+            value = sum(
+                (domain.to_sympy(sum((v * by_power[k].get(r, domain.zero) for r, v in sol.certificate.items()), domain.zero)) * ALPHA**k
+                 for k in powers),
+                sympy.Integer(0),
+            )
+            return OrderSolution(j, "obstructed", degree=D, certificate=cert, obstruction_value=sympy.factor(value),
+                                 kernel_dim=len(sol.kernel), rhs=rhs)
+        prio0 = self._priority(columns, list(range(self.slots)))
+        prio1 = self._priority(columns, list(reversed(range(self.slots))))
+        members = []
+        for prio in (prio0, prio1):
+            member = [normal_form(p, sol.kernel, prio, domain) for p in sol.particular]
+            members.append(member)
+        # family = (1 - alpha) member0 + alpha member1, each member a polynomial in alpha
+        fam = [alg.zero for _ in range(self.slots)]
+        mem_polys = []
+        for member in members:
+            polys = [alg.zero for _ in range(self.slots)]
+            for k, vec in zip(powers, member):
+                for col, v in vec.items():
+                    a, e = columns[col]
+                    polys[a] += alg.ring.from_dict({e + (0,) * (len(alg.gens) - self.n - 1) + (k,): v})
+            mem_polys.append(polys)
+        one_minus = alg.convert(1 - ALPHA)
+        al = alg.convert(ALPHA)
+        for a in range(self.slots):
+            fam[a] = one_minus * mem_polys[0][a] + al * mem_polys[1][a]
+        for a in range(self.slots):
+            corrections[(a, j)] = fam[a]
+        gauge_vecs = kernel_rref(sol.kernel, prio0, domain)
+        gauge = [self._vector_to_slots(v, columns) for v in gauge_vecs]
+        psi_dim = self._psi_dim(columns, D, sol.kernel) if self.slots == 2 else None
+        return OrderSolution(
+            j, "solved", degree=D, corrections=tuple(alg.to_sympy(f) for f in fam),
+            members=tuple(tuple(alg.to_sympy(p) for p in polys) for polys in mem_polys),
+            gauge=gauge, kernel_dim=len(sol.kernel), psi_dim=psi_dim, rhs=rhs,
+        )
+
+    def _mono_expr(self, mono):
+        return sympy.Mul(*(x**e for x, e in zip(self.alg.coordinates, mono)))
+
+    def _vector_to_slots(self, vec, columns):
+        out = [sympy.Integer(0)] * self.slots
+        for col, v in vec.items():
+            a, e = columns[col]
+            out[a] += self.alg.domain.to_sympy(v) * self._mono_expr(e)
+        return tuple(out)
+
+    def _psi_dim(self, columns, D, kernel):
+        """Rank of ``{(psi_G, -psi_H) : psi = H^p G^q}`` within the ansatz (they lie in the kernel)."""
+        alg = self.alg
+        Hp, Gp = self.hams
+        index = {c: k for k, c in enumerate(columns)}
+        vecs = []
+        for p in range(D + 2):
+            for q in range(D + 2):
+                if p + q == 0:
+                    continue
+                dG = q * Hp**p * Gp ** (q - 1) if q else alg.zero  # d psi / dG
+                dH = p * Hp ** (p - 1) * Gp**q if p else alg.zero  # d psi / dH
+                pair = (dG, -dH)
+                vec, ok = {}, True
+                for a, poly in enumerate(pair):
+                    for m, c in poly.items():
+                        col = index.get((a, m[: self.n]))
+                        if col is None or any(m[self.n:]):
+                            ok = False
+                            break
+                        vec[col] = c
+                    if not ok:
+                        break
+                if ok and vec:
+                    vecs.append(vec)
+        return rank(vecs, len(columns), alg.domain) if vecs else 0
+
+
+def direct_route(system, word, order: int = 2, degree=None) -> DirectResult:
+    """Solve ``X_{H_S,G_S} = X_eff + O(h^{order+1})`` order by order (Eq. L2; Eq. L1 for N = 2).
+
+    Parameters
+    ----------
+    system : System
+    word : composition spec (``"12321"``, ``"lie-trotter"``, ``Composition`` ...)
+    order : int -- highest power of ``h`` kept
+    degree : int, optional -- ansatz degree of the corrections (default: from the field)
+
+    Returns
+    -------
+    DirectResult -- stops at the first obstructed order.
+
+    Examples
+    --------
+    >>> from nambu_bch import model
+    >>> R = direct_route(model("ho"), "121", order=2)        # Eq. (SHPV1)
+    >>> sympy.expand(R.shadow()[0] - model("ho").H)
+    h**2*m*omega**4*x1**2/12 - h**2*omega**2*x2**2/(24*m)
+    """
+    order = check_order(order)
+    if degree is not None:
+        if isinstance(degree, bool) or not isinstance(degree, int) or degree < 1:
+            raise InvalidOrderError(f"degree must be a positive integer (the ansatz degree) or None, got {degree!r}")
+    comp = make_composition(word, len(system.splitting)).check(system.splitting)
+    solver = _Solver(system, comp, order, degree)
+    corrections: dict = {}
+    orders = []
+    for j in range(1, order + 1):
+        sol = solver.solve_order(j, corrections)
+        orders.append(sol)
+        if sol.status == "obstructed":
+            break
+    return DirectResult(system, comp, order, orders, solver.hams, solver.alg, solver.effective, corrections)

@@ -1,0 +1,152 @@
+"""``ShadowFamily``: the result of a shadow-Hamiltonian computation, with text / LaTeX / JSON output.
+
+A family is ``H_S(h, alpha), G_S(h, alpha)`` with ``X_{H_S,G_S} = X_eff + O(h^{order+1})``
+(Eq. L2; ``X_{H_S}``, Eq. L1, for N = 2), the free parameter(s) of the
+parametrisation (``alpha`` of Eq. Xeff3), the remaining gauge directions per
+order, and -- when no shadow pair exists -- the failed order, the ansatz
+degree tried and a certificate of the obstruction.
+
+References
+----------
+Horikoshi, Eqs. (L1), (L2), (SH12321c), (SG12321c), (Xeff3).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import sympy
+
+H_STEP = sympy.Symbol("h")
+
+
+def _collect(expr):
+    return sympy.collect(sympy.expand(expr), H_STEP, evaluate=True)
+
+
+def _latex(expr) -> str:
+    expr = sympy.expand(expr)
+    parts = sympy.collect(expr, H_STEP, evaluate=False)
+    keys = sorted(parts, key=lambda k: sympy.degree(k, H_STEP) if k != 1 else 0)
+    out = []
+    for k in keys:
+        body = sympy.factor_terms(parts[k])
+        if k == 1:
+            out.append(sympy.latex(body))
+        else:
+            out.append(sympy.latex(k) + r"\left(" + sympy.latex(body) + r"\right)")
+    return " + ".join(out) if out else "0"
+
+
+@dataclass
+class ShadowFamily:
+    """Shadow Hamiltonians of a composition on a system, as a family.
+
+    Attributes
+    ----------
+    system, composition
+    order : int -- highest power of ``h`` kept
+    route : ``"direct"`` or ``"fi"``
+    exists : bool
+    shadows : tuple -- all shadow Hamiltonians ``(H_S, G_S, ...)`` (sympy, in ``h`` and ``alpha``), or ``()``
+    free_parameters : list of str -- e.g. ``["alpha"]``
+    gauge : dict ``order -> [directions]`` -- kernel bases (one correction per Hamiltonian)
+    corrections : dict ``order -> tuple`` -- the family's ``dH_j, dG_j``
+    degree : dict ``order -> int`` -- ansatz degrees used
+    notes : list of str -- e.g. vanishing odd orders
+    failed_order, certificate, obstruction -- set when ``exists`` is false
+    details : the route's own result (``DirectResult`` or ``FIResult``)
+    """
+
+    system: object
+    composition: object
+    order: int
+    route: str
+    exists: bool
+    shadows: tuple = ()
+    free_parameters: list = field(default_factory=list)
+    gauge: dict = field(default_factory=dict)
+    corrections: dict = field(default_factory=dict)
+    degree: dict = field(default_factory=dict)
+    notes: list = field(default_factory=list)
+    failed_order: int | None = None
+    certificate: dict | None = None
+    obstruction: str | None = None
+    details: object = None
+
+    @property
+    def H_S(self):
+        """The first shadow Hamiltonian (``None`` if none exists)."""
+        return self.shadows[0] if self.shadows else None
+
+    @property
+    def G_S(self):
+        """The second shadow Hamiltonian (``None`` for N = 2 or if none exists)."""
+        return self.shadows[1] if len(self.shadows) > 1 else None
+
+    def member(self, **values) -> tuple:
+        """The shadow Hamiltonians at given parameter values, e.g. ``member(alpha=1)`` (Eq. SH12321a)."""
+        subs = {sympy.Symbol(k): sympy.sympify(v) for k, v in values.items()}
+        return tuple(sympy.expand(S.subs(subs)) for S in self.shadows)
+
+    # -- output ------------------------------------------------------------------
+    def _names(self):
+        k = len(self.system.hamiltonians)
+        if k == 1:
+            return ["H"]
+        if k == 2:
+            return ["H", "G"]
+        return [f"H_{{{a + 1}}}" for a in range(k)]
+
+    def to_latex(self) -> str:
+        """``H_S = ... + O(h^{order+1})`` (and ``G_S``), or the obstruction."""
+        tail = rf" + O(h^{{{self.order + 1}}})"
+        if not self.exists:
+            return rf"\text{{no polynomial shadow Hamiltonians: {self.obstruction}}}"
+        lines = []
+        for name, S in zip(self._names(), self.shadows):
+            lines.append(rf"{name}_{{S}} = {_latex(S)}{tail}")
+        return ",\\\\\n".join(lines)
+
+    def _repr_latex_(self):
+        return "$$" + self.to_latex().replace(",\\\\\n", r",\quad ") + "$$"
+
+    def to_dict(self) -> dict:
+        """JSON-ready dict (DESIGN.md): expressions as strings ``sympy.sympify`` reads back."""
+        sys_ = self.system
+        out = {
+            "model": sys_.name,
+            "integrator": self.composition.name,
+            "order": self.order,
+            "coordinates": [str(x) for x in sys_.coordinates],
+            "H": str(sys_.H),
+            "G": None if sys_.G is None else str(sys_.G),
+            "exists": self.exists,
+            "H_S": None if self.H_S is None else str(self.H_S),
+            "G_S": None if self.G_S is None else str(self.G_S),
+            "free_parameters": list(self.free_parameters),
+            "route": self.route,
+        }
+        if len(self.shadows) > 2:
+            out["shadows"] = [str(S) for S in self.shadows]
+        if not self.exists:
+            out["obstruction"] = self.obstruction
+            out["failed_order"] = self.failed_order
+            out["degree"] = self.degree.get(self.failed_order)
+        if self.notes:
+            out["notes"] = list(self.notes)
+        return out
+
+    def to_text(self) -> str:
+        if not self.exists:
+            return f"no polynomial shadow Hamiltonians for {self.composition.name} on {self.system.name}: {self.obstruction}"
+        lines = [f"{n}_S = {_collect(S)} + O(h^{self.order + 1})" for n, S in zip(["H", "G"] + [f"H{a}" for a in range(3, 9)], self.shadows)]
+        if self.free_parameters:
+            lines.append("free parameters: " + ", ".join(self.free_parameters))
+        lines += self.notes
+        return "\n".join(lines)
+
+    def __repr__(self):
+        state = "exists" if self.exists else f"obstructed at h^{self.failed_order}"
+        return (f"ShadowFamily({self.system.name!r}, {self.composition.name!r}, order={self.order}, route={self.route!r}, "
+                f"{state}, free_parameters={self.free_parameters})")
