@@ -244,6 +244,14 @@ class TestBracketLaws:
         F, G = ALG3.convert(f), ALG3.convert(g)
         assert ALG3.is_zero(nb3(f * g, b, c) - F * nb3(g, b, c) - G * nb3(f, b, c))
 
+    @SETTINGS
+    @given(polynomials(4, max_degree=2), polynomials(4, max_degree=2), polynomials(4, max_degree=2),
+           polynomials(4, max_degree=2), polynomials(4, max_degree=2))
+    def test_nambu_leibniz_n4(self, f, g, b, c, d):
+        F, G = ALG4.convert(f), ALG4.convert(g)
+        nb4 = lambda *fs: nambu_bracket(ALG4, *fs)  # noqa: E731
+        assert ALG4.is_zero(nb4(f * g, b, c, d) - F * nb4(g, b, c, d) - G * nb4(f, b, c, d))
+
     @settings(deadline=None, max_examples=20)
     @given(polynomials(3, max_terms=3), polynomials(3, max_terms=3), polynomials(3, max_terms=3),
            polynomials(3, max_terms=3), polynomials(3, max_terms=3))
