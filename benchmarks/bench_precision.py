@@ -78,7 +78,7 @@ def main(argv=None):
           f"{args.truncation_steps} steps (sampled every 100)")
     start = time.perf_counter()
     tr = truncation_study(args.system, args.word, orders, args.h, args.truncation_steps, every=100)
-    print(f"source: {tr.source}")
+    print(f"source: {tr.source} (bch = nambu_bch.shadow.shadow_hamiltonians; exact-series = series of F^alpha H_c, F^(1-alpha) G_c)")
     print(table(tr.rows()))
     print(f"({time.perf_counter() - start:.1f} s)\n")
     out["truncation"] = tr.to_dict()

@@ -154,12 +154,17 @@ class TruncationStudy:
     derive_seconds: list
     max_abs_error: dict
     drift_rate: dict
-    source: str
+    sources: list
+
+    @property
+    def source(self) -> str:
+        """Where the shadow Hamiltonians came from (one line; per order in :meth:`rows`)."""
+        return "; ".join(sorted(set(self.sources)))
 
     def rows(self) -> list:
         out = []
         for j, k in enumerate(self.orders):
-            row = {"order": k, "derive_seconds": _finite(self.derive_seconds[j])}
+            row = {"order": k, "derive_seconds": _finite(self.derive_seconds[j]), "source": self.sources[j]}
             for name in self.max_abs_error:
                 row[f"max|d{name}|"] = _finite(self.max_abs_error[name][j])
                 row[f"drift({name})"] = _finite(self.drift_rate[name][j])
@@ -176,9 +181,10 @@ def truncation_study(system="ho3", word="32123", orders=(2, 4, 6, 8), h=0.1, ste
     """Cost and residual drift of the truncated shadow Hamiltonians for each order ``k``.
 
     The shadow Hamiltonians come from :func:`nambu_bch.shadow.shadow_hamiltonians` (the BCH
-    route, timed on its first call in this process); where that is not available, from the
-    series of the exact ones (:meth:`nambu_bch.exact.ExactShadow.series`), and ``source``
-    says which.  One run of ``steps`` steps (sampled every ``every``) serves all orders.
+    route, timed on its first call in this process; ``source`` ``"bch"``); where that is not
+    available or finds none, from the series of the exact ones
+    (:meth:`nambu_bch.exact.ExactShadow.series`, ``source`` ``"exact-series"``).  One run of
+    ``steps`` steps (sampled every ``every``) serves all orders.
 
     Returns
     -------
@@ -193,11 +199,10 @@ def truncation_study(system="ho3", word="32123", orders=(2, 4, 6, 8), h=0.1, ste
     values = parameter_values(system, params)
     subs = {**{p: sympy.Float(v, 60) for p, v in values.items()}, sympy.Symbol("h"): sympy.Float(float(h), 60),
             sympy.Symbol("alpha"): sympy.Float(float(alpha), 60)}
-    derive, errs, drifts = [], {}, {}
-    source = "nambu_bch.shadow.shadow_hamiltonians"
+    derive, errs, drifts, sources = [], {}, {}, []
     for k in orders:
         start = time.perf_counter()
-        exprs = {}
+        exprs, source = None, "bch"
         try:
             from ..shadow import shadow_hamiltonians
 
@@ -207,17 +212,20 @@ def truncation_study(system="ho3", word="32123", orders=(2, 4, 6, 8), h=0.1, ste
                 exprs = {"H_S": fam.H_S, "G_S": getattr(fam, "G_S", None)}
                 exprs = {n: sympy.sympify(e).xreplace(free) for n, e in exprs.items() if e is not None}
         except (ImportError, NambuBCHError):
+            exprs = None
+        if exprs is None:  # BCH route unavailable (or no shadow Hamiltonian): the exact family's series
             from ..exact import exact_shadow_hamiltonians
 
-            source = "nambu_bch.exact.exact_shadow_hamiltonians(...).series(k) (BCH route unavailable)"
+            source = "exact-series"
             H_S, G_S = exact_shadow_hamiltonians(system, word).series(k)
             exprs = {n: e for n, e in (("H_S", H_S), ("G_S", G_S)) if e is not None}
         derive.append(time.perf_counter() - start)
+        sources.append(source)
         exprs = {n: e.xreplace(subs) for n, e in exprs.items()}
         for name, series in errors_along(samples, exprs, system.coordinates).items():
             errs.setdefault(name, []).append(float(np.max(np.abs(series))))
             drifts.setdefault(name, []).append(drift_rate(t, series).rate)
-    return TruncationStudy(system.name, str(word), float(h), int(steps), list(orders), derive, errs, drifts, source)
+    return TruncationStudy(system.name, str(word), float(h), int(steps), list(orders), derive, errs, drifts, sources)
 
 
 # -- arithmetic ----------------------------------------------------------------------------------------------------
