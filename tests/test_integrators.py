@@ -474,6 +474,17 @@ def test_condition1_rigid_body_all_words(rigid_body, word):
     assert satisfies_nambu_condition(ys, rigid_body.coordinates)
 
 
+@pytest.mark.parametrize("word", ["12321", "123"])
+def test_condition1_literal_epsilon_identity(ho3, word):
+    """Eq. (Condition1) as written, eps_lmn dy_i/dx_l dy_j/dx_m dy_k/dx_n = eps_ijk, for ho3's composed maps."""
+    from itertools import permutations, product
+
+    J = sympy.Matrix(composed_map(ho3.splitting, word)).jacobian(sympy.Matrix(ho3.coordinates))
+    for i, j, k in product(range(3), repeat=3):
+        lhs = sum(sympy.LeviCivita(a, b, c) * J[i, a] * J[j, b] * J[k, c] for a, b, c in permutations(range(3)))
+        assert sympy.simplify(sympy.expand(lhs) - sympy.LeviCivita(i, j, k)) == 0
+
+
 def test_condition1_fails_for_non_volume_preserving_map(ho3):
     """Control: a map that is not a composition of exact sub-flows (explicit Euler) violates Eq. (Condition1)."""
     euler = tuple(x + h * v for x, v in zip(ho3.coordinates, ho3.equations_of_motion()))
