@@ -429,7 +429,10 @@ def cmd_shadow(args):
         out["model"], out["integrator"] = system.name, word
         return out
 
-    emit(args, latex=family.to_latex, data=data)
+    def text():
+        return f"{word} on {system.name}, order {order}, route {args.route}\n" + family.to_text()
+
+    emit(args, latex=family.to_latex, text=text, data=data)
 
 
 def cmd_conserved(args):

@@ -30,20 +30,6 @@ ENV = {**os.environ, "PYTHONPATH": str(REPO)}
 x1, x2, x3, m, omega, h, alpha = sympy.symbols("x1 x2 x3 m omega h alpha")
 
 
-def _has(module, name):
-    import importlib
-
-    try:
-        return hasattr(importlib.import_module(module), name)
-    except ImportError:
-        return False
-
-
-needs_shadow = pytest.mark.skipif(not _has("nambu_bch.shadow", "shadow_hamiltonians"), reason="nambu_bch.shadow not landed")
-needs_numeric = pytest.mark.skipif(not _has("nambu_bch.numeric.diagnostics", "check"), reason="numeric check not landed")
-needs_plot = pytest.mark.skipif(not _has("nambu_bch.numeric.figures", "paper_figures"), reason="paper_figures not landed")
-
-
 # --------------------------------------------------------------------------------------------
 # helpers
 # --------------------------------------------------------------------------------------------
@@ -208,7 +194,6 @@ def test_conserved_and_exact(tmp_path):
 # --------------------------------------------------------------------------------------------
 # shadow, fi
 # --------------------------------------------------------------------------------------------
-@needs_shadow
 def test_shadow(tmp_path):
     out = tmp_path / "family.json"
     runs = cli_many(
@@ -218,24 +203,31 @@ def test_shadow(tmp_path):
         ("shadow", "--model", "ho", "--integrator", "TVT", "--order", "4", "--format", "json"),
         ("shadow", "--H", "x2^2/(2*m) + m*x3/2", "--G", "x3 - x1^2", "--param", "m", "--split", "full",
          "--name", "mine", "--degree", "2", "--format", "text"),
+        ("shadow", "--integrator", "123", "--format", "json"),
     )
-    latex = ok(runs[0])
-    assert r"\alpha" in latex
+    latex = ok(runs[0])  # the default: Eqs. (SH12321c), (SG12321c) as LaTeX
+    assert latex.startswith("H_{S} = ") and r"\alpha" in latex and "G_{S} = " in latex
     ok(runs[1])
     data = read_json(out.read_text(), "H", "G", "H_S", "G_S")
     assert data["model"] == "ho3" and data["integrator"] == "12321" and data["order"] == 2 and data["exists"] is True
-    assert data["coordinates"] == ["x1", "x2", "x3"] and "alpha" in data["free_parameters"]
+    assert data["coordinates"] == ["x1", "x2", "x3"] and data["free_parameters"] == ["alpha"]
+    SH = read(data, "H") + alpha * omega**2 / (12 * m) * h**2 * x2**2 + alpha * m * omega**4 / 12 * h**2 * x1**2
+    SG = (read(data, "G") + h**2 * x2**2 / (12 * m**2) + alpha / (6 * m**2) * h**2 * x2**2
+          - (1 - alpha) * omega**2 / 6 * h**2 * x1**2)
+    assert sympy.expand(read(data, "H_S") - SH) == 0 and sympy.expand(read(data, "G_S") - SG) == 0
+    data = read_json(ok(runs[2]), "H_S", "G_S")
+    assert data["integrator"] == "32123" and data["route"] == "fi" and data["exists"] is True
     from nambu_bch import model
     from nambu_bch.testing import assert_shadow_pair
 
-    assert_shadow_pair(model("ho3"), "12321", read(data, "H_S"), read(data, "G_S"), order=2)
-    data = read_json(ok(runs[2]), "H_S", "G_S")
-    assert data["integrator"] == "32123" and data["route"] == "fi"
+    assert_shadow_pair(model("ho3"), "32123", read(data, "H_S"), read(data, "G_S"), order=2)
     data = read_json(ok(runs[3]), "H_S")
-    assert data["G_S"] is None and data["G"] is None
+    assert data["G_S"] is None and data["G"] is None and data["order"] == 4
     assert_shadow_pair(model("ho"), "TVT", read(data, "H_S"), order=4)
     text = ok(runs[4])
-    assert "mine" in text and "H_S" in text
+    assert text.startswith("12321 on mine, order 2, route direct") and "H_S = " in text
+    data = read_json(ok(runs[5]))  # non-symmetric word: no polynomial shadow pair at h^1
+    assert data["exists"] is False and data["H_S"] is None and "h^1" in data["obstruction"]
 
 
 # Eqs. (1AX)-(2BY), transcribed from the paper's LaTeX source ({} are Nambu brackets).
@@ -282,7 +274,6 @@ def test_fi():
 # --------------------------------------------------------------------------------------------
 # check, plot
 # --------------------------------------------------------------------------------------------
-@needs_numeric
 def test_check(tmp_path):
     runs = cli_many(
         ("check", "--integrator", "32123", "--h", "0.1", "--steps", "2000", "--x0", "1,1,1",
@@ -296,10 +287,10 @@ def test_check(tmp_path):
     for key in ("H", "G", "H_c", "G_c"):
         assert isinstance(errors[key], (int, float)), key
     assert errors["H_c"] < 1e-10 and errors["G_c"] < 1e-10 and errors["H"] > 1e-5  # Figs. 1-2
+    assert errors["H_S"] < errors["H"] / 100 and errors["x3_s"] < 1e-10 < errors["x3_c"]  # Figs. 3-4
     assert "rigid-body 12321: h = 0.1, 500 steps" in ok(runs[1])
 
 
-@needs_plot
 def test_plot(tmp_path):
     done = cli("plot", "--model", "ho3", "--integrator", "32123", "--outdir", tmp_path / "figs", "--steps", "2000",
                "--short-steps", "200", "--h", "0.1", "--x0", "1,1,1", "--every", "10", "--param", "m=1", "--dpi", "40",
@@ -427,7 +418,6 @@ def test_bad_input_every_flag_in_process(tmp_path, capsys):
         assert captured.out == "", (argv, captured.out)
 
 
-@needs_numeric
 def test_bad_numeric_state_in_process(capsys):
     for argv, fragment in [
         (["check", "--x0", "1,2"], "--x0"),
