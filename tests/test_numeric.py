@@ -311,3 +311,33 @@ def test_cache_dir_env(tmp_path, monkeypatch):
 
     monkeypatch.setenv("NAMBU_BCH_CACHE", str(tmp_path / "c"))
     assert cache_dir() == tmp_path / "c" / "kernels" and os.path.isdir(cache_dir())
+
+
+# -- properties (hypothesis) -------------------------------------------------------------------------------------------
+
+from hypothesis import given, settings  # noqa: E402
+from hypothesis import strategies as st  # noqa: E402
+
+finite = st.floats(min_value=-100.0, max_value=100.0, allow_nan=False, allow_infinity=False, allow_subnormal=False)
+
+
+@settings(max_examples=25, deadline=None)
+@given(x0=st.lists(finite, min_size=3, max_size=3), a=st.integers(0, 60), b=st.integers(0, 60),
+       h=st.floats(min_value=-1.5, max_value=1.5, allow_nan=False).filter(lambda v: v == 0 or abs(v) > 1e-3))
+def test_runs_compose_bit_for_bit(x0, a, b, h):
+    """Phi^(a+b) x0 == Phi^b (Phi^a x0) exactly: the state is the whole memory of the kernel."""
+    x0 = [0.0 if abs(v) < 1e-100 else v for v in x0]
+    whole = iterate("ho3", "32123", h, a + b, x0, every=max(a + b, 1))[-1]
+    first = iterate("ho3", "32123", h, a, x0, every=max(a, 1))[-1]
+    assert np.array_equal(iterate("ho3", "32123", h, b, first, every=max(b, 1))[-1], whole)
+
+
+@settings(max_examples=20, deadline=None)
+@given(X=st.lists(st.lists(finite, min_size=5, max_size=5), min_size=3, max_size=3), steps=st.integers(0, 40),
+       every=st.integers(1, 15))
+def test_backends_agree_on_random_batches(X, steps, every):
+    X = np.array(X)
+    X[np.abs(X) < 1e-100] = 0.0
+    a = iterate("ho3", "32123", 0.1, steps, X, every=every)
+    b = iterate("ho3", "32123", 0.1, steps, X, every=every, backend="numpy")
+    assert a.shape == (len(sample_steps(steps, every)), 3, 5) and np.array_equal(a, b)

@@ -170,3 +170,14 @@ def test_committed_figures_exist():
     for k in range(1, 5):
         f = root / f"fig{k}.png"
         assert f.exists() and f.stat().st_size < 400_000
+
+
+def test_truncated_shadow_residual_scales_like_h4():
+    """The order-2 BCH shadow Hamiltonian of a symmetric scheme is conserved up to O(h^4) (Eq. BCH2 truncated)."""
+    errs = []
+    for h in (0.1, 0.05):
+        r = check("ho3", "32123", h, int(round(20 / h)), [1.0, 1.0, 1.0], include=("H_S", "G_S"))
+        if "H_S" not in r.max_abs_error:
+            pytest.skip("nambu_bch.shadow.shadow_hamiltonians is not available")
+        errs.append(r.max_abs_error["H_S"])
+    assert fit_order([0.1, 0.05], errs).order == pytest.approx(4.0, abs=0.2)
