@@ -8,6 +8,8 @@ from __future__ import annotations
 
 import pytest
 import sympy
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from nambu_bch import PAPER_WORDS, System, composed_map, liouville_field, model
 from nambu_bch.bch import effective_field
@@ -159,3 +161,27 @@ def test_exponential_map_lotka_volterra():
 def test_bad_word():
     with pytest.raises(NambuBCHError):
         conserved_quantities(model("ho3"), "12x21")
+
+
+@settings(deadline=None, max_examples=25)
+@given(
+    word=st.sampled_from(PAPER_WORDS),
+    state=st.tuples(*[st.fractions(min_value=-5, max_value=5, max_denominator=50)] * 3),
+    params=st.tuples(st.fractions(min_value=sympy.Rational(1, 4), max_value=4, max_denominator=20),
+                     st.fractions(min_value=sympy.Rational(1, 4), max_value=4, max_denominator=20),
+                     st.fractions(min_value=sympy.Rational(1, 100), max_value=1, max_denominator=100)),
+)
+def test_property_invariant_along_exact_rational_orbits(word, state, params):
+    """H_c, G_c are constant along orbits of the map computed in exact rational arithmetic (three steps)."""
+    ho3 = model("ho3")
+    cq = conserved_quantities(ho3, word)
+    mv, wv, hv = (sympy.Rational(p.numerator, p.denominator) for p in params)
+    num = {m: mv, omega: wv, h: hv}
+    phi = [e.subs(num) for e in composed_map(ho3.splitting, word)]
+    Hc, Gc = cq.H_c.subs(num), cq.G_c.subs(num)
+    point = dict(zip((x1, x2, x3), (sympy.Rational(s.numerator, s.denominator) for s in state)))
+    start = (Hc.xreplace(point), Gc.xreplace(point))
+    assert all(v.is_Rational for v in start)
+    for _ in range(3):
+        point = dict(zip((x1, x2, x3), (e.xreplace(point) for e in phi)))
+        assert (Hc.xreplace(point), Gc.xreplace(point)) == start
