@@ -126,21 +126,38 @@ def test_order_four_shadow_equation():
     assert all(sympy.expand(a - b) == 0 for a, b in zip(total.to_sympy(), Z4.to_sympy()))
 
 
-def test_cross_check_with_bch_shadow_module():
-    """If nambu_bch.shadow.shadow_hamiltonians is available: its family and the exact one give the same X_eff to h^2."""
+def _bch_family(word, order):
     shadow = pytest.importorskip("nambu_bch.shadow")
     if not hasattr(shadow, "shadow_hamiltonians"):
         pytest.skip("nambu_bch.shadow.shadow_hamiltonians has not landed")
-    ho3 = model("ho3")
-    fam = shadow.shadow_hamiltonians(ho3, "12321", order=2)
+    fam = shadow.shadow_hamiltonians(model("ho3"), word, order=order)
     assert fam.exists
+    return fam
+
+
+@pytest.mark.parametrize("word,order", [(w, 2) for w in PAPER_WORDS] + [("12321", 4), ("32123", 4)])
+def test_cross_check_with_bch_shadow_module(word, order):
+    """nambu_bch.shadow.shadow_hamiltonians (the BCH family) and the exact family give the same field to h^order."""
+    fam = _bch_family(word, order)
+    ho3 = model("ho3")
     syms = sorted({s for e in (fam.H_S, fam.G_S) for s in sympy.sympify(e).free_symbols
                    if s not in (*ho3.coordinates, *ho3.parameters, h)}, key=str)
     algebra = ho3.algebra.with_constants(*syms)
-    Xbch = [truncate_h(c, 2) for c in liouville_field(algebra, fam.H_S, fam.G_S).to_sympy()]
-    HS, GS = exact_shadow_hamiltonians(ho3, "12321").series(2)
-    Xex = _field_of_series(ho3, (HS, GS), 2)
+    Xbch = [truncate_h(c, order) for c in liouville_field(algebra, fam.H_S, fam.G_S).to_sympy()]
+    HS, GS = exact_shadow_hamiltonians(ho3, word).series(order)
+    Xex = _field_of_series(ho3, (HS, GS), order)
     assert all(sympy.expand(a - b) == 0 for a, b in zip(Xbch, Xex))
+
+
+def test_cross_check_x3_replacement_gives_the_bch_family():
+    """The h^2 terms of the exact family after the x3 replacement (text after Eq. SG12321c) are the BCH family
+    computed by nambu_bch.shadow, Eqs. (SH12321c), (SG12321c), with the same alpha."""
+    fam = _bch_family("12321", 2)
+    HS, GS = exact_shadow_hamiltonians(model("ho3"), "12321").series(2)
+    H2 = sympy.expand(_hseries_coeff(HS, 2).subs(x3, x1**2))
+    G2 = sympy.expand(_hseries_coeff(GS, 2).subs(x3, -x2**2 / (m**2 * omega**2)))
+    assert sympy.expand(_hseries_coeff(fam.H_S, 2) - H2) == 0
+    assert sympy.expand(_hseries_coeff(fam.G_S, 2) - G2) == 0
 
 
 def test_user_defined_oscillator_without_omega_parameter():
