@@ -28,7 +28,10 @@ def _rigid_body():
     return System(
         "x1 x2 x3", ["x1**2/(2*I1) + x2**2/(2*I2) + x3**2/(2*I3)", "x1**2/2 + x2**2/2 + x3**2/2"],
         "I1 I2 I3", name="rigid-body",
-        description="free rigid body (Euler equations), full split; piece i moves x_i",
+        # With H (energy) before G (|L|^2/2), {f, H, G} gives dL/dt = omega x L: Euler's equations
+        # with t -> -t.  DESIGN.md fixes this order; reversing time maps h -> -h and changes no
+        # existence result, so the model keeps it and says so.
+        description="free rigid body (Euler equations with t -> -t for this order of H, G), full split; piece i moves x_i",
         citation="Nambu (1973); Modin (2010)",
     )
 

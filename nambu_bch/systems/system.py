@@ -103,9 +103,11 @@ class System:
 
             return parse_expression(H, symbols=(*self.coordinates, *self.parameters))
         try:
-            return sympy.sympify(H, strict=True)
+            H = sympy.sympify(H, strict=True)
         except (sympy.SympifyError, TypeError) as exc:
             raise InvalidSystemError(f"Hamiltonian {H!r} is not a sympy expression") from exc
+        # symbolic code never sees floats: read 0.5 as 1/2 (the decimal the user wrote)
+        return sympy.nsimplify(H, rational=True) if H.has(sympy.Float) else H
 
     @staticmethod
     def _ham_name(k, count):
