@@ -1,7 +1,7 @@
 """BCH engine: formal series in a free Lie algebra and concrete effective fields."""
 
 from .backward import EffectiveField, check_order, effective_field
-from .concrete import effective_field_bch
+from .concrete import clear_cache, effective_field_bch
 from .evaluation import BracketEvaluator
 from .expansion import expand_terms
 from .formal import FormalBCH, estimate_size, formal_bch
@@ -21,6 +21,7 @@ __all__ = [
     "EffectiveField",
     "FormalBCH",
     "check_order",
+    "clear_cache",
     "effective_field",
     "effective_field_bch",
     "estimate_size",

@@ -16,13 +16,17 @@ methods via BCH).
 
 from __future__ import annotations
 
+import weakref
+
 import sympy
+from sympy.polys.domains import QQ
 
 from ..algebra import VectorField
 from ..integrators.composition import composition as make_composition
 from .backward import H, EffectiveField, check_order
 from .evaluation import BracketEvaluator
 from .fast import field_backend
+from .formal import clear_cache as clear_formal_cache
 from .formal import formal_bch
 
 
@@ -57,25 +61,47 @@ def effective_field_bch(splitting, comp, order: int = 2, fast: bool = True) -> E
     comp = make_composition(comp, len(splitting)).check(splitting)
     algebra = splitting.system.algebra.with_constants(H, extension=comp.extension)
     series = formal_bch(comp, order + 1)
-    pieces = {p.number: p.field for p in splitting.pieces}
-    if comp.extension:
-        pieces = {k: VectorField(algebra, X.to_sympy()) for k, X in pieces.items()}
-    engine = field_backend(algebra, pieces, fast)
-    if engine is not None:
-        evaluator = BracketEvaluator(engine.fields, engine.bracket, engine.is_zero)
-        combine = engine.combination
-    else:
-        evaluator = BracketEvaluator(pieces)
-        combine = _combination(algebra)
+    engine, evaluator, combine = _evaluator(splitting, algebra, comp.extension, fast)
     Z = []
     for j in range(order + 1):
-        if engine is not None and hasattr(engine, "ring"):
-            pairs = series.domain_terms(j + 1, engine.ring.domain)
-        else:
-            pairs = series.terms(j + 1)
-        terms = [(c, evaluator.value(tree)) for c, tree in pairs]
-        Z.append(combine([(c, X) for c, X in terms if X is not None]))
+        if engine is not None and hasattr(engine, "scaled_combination") and (
+            series.domain == QQ or series.domain == engine.ring.domain
+        ):
+            den, pairs = series.scaled_terms(j + 1)
+            values = [(c, evaluator.value(tree)) for c, tree in pairs]
+            Z.append(engine.scaled_combination(den, [(c, X) for c, X in values if X is not None]))
+            continue
+        values = [(c, evaluator.value(tree)) for c, tree in series.terms(j + 1)]
+        Z.append(combine([(c, X) for c, X in values if X is not None]))
     return EffectiveField(tuple(Z), order, comp, splitting)
+
+
+# Bracket values are shared by every composition on a splitting (the Lyndon trees of the six paper
+# words are the same trees with other coefficients), so evaluators live as long as the splitting.
+_EVALUATORS: "weakref.WeakKeyDictionary" = weakref.WeakKeyDictionary()
+
+
+def _evaluator(splitting, algebra, extension, fast):
+    """``(backend or None, BracketEvaluator, combine)`` for ``splitting``, cached per extension and mode."""
+    per_splitting = _EVALUATORS.setdefault(splitting, {})
+    key = (tuple(extension), bool(fast))
+    if key not in per_splitting:
+        pieces = {p.number: p.field for p in splitting.pieces}
+        if extension:
+            pieces = {k: VectorField(algebra, X.to_sympy()) for k, X in pieces.items()}
+        engine = field_backend(algebra, pieces, fast)
+        if engine is not None:
+            evaluator = BracketEvaluator(engine.fields, engine.bracket, engine.is_zero)
+            per_splitting[key] = (engine, evaluator, engine.combination)
+        else:
+            per_splitting[key] = (None, BracketEvaluator(pieces), _combination(algebra))
+    return per_splitting[key]
+
+
+def clear_cache() -> None:
+    """Forget memoised bracket values and associative logs (benchmarks call this between timed runs)."""
+    _EVALUATORS.clear()
+    clear_formal_cache()
 
 
 def _combination(algebra):

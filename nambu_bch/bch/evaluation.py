@@ -51,6 +51,7 @@ class BracketEvaluator:
         self._is_zero = is_zero or (lambda X: X.is_zero())
         self._to_field = to_field
         self._cache: dict = {}
+        self._by_id: dict = {}
         self.brackets_computed = 0
 
     def leaf(self, leaf):
@@ -65,8 +66,15 @@ class BracketEvaluator:
 
     def value(self, tree):
         """The field of ``tree``, or ``None`` when it is zero."""
+        # BCH trees are shared objects (cached standard bracketings): look them up by identity
+        # first, which avoids re-hashing a nested tuple on every call
+        hit = self._by_id.get(id(tree))
+        if hit is not None and hit[0] is tree:
+            return hit[1]
         try:
-            return self._cache[tree]
+            result = self._cache[tree]
+            self._by_id[id(tree)] = (tree, result)
+            return result
         except KeyError:
             pass
         if is_bracket(tree):
@@ -84,6 +92,7 @@ class BracketEvaluator:
             if result is not None and self._is_zero(result):
                 result = None
         self._cache[tree] = result
+        self._by_id[id(tree)] = (tree, result)
         return result
 
     def field(self, tree, zero=None):

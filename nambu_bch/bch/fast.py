@@ -180,6 +180,14 @@ class FastFields:
             totals = [t + comp * k for t, comp in zip(totals, X.components)]
         return VectorField(self.algebra, [self.to_algebra(self._reduce(t)) for t in totals])
 
+    def scaled_combination(self, denominator: int, pairs) -> VectorField:
+        """``(1/denominator) sum n X`` with integer (or domain-element) numerators ``n``: one division per field."""
+        totals = [self.ring.zero] * self.algebra.n
+        for n, X in pairs:
+            totals = [t + comp * n if comp else t for t, comp in zip(totals, X.components)]
+        inv = self.ring.domain.convert(sympy.Rational(1, denominator))
+        return VectorField(self.algebra, [self.to_algebra(self._reduce(t * inv)) for t in totals])
+
     def to_algebra(self, poly):
         """A Laurent-ring element back in the algebra's ring over ``QQ(parameters)``."""
         algebra = self.algebra
@@ -192,7 +200,17 @@ class FastFields:
         for m, c in poly.items():
             groups.setdefault(m[:split], []).append((m[split:], c))
         out = {}
+        base = pring.domain
         for head, items in groups.items():
+            if len(items) == 1 and base.is_QQ:
+                # one Laurent monomial r/s p^a q^-b: already canonical as (r p^a) / (s q^b), no gcd needed
+                (lexp, c), = items
+                up = tuple(lexp[0::2])
+                down = tuple(lexp[1::2])
+                out[head] = field.raw_new(
+                    pring.from_dict({up: base(c.numerator)}), pring.from_dict({down: base(c.denominator)})
+                )
+                continue
             shift = [max((lexp[2 * k + 1] for lexp, _ in items), default=0) for k in range(len(algebra.parameters))]
             numer = {}
             for lexp, c in items:

@@ -15,8 +15,9 @@ product integral (``d!/(a! b!)`` is a binomial coefficient), and
 ``log(1 + Q) = sum_k (-1)^(k+1) Q^k / k`` adds one factor ``lcm(1..n)``.  Each
 ``L_d`` is then written in the Lyndon basis ``P_w`` by a triangular solve
 (``P_w = w + larger words``, :mod:`nambu_bch.bch.lyndon`); the residual after
-the solve must vanish, which checks on every call that the logarithm is a Lie
-element.  Algebraic coefficients (triple jump, ``2**(1/3)``) run the same code
+the solve must vanish, which checks that the logarithm is a Lie element.  For
+small degrees the inverse of that unitriangular system is tabulated once
+(int64, overflow-checked) and the solve is one matrix-vector product.  Algebraic coefficients (triple jump, ``2**(1/3)``) run the same code
 with elements of ``QQ(2**(1/3))``.
 
 References
@@ -30,7 +31,8 @@ Algebras*, Thm. 5.1 (Lyndon basis); Casas & Murua, J. Math. Phys. 50 (2009)
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
+from functools import lru_cache
 from math import comb, factorial, lcm
 
 import numpy as np
@@ -41,7 +43,15 @@ from sympy.polys.domains import QQ
 from ..errors import InvalidCompositionError, InvalidOrderError
 from ..integrators.composition import Composition
 from ..integrators.composition import composition as make_composition
-from .lyndon import lyndon_expansion, lyndon_words, standard_bracketing, tree_to_latex, witt_dimension, word_index
+from .lyndon import (
+    lyndon_expansion,
+    lyndon_words,
+    standard_bracketing,
+    tree_leaves,
+    tree_to_latex,
+    witt_dimension,
+    word_index,
+)
 
 #: Largest number of words ``g^max_degree`` of the top degree that the engine accepts.
 MAX_WORDS = 600_000
@@ -70,7 +80,7 @@ def check_degree(max_degree, n_generators: int, limit: int = MAX_WORDS) -> int:
     max_degree = int(max_degree)
     if max_degree < 1:
         raise InvalidOrderError(f"BCH degree must be a positive integer (1 = X_1 + X_2 + ...), got {max_degree}")
-    if n_generators > 1 and max_degree * np.log(n_generators) > np.log(limit) + 1e-9:
+    if n_generators > 1 and n_generators**max_degree > limit:
         size = estimate_size(n_generators, max_degree) if max_degree < 64 else None
         detail = (
             f"{size['lyndon']} Lyndon basis elements (Witt's formula) and {size['top_words']} words of top degree"
@@ -115,16 +125,18 @@ class _Scalars:
     def is_zero(self, x) -> bool:
         return not x
 
-    def element(self, numerator, denominator: int):
-        """``numerator / denominator`` in the coefficient field (``QQ`` or the algebraic field ``K``)."""
-        if self.K is None:
-            return QQ(int(numerator), denominator)
-        return numerator * self.K.convert(sympy.Rational(1, denominator))
 
-    def to_sympy(self, element):
-        if self.K is None:
-            return sympy.Rational(int(element.numerator), int(element.denominator))
-        return self.K.to_sympy(element)
+
+def _element_to_sympy(K):
+    if K is None:
+        return lambda e: sympy.Rational(int(e.numerator), int(e.denominator))
+    return K.to_sympy
+
+
+@lru_cache(maxsize=1024)
+def _lyndon_trees(g: int, d: int, generators: tuple) -> tuple:
+    """Standard bracketings of the degree-``d`` Lyndon words (table order), leaves named by ``generators``."""
+    return tuple(standard_bracketing(w, generators) for w in lyndon_words(g, d))
 
 
 def _log_of_product(letters, scalars: _Scalars, g: int, n: int):
@@ -161,6 +173,50 @@ def _log_of_product(letters, scalars: _Scalars, g: int, n: int):
     return L, dens
 
 
+_PATTERN_CACHE: dict = {}
+_PATTERN_CACHE_SIZE = 64
+
+
+def _pattern_log(pattern: tuple, coefficients: tuple, g: int, n: int):
+    """Cached ``(scalars, numerators, denominators)`` of the log for a letter pattern (read-only arrays)."""
+    key = (pattern, coefficients, n)
+    hit = _PATTERN_CACHE.get(key)
+    if hit is None:
+        scalars = _Scalars(coefficients)
+        hit = (scalars, *_log_of_product(list(pattern), scalars, g, n))
+        if len(_PATTERN_CACHE) >= _PATTERN_CACHE_SIZE:
+            _PATTERN_CACHE.pop(next(iter(_PATTERN_CACHE)))
+        _PATTERN_CACHE[key] = hit
+    return hit
+
+
+def clear_cache() -> None:
+    """Forget cached associative logarithms (benchmarks call this between timed runs)."""
+    _PATTERN_CACHE.clear()
+
+
+def _permute_letters(vector, d: int, g: int, rank):
+    """The same element with letter ``a`` renamed ``rank[a]`` (a permutation of base-``g`` digits)."""
+    if d == 0:
+        return vector
+    out = np.empty_like(vector)
+    out[_digit_permutation(d, g, tuple(rank))] = vector
+    return out
+
+
+@lru_cache(maxsize=256)
+def _digit_permutation(d: int, g: int, rank: tuple):
+    index = np.arange(g**d, dtype=np.int64)
+    new_index = np.zeros_like(index)
+    perm = np.asarray(rank, dtype=np.int64)
+    place = 1
+    for _ in range(d):
+        new_index += perm[index % g] * place
+        index //= g
+        place *= g
+    return new_index
+
+
 def _graded_product_part(R, Q, d, k, g, scalars):
     """Part ``d`` of ``R * Q`` (both scaled by degree factorials), ``R`` of min degree ``k - 1``."""
     out = scalars.zeros(g**d)
@@ -170,17 +226,68 @@ def _graded_product_part(R, Q, d, k, g, scalars):
     return out
 
 
-def _lyndon_coordinates(vector, d: int, g: int):
-    """Coordinates of a homogeneous Lie element of degree ``d`` in the Lyndon basis."""
-    residual = vector.copy()
-    coords = []
+@lru_cache(maxsize=None)
+def _lyndon_table(g: int, d: int) -> tuple:
+    """``((word, index, expansion as ((index, int coefficient), ...)), ...)`` in lexicographic order."""
+    table = []
     for w in lyndon_words(g, d):
-        c = residual[word_index(w, g)]
-        if not c:
-            continue
-        coords.append((w, c))
         idx, coef = lyndon_expansion(w, g)
-        residual[idx] -= coef.astype(object) * c
+        table.append((w, word_index(w, g), tuple(zip(idx.tolist(), coef.tolist()))))
+    return tuple(table)
+
+
+_INVERSE_LIMIT = 400  # largest Witt dimension for which the inverse of the triangular system is kept
+
+
+@lru_cache(maxsize=None)
+def _lyndon_inverse(g: int, d: int):
+    """``(Lyndon word indices, T)`` with ``T`` (int64) inverting the unitriangular system, or ``None``.
+
+    ``M[w', w]`` = coefficient of the Lyndon word ``w'`` in ``P_w`` is unit lower triangular in
+    lexicographic order, and ``L[w'] = sum_w c_w M[w', w]`` on Lyndon words, so ``c = M^{-1} L``.
+    Built once per (generators, degree); ``None`` when too large or when int64 would overflow.
+    """
+    table = _lyndon_table(g, d)
+    n = len(table)
+    if n > _INVERSE_LIMIT:
+        return None
+    position = {i: k for k, (_, i, _) in enumerate(table)}
+    M = np.zeros((n, n), dtype=np.int64)
+    for col, (_, _, expansion) in enumerate(table):
+        for j, a in expansion:
+            row = position.get(j)
+            if row is not None:
+                M[row, col] = a
+    T = np.eye(n, dtype=np.int64)
+    Tf = np.eye(n)
+    for i in range(1, n):  # forward substitution, row by row, tracked in float to detect overflow
+        T[i, :i] = -(M[i, :i] @ T[:i, :i])
+        Tf[i, :i] = -(M[i, :i].astype(float) @ Tf[:i, :i])
+    if not np.all(np.abs(Tf) < 2.0**52):
+        return None
+    return np.array([i for _, i, _ in table], dtype=np.int64), T
+
+
+def _lyndon_coordinates(vector, d: int, g: int):
+    """Coordinates ``[(position in the Lyndon table, numerator), ...]`` of a homogeneous Lie element."""
+    if not vector.any():
+        return []
+    inverse = _lyndon_inverse(g, d)
+    if inverse is not None and isinstance(vector[0], int):
+        rows, T = inverse
+        values = vector[rows]
+        bound = max(abs(int(v)) for v in values) * int(np.abs(T).max()) * len(values)
+        if bound < 2**62:
+            coeffs = T @ values.astype(np.int64)
+            return [(k, int(c)) for k, c in enumerate(coeffs.tolist()) if c]
+    residual = vector.tolist()  # plain Python list: short scattered updates are cheaper than numpy object ops
+    coords = []
+    for k, (w, i, expansion) in enumerate(_lyndon_table(g, d)):
+        c = residual[i]
+        if c:
+            coords.append((k, c))
+            for j, a in expansion:
+                residual[j] -= a * c
     if any(residual):
         raise ArithmeticError(f"internal error: the degree-{d} part of the BCH logarithm is not a Lie element")
     return coords
@@ -202,10 +309,43 @@ class FormalBCH:
     composition: Composition
     generators: tuple
     max_degree: int
-    _terms: dict
-    _words: dict
-    _domain: object = None
-    _elements: dict = None
+    _scaled: dict  # degree -> (denominator, ((numerator: int or field element, tree), ...))
+    _domain: object = None  # None: QQ; else the algebraic field of the coefficients
+    _sympy: dict = field(default_factory=dict)  # degree -> ((sympy coefficient, tree), ...), filled lazily
+    _cache: dict = field(default_factory=dict)
+
+    def scaled_terms(self, degree: int):
+        """``(D, [(n, tree), ...])`` with coefficients ``n / D``: ``n`` a Python int (rational series) or an
+        element of the algebraic field :attr:`domain`, ``D`` a positive int common to the degree."""
+        den, items = self._scaled.get(degree, (1, ()))
+        return den, list(items)
+
+    @property
+    def domain(self):
+        """The coefficient field: ``QQ``, or ``QQ(2^(1/3))`` etc. for algebraic compositions."""
+        return self._domain if self._domain is not None else QQ
+
+    @property
+    def _elements(self) -> dict:
+        if "elements" not in self._cache:
+            K = self.domain
+            out = {}
+            for d, (den, items) in self._scaled.items():
+                if self._domain is None:
+                    out[d] = tuple((QQ(int(n), den), t) for n, t in items)
+                else:
+                    inv = K.convert(sympy.Rational(1, den))
+                    out[d] = tuple((n * inv, t) for n, t in items)
+            self._cache["elements"] = out
+        return self._cache["elements"]
+
+    @property
+    def _terms(self) -> dict:
+        for d, items in self._elements.items():
+            if d not in self._sympy:
+                to_sympy = _element_to_sympy(self._domain)
+                self._sympy[d] = tuple((to_sympy(c), t) for c, t in items)
+        return self._sympy
 
     def domain_terms(self, degree: int, domain):
         """``[(c, tree)]`` with ``c`` an element of the sympy ``domain`` (QQ or an algebraic field).
@@ -213,11 +353,11 @@ class FormalBCH:
         Avoids re-deriving algebraic numbers from sympy expressions (a minimal-polynomial
         computation per coefficient) when the caller works in the same field.
         """
-        raw = self._elements.get(degree, ()) if self._elements else ()
+        raw = self._elements.get(degree, ())
         if self._domain is not None and domain == self._domain:
             return list(raw)
         if self._domain is None:
-            return [(domain.convert_from(c, QQ), t) for c, t in raw]
+            return list(raw) if domain == QQ else [(domain.convert_from(c, QQ), t) for c, t in raw]
         return [(domain.from_sympy(c), t) for c, t in self.terms(degree)]
 
     def terms(self, degree: int) -> list:
@@ -228,24 +368,25 @@ class FormalBCH:
         """
         if not isinstance(degree, int) or degree < 1 or degree > self.max_degree:
             raise InvalidOrderError(f"degree must be an integer in 1..{self.max_degree} (the computed range), got {degree!r}")
-        return list(self._terms.get(degree, ()))
+        if degree not in self._scaled:
+            return []
+        return list(self._terms[degree])
 
     def words(self, degree: int) -> list:
         """``[(coefficient, lyndon_word), ...]`` with words as tuples of piece numbers."""
-        self.terms(degree)
-        return list(self._words.get(degree, ()))
+        return [(c, tree_leaves(t)) for c, t in self.terms(degree)]
 
     @property
     def degrees(self) -> tuple:
         """Degrees ``1..max_degree`` whose part is non-zero (odd only for a symmetric composition)."""
-        return tuple(d for d in range(1, self.max_degree + 1) if self._terms.get(d))
+        return tuple(d for d in range(1, self.max_degree + 1) if self._scaled.get(d))
 
     def all_terms(self) -> list:
         """``[(coefficient, tree), ...]`` over all degrees, lowest first."""
         return [t for d in range(1, self.max_degree + 1) for t in self._terms.get(d, ())]
 
     def __len__(self):
-        return sum(len(v) for v in self._terms.values())
+        return sum(len(v[1]) for v in self._scaled.values())
 
     def to_latex(self, names=None, step="h") -> str:
         r"""The series term by term, e.g. ``X_{\rm eff} = X_{1} + X_{2} - \frac{h^{2}}{24}[...] ...``.
@@ -320,14 +461,18 @@ def formal_bch(comp, max_degree: int, n_pieces: int | None = None) -> FormalBCH:
     generators = tuple(sorted(set(comp.pieces)))
     g = len(generators)
     n = check_degree(max_degree, g)
-    letter = {k: i for i, k in enumerate(generators)}
-    scalars = _Scalars(comp.coefficients)
-    L, dens = _log_of_product([letter[k] for k in comp.pieces], scalars, g, n)
-    terms, words, elements = {}, {}, {}
+    # the associative log depends on the word only up to renaming letters (the six paper words are one
+    # scheme): compute it once per pattern, letters numbered by first appearance, then permute the digits
+    first = list(dict.fromkeys(comp.pieces))
+    pattern = tuple(first.index(k) for k in comp.pieces)
+    scalars, L, dens = _pattern_log(pattern, tuple(comp.coefficients), g, n)
+    rank = [generators.index(k) for k in first]
+    if rank != sorted(rank):
+        L = [_permute_letters(v, d, g, rank) for d, v in enumerate(L)]
+    elements = {}
     for d in range(1, n + 1):
         coords = _lyndon_coordinates(L[d], d, g)
         if coords:
-            elements[d] = tuple((scalars.element(c, dens[d]), standard_bracketing(w, generators)) for w, c in coords)
-            terms[d] = tuple((scalars.to_sympy(c), tree) for c, tree in elements[d])
-            words[d] = tuple((c, tuple(generators[a] for a in w)) for (c, _), (w, _) in zip(terms[d], coords))
-    return FormalBCH(comp, generators, n, terms, words, scalars.K, elements)
+            trees = _lyndon_trees(g, d, generators)
+            elements[d] = (dens[d], tuple((c, trees[k]) for k, c in coords))
+    return FormalBCH(comp, generators, n, elements, scalars.K)

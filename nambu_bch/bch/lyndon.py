@@ -39,7 +39,12 @@ def is_bracket(tree) -> bool:
     >>> is_bracket((1, (2, 3))), is_bracket(1), is_bracket((sympy.Symbol("A"), sympy.Symbol("C")))
     (True, False, False)
     """
-    return isinstance(tree, tuple) and len(tree) == 2 and not any(isinstance(e, sympy.Basic) for e in tree)
+    return (
+        type(tree) is tuple
+        and len(tree) == 2
+        and not isinstance(tree[0], sympy.Basic)
+        and not isinstance(tree[1], sympy.Basic)
+    )
 
 
 def tree_degree(tree) -> int:
