@@ -37,7 +37,7 @@ from ..algebra import liouville_field
 from ..bch import effective_field
 from ..errors import NoExactResultError
 from .factor import F, F_series
-from .invariants import ConservedQuantities, conserved_quantities
+from .invariants import ConservedQuantities, conserved_quantities, has_radicals
 from .linear_core import linear_core
 
 H_STEP = sympy.Symbol("h")
@@ -179,11 +179,11 @@ def _exact_shadow(system, word, cq):
             f"no exact factor form F(omega h) for {what}: no polynomial conserved quantity tends to each Hamiltonian"
         )
     X = effective_field(system.splitting, word, CHECK_ORDER)
-    Xc = liouville_field(system.algebra, *cq.hamiltonians_c).to_sympy()
+    Xc = [_taylor_in_h(c, CHECK_ORDER) for c in liouville_field(system.algebra, *cq.hamiltonians_c).to_sympy()]
     Fs = F_series(omega * H_STEP, CHECK_ORDER)
     for j, Z in enumerate(X.coefficients):
         for zc, xc in zip(Z.to_sympy(), Xc):
-            if sympy.expand(sympy.expand(Fs * xc).coeff(H_STEP, j) - zc) != 0:
+            if not _is_zero(sympy.expand(Fs * xc).coeff(H_STEP, j) - zc):
                 raise NoExactResultError(
                     f"no exact factor form for {what}: X_eff differs from F(omega h) X_(H_c,G_c) at order h^{j} "
                     "(exact shadow Hamiltonians exist here only for linear oscillators such as ho and ho3)"
@@ -192,6 +192,25 @@ def _exact_shadow(system, word, cq):
     if system.N == 2:
         return ExactShadow(Fx * cq.H_c, None, Fx, cq, frequency=omega)
     return ExactShadow(Fx**ALPHA * cq.H_c, Fx ** (1 - ALPHA) * cq.G_c, Fx, cq, frequency=omega)
+
+
+def _taylor_in_h(expr, order):
+    """``expr`` through ``h^order``: itself if polynomial in ``h``, else its Taylor polynomial at ``h = 0``
+    (conserved quantities of triple-jump compositions are rational in ``h``)."""
+    expr = sympy.expand(expr)
+    if all(not sympy.fraction(sympy.together(t))[1].has(H_STEP) for t in sympy.Add.make_args(expr)):
+        return truncate_h(expr, order)
+    return sympy.expand(sympy.series(expr, H_STEP, 0, order + 1).removeO())
+
+
+def _is_zero(expr) -> bool:
+    """Exact zero test; radicals (triple-jump coefficients) need rationalising before ``expand`` sees 0."""
+    expr = sympy.expand(expr)
+    if expr == 0:
+        return True
+    if not has_radicals(expr):
+        return False
+    return sympy.expand(sympy.radsimp(sympy.together(expr))) == 0
 
 
 def frequency(system):

@@ -241,9 +241,24 @@ def _normalise(setup: _Setup, basis, target):
     return best
 
 
-def _clean(expr):
-    """The expanded sympy form (what ``to_dict`` prints and ``sympify`` reads back)."""
-    return sympy.expand(expr)
+def has_radicals(expr) -> bool:
+    """``expr`` contains an algebraic number such as ``2**(1/3)`` (triple-jump coefficients)."""
+    return any(p.base.is_Number and not p.exp.is_Integer for p in expr.atoms(sympy.Pow))
+
+
+def _clean(expr, coords=()):
+    """The expanded sympy form (what ``to_dict`` prints and ``sympify`` reads back).
+
+    Coefficients in ``QQ<2**(1/3)>(params, h)`` come out of the ring as sums of
+    fractions with radicals in the denominators; they are rationalised and
+    factored monomial by monomial.
+    """
+    expr = sympy.expand(expr)
+    if not coords or not has_radicals(expr):
+        return expr
+    poly = sympy.Poly(expr, *coords)
+    return sympy.Add(*[sympy.factor(sympy.radsimp(sympy.together(c))) * sympy.Mul(*[x**k for x, k in zip(coords, mon)])
+                       for mon, c in poly.terms()])
 
 
 @dataclass(frozen=True, eq=False)
@@ -356,8 +371,9 @@ def _conserved(system, name, comp, degree, auto):
     for b in basis:
         if _rank(setup, quantities + [b]) > len(quantities):
             quantities.append(_primitive(b))
-    exprs = tuple(_clean(q.as_expr()) for q in quantities)
-    hams = tuple(None if I is None else _clean(I.as_expr()) for I in normalised)
+    coords = system.coordinates
+    exprs = tuple(_clean(q.as_expr(), coords) for q in quantities)
+    hams = tuple(None if I is None else _clean(I.as_expr(), coords) for I in normalised)
     H_c = hams[0]
     G_c = hams[1] if len(hams) > 1 else None
     return ConservedQuantities(H_c, G_c, exprs, degree, system, name, hams)
