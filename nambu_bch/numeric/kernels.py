@@ -48,10 +48,21 @@ NUMBA_CHUNK = 256
 NUMPY_CHUNK = 16384
 
 
+_CACHE_DIRS: dict = {}
+
+
 def cache_dir() -> Path:
     """The kernel cache directory (``$NAMBU_BCH_CACHE/kernels`` or ``~/.cache/nambu_bch/kernels``)."""
     root = os.environ.get("NAMBU_BCH_CACHE") or os.path.join(os.path.expanduser("~"), ".cache", "nambu_bch")
-    path = Path(root) / "kernels"
+    known = _CACHE_DIRS.get(root)
+    if known is not None and known.is_dir():
+        return known
+    _CACHE_DIRS[root] = path = _usable_dir(Path(root) / "kernels")
+    return path
+
+
+def _usable_dir(path: Path) -> Path:
+    """``path`` created and writable, else a per-user directory under the system temp dir."""
     try:
         path.mkdir(parents=True, exist_ok=True)
         probe = path / f".probe-{os.getpid()}"
