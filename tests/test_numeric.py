@@ -341,3 +341,16 @@ def test_backends_agree_on_random_batches(X, steps, every):
     a = iterate("ho3", "32123", 0.1, steps, X, every=every)
     b = iterate("ho3", "32123", 0.1, steps, X, every=every, backend="numpy")
     assert a.shape == (len(sample_steps(steps, every)), 3, 5) and np.array_equal(a, b)
+
+
+def test_user_symbols_named_like_generated_ones():
+    """Coordinates s0, s1 and spring constants k0, k1 do not collide with the kernel's own names."""
+    from nambu_bch import System
+
+    S = System("s1 s0", ["s0**2/(2*k1) + k0*s1**2/2"], "k0 k1", name="springs")
+    x = iterate(S, "121", 0.1, 400, [1.0, 0.0], params={"k0": 4.0, "k1": 0.5}, every=400)[-1]
+    step = step_function(S.splitting, "121", {"k0": 4.0, "k1": 0.5})
+    y = np.array([1.0, 0.0])
+    for _ in range(400):
+        y = step(y, 0.1)
+    assert np.allclose(x, y, rtol=1e-12, atol=1e-12)

@@ -129,7 +129,9 @@ def step_program(system, word) -> StepProgram:
 @lru_cache(maxsize=128)
 def _step_program(system, comp) -> StepProgram:
     coords = system.coordinates
-    state = tuple(sympy.Symbol(f"s{i}") for i in range(len(coords)))
+    # the internal symbols carry an assumption of their own, so a user's parameter or coordinate
+    # named ``s0`` or ``k1`` (a spring constant) never equals them
+    state = tuple(sympy.Symbol(f"s{i}", nambu_internal=True) for i in range(len(coords)))
     to_state = dict(zip(coords, state))
     hoister = _Hoister(state)
     updates = []
@@ -175,7 +177,7 @@ class _Hoister:
     def constant(self, expr):
         expr = sympy.nsimplify(expr) if expr.has(sympy.Float) else expr
         if expr not in self._index:
-            sym = sympy.Symbol(f"k{len(self.constants)}")
+            sym = sympy.Symbol(f"k{len(self.constants)}", nambu_internal=True)
             self._index[expr] = sym
             self.constants.append((sym, expr))
         return self._index[expr]
