@@ -182,11 +182,17 @@ class FastFields:
 
     def scaled_combination(self, denominator: int, pairs) -> VectorField:
         """``(1/denominator) sum n X`` with integer (or domain-element) numerators ``n``: one division per field."""
-        totals = [self.ring.zero] * self.algebra.n
+        if not pairs:
+            return VectorField.zero(self.algebra)
+        # accumulate monomial by monomial: for the many small fields of a series this beats ring arithmetic
+        totals = [{} for _ in range(self.algebra.n)]
         for n, X in pairs:
-            totals = [t + comp * n if comp else t for t, comp in zip(totals, X.components)]
+            for acc, comp in zip(totals, X.components):
+                for monom, coeff in comp.items():
+                    acc[monom] = acc.get(monom, 0) + coeff * n
         inv = self.ring.domain.convert(sympy.Rational(1, denominator))
-        return VectorField(self.algebra, [self.to_algebra(self._reduce(t * inv)) for t in totals])
+        polys = [self.ring.from_dict({m: c * inv for m, c in acc.items() if c}) for acc in totals]
+        return VectorField(self.algebra, [self.to_algebra(p) for p in polys])
 
     def to_algebra(self, poly):
         """A Laurent-ring element back in the algebra's ring over ``QQ(parameters)``."""

@@ -140,13 +140,42 @@ def _lyndon_trees(g: int, d: int, generators: tuple) -> tuple:
 
 
 def _log_of_product(letters, scalars: _Scalars, g: int, n: int):
-    """Numerators ``N_d`` (arrays over the ``g^d`` words) and denominators of ``log prod exp``."""
+    """Numerators ``N_d`` (arrays over the ``g^d`` words) and denominators of ``log prod exp``.
+
+    Rational compositions run in int64 when a float64 run on absolute values (an upper bound of
+    every intermediate magnitude) stays below ``2^60``: then no int64 operation can overflow and
+    the result is exact.  Otherwise (and for algebraic coefficients) Python ints / field elements.
+    """
+    big = lcm(*range(1, n + 1))
+    dens = [factorial(d) * big * scalars.q**d for d in range(n + 1)]
+    if scalars.K is None:
+        _, largest = _log_arrays(letters, [float(abs(c)) for c in scalars.values], np.float64, 0.0, 1.0, g, n, big, True)
+        if largest < 2.0**60:
+            L, _ = _log_arrays(letters, scalars.values, np.int64, 0, 1, g, n, big, False)
+            return L, dens
+    L, _ = _log_arrays(letters, scalars.values, object, scalars.zero, scalars.one, g, n, big, False)
+    return L, dens
+
+
+def _log_arrays(letters, values, dtype, zero, one, g, n, big, bounding):
+    """The log's arrays and, when ``bounding`` (non-negative floats), the largest magnitude met."""
+    largest = [0.0]
+
+    def zeros(size):
+        a = np.empty(size, dtype=dtype)
+        a.fill(zero)
+        return a
+
+    def track(a):
+        if bounding and a.size:
+            largest[0] = max(largest[0], float(a.max()))
+
     # P_d scaled by d!; degree 0 is the unit
-    P = [scalars.zeros(g**d) for d in range(n + 1)]
-    P[0][0] = scalars.one
-    for a, c in zip(letters, scalars.values):
-        new = [scalars.zeros(g**d) for d in range(n + 1)]
-        powers = [scalars.one]
+    P = [zeros(g**d) for d in range(n + 1)]
+    P[0][0] = one
+    for a, c in zip(letters, values):
+        new = [zeros(g**d) for d in range(n + 1)]
+        powers = [one]
         for _ in range(n):
             powers.append(powers[-1] * c)
         for d in range(n + 1):
@@ -154,23 +183,22 @@ def _log_of_product(letters, scalars: _Scalars, g: int, n: int):
                 col = word_index((a,) * b, g)
                 view = new[d].reshape(g ** (d - b), g**b)
                 view[:, col] += P[d - b] * (comb(d, b) * powers[b])
+            track(new[d])
         P = new
     Q = P
-    Q[0] = scalars.zeros(1)
-    L = [scalars.zeros(g**d) for d in range(n + 1)]
-    big = lcm(*range(1, n + 1))
+    Q[0] = zeros(1)
+    L = [zeros(g**d) for d in range(n + 1)]
     R = Q
     for k in range(1, n + 1):
         if k > 1:
-            R = [
-                _graded_product_part(R, Q, d, k, g, scalars) if d >= k else scalars.zeros(g**d)
-                for d in range(n + 1)
-            ]
-        sign = 1 if k % 2 else -1
+            R = [_graded_product_part(R, Q, d, k, g, zeros) if d >= k else zeros(g**d) for d in range(n + 1)]
+            for v in R:
+                track(v)
+        sign = 1 if (k % 2 or bounding) else -1
         for d in range(k, n + 1):
             L[d] += R[d] * (sign * (big // k))
-    dens = [factorial(d) * big * scalars.q**d for d in range(n + 1)]
-    return L, dens
+            track(L[d])
+    return L, largest[0]
 
 
 _PATTERN_CACHE: dict = {}
@@ -217,9 +245,9 @@ def _digit_permutation(d: int, g: int, rank: tuple):
     return new_index
 
 
-def _graded_product_part(R, Q, d, k, g, scalars):
+def _graded_product_part(R, Q, d, k, g, zeros):
     """Part ``d`` of ``R * Q`` (both scaled by degree factorials), ``R`` of min degree ``k - 1``."""
-    out = scalars.zeros(g**d)
+    out = zeros(g**d)
     for a in range(k - 1, d):
         b = d - a
         out += np.multiply.outer(R[a], Q[b]).ravel() * comb(d, a)
@@ -273,13 +301,12 @@ def _lyndon_coordinates(vector, d: int, g: int):
     if not vector.any():
         return []
     inverse = _lyndon_inverse(g, d)
-    if inverse is not None and isinstance(vector[0], int):
+    if inverse is not None and vector.dtype == np.int64:
         rows, T = inverse
         values = vector[rows]
-        bound = max(abs(int(v)) for v in values) * int(np.abs(T).max()) * len(values)
+        bound = int(np.abs(values).max()) * int(np.abs(T).max()) * len(values)
         if bound < 2**62:
-            coeffs = T @ values.astype(np.int64)
-            return [(k, int(c)) for k, c in enumerate(coeffs.tolist()) if c]
+            return [(k, c) for k, c in enumerate((T @ values).tolist()) if c]
     residual = vector.tolist()  # plain Python list: short scattered updates are cheaper than numpy object ops
     coords = []
     for k, (w, i, expansion) in enumerate(_lyndon_table(g, d)):
