@@ -67,7 +67,7 @@ from ..bch.backward import check_order
 from ..bch.concrete import effective_field_bch
 from ..errors import InvalidOrderError, NambuBCHError
 from ..integrators.composition import composition as make_composition
-from .linear import kernel_rref, normal_form, rank, solve_affine
+from .linear import rank, solve_affine
 
 H_STEP = sympy.Symbol("h")
 ALPHA = sympy.Symbol("alpha")
@@ -85,7 +85,7 @@ class OrderSolution:
     degree : int or None -- the ansatz degree used
     corrections : tuple of sympy expressions -- the family's ``dH^a_order`` (in ``alpha``)
     members : (tuple, tuple) -- the ``alpha = 0`` and ``alpha = 1`` members
-    gauge : list of tuples -- a basis of the kernel (one correction per slot), echelon form
+    gauge : list of tuples -- a basis of the kernel (one correction per slot), one vector per free column
     kernel_dim, psi_dim : int -- dimension of the kernel, and of the part spanned by
         ``(d psi/dG, -d psi/dH)`` for monomials ``psi = H^p G^q`` (N = 3; ``None`` otherwise)
     certificate : dict ``{(component, monomial): coefficient}`` or None
@@ -282,7 +282,19 @@ class _Solver:
                 by_power[k][r] = by_power[k].get(r, alg.domain.zero) + c
         powers = sorted(by_power)
         domain = alg.domain
-        sol = solve_affine(col_vectors, [by_power[k] for k in powers], len(row_index), domain)
+        rhs_list = [by_power[k] for k in powers]
+        prio0 = self._priority(columns, list(range(self.slots)))
+        prio1 = self._priority(columns, list(reversed(range(self.slots))))
+
+        def solve(prio):
+            # rref with the highest-priority columns last: free columns are set to zero, so the
+            # particular solution is the normal form modulo the kernel (linear.normal_form, cheaper)
+            order = list(reversed(prio))
+            res = solve_affine([col_vectors[c] for c in order], rhs_list, len(row_index), domain)
+            back = lambda vec: {order[c]: v for c, v in vec.items()}  # noqa: E731
+            return res, ([back(p) for p in res.particular] if res.consistent else None), [back(k) for k in res.kernel]
+
+        sol, member0, kernel = solve(prio0)
         if not sol.consistent:
             inverse = {v: k for k, v in row_index.items()}
             cert = {}
@@ -296,12 +308,8 @@ class _Solver:
             )
             return OrderSolution(j, "obstructed", degree=D, certificate=cert, obstruction_value=sympy.factor(value),
                                  kernel_dim=len(sol.kernel), rhs=rhs)
-        prio0 = self._priority(columns, list(range(self.slots)))
-        prio1 = self._priority(columns, list(reversed(range(self.slots))))
-        members = []
-        for prio in (prio0, prio1):
-            member = [normal_form(p, sol.kernel, prio, domain) for p in sol.particular]
-            members.append(member)
+        _, member1, _ = solve(prio1) if self.slots > 1 else (None, member0, None)
+        members = [member0, member1]
         # family = (1 - alpha) member0 + alpha member1, each member a polynomial in alpha
         fam = [alg.zero for _ in range(self.slots)]
         mem_polys = []
@@ -318,13 +326,12 @@ class _Solver:
             fam[a] = one_minus * mem_polys[0][a] + al * mem_polys[1][a]
         for a in range(self.slots):
             corrections[(a, j)] = fam[a]
-        gauge_vecs = kernel_rref(sol.kernel, prio0, domain)
-        gauge = [self._vector_to_slots(v, columns) for v in gauge_vecs]
-        psi_dim = self._psi_dim(columns, D, sol.kernel) if self.slots == 2 else None
+        gauge = [self._vector_to_slots(v, columns) for v in kernel]
+        psi_dim = self._psi_dim(columns, D, kernel) if self.slots == 2 else None
         return OrderSolution(
             j, "solved", degree=D, corrections=tuple(alg.to_sympy(f) for f in fam),
             members=tuple(tuple(alg.to_sympy(p) for p in polys) for polys in mem_polys),
-            gauge=gauge, kernel_dim=len(sol.kernel), psi_dim=psi_dim, rhs=rhs,
+            gauge=gauge, kernel_dim=len(kernel), psi_dim=psi_dim, rhs=rhs,
         )
 
     def _mono_expr(self, mono):
@@ -343,9 +350,11 @@ class _Solver:
         Hp, Gp = self.hams
         index = {c: k for k, c in enumerate(columns)}
         vecs = []
+        dh, dg = (max(_total_degree(Hp, self.n), 1), max(_total_degree(Gp, self.n), 1))
         for p in range(D + 2):
             for q in range(D + 2):
-                if p + q == 0:
+                # psi_G and psi_H must fit the ansatz degree: skip the products that cannot
+                if p + q == 0 or dh * p + dg * (q - 1) > D and dh * (p - 1) + dg * q > D:
                     continue
                 dG = q * Hp**p * Gp ** (q - 1) if q else alg.zero  # d psi / dG
                 dH = p * Hp ** (p - 1) * Gp**q if p else alg.zero  # d psi / dH

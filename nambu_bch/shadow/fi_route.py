@@ -133,7 +133,7 @@ class FIResult:
             items = w.items() if isinstance(w, dict) else enumerate(w)
             for key, value in items:
                 rep = self._rep(comm, key)
-                total = total + rep.formal.scale(sympy.sympify(value))
+                total = total + rep.formal.scale(comm.coefficient * sympy.sympify(value))
             if sympy.simplify(sum(sympy.sympify(v) for _, v in (w.items() if isinstance(w, dict) else enumerate(w))) - 1) != 0:
                 raise NambuBCHError(f"the weights of commutator {t} ({comm.label()}) must sum to 1, got {w}")
         return total
@@ -158,6 +158,19 @@ class FIResult:
     def check_member(self, weights, corrections) -> bool:
         """Do these representation weights give ``X_{H,dG} + X_{dH,G}`` with these corrections (formally)?"""
         return self.combination(weights) == self.target(corrections)
+
+    def kernel_corrections(self) -> list:
+        """The ``(dH, dG, ...)`` part of every homogeneous solution (weights dropped), as sympy expressions."""
+        alg, nw, ccols = self._ctx["algebra"], self._ctx["nw"], self._ctx["ccols"]
+        out = []
+        for vec in self.kernel:
+            corr = [sympy.Integer(0)] * len(self.system.hamiltonians)
+            for col, v in vec.items():
+                if col >= nw:
+                    a, e = ccols[col - nw]
+                    corr[a] += alg.domain.to_sympy(v) * sympy.Mul(*(x**p for x, p in zip(alg.coordinates, e)))
+            out.append(tuple(corr))
+        return out
 
     def to_text(self) -> str:
         lines = [f"FI route, {self.composition.name}, h^{self.power}:"]
@@ -321,6 +334,7 @@ def fi_route(system, word, order: int = 2, degree=None, terms=None) -> FIResult:
         result.certificate = {str(inverse[r]): alg.domain.to_sympy(v) for r, v in sol.certificate.items()}
         return result
     nw = len(wcols)
+    ctx.update(nw=nw, ccols=ccols)
     index = {c: nw + k for k, c in enumerate(ccols)}
     zero = (0,) * alg.n
 

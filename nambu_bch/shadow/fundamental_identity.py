@@ -40,7 +40,8 @@ FI_LABELS = ("1AX", "1AY", "1BX", "1BY", "2AX", "2AY", "2BX", "2BY")
 
 
 def _bracket(algebra, *fs):
-    return algebra.to_sympy(nambu_bracket(algebra, *fs))
+    # ring elements stay ring elements (fast nesting); anything else is a sympy expression
+    return nambu_bracket(algebra, *fs)
 
 
 def commutator_terms(algebra, left, right, way: str, coefficient=1) -> list:

@@ -33,6 +33,7 @@ from functools import lru_cache
 
 import sympy
 from sympy.core.sorting import default_sort_key
+from sympy.polys.rings import PolyElement
 
 from ..algebra import VectorField, liouville_field
 from ..errors import NambuBCHError
@@ -67,8 +68,14 @@ class LiouvilleTerm:
     coefficient: object = sympy.Integer(1)
 
     def __post_init__(self):
-        object.__setattr__(self, "slots", tuple(sympy.sympify(s) for s in self.slots))
+        # ring elements (exact sparse polynomials) are kept as they are: nested brackets stay fast
+        object.__setattr__(self, "slots", tuple(s if isinstance(s, PolyElement) else sympy.sympify(s) for s in self.slots))
         object.__setattr__(self, "coefficient", sympy.sympify(self.coefficient))
+
+    @property
+    def expressions(self) -> tuple:
+        """The slots as sympy expressions."""
+        return tuple(s.as_expr() if isinstance(s, PolyElement) else s for s in self.slots)
 
     def __neg__(self):
         return LiouvilleTerm(self.slots, -self.coefficient)
@@ -78,14 +85,15 @@ class LiouvilleTerm:
 
     def canonical(self) -> "LiouvilleTerm":
         """Slots in sympy's canonical order, the coefficient times the permutation's sign (antisymmetry)."""
-        order = sorted(range(len(self.slots)), key=lambda i: default_sort_key(self.slots[i]))
-        return LiouvilleTerm(tuple(self.slots[i] for i in order), _perm_sign(order) * self.coefficient)
+        exprs = self.expressions
+        order = sorted(range(len(exprs)), key=lambda i: default_sort_key(exprs[i]))
+        return LiouvilleTerm(tuple(exprs[i] for i in order), _perm_sign(order) * self.coefficient)
 
     def vanishes(self, coordinates) -> bool:
         """``X_{slots} = 0``: every ``(N-1)``-minor of the slots' gradients is zero (exact, sympy)."""
         if self.coefficient == 0:
             return True
-        J = sympy.Matrix([[sympy.diff(P, x) for x in coordinates] for P in self.slots])
+        J = sympy.Matrix([[sympy.diff(P, x) for x in coordinates] for P in self.expressions])
         n = len(coordinates)
         for skip in range(n):
             cols = [j for j in range(n) if j != skip]
@@ -102,12 +110,12 @@ class LiouvilleTerm:
         return LiouvilleSum.from_slots(algebra, self.slots, self.coefficient)
 
     def to_latex(self) -> str:
-        body = "X_{" + ", ".join(sympy.latex(sympy.factor(s)) for s in self.slots) + "}"
+        body = "X_{" + ", ".join(sympy.latex(sympy.factor(s)) for s in self.expressions) + "}"
         c = self.coefficient
         return body if c == 1 else (f"-{body}" if c == -1 else rf"\left({sympy.latex(c)}\right){body}")
 
     def __str__(self):
-        body = "X_{" + ", ".join(str(sympy.factor(s)) for s in self.slots) + "}"
+        body = "X_{" + ", ".join(str(sympy.factor(s)) for s in self.expressions) + "}"
         return body if self.coefficient == 1 else f"({self.coefficient})*{body}"
 
 
@@ -155,7 +163,7 @@ class _Context:
             sign, key = canonical_key(tuple(v for _, v in entries))
             out = (sign, None if key is None else tuple((0, v) for v in key))
         else:
-            slots = [self.atoms[v] if kind == 1 else sympy.Mul(*(x**e for x, e in zip(self.algebra.coordinates, v)))
+            slots = [_ATOMS[v] if kind == 1 else sympy.Mul(*(x**e for x, e in zip(self.algebra.coordinates, v)))
                      for kind, v in entries]
             if liouville_field(self.algebra, *slots).is_zero():
                 out = (0, None)
@@ -167,6 +175,15 @@ class _Context:
 
 
 _CONTEXTS: dict = {}
+_ATOMS: list = []  # atom expressions by id: keys of formal sums name atoms by content, not by position
+_ATOM_IDS: dict = {}
+
+
+def _atom_id(expr) -> int:
+    if expr not in _ATOM_IDS:
+        _ATOM_IDS[expr] = len(_ATOMS)
+        _ATOMS.append(expr)
+    return _ATOM_IDS[expr]
 
 
 def _context(algebra, atoms) -> _Context:
@@ -187,7 +204,7 @@ class LiouvilleSum:
     """A formal sum ``sum_k c_k X_{e_k1, ..., e_k(N-1)}`` modulo multilinearity, antisymmetry, vanishing.
 
     Each slot entry ``e`` is a basis element: a coordinate monomial ``x^a``
-    (key ``(0, a)``) or, optionally, an *atom* -- a named function kept whole,
+    (key ``(0, a)``) or, optionally, an *atom* -- a function kept whole (key ``(1, id)``, by content),
     such as a separable piece ``A = x_2^2/(2m)`` of ``H`` (key ``(1, k)``).
     Atoms keep the bookkeeping of the paper's FI calculation: ``X_{B, x_2^2}``
     (a piece of ``H`` in the first slot, so it belongs to ``X_{H, dG}``) and
@@ -235,7 +252,7 @@ class LiouvilleSum:
         for s in slots:
             s_expr = algebra.to_sympy(s) if algebra.is_polynomial(s) else sympy.sympify(s)
             if atoms and s_expr in atoms:
-                polys.append([((1, atoms.index(s_expr)), algebra.domain.one)])
+                polys.append([((1, _atom_id(s_expr)), algebra.domain.one)])
                 continue
             p = algebra.convert(s)
             if not algebra.is_polynomial(p):
@@ -297,7 +314,7 @@ class LiouvilleSum:
         """The function of a slot entry: ``x^a`` for ``(0, a)``, the atom for ``(1, k)``."""
         kind, value = entry
         if kind == 1:
-            return self.atoms[value]
+            return _ATOMS[value]
         return sympy.Mul(*(x**e for x, e in zip(self.algebra.coordinates, value)))
 
     def field(self) -> VectorField:
