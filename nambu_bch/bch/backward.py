@@ -26,7 +26,7 @@ import sympy
 from ..algebra import VectorField
 from ..errors import InvalidOrderError
 from ..integrators.composition import composition as make_composition
-from .fast import FastFields
+from .fast import FastFields, field_backend
 
 H = sympy.Symbol("h")
 MAX_ORDER = 16
@@ -136,9 +136,10 @@ def effective_field(splitting, comp, order: int = 2, fast: bool = True) -> Effec
     order : int
         Highest power of ``h`` kept in ``X_eff``.
     fast : bool
-        Run the series in Laurent polynomials of the parameters over QQ
-        (:mod:`nambu_bch.bch.fast`, no rational-function gcds) when the fields
-        allow it; ``False`` keeps the system's ring over ``QQ(parameters)``.
+        Run the series graded by powers of ``h`` in Laurent polynomials of the
+        parameters over QQ (:mod:`nambu_bch.bch.fast`, no rational-function gcds),
+        or in expanded sympy expressions for non-polynomial fields; ``False`` runs
+        the reference recursion on the system's ring over ``QQ(parameters)``.
         The result is the same exact field either way.
 
     Examples
@@ -152,9 +153,10 @@ def effective_field(splitting, comp, order: int = 2, fast: bool = True) -> Effec
     comp = make_composition(comp, len(splitting)).check(splitting)
     algebra = splitting.system.algebra.with_constants(H, extension=comp.extension)
     fields = [VectorField(algebra, p.field.to_sympy()) if comp.extension else p.field for p in splitting.pieces]
-    engine = FastFields.build(algebra, dict(enumerate(fields, 1))) if fast else None
+    engine = field_backend(algebra, dict(enumerate(fields, 1)), fast)
     if engine is not None:
-        return EffectiveField(_backward_laurent(engine, comp, order), order, comp, splitting)
+        ops = _LaurentOps(engine, comp) if isinstance(engine, FastFields) else _SympyOps(engine, comp)
+        return EffectiveField(_backward_graded(ops, comp, order), order, comp, splitting)
     series = _HSeries(algebra)
     h = algebra.convert(H)
     top = order + 1
@@ -179,58 +181,98 @@ def effective_field(splitting, comp, order: int = 2, fast: bool = True) -> Effec
     return EffectiveField(tuple(Z), order, comp, splitting)
 
 
-def _backward_laurent(engine, comp, order) -> tuple:
-    """The same recursion as :func:`effective_field`, graded by powers of ``h``, in the Laurent ring.
+class _LaurentOps:
+    """Arithmetic of :func:`_backward_graded` on raw Laurent-ring elements (:class:`FastFields`)."""
 
-    Series in ``h`` are lists ``[f_0, ..., f_top]`` of ``h``-free ring elements, so
-    no product ever produces a power of ``h`` that is thrown away.  The pull-back
+    def __init__(self, engine, comp):
+        self.engine, R = engine, engine.ring
+        self.coords = R.gens[: engine.algebra.n]
+        self.zero, self.one = R.zero, R.domain.one
+        self.fields = {k: X.components for k, X in engine.fields.items()}
+        self.coefficients = engine.coefficients(comp.coefficients)
+        self.rational = lambda q: R.domain.convert(q)
+
+    def apply(self, components, f):
+        total = self.zero
+        if not f:
+            return total
+        for c, x in zip(components, self.coords):
+            if c:
+                d = f.diff(x)
+                if d:
+                    total = total + c * d
+        return self.engine._reduce(total)
+
+    @staticmethod
+    def is_zero(f) -> bool:
+        return not f
+
+    def finish(self, comps) -> VectorField:
+        return VectorField(self.engine.algebra, [self.engine.to_algebra(self.engine._reduce(c)) for c in comps])
+
+
+class _SympyOps:
+    """The same on expanded sympy expressions (non-polynomial fields: ``cos(x1)``, ``H1(x1)``)."""
+
+    def __init__(self, backend, comp):
+        self.algebra = backend.algebra
+        self.coords = self.algebra.coordinates
+        self.zero, self.one = sympy.Integer(0), sympy.Integer(1)
+        self.fields = backend.fields
+        self.coefficients = list(comp.coefficients)
+        self.rational = lambda q: q
+
+    def apply(self, components, f):
+        if f == 0:
+            return self.zero
+        return sympy.expand(sum((c * sympy.diff(f, x) for c, x in zip(components, self.coords) if c != 0), self.zero))
+
+    @staticmethod
+    def is_zero(f) -> bool:
+        return f == 0
+
+    def finish(self, comps) -> VectorField:
+        return VectorField(self.algebra, [sympy.expand(c) for c in comps])
+
+
+def _backward_graded(ops, comp, order) -> tuple:
+    """The same recursion as :func:`effective_field`, graded by powers of ``h``.
+
+    Series in ``h`` are lists ``[f_0, ..., f_top]`` of ``h``-free elements, so no
+    product ever produces a power of ``h`` that is thrown away.  The pull-back
     is ``[h^n] exp(c h X) f = sum_k c^k/k! X^k f_{n-k}``.  For the modified field,
     with ``U_k = (h Y)^k x`` and ``Y = sum_l h^l Z_l``,
     ``[h^n] U_k = sum_l Z_l [h^(n-1-l)] U_{k-1}`` involves only ``Z_l`` with
     ``l <= n - k``; so ``Z_j^i = [h^(j+1)] Phi^* x_i - sum_{k >= 2} [h^(j+1)] U_k / k!``
     and every ``[h^n] U_k`` is computed once (Hairer-Lubich-Wanner IX.1).
     """
-    algebra, R = engine.algebra, engine.ring
-    n = algebra.n
-    coords = R.gens[:n]
+    coords, zero = ops.coords, ops.zero
+    n = len(coords)
     top = order + 1
-    zero = R.zero
-
-    def apply(components, f):
-        total = zero
-        if not f:
-            return total
-        for c, x in zip(components, coords):
-            if c:
-                d = f.diff(x)
-                if d:
-                    total = total + c * d
-        return engine._reduce(total)
 
     def exp_pullback(components, c, series):
         out = [zero] * (top + 1)
         for m, f in enumerate(series):
-            term, scale = f, R.domain.one
+            term, scale = f, ops.one
             for k in range(0, top - m + 1):
                 if k:
-                    term = apply(components, term)
-                    scale = scale * c * R.domain.convert(sympy.Rational(1, k))
-                if not term:
+                    term = ops.apply(components, term)
+                    scale = scale * c * ops.rational(sympy.Rational(1, k))
+                if ops.is_zero(term):
                     break
                 out[m + k] = out[m + k] + term * scale
         return out
 
-    coefficients = engine.coefficients(comp.coefficients)
     pulled = []
     for x in coords:
         series = [x] + [zero] * top
-        for k, c in reversed(list(zip(comp.pieces, coefficients))):
-            series = exp_pullback(engine.fields[k].components, c, series)
+        for k, c in reversed(list(zip(comp.pieces, ops.coefficients))):
+            series = exp_pullback(ops.fields[k], c, series)
         pulled.append(series)
     Z = []
     # U[i][k][m] = [h^m] (hY)^k x_i
     U = [[[x] + [zero] * top] + [[zero] * (top + 1) for _ in range(top)] for x in coords]
-    inverse_factorial = [R.domain.convert(1 / sympy.factorial(k)) for k in range(top + 1)]
+    inverse_factorial = [ops.rational(1 / sympy.factorial(k)) for k in range(top + 1)]
     for j in range(order + 1):
         m = j + 1
         comps = []
@@ -240,11 +282,11 @@ def _backward_laurent(engine, comp, order) -> tuple:
             for k in range(2, m + 1):
                 value = zero
                 for l in range(0, m - k + 1):
-                    value = value + apply(Z[l], Ui[k - 1][m - 1 - l])
+                    value = value + ops.apply(Z[l], Ui[k - 1][m - 1 - l])
                 Ui[k][m] = value
                 rest = rest + value * inverse_factorial[k]
-            comps.append(engine._reduce(pulled[i][m] - rest))
+            comps.append(pulled[i][m] - rest)
         Z.append(comps)
         for i in range(n):
             U[i][1][m] = comps[i]
-    return tuple(VectorField(algebra, [engine.to_algebra(c) for c in comps]) for comps in Z)
+    return tuple(ops.finish(comps) for comps in Z)

@@ -139,6 +139,9 @@ def _lyndon_trees(g: int, d: int, generators: tuple) -> tuple:
     return tuple(standard_bracketing(w, generators) for w in lyndon_words(g, d))
 
 
+_INT64_LIMIT = 2.0**60  # int64 run allowed when every intermediate magnitude is bounded by this
+
+
 def _log_of_product(letters, scalars: _Scalars, g: int, n: int):
     """Numerators ``N_d`` (arrays over the ``g^d`` words) and denominators of ``log prod exp``.
 
@@ -150,7 +153,7 @@ def _log_of_product(letters, scalars: _Scalars, g: int, n: int):
     dens = [factorial(d) * big * scalars.q**d for d in range(n + 1)]
     if scalars.K is None:
         _, largest = _log_arrays(letters, [float(abs(c)) for c in scalars.values], np.float64, 0.0, 1.0, g, n, big, True)
-        if largest < 2.0**60:
+        if largest < _INT64_LIMIT:
             L, _ = _log_arrays(letters, scalars.values, np.int64, 0, 1, g, n, big, False)
             return L, dens
     L, _ = _log_arrays(letters, scalars.values, object, scalars.zero, scalars.one, g, n, big, False)

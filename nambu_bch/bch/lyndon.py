@@ -32,6 +32,8 @@ from functools import lru_cache
 import numpy as np
 import sympy
 
+from ..errors import UnknownPieceError
+
 
 def is_bracket(tree) -> bool:
     """``True`` for a bracket node ``(left, right)``, ``False`` for a leaf.
@@ -236,7 +238,11 @@ def tree_to_latex(tree, names=None) -> str:
     if is_bracket(tree):
         return f"[{tree_to_latex(tree[0], names)},{tree_to_latex(tree[1], names)}]"
     if names is not None:
-        return names(tree) if callable(names) else names[tree]
+        if callable(names):
+            return names(tree)
+        if tree not in names:
+            raise UnknownPieceError(f"no LaTeX name for generator {tree!r}; names given for {sorted(names, key=str)}")
+        return names[tree]
     if isinstance(tree, tuple):
         return "X_{" + ",".join(sympy.latex(e) for e in tree) + "}"
     return f"X_{{{tree}}}"
