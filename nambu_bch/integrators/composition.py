@@ -41,6 +41,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from fractions import Fraction
+from functools import lru_cache
 
 import sympy
 from sympy.polys.domains import QQ
@@ -208,6 +209,18 @@ def composition(spec, n_pieces: int | None = None) -> Composition:
     >>> composition("123").order, composition("123").symmetric
     (1, False)
     """
+    if isinstance(spec, str):
+        # compositions are immutable and radical coefficients are slow to normalise: build each once
+        return _composition_from_text(spec, n_pieces)
+    return _build(spec, n_pieces)
+
+
+@lru_cache(maxsize=512)
+def _composition_from_text(spec: str, n_pieces):
+    return _build(spec, n_pieces)
+
+
+def _build(spec, n_pieces):
     if isinstance(spec, Composition):
         return spec
     if isinstance(spec, (list, tuple)):
