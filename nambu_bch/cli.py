@@ -430,7 +430,10 @@ def cmd_shadow(args):
         return out
 
     def text():
-        return f"{word} on {system.name}, order {order}, route {args.route}\n" + family.to_text()
+        out = f"{word} on {system.name}, order {order}, route {args.route}\n" + family.to_text()
+        if args.route == "fi" and hasattr(family.details, "to_text"):
+            out += "\n" + family.details.to_text()  # each commutator's representations and weights
+        return out
 
     emit(args, latex=family.to_latex, text=text, data=data)
 
