@@ -73,3 +73,12 @@ def test_original_G_is_not_invariant(ho3):
     """G itself drifts under Phi^{12321} (Fig. 2): the failure message shows the residual."""
     with pytest.raises(AssertionError, match=r"not invariant under Phi_h = 12321 .* residual I\(Phi_h\(x\)\) - I\(x\) = "):
         assert_invariant(ho3, "12321", "x3 - x1^2")
+
+
+def test_library_family_is_a_shadow_pair(ho3):
+    """The alpha-family that nambu_bch derives (Eqs. SH12321c/SG12321c continued to h^4) passes the independent check."""
+    from nambu_bch.shadow import shadow_hamiltonians
+
+    family = shadow_hamiltonians(ho3, "12321", order=4)
+    assert family.exists and family.free_parameters == ["alpha"]
+    assert_shadow_pair(ho3, "12321", family.H_S, family.G_S, order=4)

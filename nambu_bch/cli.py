@@ -519,6 +519,14 @@ def fi_representations(system, comp):
     return out
 
 
+def _slots(term):
+    """The slots of a LiouvilleTerm as sympy expressions."""
+    exprs = getattr(term, "expressions", None)
+    if exprs is None:
+        return tuple(term.slots)
+    return tuple(exprs() if callable(exprs) else exprs)
+
+
 def cmd_fi(args):
     system, values = system_from_args(args)
     system = substituted(system, values)
@@ -545,7 +553,7 @@ def cmd_fi(args):
                 {
                     "coefficient": render.expression(c),
                     "commutator": [[render.expression(s) for s in t] for t in abd],
-                    "forms": {lab: [{"coefficient": render.expression(t.coefficient), "slots": [render.expression(s) for s in t.slots]}
+                    "forms": {lab: [{"coefficient": render.expression(t.coefficient), "slots": [render.expression(s) for s in _slots(t)]}
                                     for t in terms] for lab, terms in forms.items()},
                 }
                 for c, abd, forms in reps
@@ -791,6 +799,10 @@ def _normalise(args):
         args.dpi = positive_int(args.dpi, "--dpi", 1200)
     if getattr(args, "every", None) and getattr(args, "steps", None) and args.every > args.steps:
         raise NambuBCHError(f"--every {args.every} is larger than --steps {args.steps}")
+    for flag in ("output", "outdir", "system"):
+        value = getattr(args, flag, None)
+        if value is not None and not value.strip():
+            raise NambuBCHError(f"--{flag} is empty; give a file or directory path")
     for flag in ("integrator", "coords", "name", "model"):
         value = getattr(args, flag, None)
         if value is not None and (not value.strip() or len(value) > 200):

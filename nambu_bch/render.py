@@ -27,6 +27,8 @@ def expression(value):
     """A sympy expression as a sympify-able string (``None`` stays ``None``)."""
     if value is None:
         return None
+    if not isinstance(value, sympy.Basic) and hasattr(value, "as_expr"):  # a sparse-ring element
+        value = value.as_expr()
     return str(sympy.sympify(value))
 
 
@@ -46,7 +48,7 @@ def jsonable(obj):
         return {str(k): jsonable(v) for k, v in obj.items()}
     if isinstance(obj, (list, tuple)):
         return [jsonable(v) for v in obj]
-    if isinstance(obj, sympy.Basic):
+    if isinstance(obj, sympy.Basic) or hasattr(obj, "as_expr"):
         return expression(obj)
     return str(obj)
 

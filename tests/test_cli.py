@@ -279,7 +279,7 @@ def test_check(tmp_path):
         ("check", "--integrator", "32123", "--h", "0.1", "--steps", "2000", "--x0", "1,1,1",
          "--param", "m=1", "--param", "omega=1", "--every", "10", "--format", "json"),
         ("check", "--model", "rigid-body", "--param", "I1=1", "--param", "I2=2", "--param", "I3=3", "--steps", "500",
-         "--x0", "1 0.5 0.2", "--order", "2", "--alpha", "1/3"),
+         "--x0", "1 0.5 0.2", "--order", "2", "--alpha", "1/3", "--format", "text", "--output", tmp_path / "rb.txt"),
     )
     data = json.loads(ok(runs[0]))
     assert data["h"] == 0.1 and data["steps"] == 2000 and data["every"] == 10
@@ -288,7 +288,8 @@ def test_check(tmp_path):
         assert isinstance(errors[key], (int, float)), key
     assert errors["H_c"] < 1e-10 and errors["G_c"] < 1e-10 and errors["H"] > 1e-5  # Figs. 1-2
     assert errors["H_S"] < errors["H"] / 100 and errors["x3_s"] < 1e-10 < errors["x3_c"]  # Figs. 3-4
-    assert "rigid-body 12321: h = 0.1, 500 steps" in ok(runs[1])
+    ok(runs[1])
+    assert "rigid-body 12321: h = 0.1, 500 steps" in (tmp_path / "rb.txt").read_text()
 
 
 def test_plot(tmp_path):
@@ -381,6 +382,10 @@ def bad_cases(tmp_path):
         (["bch", "--field", "--terms", "--format", "pdf"], "invalid choice"),
         (["bch", "--output", str(tmp_path / "no" / "such" / "dir.tex")], "--output"),
         (["bch", "--field=1"], "--field"),
+        (["bch", "--terms=yes"], "--terms"),
+        (["fi", "--integrator", "1:1/2,2:1"], "sum to 1"),
+        (["fi", "--model", "ho", "--format", "html"], "invalid choice"),
+        (["models", "--format", "latex", "--output", ""], "--output"),
         (["shadow", "--route", "magic"], "invalid choice"),
         (["shadow", "--degree", "0"], "--degree"),
         (["shadow", "--order", "-3"], "--order"),
