@@ -55,49 +55,69 @@ from .lyndon import (
 
 #: Largest number of words ``g^max_degree`` of the top degree that the engine accepts.
 MAX_WORDS = 600_000
+#: Largest total size ``sum_d dim L_d 2^(d-1)`` of the Lyndon-basis expansions the projection walks.
+MAX_EXPANSION = 15_000_000
+_HARD_DEGREE = 64  # beyond this not even the estimate is computed
 
 
 def estimate_size(n_generators: int, max_degree: int) -> dict:
-    """Sizes of the BCH computation: Lyndon basis elements (Witt) and associative words.
+    """Sizes of the BCH computation: Lyndon basis elements (Witt), associative words, expansion entries.
 
-    >>> estimate_size(3, 7)["lyndon"]
-    508
+    ``expansion`` bounds the work of the Lyndon projection: ``P_w`` of a word of
+    length ``d`` has at most ``2^(d-1)`` terms.
+
+    >>> estimate_size(3, 7)["lyndon"], estimate_size(3, 9)["expansion"]
+    (508, 687417)
     """
     g = n_generators
     return {
         "lyndon": sum(witt_dimension(g, d) for d in range(1, max_degree + 1)),
         "words": sum(g**d for d in range(1, max_degree + 1)),
         "top_words": g**max_degree,
+        "expansion": sum(witt_dimension(g, d) * 2 ** (d - 1) for d in range(1, max_degree + 1)),
     }
 
 
-def check_degree(max_degree, n_generators: int, limit: int = MAX_WORDS) -> int:
-    """``max_degree`` as an int ``>= 1`` whose computation fits the size limit, else :class:`InvalidOrderError`."""
+def _fits(g: int, n: int) -> bool:
+    if g <= 1:
+        return True
+    if n > _HARD_DEGREE or g**n > MAX_WORDS:
+        return False
+    return estimate_size(g, n)["expansion"] <= MAX_EXPANSION
+
+
+def check_degree(max_degree, n_generators: int) -> int:
+    """``max_degree`` as an int ``>= 1`` whose computation fits the size limits, else :class:`InvalidOrderError`.
+
+    The size is estimated up front (Witt's formula for the number of Lyndon words,
+    ``g^n`` associative words) so that an order too high to finish is refused
+    instead of hanging.
+    """
     if isinstance(max_degree, sympy.Integer):
         max_degree = int(max_degree)
     if isinstance(max_degree, bool) or not isinstance(max_degree, (int, np.integer)):
         raise InvalidOrderError(f"BCH degree must be a positive integer, got {max_degree!r}")
     max_degree = int(max_degree)
+    g = n_generators
     if max_degree < 1:
         raise InvalidOrderError(f"BCH degree must be a positive integer (1 = X_1 + X_2 + ...), got {max_degree}")
-    if n_generators > 1 and n_generators**max_degree > limit:
-        size = estimate_size(n_generators, max_degree) if max_degree < 64 else None
-        detail = (
-            f"{size['lyndon']} Lyndon basis elements (Witt's formula) and {size['top_words']} words of top degree"
-            if size else f"more than {limit} words of top degree"
-        )
+    if not _fits(g, max_degree):
+        if max_degree <= _HARD_DEGREE:
+            size = estimate_size(g, max_degree)
+            detail = (
+                f"{size['lyndon']} Lyndon basis elements (Witt's formula), {size['top_words']} words of top "
+                f"degree and {size['expansion']} expansion terms"
+            )
+        else:
+            detail = f"more than {MAX_WORDS} words of top degree"
+        best = 1
+        while _fits(g, best + 1):
+            best += 1
         raise InvalidOrderError(
-            f"BCH to degree {max_degree} in {n_generators} generators needs {detail}; the limit is "
-            f"{limit} words (degree <= {_max_degree(n_generators, limit)} for {n_generators} generators)"
+            f"BCH to degree {max_degree} in {g} generators needs {detail}, too many to finish in reasonable time; "
+            f"the largest accepted degree for {g} generators is {best} (X_eff to h^{best - 1})"
         )
     return max_degree
-
-
-def _max_degree(g: int, limit: int) -> int:
-    d = 1
-    while g ** (d + 1) <= limit:
-        d += 1
-    return d
 
 
 class _Scalars:
@@ -257,13 +277,18 @@ def _graded_product_part(R, Q, d, k, g, zeros):
     return out
 
 
+_TUPLE_TABLE_DEGREE = 8  # up to this degree expansions are kept as Python tuples (fast loops, more memory)
+
+
 @lru_cache(maxsize=None)
 def _lyndon_table(g: int, d: int) -> tuple:
-    """``((word, index, expansion as ((index, int coefficient), ...)), ...)`` in lexicographic order."""
+    """``((word, index, expansion), ...)`` in lexicographic order; the expansion of ``P_w`` as
+    ``((index, coefficient), ...)`` (small degrees) or as ``(indices, coefficients)`` int64 arrays."""
     table = []
     for w in lyndon_words(g, d):
         idx, coef = lyndon_expansion(w, g)
-        table.append((w, word_index(w, g), tuple(zip(idx.tolist(), coef.tolist()))))
+        expansion = tuple(zip(idx.tolist(), coef.tolist())) if d <= _TUPLE_TABLE_DEGREE else (idx, coef)
+        table.append((w, word_index(w, g), expansion))
     return tuple(table)
 
 
@@ -285,7 +310,7 @@ def _lyndon_inverse(g: int, d: int):
     position = {i: k for k, (_, i, _) in enumerate(table)}
     M = np.zeros((n, n), dtype=np.int64)
     for col, (_, _, expansion) in enumerate(table):
-        for j, a in expansion:
+        for j, a in expansion if d <= _TUPLE_TABLE_DEGREE else zip(expansion[0].tolist(), expansion[1].tolist()):
             row = position.get(j)
             if row is not None:
                 M[row, col] = a
@@ -312,11 +337,12 @@ def _lyndon_coordinates(vector, d: int, g: int):
             return [(k, c) for k, c in enumerate((T @ values).tolist()) if c]
     residual = vector.tolist()  # plain Python list: short scattered updates are cheaper than numpy object ops
     coords = []
+    as_tuples = d <= _TUPLE_TABLE_DEGREE
     for k, (w, i, expansion) in enumerate(_lyndon_table(g, d)):
         c = residual[i]
         if c:
             coords.append((k, c))
-            for j, a in expansion:
+            for j, a in expansion if as_tuples else zip(expansion[0].tolist(), expansion[1].tolist()):
                 residual[j] -= a * c
     if any(residual):
         raise ArithmeticError(f"internal error: the degree-{d} part of the BCH logarithm is not a Lie element")
