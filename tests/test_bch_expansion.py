@@ -225,3 +225,33 @@ def test_property_pruning_never_changes_the_value(items):
 def test_unknown_generator(prune):
     with pytest.raises(UnknownPieceError, match="7"):
         expand_terms([(1, (1, 7))], model("ho3").splitting, prune=prune)
+
+
+def test_BCH3_printed_term_by_term_equals_the_papers_latex():
+    """Eq. (BCH3): expanding Eq. (BCH2) and printing it with X_{ij} names reproduces the paper's LaTeX term by
+    term (whitespace aside; within a block of eight the order of X_{31}, X_{13} follows Piece.terms)."""
+    from nambu_bch.bch import terms_to_latex
+
+    system, H, G = _generic_system()
+    index = {(h, g): f"X_{{{i}{j}}}" for i, h in enumerate(H, 1) for j, g in enumerate(G, 1)}
+    printed = terms_to_latex(expand_terms(BCH2, system.splitting, prune=False), index).replace(" ", "")
+    token = re.compile(r"[+-]?\d*\[X_\{\d\d\},\[X_\{\d\d\},X_\{\d\d\}\]\]")
+
+    def blocks(text):
+        terms = [t if t[0] in "+-" else "+" + t for t in token.findall(text)]
+        assert "".join(terms).lstrip("+") == text.lstrip("+")  # nothing but these terms
+        return [sorted(terms[i:i + 8]) for i in range(0, len(terms), 8)]
+
+    ours, paper = blocks(printed), blocks("".join(BCH3_TEXT.split()))
+    assert len(paper) == 9 and ours == paper
+
+
+def test_BCH2_printed_term_by_term():
+    """Eq. (BCH2) in the paper's nine-term form, printed as LaTeX."""
+    from nambu_bch.bch import terms_to_latex
+
+    assert terms_to_latex(BCH2).replace(" ", "") == (
+        "[X_{1},[X_{1},X_{2}]]+[X_{1},[X_{1},X_{3}]]+[X_{1},[X_{2},X_{3}]]"
+        "-2[X_{2},[X_{2},X_{1}]]+[X_{2},[X_{2},X_{3}]]+[X_{2},[X_{1},X_{3}]]"
+        "-2[X_{3},[X_{3},X_{1}]]-2[X_{3},[X_{3},X_{2}]]+3[X_{3},[X_{1},X_{2}]]"
+    )

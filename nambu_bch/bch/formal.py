@@ -47,8 +47,8 @@ from .lyndon import (
     lyndon_expansion,
     lyndon_words,
     standard_bracketing,
+    terms_to_latex,
     tree_leaves,
-    tree_to_latex,
     witt_dimension,
     word_index,
 )
@@ -459,8 +459,8 @@ class FormalBCH:
         for d in range(1, self.max_degree + 1):
             power = sympy.Symbol(step) ** (d - 1) if step else sympy.Integer(1)
             for c, tree in self._terms.get(d, ()):
-                pieces.append(_term_latex(c, power, tree_to_latex(tree, names)))
-        series = " ".join(pieces).lstrip("+ ") if pieces else "0"
+                pieces.append((c, tree, power))
+        series = terms_to_latex(pieces, names)
         lhs = r"X_{\rm eff}" if step else r"\log \Phi"
         tail = f" + O({sympy.latex(sympy.Symbol(step) ** self.max_degree)})" if step else ""
         return f"{lhs} = {series}{tail}"
@@ -470,17 +470,6 @@ class FormalBCH:
 
     def __repr__(self):
         return f"FormalBCH({self.composition.name!r}, max_degree={self.max_degree}, terms={len(self)})"
-
-
-def _term_latex(c, power, body: str) -> str:
-    """`` + \\frac{h^{2}}{12} [X_1,[X_1,X_2]]``: sign, then magnitude (rational) or parenthesised coefficient."""
-    if c.is_Rational:
-        sign = "-" if c < 0 else "+"
-        magnitude = abs(c) * power
-        text = "" if magnitude == 1 else sympy.latex(magnitude) + " "
-        return f"{sign} {text}{body}"
-    factor = "" if power == 1 else " " + sympy.latex(power)
-    return rf"+ \left({sympy.latex(c)}\right){factor} {body}"
 
 
 def formal_bch(comp, max_degree: int, n_pieces: int | None = None) -> FormalBCH:

@@ -246,3 +246,41 @@ def tree_to_latex(tree, names=None) -> str:
     if isinstance(tree, tuple):
         return "X_{" + ",".join(sympy.latex(e) for e in tree) + "}"
     return f"X_{{{tree}}}"
+
+
+def terms_to_latex(terms, names=None) -> str:
+    r"""A linear combination of bracket trees as LaTeX, term by term.
+
+    Parameters
+    ----------
+    terms : iterable of ``(coefficient, tree)`` or ``(coefficient, tree, factor)``
+        ``factor`` (e.g. ``h**2``) multiplies the coefficient when printed.
+    names : dict or callable, optional
+        As in :func:`tree_to_latex`.
+
+    Examples
+    --------
+    Eq. (BCH1) in the paper's form:
+
+    >>> terms_to_latex([(1, 1), (1, 2), (sympy.Rational(-1, 24), (1, (1, 2))), (sympy.Rational(1, 12), (2, (2, 1)))],
+    ...                {1: "X_T", 2: "X_V"})
+    'X_T + X_V - \\frac{1}{24} [X_T,[X_T,X_V]] + \\frac{1}{12} [X_V,[X_V,X_T]]'
+    """
+    parts = []
+    for item in terms:
+        c, tree, factor = item if len(item) == 3 else (*item, sympy.Integer(1))
+        c = sympy.sympify(c)
+        body = tree_to_latex(tree, names)
+        if c.is_Rational:
+            magnitude = abs(c) * factor
+            text = "" if magnitude == 1 else sympy.latex(magnitude) + " "
+            parts.append(f"{'-' if c < 0 else '+'} {text}{body}")
+        else:
+            extra = "" if factor == 1 else " " + sympy.latex(factor)
+            parts.append(rf"+ \left({sympy.latex(c)}\right){extra} {body}")
+    text = " ".join(parts)
+    if text.startswith("+ "):
+        text = text[2:]
+    elif text.startswith("- "):
+        text = "-" + text[2:]
+    return text or "0"
