@@ -708,7 +708,12 @@ def build_parser() -> argparse.ArgumentParser:
     parser = _Parser(
         prog=PROG, formatter_class=_Formatter,
         description="Shadow Hamiltonians of splitting integrators in Nambu mechanics (Horikoshi).",
-        epilog="examples:\n  nambu-bch shadow            # the paper's alpha-family, LaTeX\n"
+        epilog="the system: --model NAME (default ho3) | --system FILE.toml | --H EXPR [--G EXPR] [--coords ...] [--param NAME]\n"
+               "parameter values: --param NAME=VALUE (exact, e.g. m=1/2): check/plot use them (default 1),\n"
+               "  symbolic subcommands substitute them before the analysis\n"
+               "bad input: one line on stderr, exit status 2; expressions are parsed by a whitelist, never eval-ed\n\n"
+               "examples:\n  nambu-bch shadow            # the paper's alpha-family of Phi^{12321}, LaTeX\n"
+               "  nambu-bch shadow --integrator 32123 --format json\n"
                "  nambu-bch models\n  nambu-bch SUBCOMMAND --help",
     )
     from . import __version__
