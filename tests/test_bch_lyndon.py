@@ -118,3 +118,12 @@ def test_large_coefficients_take_the_exact_python_int_path():
     assert L[7].dtype == object
     assert B.terms(2) == [((a - b) / 2, (1, 2))]
     assert B.degrees == tuple(range(1, 8))
+
+
+def test_huge_coefficients_are_exact():
+    """Coefficients far beyond int64 (10^30): degree 2 is (a - b)/2 [X, Y] exactly."""
+    a, b = sympy.Integer(10) ** 30, 1 - sympy.Integer(10) ** 30
+    B = formal_bch(f"1:{a},2:1,1:{b}", 5)
+    assert B.terms(2) == [((a - b) / 2, (1, 2))]
+    # and the whole series is a Lie element with exact coefficients (checked by the residual solve)
+    assert all(isinstance(c, sympy.Rational) for c, _ in B.all_terms())

@@ -17,8 +17,9 @@ product integral (``d!/(a! b!)`` is a binomial coefficient), and
 (``P_w = w + larger words``, :mod:`nambu_bch.bch.lyndon`); the residual after
 the solve must vanish, which checks that the logarithm is a Lie element.  For
 small degrees the inverse of that unitriangular system is tabulated once
-(int64, overflow-checked) and the solve is one matrix-vector product.  Algebraic coefficients (triple jump, ``2**(1/3)``) run the same code
-with elements of ``QQ(2**(1/3))``.
+(int64, overflow-checked) and the solve is one matrix-vector product.
+Algebraic coefficients (triple jump, ``2**(1/3)``) run the same code with
+elements of ``QQ(2**(1/3))``.
 
 References
 ----------
@@ -137,14 +138,6 @@ class _Scalars:
             self.K = K
             self.zero, self.one = K.zero, K.one
 
-    def zeros(self, n):
-        a = np.empty(n, dtype=object)
-        a.fill(self.zero)
-        return a
-
-    def is_zero(self, x) -> bool:
-        return not x
-
 
 
 def _element_to_sympy(K):
@@ -205,7 +198,10 @@ def _log_arrays(letters, values, dtype, zero, one, g, n, big, bounding):
             for b in range(d + 1):
                 col = word_index((a,) * b, g)
                 view = new[d].reshape(g ** (d - b), g**b)
-                view[:, col] += P[d - b] * (comb(d, b) * powers[b])
+                factor = comb(d, b) * powers[b]
+                if bounding:
+                    largest[0] = max(largest[0], float(factor))
+                view[:, col] += P[d - b] * factor
             track(new[d])
         P = new
     Q = P
