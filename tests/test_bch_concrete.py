@@ -140,7 +140,7 @@ def test_lie_trotter_first_coefficient_is_half_commutator():
 
 # -- bad input -------------------------------------------------------------------------------------------------
 
-@pytest.mark.parametrize("order", [-1, 2.5, None, 10**6, 17])
+@pytest.mark.parametrize("order", [-1, 2.5, None, 10**6, 17, True, "2", float("inf"), float("nan")])
 def test_bad_orders(order):
     with pytest.raises(InvalidOrderError):
         effective_field_bch(model("ho").splitting, "121", order)
@@ -149,6 +149,14 @@ def test_bad_orders(order):
 def test_order_too_high_to_finish_is_refused_up_front():
     with pytest.raises(InvalidOrderError, match="Witt"):
         effective_field_bch(model("ho3").splitting, "12321", 15)
+
+
+@pytest.mark.parametrize("route", [effective_field, effective_field_bch])
+def test_integral_orders_accepted(route):
+    import numpy
+
+    S = model("ho").splitting
+    assert route(S, "121", 2.0).order == route(S, "121", sympy.Integer(2)).order == route(S, "121", numpy.int64(2)).order == 2
 
 
 def test_unknown_piece():

@@ -33,13 +33,22 @@ MAX_ORDER = 16
 
 
 def check_order(order, limit: int = MAX_ORDER) -> int:
-    """``order`` as an int in ``0..limit``, else :class:`InvalidOrderError`."""
-    if isinstance(order, bool) or not isinstance(order, int) or isinstance(order, float):
+    """``order`` as an int in ``0..limit``, else :class:`InvalidOrderError`.
+
+    Integral numbers (``2``, ``2.0``, ``sympy.Integer(2)``, numpy ints) are accepted;
+    booleans, strings, fractions, ``nan`` and ``inf`` are not.
+
+    >>> check_order(2.0)
+    2
+    """
+    if isinstance(order, (bool, str, bytes)) or order is None:
+        raise InvalidOrderError(f"order must be a non-negative integer, got {order!r}")
+    if not isinstance(order, int):
         try:
             if float(order) != int(order):
                 raise ValueError
             order = int(order)
-        except (TypeError, ValueError):
+        except (TypeError, ValueError, OverflowError):
             raise InvalidOrderError(f"order must be a non-negative integer, got {order!r}") from None
     if order < 0 or order > limit:
         raise InvalidOrderError(f"order must be between 0 and {limit}, got {order}")
