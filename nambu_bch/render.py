@@ -12,10 +12,10 @@ reading in a terminal and for ``grep``.
 
 from __future__ import annotations
 
+from .atomic import write_atomic
+
 import json
 import math
-import os
-import tempfile
 
 import numpy as np
 import sympy
@@ -105,27 +105,8 @@ def latex_document(body: str) -> str:
 
 
 def write_output(text: str, path) -> None:
-    """Write ``text`` to ``path`` atomically: a temporary file in the same directory, then ``os.replace``.
-
-    A reader never sees a half-written file, and an existing file is replaced
-    only once the new content is complete.
-    """
-    path = os.fspath(path)
-    directory = os.path.dirname(os.path.abspath(path))
-    fd, tmp = tempfile.mkstemp(prefix=".tmp-" + os.path.basename(path) + "-", dir=directory)
-    try:
-        with os.fdopen(fd, "w", encoding="utf-8") as handle:
-            handle.write(text)
-            handle.flush()
-            os.fsync(handle.fileno())
-        os.chmod(tmp, 0o644)
-        os.replace(tmp, path)
-    except BaseException:
-        try:
-            os.unlink(tmp)
-        except OSError:
-            pass
-        raise
+    """Write ``text`` to ``path`` atomically (see :func:`nambu_bch.atomic.write_atomic`)."""
+    write_atomic(path, text)
 
 
 # --------------------------------------------------------------------------------------------

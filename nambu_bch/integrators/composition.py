@@ -132,7 +132,10 @@ class Composition:
 
     def to_latex(self) -> str:
         def exponent(c):
-            return "h" if c == 1 else rf"{sympy.latex(c)}\,h"
+            if c == 1:
+                return "h"
+            text = sympy.latex(c)
+            return rf"\left({text}\right)h" if c.is_Add else rf"{text}\,h"
 
         return r"\Phi_h = " + " ".join(rf"e^{{{exponent(c)} X_{{{k}}}}}" for k, c in self.factors())
 

@@ -24,10 +24,12 @@ Horikoshi, Sect. 5.5, Figs. 1-4, Eqs. (OHsol), (CQsol), (SHsol), Table (table).
 
 from __future__ import annotations
 
+import io
 from pathlib import Path
 
 import numpy as np
 
+from ..atomic import write_atomic
 from ..errors import InvalidRunError
 from .diagnostics import errors_along, quantities, solution_differences
 from .iterate import as_system, iterate, sample_times
@@ -146,5 +148,8 @@ def _headroom(ax, frac=0.35):
 def _save(fig, path, dpi):
     if not fig.get_tight_layout():
         fig.tight_layout()
-    fig.savefig(path, dpi=dpi, metadata={"Software": None} if str(path).endswith(".png") else None)
+    buffer = io.BytesIO()
+    fmt = Path(path).suffix.lstrip(".") or "png"
+    fig.savefig(buffer, format=fmt, dpi=dpi, metadata={"Software": None} if fmt == "png" else None)
+    write_atomic(path, buffer.getvalue())
     return path
