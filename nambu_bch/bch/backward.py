@@ -197,7 +197,7 @@ class _LaurentOps:
         self.engine, R = engine, engine.ring
         self.coords = R.gens[: engine.algebra.n]
         self.zero, self.one = R.zero, R.domain.one
-        self.fields = {k: X.components for k, X in engine.fields.items()}
+        self.fields = engine.rational_fields
         self.coefficients = engine.coefficients(comp.coefficients)
         self.rational = lambda q: R.domain.convert(q)
 

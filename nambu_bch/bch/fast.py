@@ -26,20 +26,24 @@ reduced explicitly); Horikoshi, Eq. (CL1) (bracket convention).
 
 from __future__ import annotations
 
+from math import lcm
+
 import sympy
 from sympy.polys.constructor import construct_domain
+from sympy.polys.domains import ZZ
 from sympy.polys.rings import PolyElement, ring
 
 from ..algebra import VectorField
 
 
 class _Field:
-    """Components in the Laurent ring plus their coordinate derivatives (computed once)."""
+    """``components / scale`` (integral components when the base is QQ) plus derivatives computed once."""
 
-    __slots__ = ("components", "_derivatives")
+    __slots__ = ("components", "scale", "_derivatives")
 
-    def __init__(self, components):
+    def __init__(self, components, scale=1):
         self.components = tuple(components)
+        self.scale = scale
         self._derivatives = None
 
     def derivatives(self, gens):
@@ -69,9 +73,11 @@ class FastFields:
 
     def __init__(self, algebra, ring_, laurent, fields):
         self.algebra = algebra
-        self.ring = ring_
+        self.ring = ring_  # over QQ (or QQ(2^(1/3))): the values, for rational arithmetic
+        self.bracket_ring = ring_  # over ZZ when the base is QQ: brackets of integral components
         self._laurent = laurent  # [(index of p, index of p_inv)] in the ring's generators
         self.fields = fields
+        self.rational_fields: dict = {}  # key -> components in ``ring`` (the actual values)
         self._coords = ring_.gens[: algebra.n]
 
     # -- construction -------------------------------------------------------------
@@ -92,13 +98,22 @@ class FastFields:
         first = algebra.n + len(algebra.constants)
         laurent = [(first + 2 * k, first + 2 * k + 1) for k in range(len(params))]
         self = cls(algebra, ring_, laurent, {})
-        converted = {}
+        if base.is_QQ:
+            # brackets are multilinear: clear each field's denominators and bracket over ZZ (Python ints,
+            # no rational normalisation), carrying the product of the scales along
+            self.bracket_ring = ring(names, ZZ)[0]
+            self._coords = self.bracket_ring.gens[: algebra.n]
         for key, X in fields.items():
             parts = [self._from_algebra(c) for c in X.components]
             if any(p is None for p in parts):
                 return None
-            converted[key] = _Field(parts)
-        self.fields = converted
+            self.rational_fields[key] = tuple(parts)
+            if base.is_QQ:
+                scale = lcm(1, *(int(c.denominator) for part in parts for c in part.coeffs()))
+                parts = [self.bracket_ring.from_dict({m: ZZ(int(c * scale)) for m, c in part.items()}) for part in parts]
+            else:
+                scale = 1
+            self.fields[key] = _Field(parts, scale)
         return self
 
     def _from_algebra(self, poly):
@@ -135,13 +150,13 @@ class FastFields:
                 m[i], m[j] = (k, 0) if k >= 0 else (0, -k)
             key = tuple(m)
             out[key] = out.get(key, 0) + c
-        return self.ring.from_dict({k: v for k, v in out.items() if v})
+        return poly.ring.from_dict({k: v for k, v in out.items() if v})
 
     def bracket(self, X: _Field, Y: _Field) -> _Field:
         """``[X, Y]^i = X^j d_j Y^i - Y^j d_j X^i`` (operator commutator, Eq. CL1)."""
         gens = self._coords
         dX, dY = X.derivatives(gens), Y.derivatives(gens)
-        zero = self.ring.zero
+        zero = self.bracket_ring.zero
         comps = []
         for i in range(len(gens)):
             total = zero
@@ -151,7 +166,7 @@ class FastFields:
                 if Y.components[j] and dX[i][j]:
                     total = total - Y.components[j] * dX[i][j]
             comps.append(self._reduce(total))
-        return _Field(comps)
+        return _Field(comps, X.scale * Y.scale)
 
     def coefficients(self, numbers) -> list:
         """Exact sympy numbers as elements of the ring's domain (algebraic ones via one primitive element)."""
@@ -174,24 +189,32 @@ class FastFields:
 
     def combination(self, pairs) -> VectorField:
         """``sum c X`` (``c`` exact sympy numbers or domain elements) as a :class:`VectorField` of the algebra."""
-        totals = [self.ring.zero] * self.algebra.n
-        for c, X in pairs:
-            k = self._coefficient(c)
-            totals = [t + comp * k for t, comp in zip(totals, X.components)]
-        return VectorField(self.algebra, [self.to_algebra(self._reduce(t)) for t in totals])
+        return self._combine([(self._coefficient(c), X) for c, X in pairs], self.ring.domain.one)
 
     def scaled_combination(self, denominator: int, pairs) -> VectorField:
         """``(1/denominator) sum n X`` with integer (or domain-element) numerators ``n``: one division per field."""
+        return self._combine(pairs, self.ring.domain.convert(sympy.Rational(1, denominator)))
+
+    def _combine(self, pairs, factor) -> VectorField:
         if not pairs:
             return VectorField.zero(self.algebra)
-        # accumulate monomial by monomial: for the many small fields of a series this beats ring arithmetic
-        totals = [{} for _ in range(self.algebra.n)]
+        # accumulate monomial by monomial, one integer sum per scale: for the many small fields of a
+        # series this beats ring arithmetic, and rationals appear only once per monomial at the end
+        by_scale: dict = {}
         for n, X in pairs:
+            totals = by_scale.setdefault(X.scale, [{} for _ in range(self.algebra.n)])
             for acc, comp in zip(totals, X.components):
                 for monom, coeff in comp.items():
                     acc[monom] = acc.get(monom, 0) + coeff * n
-        inv = self.ring.domain.convert(sympy.Rational(1, denominator))
-        polys = [self.ring.from_dict({m: c * inv for m, c in acc.items() if c}) for acc in totals]
+        domain = self.ring.domain
+        out = [{} for _ in range(self.algebra.n)]
+        for scale, totals in by_scale.items():
+            k = factor * domain.convert(sympy.Rational(1, scale)) if scale != 1 else factor
+            for acc, target in zip(totals, out):
+                for monom, c in acc.items():
+                    if c:
+                        target[monom] = target.get(monom, 0) + domain.convert(c) * k
+        polys = [self.ring.from_dict({m: c for m, c in acc.items() if c}) for acc in out]
         return VectorField(self.algebra, [self.to_algebra(p) for p in polys])
 
     def to_algebra(self, poly):
