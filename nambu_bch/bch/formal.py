@@ -79,6 +79,7 @@ def estimate_size(n_generators: int, max_degree: int) -> dict:
     }
 
 
+@lru_cache(maxsize=1024)
 def _fits(g: int, n: int) -> bool:
     if g <= 1:
         return True

@@ -78,6 +78,7 @@ def map_leaves(tree, function):
     return function(tree)
 
 
+@lru_cache(maxsize=4096)
 def witt_dimension(n_letters: int, degree: int) -> int:
     """Number of Lyndon words of length ``degree`` over ``n_letters`` letters (Witt's formula).
 
