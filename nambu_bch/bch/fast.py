@@ -11,7 +11,10 @@ product is brought back to the canonical form in which no monomial contains
 both (``p^a p_inv^b -> p^(a-b)`` or ``p_inv^(b-a)``).  Laurent monomials are a
 basis, so the canonical form is unique and zero tests stay structural and
 exact; the coefficient arithmetic is plain rationals, no gcds.  Derivatives are
-taken only by coordinates, where ``p``, ``p_inv`` are constants.
+taken only by coordinates, where ``p``, ``p_inv`` are constants.  Brackets are
+multilinear, so each field's rational denominators are cleared once and nested
+brackets run over ZZ (Python ints), the product of the scales carried along and
+divided out once when a linear combination is converted back.
 
 A field with a non-monomial denominator (``1/(m + 1)``) or a non-polynomial
 component is not representable: :meth:`FastFields.build` returns ``None`` and
@@ -78,6 +81,7 @@ class FastFields:
         self._laurent = laurent  # [(index of p, index of p_inv)] in the ring's generators
         self.fields = fields
         self.rational_fields: dict = {}  # key -> components in ``ring`` (the actual values)
+        self._monomials: dict = {}  # Laurent monomial -> its canonical QQ(parameters) coefficient
         self._coords = ring_.gens[: algebra.n]
 
     # -- construction -------------------------------------------------------------
@@ -213,7 +217,7 @@ class FastFields:
             for acc, target in zip(totals, out):
                 for monom, c in acc.items():
                     if c:
-                        target[monom] = target.get(monom, 0) + domain.convert(c) * k
+                        target[monom] = target.get(monom, 0) + k * c
         polys = [self.ring.from_dict({m: c for m, c in acc.items() if c}) for acc in out]
         return VectorField(self.algebra, [self.to_algebra(p) for p in polys])
 
@@ -234,11 +238,15 @@ class FastFields:
             if len(items) == 1 and base.is_QQ:
                 # one Laurent monomial r/s p^a q^-b: already canonical as (r p^a) / (s q^b), no gcd needed
                 (lexp, c), = items
-                up = tuple(lexp[0::2])
-                down = tuple(lexp[1::2])
-                out[head] = field.raw_new(
-                    pring.from_dict({up: base(c.numerator)}), pring.from_dict({down: base(c.denominator)})
-                )
+                key = (lexp, c.numerator, c.denominator)
+                value = self._monomials.get(key)
+                if value is None:
+                    up, down = tuple(lexp[0::2]), tuple(lexp[1::2])
+                    value = field.raw_new(
+                        pring.from_dict({up: base(c.numerator)}), pring.from_dict({down: base(c.denominator)})
+                    )
+                    self._monomials[key] = value
+                out[head] = value
                 continue
             shift = [max((lexp[2 * k + 1] for lexp, _ in items), default=0) for k in range(len(algebra.parameters))]
             numer = {}
