@@ -338,6 +338,8 @@ def test_absurd_degree_refused_up_front_with_witt_count():
         formal_bch("12321", 30)
     with pytest.raises(InvalidOrderError, match="degree"):
         formal_bch("12", 10**9)
+    with pytest.raises(InvalidOrderError, match="degree"):
+        formal_bch("1", 10**9)  # one generator: cheap per degree, but not a billion degrees
 
 
 @pytest.mark.parametrize("spec", ["", "abc", [], "1:0.5", [(1, 0.5), (1, 0.5)], "1:1/2,2:1"])

@@ -81,9 +81,11 @@ def estimate_size(n_generators: int, max_degree: int) -> dict:
 
 @lru_cache(maxsize=1024)
 def _fits(g: int, n: int) -> bool:
+    if n > _HARD_DEGREE:
+        return False
     if g <= 1:
         return True
-    if n > _HARD_DEGREE or g**n > MAX_WORDS:
+    if g**n > MAX_WORDS:
         return False
     return estimate_size(g, n)["expansion"] <= MAX_EXPANSION
 
