@@ -67,7 +67,7 @@ class VectorField:
 
     def bracket(self, other: "VectorField") -> "VectorField":
         """The commutator ``[self, other]`` as differential operators."""
-        self._check(other)
+        other = self._aligned(other)
         A = self.algebra
         comps = [
             u - v for u, v in (A.common(self.apply(b), other.apply(a)) for a, b in zip(self.components, other.components))
@@ -83,12 +83,16 @@ class VectorField:
         return total
 
     # -- linear structure -------------------------------------------------------------
-    def _check(self, other):
+    def _aligned(self, other) -> "VectorField":
+        """``other`` expressed in this field's algebra (rings differ e.g. by a 2**(1/3) extension)."""
         if not isinstance(other, VectorField) or other.algebra.coordinates != self.algebra.coordinates:
             raise NambuBCHError("vector fields on different coordinates cannot be combined")
+        if other.algebra.ring == self.algebra.ring:
+            return other
+        return VectorField(self.algebra, other.to_sympy())
 
     def __add__(self, other):
-        self._check(other)
+        other = self._aligned(other)
         pairs = (self.algebra.common(a, b) for a, b in zip(self.components, other.components))
         return VectorField(self.algebra, [a + b for a, b in pairs])
 
