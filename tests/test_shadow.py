@@ -463,3 +463,34 @@ def test_bad_input():
         shadow_hamiltonians(System("x1 x2 x3", ["x1*x2 + x3", "x3"]), "12321")
     with pytest.raises(NambuBCHError, match="system"):
         shadow_hamiltonians(42, "121")
+
+
+# ---------------------------------------------------------------------------------------------
+# 8. N = 4 (three Hamiltonians, multilinear expansion)
+# ---------------------------------------------------------------------------------------------
+
+N4_HAMILTONIANS = ["x1**2/2 + x2**2/2 + x3**2/2 + x4**2/2", "x1**2/2 + x2**2 + 3*x3**2/2 + 2*x4**2", "x1 + x2 + x3 + x4"]
+
+
+def test_n4_full_split_is_obstructed():
+    """N = 4, H1 = |x|^2/2, H2 = sum k x_k^2/2, H3 = sum x_k, every Hamiltonian split (piece i moves x_i):
+    the symmetric Phi^{1234321} has NO polynomial shadow triple at h^2 (degree 4 tried; degree 6 too, slower),
+    and Phi^{1234} fails already at h^1 (degree 3)."""
+    S = System("x1 x2 x3 x4", N4_HAMILTONIANS, name="n4")
+    F = shadow_hamiltonians(S, "1234321", 2)
+    assert not F.exists and F.failed_order == 2 and F.degree[2] == 4
+    assert F.details.orders[-1].obstruction_value == -6
+    assert "sum_a X_{H_1..dH_a..H_3}" in F.obstruction
+    G = shadow_hamiltonians(S, "1234", 1)
+    assert not G.exists and G.failed_order == 1 and G.degree[1] == 3
+
+
+@pytest.mark.parametrize("word, order", [("1234321", 2), ("1234", 2)])
+def test_n4_single_split_has_shadows(word, order):
+    """N = 4, only H1 split (pieces X_{x_k^2/2, H2, H3}): shadow triples EXIST, Phi^{1234} with h and h^2 terms (the
+    h^2 equation carries the cross terms X_{dH1_1, dH2_1, H3} etc.); checked against X_eff independently."""
+    S = System("x1 x2 x3 x4", N4_HAMILTONIANS, name="n4-single", split="single")
+    F = shadow_hamiltonians(S, word, order)
+    assert F.exists and len(F.shadows) == 3
+    _check_shadow(S, word, order, F.shadows)
+    assert "shadows" in F.to_dict()

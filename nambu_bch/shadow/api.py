@@ -29,13 +29,21 @@ def _system(system):
     return system
 
 
-def _obstruction_text(sol) -> str:
+def _operator(n_hams: int) -> str:
+    if n_hams == 1:
+        return "X_{dH}"
+    if n_hams == 2:
+        return "X_{dH,G} + X_{H,dG}"
+    return "sum_a X_{H_1..dH_a..H_" + str(n_hams) + "}"
+
+
+def _obstruction_text(sol, n_hams: int = 2) -> str:
     terms = sorted(sol.certificate.items(), key=lambda kv: (str(kv[0][0]), sympy.default_sort_key(kv[0][1])))
     shown = " + ".join(f"({c})*[{mono}]Y^{x}" for (x, mono), c in terms[:6])
     more = f" + ... ({len(terms)} terms)" if len(terms) > 6 else ""
     return (
         f"at h^{sol.order} no polynomial corrections of degree <= {sol.degree} solve "
-        f"X_{{dH,G}} + X_{{H,dG}} = Z_{sol.order} - (cross terms): the functional l(Y) = {shown}{more} "
+        f"{_operator(n_hams)} = Z_{sol.order} - (cross terms): the functional l(Y) = {shown}{more} "
         f"vanishes on every such field but l(RHS) = {sol.obstruction_value}"
     )
 
@@ -90,7 +98,7 @@ def shadow_hamiltonians(system, word, order: int = 2, route: str = "direct", deg
             bad = R.orders[-1]
             fam.failed_order = bad.order
             fam.certificate = bad.certificate
-            fam.obstruction = _obstruction_text(bad)
+            fam.obstruction = _obstruction_text(bad, len(system.hamiltonians))
     else:
         power = 2 if comp.symmetric else 1
         if order > power + (1 if comp.symmetric else 0):

@@ -282,8 +282,14 @@ def fi_route(system, word, order: int = 2, degree=None, terms=None) -> FIResult:
             entries.append((sympy.sympify(coef), tuple(tree)))
     entries = _merge(entries)
     commutators = []
+    ring_of: dict = {}
+
+    def to_ring(term):  # convert each Hamiltonian piece once; brackets then stay in the ring
+        return tuple(ring_of.setdefault(f, alg.convert(f)) for f in term)
+
     for coef, leaves in entries:
-        reps = representations(alg, *leaves) if len(leaves) == 3 else single_representations(alg, *leaves)
+        rleaves = tuple(to_ring(t) for t in leaves)
+        reps = representations(alg, *rleaves) if len(leaves) == 3 else single_representations(alg, *rleaves)
         distinct: list = []
         for label, rep_terms in reps.items():
             formal = LiouvilleSum.zero(alg, atoms)

@@ -31,6 +31,7 @@ from __future__ import annotations
 from itertools import product
 
 import sympy
+from sympy.polys.rings import PolyElement
 
 from ..algebra import nambu_bracket
 from .liouville_terms import LiouvilleTerm
@@ -39,8 +40,19 @@ from .liouville_terms import LiouvilleTerm
 FI_LABELS = ("1AX", "1AY", "1BX", "1BY", "2AX", "2AY", "2BX", "2BY")
 
 
+_MEMO: dict = {}
+
+
 def _bracket(algebra, *fs):
-    # ring elements stay ring elements (fast nesting); anything else is a sympy expression
+    # ring elements stay ring elements (fast nesting) and are memoised: the eight representations
+    # share most inner brackets; anything else is a sympy expression, computed afresh
+    if all(isinstance(f, PolyElement) for f in fs):
+        key = (algebra.ring, fs)
+        if key not in _MEMO:
+            if len(_MEMO) > 100000:
+                _MEMO.clear()
+            _MEMO[key] = nambu_bracket(algebra, *fs)
+        return _MEMO[key]
     return nambu_bracket(algebra, *fs)
 
 
