@@ -494,3 +494,20 @@ def test_n4_single_split_has_shadows(word, order):
     assert F.exists and len(F.shadows) == 3
     _check_shadow(S, word, order, F.shadows)
     assert "shadows" in F.to_dict()
+
+
+def test_fi_route_for_N2_is_eq_CL1_and_SHPV1():
+    """N = 2: both uses of the identity coincide (Jacobi, Eq. CL1): one representation; the result is Eq. (SHPV1)."""
+    F = shadow_hamiltonians(model("ho"), "121", route="fi")
+    assert all(len(c.representations) == 1 for c in F.details.commutators)
+    assert zero(F.H_S - model("ho").H + omega**2 * h**2 * x2**2 / (24 * m) - m * omega**4 * h**2 * x1**2 / 12)
+
+
+@pytest.mark.parametrize("name, word", [("ho3", "123"), ("lotka-volterra", "123"), ("ho", "12")])
+def test_fi_route_agrees_with_direct_at_h1(name, word):
+    """Non-symmetric words, h^1 (single commutators, Eqs. CL2a/CL2b): the FI route finds a family iff the direct route does."""
+    F = shadow_hamiltonians(model(name), word, 1, route="fi")
+    D = shadow_hamiltonians(model(name), word, 1)
+    assert F.exists == D.exists
+    if F.exists:
+        assert all(zero(a - b) for a, b in zip(F.shadows, D.shadows))
