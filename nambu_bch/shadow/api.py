@@ -118,7 +118,7 @@ def shadow_hamiltonians(system, word, order: int = 2, route: str = "direct", deg
             if R.exists:
                 fam.shadows = R.shadow()
                 fam.corrections[power] = R.corrections
-                fam.gauge[power] = R.kernel
+                fam.gauge[power] = R.kernel_corrections()
                 if order > power:
                     notes.append(f"h^{order}: the correction vanishes (odd order of a symmetric word)")
             else:

@@ -30,11 +30,11 @@ def _latex(expr) -> str:
     keys = sorted(parts, key=lambda k: sympy.degree(k, H_STEP) if k != 1 else 0)
     out = []
     for k in keys:
-        body = sympy.factor_terms(parts[k])
         if k == 1:
-            out.append(sympy.latex(body))
-        else:
-            out.append(sympy.latex(k) + r"\left(" + sympy.latex(body) + r"\right)")
+            out.append(sympy.latex(parts[k]))
+            continue
+        body = sympy.collect(sympy.expand(parts[k]), sympy.Symbol("alpha"))
+        out.append(sympy.latex(k) + r"\left(" + sympy.latex(body) + r"\right)")
     return " + ".join(out) if out else "0"
 
 
