@@ -129,7 +129,7 @@ class EffectiveField:
         for j, Z in enumerate(self.coefficients):
             if not Z.is_zero():
                 parts.append((f"h^{{{j}}}" if j > 1 else ("h" if j == 1 else "")) + r"\Big(" + Z.to_latex() + r"\Big)")
-        return r"X_{\rm eff} = " + " + ".join(parts) + rf" + O(h^{{{self.order + 1}}})"
+        return r"X_{\rm eff} = " + " + ".join(parts) + rf" + O(h^{{{self.composition.remainder_power(self.order)}}})"
 
     def _repr_latex_(self):
         return f"${self.to_latex()}$"

@@ -461,7 +461,8 @@ class FormalBCH:
                 pieces.append((c, tree, power))
         series = terms_to_latex(pieces, names)
         lhs = r"X_{\rm eff}" if step else r"\log \Phi"
-        tail = f" + O({sympy.latex(sympy.Symbol(step) ** self.max_degree)})" if step else ""
+        next_power = self.composition.remainder_power(self.max_degree - 1)
+        tail = f" + O({sympy.latex(sympy.Symbol(step) ** next_power)})" if step else ""
         return f"{lhs} = {series}{tail}"
 
     def _repr_latex_(self):

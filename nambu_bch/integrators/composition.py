@@ -111,6 +111,18 @@ class Composition:
                 atoms |= {sympy.root(a.base, a.exp.q) for a in c.atoms(sympy.Pow) if a.exp.is_Rational and not a.exp.is_Integer}
         return tuple(sorted(atoms, key=str))
 
+    def remainder_power(self, order: int) -> int:
+        """The first power of ``h`` after ``h**order`` that ``X_eff`` can contain.
+
+        ``order + 1`` in general; symmetric schemes have only even powers in ``X_eff``
+        (Hairer, Lubich, Wanner, Thm. IX.3.2), so their remainder after an even order is
+        ``O(h**(order + 2))``.
+
+        >>> composition("12321").remainder_power(2), composition("123").remainder_power(2)
+        (4, 3)
+        """
+        return order + 2 if self.symmetric and order % 2 == 0 else order + 1
+
     def factors(self):
         """``[(piece, coefficient), ...]`` in operator order."""
         return list(zip(self.pieces, self.coefficients))

@@ -20,22 +20,33 @@ import sympy
 H_STEP = sympy.Symbol("h")
 
 
-def _collect(expr):
-    return sympy.collect(sympy.expand(expr), H_STEP, evaluate=True)
+def _corrections(shadow, base, coordinates):
+    """``shadow - base`` by powers of ``h``: ``[(k, expr)]``, each coefficient of a monomial factored.
 
-
-def _latex(expr) -> str:
-    expr = sympy.expand(expr)
-    parts = sympy.collect(expr, H_STEP, evaluate=False)
-    keys = sorted(parts, key=lambda k: sympy.degree(k, H_STEP) if k != 1 else 0)
+    Factoring per monomial keeps rational functions of the parameters readable
+    (``(I2 - I3)/(I2 I3)`` rather than one long common denominator) and gives the
+    paper's layout, e.g. ``h^2 (alpha omega^2/(12 m) x2^2 + alpha m omega^4/12 x1^2)``.
+    """
+    groups = sympy.collect(sympy.expand(shadow - base), H_STEP, evaluate=False)
     out = []
-    for k in keys:
-        if k == 1:
-            out.append(sympy.latex(parts[k]))
-            continue
-        body = sympy.collect(sympy.expand(parts[k]), sympy.Symbol("alpha"))
-        out.append(sympy.latex(k) + r"\left(" + sympy.latex(body) + r"\right)")
-    return " + ".join(out) if out else "0"
+    for key, part in groups.items():
+        power = 0 if key == 1 else sympy.degree(key, H_STEP)
+        poly = sympy.Poly(part, *coordinates)
+        terms = [sympy.factor(c) * sympy.Mul(*(x**e for x, e in zip(coordinates, m))) for m, c in poly.terms()]
+        out.append((power, sympy.Add(*terms, evaluate=False)))
+    return sorted(out, key=lambda item: item[0])
+
+
+def _render(name, base_name, shadow, base, coordinates, tail, latex):
+    show = sympy.latex if latex else str
+    parts = [base_name]
+    for power, expr in _corrections(shadow, base, coordinates):
+        step = show(H_STEP**power) if power else ""
+        if latex:
+            parts.append(rf"{step}\left({show(expr)}\right)")
+        else:
+            parts.append(f"{step}*({show(expr)})" if step else f"({show(expr)})")
+    return f"{name} = " + " + ".join(parts) + tail
 
 
 @dataclass
@@ -98,15 +109,27 @@ class ShadowFamily:
             return ["H", "G"]
         return [f"H_{{{a + 1}}}" for a in range(k)]
 
+    def _lines(self, latex: bool) -> list:
+        """``H_S = H + h^2(...) + O(h^k)`` per Hamiltonian, then the definitions ``H = ...``."""
+        power = self.composition.remainder_power(self.order)
+        tail = rf" + O(h^{{{power}}})" if latex else f" + O(h^{power})"
+        coords = self.system.coordinates
+        names = self._names()
+        lines = []
+        for name, S, base in zip(names, self.shadows, self.system.hamiltonians):
+            shadow_name = rf"{name}_{{S}}" if latex else f"{name}_S".replace("{", "").replace("}", "")
+            base_name = name if latex else name.replace("{", "").replace("}", "")
+            lines.append(_render(shadow_name, base_name, S, base, coords, tail, latex))
+        show = sympy.latex if latex else str
+        definitions = [f"{n if latex else n.replace('{', '').replace('}', '')} = {show(b)}" for n, b in zip(names, self.system.hamiltonians)]
+        lines.append((r",\quad " if latex else ", ").join(definitions))
+        return lines
+
     def to_latex(self) -> str:
-        """``H_S = ... + O(h^{order+1})`` (and ``G_S``), or the obstruction."""
-        tail = rf" + O(h^{{{self.order + 1}}})"
+        """``H_S = H + h^2(...) + O(h^4)`` (and ``G_S``; the remainder skips odd powers of symmetric words), or the obstruction."""
         if not self.exists:
             return rf"\text{{no polynomial shadow Hamiltonians: {self.obstruction}}}"
-        lines = []
-        for name, S in zip(self._names(), self.shadows):
-            lines.append(rf"{name}_{{S}} = {_latex(S)}{tail}")
-        return ",\\\\\n".join(lines)
+        return ",\\\\\n".join(self._lines(latex=True))
 
     def _repr_latex_(self):
         return "$$" + self.to_latex().replace(",\\\\\n", r",\quad ") + "$$"
@@ -140,7 +163,7 @@ class ShadowFamily:
     def to_text(self) -> str:
         if not self.exists:
             return f"no polynomial shadow Hamiltonians for {self.composition.name} on {self.system.name}: {self.obstruction}"
-        lines = [f"{n}_S = {_collect(S)} + O(h^{self.order + 1})" for n, S in zip(["H", "G"] + [f"H{a}" for a in range(3, 9)], self.shadows)]
+        lines = self._lines(latex=False)
         if self.free_parameters:
             lines.append("free parameters: " + ", ".join(self.free_parameters))
         lines += self.notes
