@@ -31,6 +31,7 @@ have.
 from __future__ import annotations
 
 import ast
+import warnings
 from decimal import Decimal, InvalidOperation
 
 import sympy
@@ -130,7 +131,10 @@ def parse_expression(text: str, symbols, what: str = "expression") -> sympy.Expr
     # '^' means power to physicists; Python would parse it as xor with the wrong precedence
     source = text.replace("^", "**").strip()
     try:
-        tree = ast.parse(source, mode="eval")
+        with warnings.catch_warnings():
+            # "invalid decimal literal" and friends: the input is rejected or accepted on its own terms
+            warnings.simplefilter("ignore", SyntaxWarning)
+            tree = ast.parse(source, mode="eval")
     except (SyntaxError, ValueError, MemoryError, RecursionError) as exc:
         why = getattr(exc, "msg", None) or str(exc) or type(exc).__name__
         raise ExpressionParseError(
