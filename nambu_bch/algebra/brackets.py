@@ -26,7 +26,8 @@ from .polynomial import PolynomialAlgebra
 from .vector_field import VectorField
 
 
-def _permutation_sign(perm) -> int:
+def permutation_sign(perm) -> int:
+    """The sign (+1 or -1) of a permutation of ``0..n-1`` given as a sequence."""
     sign, seen = 1, list(perm)
     for i in range(len(seen)):
         while seen[i] != i:
@@ -56,7 +57,7 @@ def _determinant(algebra: PolynomialAlgebra, rows):
                 break
             product = entry if product is None else product * entry
         if product is not None:
-            term = product if _permutation_sign(perm) > 0 else -product
+            term = product if permutation_sign(perm) > 0 else -product
             total = term if total is None else total + term
     if total is None:
         return algebra.zero if algebra.is_polynomial(flat[0]) else sympy.Integer(0)

@@ -36,17 +36,8 @@ from sympy.core.sorting import default_sort_key
 from sympy.polys.rings import PolyElement
 
 from ..algebra import VectorField, liouville_field
+from ..algebra.brackets import permutation_sign
 from ..errors import NambuBCHError
-
-
-def _perm_sign(order) -> int:
-    sign, seen = 1, list(order)
-    for i in range(len(seen)):
-        while seen[i] != i:
-            j = seen[i]
-            seen[i], seen[j] = seen[j], seen[i]
-            sign = -sign
-    return sign
 
 
 @dataclass(frozen=True)
@@ -87,7 +78,7 @@ class LiouvilleTerm:
         """Slots in sympy's canonical order, the coefficient times the permutation's sign (antisymmetry)."""
         exprs = self.expressions
         order = sorted(range(len(exprs)), key=lambda i: default_sort_key(exprs[i]))
-        return LiouvilleTerm(tuple(exprs[i] for i in order), _perm_sign(order) * self.coefficient)
+        return LiouvilleTerm(tuple(exprs[i] for i in order), permutation_sign(order) * self.coefficient)
 
     def vanishes(self, coordinates) -> bool:
         """``X_{slots} = 0``: every ``(N-1)``-minor of the slots' gradients is zero (exact, sympy)."""
@@ -144,7 +135,7 @@ def canonical_key(monomials: tuple):
     if len(set(monomials)) < len(monomials) or _dependent(monomials):
         return 0, None
     order = sorted(range(len(monomials)), key=lambda i: monomials[i])
-    return _perm_sign(order), tuple(monomials[i] for i in order)
+    return permutation_sign(order), tuple(monomials[i] for i in order)
 
 
 class _Context:
@@ -169,7 +160,7 @@ class _Context:
                 out = (0, None)
             else:
                 order = sorted(range(len(entries)), key=lambda i: entries[i])
-                out = (_perm_sign(order), tuple(entries[i] for i in order))
+                out = (permutation_sign(order), tuple(entries[i] for i in order))
         self.cache[entries] = out
         return out
 
