@@ -317,6 +317,26 @@ def _indent(lines, n):
     return "\n".join(pad + line for line in lines)
 
 
+def _sampling_loop(step, sample, checks=()):
+    """The loop every kernel shares: ``steps`` steps, a sample into ``out[j]`` after each ``every`` of them.
+
+    ``step`` are the lines of one step, ``sample`` the lines that store sample ``j``, ``checks``
+    lines run after it (finiteness, progress).  Returns lines at indent 0.
+    """
+    return [
+        "n = 0",
+        "j = 1",
+        "while n < steps:",
+        "    m = every if steps - n >= every else steps - n",
+        "    for _ in range(m):",
+        *("        " + line for line in step),
+        "    n += m",
+        *("    " + line for line in sample),
+        "    j += 1",
+        *("    " + line for line in checks),
+    ]
+
+
 def python_source(program: StepProgram) -> str:
     """The generated kernel module (numba-compatible Python; see :mod:`nambu_bch.numeric.kernels`).
 
@@ -354,17 +374,7 @@ def {name}({args}):
 {_indent(consts, 4)}
     {load}
     {comp_load if kahan else ''}
-    n = 0
-    j = 1
-    while n < steps:
-        m = every if steps - n >= every else steps - n
-        for _ in range(m):
-{_indent(body, 12)}
-        n += m
-        {sample}
-        j += 1
-        if not ({finite}):
-            break
+{_indent(_sampling_loop(body, [sample], [f"if not ({finite}):", "    break"]), 4)}
     {store}
     {comp_store if kahan else ''}
     return n
@@ -377,6 +387,8 @@ def {name}({args}):
         scatter = [f"X[{i}, b0 + b] = S{i}[b]" for i in range(N)] + ([f"C[{i}, b0 + b] = Q{i}[b]" for i in range(N)] if kahan else [])
         inner_load = [f"s{i} = S{i}[b]" for i in range(N)] + ([f"c{i} = Q{i}[b]" for i in range(N)] if kahan else [])
         inner_store = [f"S{i}[b] = s{i}" for i in range(N)] + ([f"Q{i}[b] = c{i}" for i in range(N)] if kahan else [])
+        chunk_step = ["for b in range(nb):", *("    " + line for line in inner_load + body + inner_store)]
+        chunk_sample = ["for b in range(nb):", *(f"    out[j, {i}, b0 + b] = S{i}[b]" for i in range(N))]
         src.append(f"""
 def {name}({args}):
 {_indent(consts, 4)}
@@ -386,19 +398,7 @@ def {name}({args}):
         nb = min(chunk, B - b0)
         for b in range(nb):
 {_indent(gather, 12)}
-        n = 0
-        j = 1
-        while n < steps:
-            m = every if steps - n >= every else steps - n
-            for _ in range(m):
-                for b in range(nb):
-{_indent(inner_load, 20)}
-{_indent(body, 20)}
-{_indent(inner_store, 20)}
-            n += m
-            for b in range(nb):
-{_indent([f"out[j, {i}, b0 + b] = S{i}[b]" for i in range(N)], 16)}
-            j += 1
+{_indent(_sampling_loop(chunk_step, chunk_sample), 8)}
         for b in range(nb):
 {_indent(scatter, 12)}
     return steps
@@ -415,15 +415,7 @@ def {name}({args}):
     for b0 in range(0, B, chunk):
         b1 = min(b0 + chunk, B)
 {_indent(vload, 8)}
-        n = 0
-        j = 1
-        while n < steps:
-            m = every if steps - n >= every else steps - n
-            for _ in range(m):
-{_indent(vbody, 16)}
-            n += m
-{_indent([f"out[j, {i}, b0:b1] = s{i}" for i in range(N)], 12)}
-            j += 1
+{_indent(_sampling_loop(vbody, [f"out[j, {i}, b0:b1] = s{i}" for i in range(N)]), 8)}
 {_indent(vstore, 8)}
     return steps
 """)
@@ -436,23 +428,14 @@ def mpmath_source(program: StepProgram) -> str:
     s = [f"s{i}" for i in range(N)]
     consts = [f"k{j} = K[{j}]" for j in range(len(program.constants))] or ["pass"]
     body = body_lines(program, lambda e: print_python(e, "_mp_"))
+    sample = ["; ".join(f"out[j, {i}] = {v}" for i, v in enumerate(s))]
+    checks = ["if progress is not None:", "    progress(n)",
+              f"if not ({' and '.join(f'_mp_isfinite({v})' for v in s)}):", "    break"]
     return f"""
 def run(x, K, steps, every, out, progress=None):
 {_indent(consts, 4)}
     {"; ".join(f"{v} = x[{i}]" for i, v in enumerate(s))}
-    n = 0
-    j = 1
-    while n < steps:
-        m = every if steps - n >= every else steps - n
-        for _ in range(m):
-{_indent(body, 12)}
-        n += m
-        {"; ".join(f"out[j, {i}] = {v}" for i, v in enumerate(s))}
-        j += 1
-        if progress is not None:
-            progress(n)
-        if not ({" and ".join(f"_mp_isfinite({v})" for v in s)}):
-            break
+{_indent(_sampling_loop(body, sample, checks), 4)}
     {"; ".join(f"x[{i}] = {v}" for i, v in enumerate(s))}
     return n
 """
