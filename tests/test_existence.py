@@ -112,6 +112,7 @@ def test_rigid_body_lie_trotter_certified_numerically_with_drift():
     o = F.evidence["certificate_orbit"]
     assert all(abs(a) > 1000 * e for a, e in zip(o["averages"], o["errors"]))
     _check_drift(F, 1)
+    assert json.loads(json.dumps(F.to_dict()))["evidence"]["orbits_closed"] >= 1
 
 
 def test_issue_example_non_symmetric_word_drifts(ex17):
@@ -166,6 +167,13 @@ def test_issue_example_smooth_corrections_are_conserved(ex17, ex17_12321):
         HG = np.array([Hf(x) for x in xs])
         corrected = HG + h**2 * np.array([dec.correction(x, section) for x in xs])
         out[h] = (np.abs(HG - HG[0]).max(axis=0), np.abs(corrected - corrected[0]).max(axis=0))
+    # no secular drift over a longer run (the issue: t = 1000; here t = 400): the mean of H - H(0) over the first
+    # and over the last tenth agree, and both are O(h^2)
+    xs = iterate(ex17, "12321", 0.1, 4000, [0.7, 0.4, 0.3], progress=False)
+    dH = np.array([Hf(x)[0] for x in xs[::4]]) - Hf(xs[0])[0]
+    tenth = len(dH) // 10
+    first, last = dH[:tenth].mean(), dH[-tenth:].mean()
+    assert abs(last - first) < 0.05 * np.abs(dH).max() and np.abs(dH).max() < 0.02 * 0.1**2
     (raw1, cor1), (raw2, cor2) = out[0.1], out[0.05]
     assert np.all(cor1 < 0.01 * raw1) and np.all(cor2 < 0.01 * raw2)
     assert np.all(np.abs(raw1 / raw2 / 4 - 1) < 0.2)              # O(h^2) oscillation of H, G
@@ -211,6 +219,8 @@ def test_bad_input():
         decide(R, orbits=0)
     with pytest.raises(NambuBCHError, match="points must be"):
         decide(R, points=[[1.0, 2.0]])
+    with pytest.raises(NambuBCHError, match="existence must be"):
+        shadow_hamiltonians(model("ho3"), "123", 1, existence="yes")
     with pytest.raises(NambuBCHError, match="max_unknowns"):
         direct_route(model("ho3"), "123", 1, max_unknowns=0)
     S = System("x1 x2", ["x1**2/2 + x2**2/2"])
@@ -218,3 +228,16 @@ def test_bad_input():
     with pytest.raises(NambuBCHError, match="rtol"):
         orbit_average(F, [1.0, 0.0], rtol=1.0)
     assert not orbit_average(F, [0.0, 0.0]).closed          # an equilibrium: no orbit, said so
+
+
+def test_cli_shadow_prints_the_outcome(capsys):
+    """CLI `shadow`: JSON carries exists / polynomial / drift / evidence; --no-existence leaves it undecided."""
+    from nambu_bch.cli import main
+
+    assert main(["shadow", "--integrator", "123", "--order", "1", "--format", "json"]) == 0
+    d = json.loads(capsys.readouterr().out)
+    assert d["exists"] is False and d["polynomial"] is False and d["evidence"]["method"] == "exact"
+    assert sympy.simplify(sympy.sympify(d["drift"]["G"]) - sympy.sympify("h*(G*m*omega**2 - 2*H)/(2*m)")) == 0
+    assert main(["shadow", "--integrator", "123", "--order", "1", "--no-existence", "--format", "json"]) == 0
+    d = json.loads(capsys.readouterr().out)
+    assert d["exists"] is None and d["evidence"]["outcome"] == "undecided"

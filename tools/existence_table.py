@@ -22,7 +22,7 @@ CASES = [
     ("ho3, full", lambda: model("ho3"), "123", 2),
     ("ho3, full", lambda: model("ho3"), "12", 2),
     ("ho3, full", lambda: model("ho3"), "lie-trotter", 2),
-    ("rigid-body, full", lambda: model("rigid-body"), "12321", 4),
+    ("rigid-body, full", lambda: model("rigid-body"), "12321", 6),
     ("rigid-body, full", lambda: model("rigid-body"), "123", 2),
     ("lotka-volterra, single", lambda: model("lotka-volterra"), "12321", 4),
     ("lotka-volterra, single", lambda: model("lotka-volterra"), "123", 2),
@@ -57,7 +57,7 @@ def row(label, make, word, order):
         detail = "the word is not consistent with X_{H,G} (Z_0 != X_{H,G}" + (f"; {missing.group(0)}" if missing else "") + ")"
     elif F.exists is False:
         if ev.get("averages"):
-            detail = "; ".join(f"<R.grad {k}> = {v}" for k, v in ev["averages"].items())
+            detail = "; ".join(f"⟨R·∇{k}⟩ = `{v}`" for k, v in ev["averages"].items())
         else:
             o = ev["certificate_orbit"]
             detail = "; ".join(f"{a:.4g}±{e:.0e}" for a, e in zip(o["averages"], o["errors"])) + " on one orbit"
@@ -71,8 +71,8 @@ def row(label, make, word, order):
                        f"drift(h)/drift(h/2) = {q}")
     elif F.exists is True:
         worst = max(max(abs(a) for a in o["averages"]) for o in ev["orbits"] if o.get("closed"))
-        detail = (f"{', '.join(ev.get('involutions', []))} reverse the flow and make R.grad H, R.grad G odd; "
-                  f"{ev.get('orbits_closed')} sampled orbits, numerically max |<g>| = {worst:.1e}")
+        detail = (f"{', '.join(ev.get('involutions', []))} reverse the flow and make R·∇H, R·∇G odd; "
+                  f"{ev.get('orbits_closed')} sampled orbits, numerically max abs⟨g⟩ = {worst:.1e}")
     else:
         detail = ev.get("reason", "")
     poly = f"no polynomial pair at h^{F.failed_order} (degree {F.degree.get(F.failed_order)})"

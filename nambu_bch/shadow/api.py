@@ -97,6 +97,8 @@ def shadow_hamiltonians(system, word, order: int = 2, route: str = "direct", deg
     ['alpha']
     """
     system = _system(system)
+    if not isinstance(existence, bool):
+        raise NambuBCHError(f"existence must be True or False, got {existence!r}")
     if route not in ROUTES:
         raise NambuBCHError(f"route must be one of {', '.join(ROUTES)}, got {route!r}")
     order = check_order(order)

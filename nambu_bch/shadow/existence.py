@@ -354,6 +354,14 @@ def decide(result, params=None, points=None, orbits: int = DEFAULT_ORBITS, measu
     Returns
     -------
     Existence
+
+    Examples
+    --------
+    >>> from nambu_bch import model
+    >>> from nambu_bch.shadow.direct_route import direct_route
+    >>> d = decide(direct_route(model("ho3"), "123", 1), measure=False)    # Lie-Trotter on ho3: h^1
+    >>> d.outcome, d.method, d.averages
+    ('none', 'exact', [omega**2*(G*m*omega**2 - 2*H)/4, (G*m*omega**2 - 2*H)/(2*m)])
     """
     system = result.system
     if isinstance(orbits, bool) or not isinstance(orbits, int) or not 1 <= orbits <= 64:
@@ -456,7 +464,11 @@ def decide(result, params=None, points=None, orbits: int = DEFAULT_ORBITS, measu
         rate = max(abs(a) for a in o.averages) + 1e-300
         h1 = float(min(0.05, o.period / 100, (0.005 * size / (rate * PERIODS * o.period)) ** (1.0 / j)))
         for h in (h1, h1 / 2):
-            rates = measure_drift(system, result.composition, conserved, o.x0, params, h, PERIODS, o.period)
+            try:
+                rates = measure_drift(system, result.composition, conserved, o.x0, params, h, PERIODS, o.period)
+            except NambuBCHError as exc:  # e.g. a step outside the stability interval: say so, keep the certificate
+                dec.measured.append({"h": h, "error": str(exc)})
+                continue
             predicted = [float(h**j * (c.subs(params).subs(dict(zip([sympy.Symbol(s) for s in names], o.hamiltonians)))
                                        if dec.method == "exact" else a))
                          for c, a in zip(exact if dec.method == "exact" else [None] * len(names), o.averages)]
