@@ -418,7 +418,7 @@ def cmd_shadow(args):
     system = substituted(system, values)
     word, comp = integrator_from_args(args, system)
     order = args.order if args.order is not None else 2
-    kwargs = {"order": order, "route": args.route}
+    kwargs = {"order": order, "route": args.route, "existence": args.existence}
     if args.degree is not None:
         kwargs["degree"] = args.degree
     family = shadow_hamiltonians(system, comp, **kwargs)
@@ -749,6 +749,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--route", choices=("direct", "fi"), default="direct",
                    help="direct: order-by-order linear solve; fi: fundamental-identity representations (default direct)")
     p.add_argument("--degree", metavar="D", type=str, help="polynomial degree of the ansatz for H_S, G_S (default: the library's)")
+    p.add_argument("--no-existence", dest="existence", action="store_false",
+                   help="when no polynomial pair is found, do not decide existence by orbit averages (answer: undecided)")
     _output_options(p, "latex")
 
     p = add("conserved", cmd_conserved)

@@ -2,6 +2,7 @@
 
 from .api import shadow_hamiltonians
 from .direct_route import DirectResult, OrderSolution, direct_route
+from .existence import Existence, decide
 from .family import ShadowFamily
 from .fi_route import FICommutator, FIRepresentation, FIResult, fi_route
 from .fundamental_identity import FI_LABELS, commutator_terms, double_commutator_terms, representations
@@ -11,6 +12,7 @@ from .liouville_terms import LiouvilleSum, LiouvilleTerm
 __all__ = [
     "FI_LABELS",
     "DirectResult",
+    "Existence",
     "FICommutator",
     "FIRepresentation",
     "FIResult",
@@ -20,6 +22,7 @@ __all__ = [
     "OrderSolution",
     "ShadowFamily",
     "commutator_terms",
+    "decide",
     "direct_route",
     "double_commutator_terms",
     "fi_route",

@@ -17,6 +17,7 @@ from .family import ShadowFamily
 from .fi_route import fi_route
 
 ROUTES = ("direct", "fi")
+MAX_UNKNOWNS = 800  # the direct route's exact solve is refused up front above this many unknowns per order
 
 
 def _system(system):
@@ -48,7 +49,24 @@ def _obstruction_text(sol, n_hams: int = 2) -> str:
     )
 
 
-def shadow_hamiltonians(system, word, order: int = 2, route: str = "direct", degree=None) -> ShadowFamily:
+def _decide(fam, R, existence, params):
+    """Set ``exists`` / ``drift`` / ``evidence`` of a family whose polynomial ansatz failed (issue 17)."""
+    if not existence:
+        fam.exists = None
+        fam.evidence = {"outcome": "undecided", "order": fam.failed_order, "method": None,
+                        "reason": "no polynomial pair; existence in smooth functions not decided (existence=False)"}
+        return
+    from .existence import decide
+
+    dec = decide(R, params=params)
+    fam.existence = dec
+    fam.exists = dec.exists
+    fam.drift = dec.drift_dict()
+    fam.evidence = dec.evidence()
+
+
+def shadow_hamiltonians(system, word, order: int = 2, route: str = "direct", degree=None, *,
+                        existence: bool = True, params=None, max_unknowns: int | None = MAX_UNKNOWNS) -> ShadowFamily:
     """Shadow Hamiltonians ``H_S, G_S`` of ``word`` on ``system`` through ``h^order``, as a family.
 
     Parameters
@@ -59,10 +77,15 @@ def shadow_hamiltonians(system, word, order: int = 2, route: str = "direct", deg
     route : ``"direct"`` (order-by-order linear solve, any order) or ``"fi"``
         (representations of the BCH commutators by the fundamental identity; lowest correction only)
     degree : int, optional -- ansatz degree of the corrections (default: from the field)
+    existence : bool -- when no polynomial pair is found, decide existence in smooth functions by
+        orbit averages (:mod:`nambu_bch.shadow.existence`); with False the answer stays undecided
+    params : dict, optional -- parameter values for the orbit numerics (default: generic rationals)
+    max_unknowns : int or None -- refuse the exact polynomial solve of an order with more unknowns (bounded work)
 
     Returns
     -------
-    ShadowFamily
+    ShadowFamily -- ``exists`` is True when a pair exists (``polynomial`` says whether the one found is),
+    False only when non-existence is certified (non-zero orbit average, ``drift``), None when undecided.
 
     Examples
     --------
@@ -74,13 +97,15 @@ def shadow_hamiltonians(system, word, order: int = 2, route: str = "direct", deg
     ['alpha']
     """
     system = _system(system)
+    if not isinstance(existence, bool):
+        raise NambuBCHError(f"existence must be True or False, got {existence!r}")
     if route not in ROUTES:
         raise NambuBCHError(f"route must be one of {', '.join(ROUTES)}, got {route!r}")
     order = check_order(order)
     comp = make_composition(word, len(system.splitting)).check(system.splitting)
     notes = []
     if route == "direct":
-        R = direct_route(system, comp, order, degree)
+        R = direct_route(system, comp, order, degree, max_unknowns)
         fam = ShadowFamily(system, comp, order, route, R.exists, details=R)
         for o in R.orders:
             if o.status == "vanishes":
@@ -94,11 +119,18 @@ def shadow_hamiltonians(system, word, order: int = 2, route: str = "direct", deg
                 fam.degree[o.order] = o.degree
         if R.exists:
             fam.shadows = R.shadow()
+            fam.polynomial = True
         else:
             bad = R.orders[-1]
             fam.failed_order = bad.order
-            fam.certificate = bad.certificate
-            fam.obstruction = _obstruction_text(bad, len(system.hamiltonians))
+            fam.polynomial = False
+            if bad.status == "obstructed":
+                fam.certificate = bad.certificate
+                fam.obstruction = _obstruction_text(bad, len(system.hamiltonians))
+            else:
+                fam.obstruction = (f"at h^{bad.order} the polynomial ansatz of degree <= {bad.degree} has more than "
+                                   f"max_unknowns={max_unknowns} unknowns: the exact solve was refused up front")
+            _decide(fam, R, existence, params)
     else:
         power = 2 if comp.symmetric else 1
         if order > power + (1 if comp.symmetric else 0):
@@ -126,6 +158,19 @@ def shadow_hamiltonians(system, word, order: int = 2, route: str = "direct", deg
                 fam.certificate = R.certificate
                 fam.obstruction = (f"at h^{power} no affine combination of the FI representations equals "
                                    f"X_{{H,dG}} + X_{{dH,G}} with corrections of degree <= {R.degree}")
+                # the FI ansatz failing is no certificate: the direct route and the orbit averages decide
+                fam.polynomial = False
+                if not existence:
+                    _decide(fam, None, existence, params)
+                else:
+                    D = direct_route(system, comp, order, None, max_unknowns)
+                    if D.exists:
+                        fam.exists, fam.polynomial, fam.shadows = True, True, D.shadow()
+                        notes.append("the FI ansatz failed; the shadows are the direct route's polynomial pair")
+                    else:
+                        _decide(fam, D, existence, params)
+            if R.exists:
+                fam.polynomial = True
     fam.notes = notes
     if fam.exists and any(S.has(ALPHA) for S in fam.shadows):
         fam.free_parameters = ["alpha"]

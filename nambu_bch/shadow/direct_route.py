@@ -81,7 +81,7 @@ class OrderSolution:
     ----------
     order : int
     status : ``"solved"``, ``"vanishes"`` (zero right-hand side, e.g. odd orders of a
-        symmetric word) or ``"obstructed"``
+        symmetric word), ``"obstructed"`` or ``"refused"`` (more than ``max_unknowns`` unknowns)
     degree : int or None -- the ansatz degree used
     corrections : tuple of sympy expressions -- the family's ``dH^a_order`` (in ``alpha``)
     members : (tuple, tuple) -- the ``alpha = 0`` and ``alpha = 1`` members
@@ -126,11 +126,11 @@ class DirectResult:
 
     @property
     def exists(self) -> bool:
-        return all(o.status != "obstructed" for o in self.orders)
+        return all(o.status in ("solved", "vanishes") for o in self.orders)
 
     @property
     def failed_order(self):
-        return next((o.order for o in self.orders if o.status == "obstructed"), None)
+        return next((o.order for o in self.orders if o.status not in ("solved", "vanishes")), None)
 
     def shadow(self, upto=None) -> tuple:
         """``(H_S, G_S, ...)`` as sympy expressions in ``h`` and ``alpha`` through ``h^upto``."""
@@ -165,7 +165,8 @@ def _total_degree(p, n):
 
 
 class _Solver:
-    def __init__(self, system, comp, order, degree):
+    def __init__(self, system, comp, order, degree, max_unknowns=None):
+        self.max_unknowns = max_unknowns
         self.system = system
         self.comp = comp
         self.order = order
@@ -258,6 +259,9 @@ class _Solver:
             )
         monos = _monomials(self.n, D)
         columns = [(a, e) for a in range(self.slots) for e in monos]
+        if self.max_unknowns is not None and len(columns) > self.max_unknowns:
+            # bounded work (issue 17): the exact solve is refused up front, the order stays undecided
+            return OrderSolution(j, "refused", degree=D, rhs=rhs)
         row_index: dict = {}
 
         def row(i, mono):
@@ -374,7 +378,7 @@ class _Solver:
         return rank(vecs, len(columns), alg.domain) if vecs else 0
 
 
-def direct_route(system, word, order: int = 2, degree=None) -> DirectResult:
+def direct_route(system, word, order: int = 2, degree=None, max_unknowns=None) -> DirectResult:
     """Solve ``X_{H_S,G_S} = X_eff + O(h^{order+1})`` order by order (Eq. L2; Eq. L1 for N = 2).
 
     Parameters
@@ -383,10 +387,11 @@ def direct_route(system, word, order: int = 2, degree=None) -> DirectResult:
     word : composition spec (``"12321"``, ``"lie-trotter"``, ``Composition`` ...)
     order : int -- highest power of ``h`` kept
     degree : int, optional -- ansatz degree of the corrections (default: from the field)
+    max_unknowns : int, optional -- refuse (status ``"refused"``) an order whose ansatz has more unknowns
 
     Returns
     -------
-    DirectResult -- stops at the first obstructed order.
+    DirectResult -- stops at the first obstructed or refused order.
 
     Examples
     --------
@@ -400,12 +405,14 @@ def direct_route(system, word, order: int = 2, degree=None) -> DirectResult:
         if isinstance(degree, bool) or not isinstance(degree, int) or degree < 1:
             raise InvalidOrderError(f"degree must be a positive integer (the ansatz degree) or None, got {degree!r}")
     comp = make_composition(word, len(system.splitting)).check(system.splitting)
-    solver = _Solver(system, comp, order, degree)
+    if max_unknowns is not None and (isinstance(max_unknowns, bool) or not isinstance(max_unknowns, int) or max_unknowns < 1):
+        raise InvalidOrderError(f"max_unknowns must be a positive integer or None, got {max_unknowns!r}")
+    solver = _Solver(system, comp, order, degree, max_unknowns)
     corrections: dict = {}
     orders = []
     for j in range(1, order + 1):
         sol = solver.solve_order(j, corrections)
         orders.append(sol)
-        if sol.status == "obstructed":
+        if sol.status in ("obstructed", "refused"):
             break
     return DirectResult(system, comp, order, orders, solver.hams, solver.alg, solver.effective, corrections)

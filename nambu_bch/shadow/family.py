@@ -58,7 +58,11 @@ class ShadowFamily:
     system, composition
     order : int -- highest power of ``h`` kept
     route : ``"direct"`` or ``"fi"``
-    exists : bool
+    exists : True / False / None -- a pair exists / non-existence is certified / undecided (issue 17)
+    polynomial : bool or None -- the pair found is polynomial (False: no polynomial pair up to the degree tried)
+    drift : dict or None -- predicted secular drift ``dH'/dt`` per Hamiltonian of a certified non-existence
+    evidence : dict or None -- the existence decision as data (:meth:`~nambu_bch.shadow.existence.Existence.evidence`)
+    existence : the :class:`~nambu_bch.shadow.existence.Existence` decision, or None
     shadows : tuple -- all shadow Hamiltonians ``(H_S, G_S, ...)`` (sympy, in ``h`` and ``alpha``), or ``()``
     free_parameters : list of str -- e.g. ``["alpha"]``
     gauge : dict ``order -> [directions]`` -- kernel bases (one correction per Hamiltonian)
@@ -73,7 +77,7 @@ class ShadowFamily:
     composition: object
     order: int
     route: str
-    exists: bool
+    exists: object
     shadows: tuple = ()
     free_parameters: list = field(default_factory=list)
     gauge: dict = field(default_factory=dict)
@@ -84,6 +88,17 @@ class ShadowFamily:
     certificate: dict | None = None
     obstruction: str | None = None
     details: object = None
+    polynomial: bool | None = None
+    drift: dict | None = None
+    evidence: dict | None = None
+    existence: object = None
+
+    def _outcome_text(self) -> str:
+        """One line for a family without a polynomial pair: the three outcomes of issue 17."""
+        ev = self.evidence or {}
+        what = {True: "shadow Hamiltonians exist in smooth functions but are not polynomial",
+                False: "no shadow Hamiltonians (certified)", None: "existence undecided"}[self.exists]
+        return f"{what}: {ev.get('reason', '')}; no polynomial pair: {self.obstruction}"
 
     @property
     def H_S(self):
@@ -127,8 +142,10 @@ class ShadowFamily:
 
     def to_latex(self) -> str:
         """``H_S = H + h^2(...) + O(h^4)`` (and ``G_S``; the remainder skips odd powers of symmetric words), or the obstruction."""
-        if not self.exists:
-            return rf"\text{{no polynomial shadow Hamiltonians: {self.obstruction}}}"
+        if not self.shadows:
+            if self.evidence is None:
+                return rf"\text{{no polynomial shadow Hamiltonians: {self.obstruction}}}"
+            return rf"\text{{{self._outcome_text()}}}"
         return ",\\\\\n".join(self._lines(latex=True))
 
     def _repr_latex_(self):
@@ -152,7 +169,10 @@ class ShadowFamily:
         }
         if len(self.shadows) > 2:
             out["shadows"] = [str(S) for S in self.shadows]
-        if not self.exists:
+        out["polynomial"] = self.polynomial
+        if self.failed_order is not None:
+            out["drift"] = self.drift
+            out["evidence"] = self.evidence
             out["obstruction"] = self.obstruction
             out["failed_order"] = self.failed_order
             out["degree"] = self.degree.get(self.failed_order)
@@ -161,8 +181,10 @@ class ShadowFamily:
         return out
 
     def to_text(self) -> str:
-        if not self.exists:
+        if self.exists is False and self.evidence is None:
             return f"no polynomial shadow Hamiltonians for {self.composition.name} on {self.system.name}: {self.obstruction}"
+        if not self.shadows:
+            return f"{self.composition.name} on {self.system.name}: {self._outcome_text()}"
         lines = self._lines(latex=False)
         if self.free_parameters:
             lines.append("free parameters: " + ", ".join(self.free_parameters))
@@ -170,6 +192,7 @@ class ShadowFamily:
         return "\n".join(lines)
 
     def __repr__(self):
-        state = "exists" if self.exists else f"obstructed at h^{self.failed_order}"
+        state = ("exists" if self.shadows else f"exists (smooth, not polynomial at h^{self.failed_order})") if self.exists \
+            else f"obstructed at h^{self.failed_order}" if self.exists is False else f"undecided at h^{self.failed_order}"
         return (f"ShadowFamily({self.system.name!r}, {self.composition.name!r}, order={self.order}, route={self.route!r}, "
                 f"{state}, free_parameters={self.free_parameters})")

@@ -1,0 +1,243 @@
+"""Issue 17: existence of shadow Hamiltonians decided in smooth functions (orbit averages), not only polynomials.
+
+The criterion (nambu_bch/shadow/existence.py, docs/existence.md): at the first order h^j that the polynomial
+ansatz does not solve, a shadow pair exists in smooth functions iff the orbit averages <R_j . grad H_a> vanish on
+the periodic orbits of X_{H,G} (homological equation of averaging; Hairer-Lubich-Wanner, GNI, Sect. XI.2); a
+non-zero average certifies non-existence and predicts the secular drift dH'/dt = h^j <R_j . grad H>.
+Every value below is checked two independent ways (exact formula vs orbit quadrature; prediction vs iterated map).
+"""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+import sympy
+
+from nambu_bch import System, model
+from nambu_bch.errors import NambuBCHError
+from nambu_bch.numeric.iterate import iterate
+from nambu_bch.shadow import shadow_hamiltonians
+from nambu_bch.shadow.averaging import orbit_average, orbit_functions, section_integral
+from nambu_bch.shadow.direct_route import direct_route
+from nambu_bch.shadow.existence import decide, exact_average, integrands, reversing_involutions
+
+# the issue's example: separable, closed orbits, both Hamiltonians quartic
+EX17 = ["x1**2/2 + x2**2/2 + x2**4/4 + x3**2", "x1**2/2 + x1**4/8 + x2**2/2 + x3**2/2 + x3**4/4"]
+Hs, Gs = sympy.symbols("H G")
+
+
+@pytest.fixture(scope="module")
+def ex17():
+    return System("x1 x2 x3", EX17, name="ex17")
+
+
+@pytest.fixture(scope="module")
+def ex17_12321(ex17):
+    return shadow_hamiltonians(ex17, "12321", 2)
+
+
+# -- the averages themselves -----------------------------------------------------------------------------
+
+def test_orbit_average_of_the_circle():
+    """X_H for H = (x1^2 + x2^2)/2: circles of period 2 pi; <x1^2> = H = r^2/2 exactly, <x1 x2> = 0, <x1^4> = 3 r^4/8."""
+    S = System("x1 x2", ["x1**2/2 + x2**2/2"])
+    x1, x2 = S.coordinates
+    F = orbit_functions(S, [x1**2, x1 * x2, x1**4], {})
+    A = orbit_average(F, [0.6, 0.8])            # r = 1
+    assert A.closed and abs(A.period - 2 * np.pi) < 1e-9
+    assert abs(A.averages[0] - 0.5) < 1e-10 and abs(A.averages[1]) < 1e-10 and abs(A.averages[2] - 3 / 8) < 1e-10
+    assert max(A.errors) < 1e-9
+    # the exact route gives the same: x1^2 = X_H(p) + H, x1^4 = X_H(q) + 3 H^2 / 2
+    assert exact_average(S, x1**2) == sympy.Symbol("H")
+    assert sympy.expand(exact_average(S, x1**4) - sympy.Rational(3, 2) * sympy.Symbol("H") ** 2) == 0
+
+
+def test_ho3_exact_averages_match_quadrature():
+    """ho3, Phi^{123}, h^1 (README: obstructed): the exact decomposition g = X(p) + c(H, G) gives
+    <R_1.grad H> = omega^2 (m omega^2 G - 2H)/4 and <R_1.grad G> = (m omega^2 G - 2H)/(2m) on every periodic orbit;
+    the orbit quadrature agrees on sampled orbits (m = 3/2, omega = 4/3)."""
+    S = model("ho3")
+    m, om = S.parameters
+    R = direct_route(S, "123", 1)
+    gs, j = integrands(R)
+    assert j == 1
+    cH, cG = (exact_average(S, g) for g in gs)
+    assert sympy.simplify(cH - om**2 * (m * om**2 * Gs - 2 * Hs) / 4) == 0
+    assert sympy.simplify(cG - (m * om**2 * Gs - 2 * Hs) / (2 * m)) == 0
+    params = {m: sympy.Rational(3, 2), om: sympy.Rational(4, 3)}
+    F = orbit_functions(S, gs, params)
+    for x0 in ([0.3, 0.9, 0.5], [1.0, -0.2, 2.0]):
+        A = orbit_average(F, x0)
+        levels = dict(zip((Hs, Gs), A.hamiltonians))
+        for c, a, e in zip((cH, cG), A.averages, A.errors):
+            exact = float(c.subs(params).subs(levels))
+            assert abs(a - exact) < 1e-8 and e < 1e-8 and abs(exact) > 1e-2
+
+
+# -- certified non-existence: drift predicted = drift measured, at two step sizes ----------------------------
+
+def _check_drift(F, j):
+    ev = F.evidence
+    assert F.exists is False and F.polynomial is False and ev["outcome"] == "none"
+    m1, m2 = ev["measured_drift"]
+    assert abs(m2["h"] - m1["h"] / 2) < 1e-15
+    for name in m1["measured"]:
+        p1, p2 = m1["predicted"][name], m2["predicted"][name]
+        assert abs(p1) > 0
+        # measured = predicted (the rate h^j <R.grad H>), to O(h) relative at the smaller step ...
+        assert abs(m2["measured"][name] / p2 - 1) < 0.05, (name, m1, m2)
+        # ... and rate proportional to h^j: halving h divides the measured drift by 2^j
+        assert abs(m1["measured"][name] / m2["measured"][name] / 2**j - 1) < 0.1, (name, m1, m2)
+
+
+def test_ho3_lie_trotter_certified_exactly_with_drift():
+    """ho3, Phi^{123}: no shadow pair (certified by the exact averages); JSON carries exists false, polynomial false,
+    the drift dH'/dt = h omega^2 (m omega^2 G - 2H)/4 and the measured drift at two step sizes."""
+    F = shadow_hamiltonians(model("ho3"), "123", 2)
+    assert F.failed_order == 1 and F.evidence["method"] == "exact"
+    assert sympy.simplify(sympy.sympify(F.drift["H"]) - sympy.Symbol("h") * sympy.sympify(F.evidence["averages"]["H"])) == 0
+    _check_drift(F, 1)
+    d = json.loads(json.dumps(F.to_dict()))
+    assert d["exists"] is False and d["polynomial"] is False and set(d["drift"]) == {"H", "G"}
+
+
+def test_rigid_body_lie_trotter_certified_numerically_with_drift():
+    """Free rigid body, Phi^{123} (README: obstructed at h^1): averages involve elliptic integrals (no exact
+    decomposition); the quadrature gives a non-zero average far above its error estimate, and the iterated map
+    drifts at the predicted rate."""
+    F = shadow_hamiltonians(model("rigid-body"), "123", 1)
+    assert F.evidence["method"] == "numerical"
+    o = F.evidence["certificate_orbit"]
+    assert all(abs(a) > 1000 * e for a, e in zip(o["averages"], o["errors"]))
+    _check_drift(F, 1)
+    assert json.loads(json.dumps(F.to_dict()))["evidence"]["orbits_closed"] >= 1
+
+
+def test_issue_example_non_symmetric_word_drifts(ex17):
+    """The issue's system with Phi^{123} (drifts to overflow in the issue): certified non-existence at h^1."""
+    F = shadow_hamiltonians(ex17, "123", 1)
+    assert F.failed_order == 1
+    _check_drift(F, 1)
+
+
+def test_inconsistent_word_is_not_an_obstruction_but_no_method():
+    """ho3 with Phi^{12} (README: 'none at h^1'): piece 3 is missing, Z_0 != X_{H,G}: the word does not integrate
+    this system at all; reported as such (no shadow pair H + O(h) can exist), not as an averaging certificate."""
+    F = shadow_hamiltonians(model("ho3"), "12", 1)
+    assert F.exists is False and F.evidence["order"] == 0 and "not consistent" in F.evidence["reason"]
+    assert "pieces [3] are missing" in F.evidence["reason"] and F.drift is None
+
+
+# -- smooth, not polynomial: the issue's example --------------------------------------------------------------
+
+def test_issue_example_has_a_smooth_pair_not_polynomial(ex17, ex17_12321):
+    """H = x1^2/2 + x2^2/2 + x2^4/4 + x3^2, G = x1^2/2 + x1^4/8 + x2^2/2 + x3^2/2 + x3^4/4, Phi^{12321}, h^2:
+    the polynomial solve (degree 14) is refused up front (bounded work) and the averages vanish exactly by
+    reversibility (x_i -> -x_i fixes H, G and makes R_2.grad H, R_2.grad G odd; HGW Sect. XI.1), numerically too."""
+    F = ex17_12321
+    assert F.exists is True and F.polynomial is False and F.shadows == ()
+    assert F.details.orders[-1].status == "refused" and F.degree[2] == 14
+    ev = F.evidence
+    assert ev["method"] == "symmetry" and ev["outcome"] == "smooth" and ev["orbits_closed"] >= 4
+    assert all(max(abs(a) for a in o["averages"]) < 1e-9 for o in ev["orbits"] if o["closed"])
+    # the symmetry itself, checked independently of the module's search
+    R = F.details
+    gs, j = integrands(R)
+    x1 = ex17.coordinates[0]
+    assert j == 2 and all(sympy.expand(g.subs(x1, -x1) + g) == 0 for g in gs)
+    assert (0,) in reversing_involutions(ex17, gs)
+    d = json.loads(json.dumps(F.to_dict()))
+    assert d["exists"] is True and d["polynomial"] is False and d["drift"] is None
+    assert "smooth" in F.to_text() and "undecided" not in repr(F)
+
+
+def test_issue_example_smooth_corrections_are_conserved(ex17, ex17_12321):
+    """The smooth corrections a = int R_2.grad H dt (to the reversing section) make H + h^2 a, G + h^2 b conserved
+    by the iterated Phi^{12321} to O(h^4): bounded, no secular drift (t = 60 from the issue's (0.7, 0.4, 0.3)),
+    while H, G themselves oscillate at O(h^2); both scale as predicted when h is halved."""
+    dec = ex17_12321.existence
+    Hf = sympy.lambdify([ex17.coordinates], list(ex17.hamiltonians))
+    out = {}
+    for h in (0.1, 0.05):
+        steps = int(round(60 / h))
+        xs = iterate(ex17, "12321", h, steps, [0.7, 0.4, 0.3], every=steps // 12, progress=False)
+        section = dec.section_for(xs[0])
+        HG = np.array([Hf(x) for x in xs])
+        corrected = HG + h**2 * np.array([dec.correction(x, section) for x in xs])
+        out[h] = (np.abs(HG - HG[0]).max(axis=0), np.abs(corrected - corrected[0]).max(axis=0))
+    # no secular drift over a longer run (the issue: t = 1000; here t = 400): the mean of H - H(0) over the first
+    # and over the last tenth agree, and both are O(h^2)
+    xs = iterate(ex17, "12321", 0.1, 4000, [0.7, 0.4, 0.3], progress=False)
+    dH = np.array([Hf(x)[0] for x in xs[::4]]) - Hf(xs[0])[0]
+    tenth = len(dH) // 10
+    first, last = dH[:tenth].mean(), dH[-tenth:].mean()
+    assert abs(last - first) < 0.05 * np.abs(dH).max() and np.abs(dH).max() < 0.02 * 0.1**2
+    (raw1, cor1), (raw2, cor2) = out[0.1], out[0.05]
+    assert np.all(cor1 < 0.01 * raw1) and np.all(cor2 < 0.01 * raw2)
+    assert np.all(np.abs(raw1 / raw2 / 4 - 1) < 0.2)              # O(h^2) oscillation of H, G
+    assert np.all(raw1 / raw2 > 3) and np.all(cor1 / cor2 > 8)    # the corrected ones: O(h^4)
+
+
+def test_section_integral_solves_the_homological_equation(ex17, ex17_12321):
+    """a(phi_s x) - a(x) = -int_0^s g: along one orbit the section integral decreases by the integral of g."""
+    dec = ex17_12321.existence
+    F = dec.functions
+    x = np.array([0.3, -0.5, 0.4])
+    i = dec.section_for(x)
+    # a step along the orbit with the averaging integrator: y = phi_s(x), I = int_0^s g
+    from nambu_bch.shadow.averaging import _rk_step
+    y = np.concatenate([x, np.zeros(F.m)])
+    for _ in range(200):
+        y, _, _ = _rk_step(F.rhs, y, F.rhs(y), 0.0025)
+    a0, a1 = section_integral(F, x, i), section_integral(F, y[:3], i)
+    assert np.allclose(a1 - a0, -y[3:], atol=1e-8)
+
+
+# -- polynomial results unchanged, options, bad input -------------------------------------------------------------
+
+def test_polynomial_results_unchanged():
+    """ho3 Phi^{12321} (Eqs. SH12321c, SG12321c): polynomial pair as before; JSON adds polynomial: true only."""
+    F = shadow_hamiltonians(model("ho3"), "12321", 2)
+    assert F.exists is True and F.polynomial is True and F.existence is None
+    d = F.to_dict()
+    assert d["polynomial"] is True and "drift" not in d and "evidence" not in d
+
+
+def test_existence_false_leaves_it_undecided():
+    F = shadow_hamiltonians(model("ho3"), "123", 1, existence=False)
+    assert F.exists is None and F.polynomial is False and "existence=False" in F.evidence["reason"]
+    assert "undecided" in F.to_text() and F.to_dict()["exists"] is None
+
+
+def test_bad_input():
+    R = direct_route(model("ho3"), "123", 1)
+    with pytest.raises(NambuBCHError, match="unknown parameter"):
+        decide(R, params={"k": 1})
+    with pytest.raises(NambuBCHError, match="orbits must be"):
+        decide(R, orbits=0)
+    with pytest.raises(NambuBCHError, match="points must be"):
+        decide(R, points=[[1.0, 2.0]])
+    with pytest.raises(NambuBCHError, match="existence must be"):
+        shadow_hamiltonians(model("ho3"), "123", 1, existence="yes")
+    with pytest.raises(NambuBCHError, match="max_unknowns"):
+        direct_route(model("ho3"), "123", 1, max_unknowns=0)
+    S = System("x1 x2", ["x1**2/2 + x2**2/2"])
+    F = orbit_functions(S, [S.coordinates[0]], {})
+    with pytest.raises(NambuBCHError, match="rtol"):
+        orbit_average(F, [1.0, 0.0], rtol=1.0)
+    assert not orbit_average(F, [0.0, 0.0]).closed          # an equilibrium: no orbit, said so
+
+
+def test_cli_shadow_prints_the_outcome(capsys):
+    """CLI `shadow`: JSON carries exists / polynomial / drift / evidence; --no-existence leaves it undecided."""
+    from nambu_bch.cli import main
+
+    assert main(["shadow", "--integrator", "123", "--order", "1", "--format", "json"]) == 0
+    d = json.loads(capsys.readouterr().out)
+    assert d["exists"] is False and d["polynomial"] is False and d["evidence"]["method"] == "exact"
+    assert sympy.simplify(sympy.sympify(d["drift"]["G"]) - sympy.sympify("h*(G*m*omega**2 - 2*H)/(2*m)")) == 0
+    assert main(["shadow", "--integrator", "123", "--order", "1", "--no-existence", "--format", "json"]) == 0
+    d = json.loads(capsys.readouterr().out)
+    assert d["exists"] is None and d["evidence"]["outcome"] == "undecided"
