@@ -34,13 +34,25 @@ exception is a bug and propagates with its traceback (exit status 1).
 from __future__ import annotations
 
 import argparse
+import importlib
 import os
 import sys
 
-import sympy
-
-from . import render
 from .errors import NambuBCHError
+
+
+class _Lazy:
+    """A module imported on first attribute access: ``--help`` and argument errors never import sympy."""
+
+    def __init__(self, name):
+        self._name = name
+
+    def __getattr__(self, attr):
+        return getattr(importlib.import_module(self._name), attr)
+
+
+sympy = _Lazy("sympy")
+render = _Lazy("nambu_bch.render")
 
 PROG = "nambu-bch"
 DEFAULT_MODEL = "ho3"
@@ -249,7 +261,7 @@ def emit(args, *, latex=None, text=None, data=None):
     if fmt == "json":
         out = render.to_json(data())
     elif fmt == "latex" and latex is not None:
-        out = render.latex_document(latex())
+        out = render.latex_document(latex(), standalone=getattr(args, "standalone", False))
     elif text is not None:
         out = text()
         out = out if out.endswith("\n") else out + "\n"
@@ -320,12 +332,16 @@ def cmd_models(args):
         return "\n".join(lines)
 
     def latex():
+        from .printing import aligned, latex_text
+
         blocks = []
         for s in systems:
-            rows = [rf"\text{{{s.name}}}:\quad {s.to_latex()}"]
-            rows += [rf"X_{{{p.number}}} = {p.label()} = {p.field.to_latex()}" for p in s.splitting.pieces]
-            blocks.append(" \\\\\n".join(rows))
-        return "\\begin{gathered}\n" + " \\\\[1ex]\n".join(blocks) + "\n\\end{gathered}"
+            rows = [("", "", [latex_text(s.name) + ":"])]
+            labels = ["H", "G"] if len(s.hamiltonians) == 2 else [f"H_{{{k + 1}}}" for k in range(len(s.hamiltonians))]
+            rows += [(lab, "=", [sympy.latex(H)]) for lab, H in zip(labels[: len(s.hamiltonians)] or ["H"], s.hamiltonians)]
+            rows += [(f"X_{{{p.number}}}", "=", [p.label(), "= " + p.field.to_latex()]) for p in s.splitting.pieces]
+            blocks.append(aligned(rows))
+        return blocks
 
     emit(args, latex=latex, text=text, data=data)
 
@@ -365,7 +381,8 @@ def cmd_bch(args):
             out["X_eff"] = [[render.expression(c) for c in Z.to_sympy()] for Z in field.coefficients]
         if expanded is not None:
             out["liouville_terms"] = [
-                {"degree": d, "coefficient": render.expression(c), "bracket": tree_to_latex(t)}
+                {"degree": d, "coefficient": render.expression(c), "bracket": render.bracket_text(t),
+                 "tree": render.bracket_tree(t), "latex": tree_to_latex(t)}
                 for d, items in expanded.items() for c, t in items
             ]
         return out
@@ -384,18 +401,25 @@ def cmd_bch(args):
             lines.append("Liouville terms (zero brackets pruned):")
             for d, items in expanded.items():
                 for c, t in items:
-                    lines.append(f"  h^{d - 1}  {c}  {tree_to_latex(t)}")
+                    lines.append(f"  h^{d - 1}  {c}  {render.bracket_text(t)}")
         return "\n".join(lines)
 
     def latex():
-        rows = [comp.to_latex(), series.to_latex()]
+        from .printing import aligned
+
+        lhs, _, rhs = comp.to_latex().partition(" = ")
+        blocks = [aligned([(lhs, "=", rhs.split(" "))]), series.to_latex()]
         if field is not None:
-            rows.append(field.to_latex())
+            blocks.append(field.to_latex())
         if expanded is not None:
+            rows = []
             for d, items in expanded.items():
-                body = " ".join(_signed_latex(c * sympy.Symbol("h") ** (d - 1)) + " " + tree_to_latex(t) for c, t in items)
-                rows.append(rf"X_{{\rm eff}}\big|_{{h^{{{d - 1}}}}} = {body.lstrip('+ ') or '0'}")
-        return " \\\\\n".join(rows)
+                tokens = [_signed_latex(c * sympy.Symbol("h") ** (d - 1)) + " " + tree_to_latex(t) for c, t in items]
+                if tokens and tokens[0].startswith("+ "):
+                    tokens[0] = tokens[0][2:]
+                rows.append((rf"X_{{\rm eff}}\big|_{{h^{{{d - 1}}}}}", "=", tokens or ["0"]))
+            blocks.append(aligned(rows))
+        return blocks
 
     emit(args, latex=latex, text=text, data=data)
 
@@ -452,7 +476,7 @@ def cmd_conserved(args):
         out["model"], out["integrator"] = system.name, word
         return out
 
-    emit(args, latex=result.to_latex, data=data)
+    emit(args, latex=result.to_latex, text=result.to_text, data=data)
 
 
 def cmd_exact(args):
@@ -470,18 +494,13 @@ def cmd_exact(args):
         out["model"], out["integrator"] = system.name, word
         if series is not None:
             out.update(order=args.order, H_S_series=render.expression(series[0]), G_S_series=render.expression(series[1]))
+            out.update({k: v for k, v in result.to_dict(order=args.order).items() if k in ("series", "remainder_power")})
         return out
 
     def latex():
-        text = result.to_latex()
-        if series is not None:
-            O = sympy.latex(sympy.Symbol("h") ** (args.order + 1))
-            text += rf" \\" + "\n" + rf"H_S^e = {sympy.latex(series[0])} + O({O})"
-            if series[1] is not None:
-                text += rf",\quad G_S^e = {sympy.latex(series[1])} + O({O})"
-        return text
+        return result.to_latex(order=args.order)
 
-    emit(args, latex=latex, data=data)
+    emit(args, latex=latex, text=lambda: result.to_text(order=args.order), data=data)
 
 
 FI_LABELS = ("1AX", "1AY", "1BX", "1BY", "2AX", "2AY", "2BX", "2BY")
@@ -540,10 +559,9 @@ def cmd_fi(args):
         a, b, d = ("X_{" + ", ".join(slot_latex(s) for s in t) + "}" for t in abd)
         return _signed_latex(c).lstrip("+ ") + rf" [{a}, [{b}, {d}]]"
 
-    def terms_latex(terms):
-        if not terms:
-            return "0"
-        return " ".join(("+ " + t.to_latex()) if not t.to_latex().startswith("-") else t.to_latex() for t in terms).lstrip("+ ")
+    def terms_tokens(terms):
+        tokens = [t.to_latex() for t in terms] or ["0"]
+        return [tok if i == 0 or tok.startswith("-") else "+ " + tok for i, tok in enumerate(tokens)]
 
     def data():
         out = {"forms": [{"label": lab, "text": render.fi_form_text(lab), "latex": render.fi_form_latex(lab)} for lab in FI_LABELS]}
@@ -569,11 +587,15 @@ def cmd_fi(args):
         return "\n".join(lines)
 
     def latex():
-        rows = [render.fi_form_latex(lab) for lab in FI_LABELS]
+        from .printing import aligned, latex_text
+
+        lhs = "[X_{A,B},[X_{C,D},X_{E,F}]]"
+        blocks = [aligned([(lhs, rf"\overset{{\rm {lab}}}{{=}}", render.fi_form_tokens(lab)) for lab in FI_LABELS])]
         for c, abd, forms in reps or ():
-            rows.append(r"\text{" + f"{word} on {system.name}" + r"}:\quad h^2\," + commutator_latex(c, abd))
-            rows += [rf"\quad \overset{{\rm {lab}}}{{=}} {terms_latex(terms)}" for lab, terms in forms.items()]
-        return " \\\\\n".join(rows)
+            rows = [("", "", [latex_text(f"{word} on {system.name}") + r":\quad h^2\," + commutator_latex(c, abd)])]
+            rows += [("", rf"\overset{{\rm {lab}}}{{=}}", terms_tokens(terms)) for lab, terms in forms.items()]
+            blocks.append(aligned(rows))
+        return blocks
 
     emit(args, latex=latex, text=text, data=data)
 
@@ -662,6 +684,15 @@ def _integrator_options(parser, order=False):
 def _output_options(parser, default, choices=_SYMBOLIC):
     parser.add_argument("--format", choices=choices, default=default, help=f"output format (default {default})")
     parser.add_argument("--output", metavar="FILE", help="write the result to FILE (atomically) instead of stdout")
+    if "latex" in choices:
+        parser.add_argument("--standalone", action="store_true",
+                            help="with --format latex: a complete LaTeX document (default: align* environments "
+                                 "for the body of a document with amsmath)")
+
+
+def _progress_option(parser):
+    parser.add_argument("--no-progress", action="store_true",
+                        help="no progress bars on stderr (default: shown for long runs on a terminal or in Jupyter)")
 
 
 def _numeric_options(parser, defaults):
@@ -744,6 +775,7 @@ def build_parser() -> argparse.ArgumentParser:
     _output_options(p, "latex")
 
     p = add("shadow", cmd_shadow)
+    _progress_option(p)
     _system_options(p)
     _integrator_options(p, order=True)
     p.add_argument("--route", choices=("direct", "fi"), default="direct",
@@ -752,6 +784,7 @@ def build_parser() -> argparse.ArgumentParser:
     _output_options(p, "latex")
 
     p = add("conserved", cmd_conserved)
+    _progress_option(p)
     _system_options(p)
     _integrator_options(p)
     p.add_argument("--degree", metavar="D", type=str,
@@ -766,6 +799,7 @@ def build_parser() -> argparse.ArgumentParser:
     _output_options(p, "latex")
 
     p = add("check", cmd_check)
+    _progress_option(p)
     _system_options(p)
     _integrator_options(p, order=True)
     _numeric_options(p, {"h": 0.1, "steps": 1000, "every": 1})
@@ -773,6 +807,7 @@ def build_parser() -> argparse.ArgumentParser:
     _output_options(p, "text", choices=("text", "json"))
 
     p = add("plot", cmd_plot)
+    _progress_option(p)
     _system_options(p)
     _integrator_options(p)
     p.add_argument("--outdir", metavar="DIR", default=".", help="directory for fig1.png .. fig4.png (default .)")
@@ -815,6 +850,21 @@ def _normalise(args):
     return args
 
 
+class _progress_off:
+    """``--no-progress``: ``NAMBU_BCH_PROGRESS=0`` for the run (read by :mod:`nambu_bch.numeric.progress`), then restored."""
+
+    def __enter__(self):
+        self.saved = os.environ.get("NAMBU_BCH_PROGRESS")
+        os.environ["NAMBU_BCH_PROGRESS"] = "0"
+
+    def __exit__(self, *exc):
+        if self.saved is None:
+            os.environ.pop("NAMBU_BCH_PROGRESS", None)
+        else:
+            os.environ["NAMBU_BCH_PROGRESS"] = self.saved
+        return False
+
+
 def main(argv=None) -> int:
     """Run the CLI on ``argv`` (default ``sys.argv[1:]``); returns the exit status.
 
@@ -826,7 +876,11 @@ def main(argv=None) -> int:
         args = parser.parse_args(argv)
         prog = f"{PROG} {args.command}"
         _normalise(args)
-        args.func(args)
+        if getattr(args, "no_progress", False):
+            with _progress_off():
+                args.func(args)
+        else:
+            args.func(args)
     except SystemExit as exc:  # --help, --version
         return exc.code if isinstance(exc.code, int) else 0
     except UsageError as exc:

@@ -20,7 +20,8 @@ import math
 import numpy as np
 import sympy
 
-__all__ = ["expression", "jsonable", "to_json", "to_text", "system_dict", "write_output", "latex_document"]
+__all__ = ["expression", "jsonable", "to_json", "to_text", "system_dict", "write_output", "latex_document",
+           "bracket_text", "bracket_tree"]
 
 
 def expression(value):
@@ -99,9 +100,48 @@ def system_dict(system) -> dict:
     return data
 
 
-def latex_document(body: str) -> str:
-    """Display math, one result per ``equation*``-free line (ready for ``\\[ ... \\]`` or Jupyter)."""
-    return body.rstrip("\n") + "\n"
+def latex_document(blocks, standalone: bool = False) -> str:
+    r"""LaTeX output of the CLI: each ``aligned`` block in ``\[ ... \]`` (a fragment for a document with
+    ``amsmath``), or with ``standalone`` a complete document (see :mod:`nambu_bch.printing`, docs/latex.md)."""
+    from .printing import display
+    from .printing import standalone as document
+
+    blocks = [blocks] if isinstance(blocks, str) else list(blocks)
+    fragment = display(*blocks)
+    return document(fragment) if standalone else fragment
+
+
+def bracket_text(tree) -> str:
+    """A bracket tree as sympy-readable text: ``[X(a, b), [X(c, d), X(e, f)]]`` (leaves ``X(slots)`` or ``Xk``).
+
+    ``sympy.sympify`` reads it back as nested lists of ``X(...)`` applications, the slots
+    with the system's symbol names.
+
+    >>> import sympy
+    >>> x1, x2 = sympy.symbols("x1 x2")
+    >>> bracket_text(((x2**2 / 2, x1), (x1, 1)))
+    '[X(x2**2/2, x1), X(x1, 1)]'
+    """
+    if _is_tree(tree):
+        return f"[{bracket_text(tree[0])}, {bracket_text(tree[1])}]"
+    if isinstance(tree, tuple):
+        return "X(" + ", ".join(expression(e) for e in tree) + ")"
+    return f"X{tree}"
+
+
+def bracket_tree(tree):
+    """A bracket tree as JSON: ``[left, right]`` for a bracket, a list of slot strings (or an int) for a leaf."""
+    if _is_tree(tree):
+        return {"bracket": [bracket_tree(tree[0]), bracket_tree(tree[1])]}
+    if isinstance(tree, tuple):
+        return [expression(e) for e in tree]
+    return tree
+
+
+def _is_tree(node) -> bool:
+    from .bch.lyndon import is_bracket
+
+    return is_bracket(node)
 
 
 def write_output(text: str, path) -> None:
@@ -147,6 +187,17 @@ def fi_form_text(label: str) -> str:
     terms = fi_form(label)
     body = " ".join(("+ " if s > 0 else "- ") + "X_{" + ",".join(slots) + "}" for s, slots in terms)
     return "[X_{A,B},[X_{C,D},X_{E,F}]] = " + body.lstrip("+ ")
+
+
+def fi_form_tokens(label: str) -> list:
+    """The right-hand side of :func:`fi_form_latex` as signed LaTeX terms (for line breaking)."""
+
+    def lx(text):
+        return text.replace("{", r"\{").replace("}", r"\}")
+
+    tokens = [("+ " if s > 0 else "- ") + "X_{" + ",".join(lx(t) for t in slots) + "}" for s, slots in fi_form(label)]
+    tokens[0] = tokens[0][2:] if tokens[0].startswith("+ ") else tokens[0]
+    return tokens
 
 
 def fi_form_latex(label: str) -> str:
