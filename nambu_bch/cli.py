@@ -251,12 +251,31 @@ def integrator_from_args(args, system):
 # --------------------------------------------------------------------------------------------
 # output
 # --------------------------------------------------------------------------------------------
-def emit(args, *, latex=None, text=None, data=None):
+def emit(args, *, latex=None, text=None, data=None, cache=None):
     """Print (or write to ``--output``) the result in the chosen ``--format``.
 
     ``latex`` / ``text`` are callables returning strings, ``data`` a callable
-    returning the JSON-able dict; only the one needed is computed.
+    returning the JSON-able dict; only the one needed is computed.  With ``cache``
+    (a request tuple) the output is kept in :mod:`nambu_bch.cli_cache`.
     """
+    if cache is not None:
+        from .cli_cache import cached_text
+
+        out = cached_text((*cache, args.format, getattr(args, "standalone", False)), lambda: _formatted(args, latex, text, data))
+    else:
+        out = _formatted(args, latex, text, data)
+    if args.output:
+        try:
+            render.write_output(out, args.output)
+        except OSError as exc:
+            raise NambuBCHError(f"--output {args.output}: cannot write the file ({exc.strerror or exc})") from None
+        print(f"wrote {args.output}", file=sys.stderr)
+    else:
+        sys.stdout.write(out)
+        sys.stdout.flush()
+
+
+def _formatted(args, latex, text, data) -> str:
     fmt = args.format
     if fmt == "json":
         out = render.to_json(data())
@@ -267,15 +286,7 @@ def emit(args, *, latex=None, text=None, data=None):
         out = out if out.endswith("\n") else out + "\n"
     else:
         out = render.to_text(data())
-    if args.output:
-        try:
-            render.write_output(out, args.output)
-        except OSError as exc:
-            raise NambuBCHError(f"--output {args.output}: cannot write the file ({exc.strerror or exc})") from None
-        print(f"wrote {args.output}", file=sys.stderr)
-    else:
-        sys.stdout.write(out)
-        sys.stdout.flush()
+    return out
 
 
 def _base(system, word, **extra):
@@ -289,13 +300,16 @@ def _base(system, word, **extra):
 # subcommands
 # --------------------------------------------------------------------------------------------
 def cmd_models(args):
-    from .systems import model, model_names
+    chosen = any((args.model, args.system, args.H, args.G, args.coords, args.param, args.split, args.name))
 
-    if any((args.model, args.system, args.H, args.G, args.coords, args.param, args.split, args.name)):
-        system, values = system_from_args(args)
-        systems = [substituted(system, values)]
-    else:
-        systems = [model(name) for name in model_names()]
+    @_once
+    def systems():
+        from .systems import model, model_names
+
+        if chosen:
+            system, values = system_from_args(args)
+            return [substituted(system, values)]
+        return [model(name) for name in model_names()]
 
     def piece_dict(system, piece):
         return {
@@ -307,7 +321,7 @@ def cmd_models(args):
 
     def data():
         out = []
-        for s in systems:
+        for s in systems():
             d = render.system_dict(s)
             d.update(N=s.N, split=s.split, description=s.description, citation=s.citation,
                      pieces=[piece_dict(s, p) for p in s.splitting.pieces], default_integrator=default_word(s))
@@ -316,7 +330,7 @@ def cmd_models(args):
 
     def text():
         lines = []
-        for s in systems:
+        for s in systems():
             lines.append(f"{s.name}  (N = {s.N}, split = {s.split}, default integrator {default_word(s)})")
             if s.description:
                 lines.append(f"  {s.description}")
@@ -335,7 +349,7 @@ def cmd_models(args):
         from .printing import aligned, latex_text
 
         blocks = []
-        for s in systems:
+        for s in systems():
             rows = [("", "", [latex_text(s.name) + ":"])]
             labels = ["H", "G"] if len(s.hamiltonians) == 2 else [f"H_{{{k + 1}}}" for k in range(len(s.hamiltonians))]
             rows += [(lab, "=", [sympy.latex(H)]) for lab, H in zip(labels[: len(s.hamiltonians)] or ["H"], s.hamiltonians)]
@@ -343,7 +357,19 @@ def cmd_models(args):
             blocks.append(aligned(rows))
         return blocks
 
-    emit(args, latex=latex, text=text, data=data)
+    emit(args, latex=latex, text=text, data=data, cache=None if chosen else ("models",))
+
+
+def _once(func):
+    """``func()`` computed on the first call only."""
+    memo = []
+
+    def wrapper():
+        if not memo:
+            memo.append(func())
+        return memo[0]
+
+    return wrapper
 
 
 def cmd_bch(args):

@@ -216,7 +216,7 @@ def width(latex: str) -> float:
     r"""Estimated printed width of a LaTeX math string, in characters (``\frac`` counts its wider part).
 
     >>> width(r"\frac{x_{2}^{2}}{2 m} + x_{3}")
-    5.6
+    6.3
     """
     total, i = 0.0, 0
     while i < len(latex):

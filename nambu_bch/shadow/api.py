@@ -48,7 +48,7 @@ def _obstruction_text(sol, n_hams: int = 2) -> str:
     )
 
 
-def shadow_hamiltonians(system, word, order: int = 2, route: str = "direct", degree=None) -> ShadowFamily:
+def shadow_hamiltonians(system, word, order: int = 2, route: str = "direct", degree=None, progress=None) -> ShadowFamily:
     """Shadow Hamiltonians ``H_S, G_S`` of ``word`` on ``system`` through ``h^order``, as a family.
 
     Parameters
@@ -59,6 +59,8 @@ def shadow_hamiltonians(system, word, order: int = 2, route: str = "direct", deg
     route : ``"direct"`` (order-by-order linear solve, any order) or ``"fi"``
         (representations of the BCH commutators by the fundamental identity; lowest correction only)
     degree : int, optional -- ansatz degree of the corrections (default: from the field)
+    progress : bool or None -- direct route: a progress bar over the orders; None: automatic
+        (a terminal or Jupyter, shown once the run has lasted a second); False: never
 
     Returns
     -------
@@ -80,7 +82,7 @@ def shadow_hamiltonians(system, word, order: int = 2, route: str = "direct", deg
     comp = make_composition(word, len(system.splitting)).check(system.splitting)
     notes = []
     if route == "direct":
-        R = direct_route(system, comp, order, degree)
+        R = direct_route(system, comp, order, degree, progress=progress)
         fam = ShadowFamily(system, comp, order, route, R.exists, details=R)
         for o in R.orders:
             if o.status == "vanishes":
