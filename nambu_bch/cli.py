@@ -385,9 +385,6 @@ def cmd_bch(args):
     def tree_text(tree):
         return tree_to_latex(tree).replace("X_{", "X").replace("}", "")
 
-    def tree_json(tree):
-        return list(map(tree_json, tree)) if isinstance(tree, tuple) else tree
-
     field = effective_field(system.splitting, comp, order) if args.field else None
     expanded = None
     if args.terms:
@@ -397,7 +394,8 @@ def cmd_bch(args):
 
     def data():
         terms = [
-            {"degree": d, "power_of_h": d - 1, "coefficient": render.expression(c), "bracket": tree_text(t), "tree": tree_json(t)}
+            {"degree": d, "power_of_h": d - 1, "coefficient": render.expression(c), "bracket": render.bracket_text(t),
+             "tree": render.bracket_tree(t)}
             for d in range(1, series.max_degree + 1) for c, t in series.terms(d)
         ]
         out = _base(system, word, order=order, max_degree=series.max_degree,

@@ -171,16 +171,25 @@ def series_tokens(base_latex, expr, base, coordinates, remainder=None, step=H_ST
 
 
 def series_text(base_text, expr, base, coordinates, remainder=None, step=H_STEP) -> str:
-    """Plain-text twin of :func:`series_tokens`: ``H + h**2*(...) + O(h^4)``."""
+    """Plain-text twin of :func:`series_tokens`: ``H + h**2*(...) - h**4*x1**2/12 + O(h^4)``.
+
+    >>> x, h = sympy.symbols("x h")
+    >>> series_text("H", x**2/2 - h**2*x**2/8 + h**4*(x + x**2), x**2/2, [x], 6)
+    'H - h**2*x**2/8 + h**4*(x**2 + x) + O(h^6)'
+    """
     coefficients = h_coefficients(expr, base, coordinates, step)
-    parts = [base_text]
+    text = base_text
     if coefficients is None:
-        parts.append(f"({sympy.expand(sympy.sympify(expr) - sympy.sympify(base))})")
+        text += f" + ({sympy.expand(sympy.sympify(expr) - sympy.sympify(base))})"
     for k, c in coefficients or ():
-        parts.append(f"{step}**{k}*({c})" if k > 1 else (f"{step}*({c})" if k == 1 else f"({c})"))
+        if isinstance(c, sympy.Add) or k == 0:
+            text += " + " + (f"{step}**{k}*({c})" if k > 1 else (f"{step}*({c})" if k == 1 else f"({c})"))
+        else:
+            term = sympy.sympify(step**k * c)
+            text += f" - {-term}" if term.could_extract_minus_sign() else f" + {term}"
     if remainder is not None:
-        parts.append(f"O({step}^{remainder})")
-    return " + ".join(parts)
+        text += f" + O({step}^{remainder})"
+    return text
 
 
 # --------------------------------------------------------------------------------------------

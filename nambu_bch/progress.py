@@ -19,6 +19,8 @@ import os
 import sys
 
 _OFF = ("0", "false", "no", "off")
+#: Seconds a run must last before its bar appears (the default ``delay`` of :func:`stages`).
+DELAY = 1.0
 
 
 def _in_jupyter() -> bool:
@@ -109,11 +111,11 @@ class Progress:
         return False
 
 
-def stages(items, label, enabled=None, stream=None, delay=1.0, unit="order"):
+def stages(items, label, enabled=None, stream=None, delay=None, unit="order"):
     """Iterate over ``items`` (symbolic stages such as orders ``1..k``) with a progress bar when enabled.
 
     ``enabled=None`` decides automatically (:func:`progress_wanted`); the bar appears only
-    once the stages have taken ``delay`` seconds, so quick computations print nothing.
+    once the stages have taken ``delay`` seconds (default :data:`DELAY`), so quick computations print nothing.
 
     >>> import io
     >>> s = io.StringIO()
@@ -123,6 +125,7 @@ def stages(items, label, enabled=None, stream=None, delay=1.0, unit="order"):
     True
     """
     items = list(items)
+    delay = DELAY if delay is None else delay
     with Progress(len(items), label, enabled=enabled, stream=stream, delay=delay, interval=0.1, unit=unit) as bar:
         for k, item in enumerate(items, 1):
             yield item

@@ -128,8 +128,8 @@ class ShadowFamily(Printable):
             if value is not None:
                 rows.append((r"\ell(\text{right-hand side})", "=", [sympy.latex(value) + r" \neq 0"]))
         elif cert:
-            rows.append(("", "", [r"\text{no affine combination of the FI representations solves the equation"
-                                  r" (certificate in the JSON output)}"]))
+            rows.append(("", "", [r"\text{no affine combination of the FI representations}",
+                                  r"\text{solves the equation (certificate in the JSON output)}"]))
         return rows
 
     def _failed_solution(self):
@@ -184,7 +184,8 @@ class ShadowFamily(Printable):
             out["notes"] = list(self.notes)
         out["series"] = {name: {str(k): str(c) for k, c in coefficients.items()} for name, coefficients in self.series().items()}
         names = [name for _, name in self._names()]
-        out["gauge"] = {str(k): [dict(zip((f"d{n}" for n in names), map(str, direction))) for direction in directions]
+        out["gauge"] = {str(k): [dict(zip((f"d{n}" for n in names), map(str, direction))) for direction in directions
+                                 if any(sympy.sympify(c) != 0 for c in direction)]  # weight-only FI directions dropped
                         for k, directions in sorted(self.gauge.items())}
         out["certificate"] = self._certificate_data()
         return out
