@@ -108,8 +108,8 @@ class ShadowFamily(Printable):
     def _obstruction_rows(self):
         """The obstruction as ``aligned`` rows: headline, then the certificate functional (direct route)."""
         order, degree = self.failed_order, self.degree.get(self.failed_order)
-        head = [r"\text{no polynomial shadow Hamiltonians of }" + latex_text(self.composition.name) + r"\text{ on }"
-                + latex_text(self.system.name),
+        head = [r"\text{no polynomial shadow Hamiltonians of }" + latex_text(self.composition.name),
+                r"\text{on }" + latex_text(self.system.name),
                 r"\text{at order }" + sympy.latex(H_STEP**order)
                 + (rf"\text{{ with corrections of degree }} \le {degree}" if degree is not None else "") + ":"]
         rows = [("", "", head)]
