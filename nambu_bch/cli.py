@@ -382,9 +382,6 @@ def cmd_bch(args):
     order = args.order if args.order is not None else 2
     series = formal_bch(comp, order + 1)
 
-    def tree_text(tree):
-        return tree_to_latex(tree).replace("X_{", "X").replace("}", "")
-
     field = effective_field(system.splitting, comp, order) if args.field else None
     expanded = None
     if args.terms:
@@ -416,7 +413,7 @@ def cmd_bch(args):
         lines.append(f"X_eff through h^{order} (formal BCH in the Lyndon basis):")
         for d in range(1, series.max_degree + 1):
             for c, t in series.terms(d):
-                lines.append(f"  h^{d - 1}  {c}  {tree_text(t)}")
+                lines.append(f"  h^{d - 1}  {c}  {render.bracket_text(t)}")
         if field is not None:
             for j, Z in enumerate(field.coefficients):
                 comps = ", ".join(str(c) for c in Z.to_sympy())
@@ -436,27 +433,13 @@ def cmd_bch(args):
         if field is not None:
             blocks.append(field.to_latex())
         if expanded is not None:
-            rows = []
-            for d, items in expanded.items():
-                tokens = [_signed_latex(c * sympy.Symbol("h") ** (d - 1)) + " " + tree_to_latex(t) for c, t in items]
-                if tokens and tokens[0].startswith("+ "):
-                    tokens[0] = tokens[0][2:]
-                rows.append((rf"X_{{\rm eff}}\big|_{{h^{{{d - 1}}}}}", "=", tokens or ["0"]))
-            blocks.append(aligned(rows))
+            from .printing import bracket_sum
+
+            blocks += [bracket_sum(rf"X_{{\rm eff}}\big|_{{h^{{{d - 1}}}}}", [(c, t, d - 1) for c, t in items])
+                       for d, items in expanded.items()]
         return blocks
 
     emit(args, latex=latex, text=text, data=data)
-
-
-def _signed_latex(term) -> str:
-    """``+ \\frac{h^{2}}{12}`` / ``- \\frac{h^{2}}{24}`` / ``+`` for a unit coefficient."""
-    if term == 1:
-        return "+"
-    if term == -1:
-        return "-"
-    if term.could_extract_minus_sign():
-        return "- " + sympy.latex(-term)
-    return "+ " + sympy.latex(term)
 
 
 def cmd_shadow(args):
@@ -527,7 +510,6 @@ def cmd_exact(args):
     emit(args, latex=latex, text=lambda: result.to_text(order=args.order), data=data)
 
 
-FI_LABELS = ("1AX", "1AY", "1BX", "1BY", "2AX", "2AY", "2BX", "2BY")
 
 
 def _system_chosen(args) -> bool:
@@ -576,19 +558,8 @@ def cmd_fi(args):
     word, comp = integrator_from_args(args, system)
     reps = fi_representations(system, comp) if _system_chosen(args) else None
 
-    def slot_latex(slot):
-        return sympy.latex(sympy.factor(slot))
-
-    def commutator_latex(c, abd):
-        a, b, d = ("X_{" + ", ".join(slot_latex(s) for s in t) + "}" for t in abd)
-        return _signed_latex(c).lstrip("+ ") + rf" [{a}, [{b}, {d}]]"
-
-    def terms_tokens(terms):
-        tokens = [t.to_latex() for t in terms] or ["0"]
-        return [tok if i == 0 or tok.startswith("-") else "+ " + tok for i, tok in enumerate(tokens)]
-
     def data():
-        out = {"forms": [{"label": lab, "text": render.fi_form_text(lab), "latex": render.fi_form_latex(lab)} for lab in FI_LABELS]}
+        out = {"forms": [{"label": lab, "text": render.fi_form_text(lab), "latex": render.fi_form_latex(lab)} for lab in render.FI_LABELS]}
         if reps is not None:
             out = {**_base(system, word), **out}
             out["representations"] = [
@@ -603,7 +574,7 @@ def cmd_fi(args):
         return out
 
     def text():
-        lines = [f"{lab}: {render.fi_form_text(lab)}" for lab in FI_LABELS]
+        lines = [f"{lab}: {render.fi_form_text(lab)}" for lab in render.FI_LABELS]
         for c, abd, forms in reps or ():
             a, b, d = ("X_{" + ", ".join(str(s) for s in t) + "}" for t in abd)
             lines.append(f"{c} [{a}, [{b}, {d}]] (h^2 term of {word} on {system.name}):")
@@ -611,14 +582,8 @@ def cmd_fi(args):
         return "\n".join(lines)
 
     def latex():
-        from .printing import aligned, latex_text
-
-        lhs = "[X_{A,B},[X_{C,D},X_{E,F}]]"
-        blocks = [aligned([(lhs, rf"\overset{{\rm {lab}}}{{=}}", render.fi_form_tokens(lab)) for lab in FI_LABELS])]
-        for c, abd, forms in reps or ():
-            rows = [("", "", [latex_text(f"{word} on {system.name}") + r":\quad h^2\," + commutator_latex(c, abd)])]
-            rows += [("", rf"\overset{{\rm {lab}}}{{=}}", terms_tokens(terms)) for lab, terms in forms.items()]
-            blocks.append(aligned(rows))
+        blocks = [render.fi_forms_latex()]
+        blocks += [render.fi_representations_latex(f"{word} on {system.name}", c, abd, forms) for c, abd, forms in reps or ()]
         return blocks
 
     emit(args, latex=latex, text=text, data=data)

@@ -34,7 +34,7 @@ import re
 import sympy
 
 __all__ = [
-    "Printable", "WIDTH", "h_coefficients", "series_tokens", "series_text", "sum_tokens", "signed",
+    "Printable", "HSeries", "bracket_sum", "WIDTH", "h_coefficients", "series_tokens", "series_text", "sum_tokens", "signed",
     "aligned", "latex_text", "display", "standalone", "flatten",
 ]
 
@@ -190,6 +190,59 @@ def series_text(base_text, expr, base, coordinates, remainder=None, step=H_STEP)
     if remainder is not None:
         text += f" + O({step}^{remainder})"
     return text
+
+
+class HSeries(Printable):
+    r"""An expression shown as the paper writes a shadow Hamiltonian: ``lhs = H + h^2(...) + O(h^p)``.
+
+    For a quantity typed in from the paper, a family member, a difference: anything near a
+    Hamiltonian ``base`` (see :func:`series_tokens`).
+
+    Parameters
+    ----------
+    lhs : str -- LaTeX of the left-hand side, e.g. ``"H_S"``
+    expr, base : sympy expressions
+    base_name : str -- LaTeX of ``base`` (``"H"``; ``"0"`` prints ``expr`` itself by powers of h)
+    coordinates : sequence of Symbols (monomials whose coefficients are factored)
+    remainder : int, optional -- print ``+ O(h^remainder)``
+
+    >>> x, h = sympy.symbols("x h")
+    >>> print(HSeries("H_S", x**2/2 + h**2*x**2/12, x**2/2, "H", [x], 4))
+    H_S = H + h**2*x**2/12 + O(h^4)
+    """
+
+    def __init__(self, lhs, expr, base, base_name, coordinates, remainder=None):
+        self.lhs, self.expr, self.base, self.base_name = lhs, sympy.sympify(expr), sympy.sympify(base), base_name
+        self.coordinates, self.remainder = tuple(coordinates), remainder
+
+    def to_latex(self) -> str:
+        return aligned([(self.lhs, "=", series_tokens(self.base_name, self.expr, self.base, self.coordinates, self.remainder))])
+
+    def to_text(self) -> str:
+        plain = lambda t: t.replace("{", "").replace("}", "").replace("\\", "")  # noqa: E731
+        body = series_text(plain(self.base_name), self.expr, self.base, self.coordinates, self.remainder)
+        return f"{plain(self.lhs)} = " + (body[4:] if body.startswith("0 + ") else body)
+
+    def __repr__(self):
+        return f"HSeries({self.lhs!r}, {self.expr})"
+
+
+def bracket_sum(lhs, items, names=None, remainder=None, step=H_STEP) -> str:
+    r"""``lhs &= c_1 h^{k_1} [X,[X,X]] + ...`` as an ``aligned`` block, one token per bracket term.
+
+    ``items`` are ``(coefficient, tree, power_of_h)``; trees are printed by
+    :func:`nambu_bch.bch.lyndon.tree_to_latex` (generators ``X_{k}`` or Liouville terms
+    ``X_{A,B}``), e.g. the Liouville-term expansion of Eq. (BCH4).
+    """
+    from .bch.lyndon import terms_to_latex
+
+    tokens = []
+    for c, tree, k in items:
+        tok = terms_to_latex([(c, tree, step**k)], names)
+        tokens.append(tok if not tokens else ("- " + tok[1:] if tok.startswith("-") else "+ " + tok))
+    if remainder is not None:
+        tokens.append(f"+ O({sympy.latex(step ** remainder)})")
+    return aligned([(lhs, "=", tokens or ["0"])])
 
 
 # --------------------------------------------------------------------------------------------

@@ -112,7 +112,7 @@ def latex_document(blocks, standalone: bool = False) -> str:
 
 
 def bracket_text(tree) -> str:
-    """A bracket tree as sympy-readable text: ``[X(a, b), [X(c, d), X(e, f)]]`` (leaves ``X(slots)`` or ``Xk``).
+    """A bracket tree as sympy-readable text: ``[X(a, b),[X(c, d),X(e, f)]]`` (leaves ``X(slots)`` or ``Xk``).
 
     ``sympy.sympify`` reads it back as nested lists of ``X(...)`` applications, the slots
     with the system's symbol names.
@@ -120,10 +120,10 @@ def bracket_text(tree) -> str:
     >>> import sympy
     >>> x1, x2 = sympy.symbols("x1 x2")
     >>> bracket_text(((x2**2 / 2, x1), (x1, 1)))
-    '[X(x2**2/2, x1), X(x1, 1)]'
+    '[X(x2**2/2, x1),X(x1, 1)]'
     """
     if _is_tree(tree):
-        return f"[{bracket_text(tree[0])}, {bracket_text(tree[1])}]"
+        return f"[{bracket_text(tree[0])},{bracket_text(tree[1])}]"
     if isinstance(tree, tuple):
         return "X(" + ", ".join(expression(e) for e in tree) + ")"
     return f"X{tree}"
@@ -198,6 +198,35 @@ def fi_form_tokens(label: str) -> list:
     tokens = [("+ " if s > 0 else "- ") + "X_{" + ",".join(lx(t) for t in slots) + "}" for s, slots in fi_form(label)]
     tokens[0] = tokens[0][2:] if tokens[0].startswith("+ ") else tokens[0]
     return tokens
+
+
+FI_LABELS = ("1AX", "1AY", "1BX", "1BY", "2AX", "2AY", "2BX", "2BY")
+
+
+def fi_forms_latex(labels=FI_LABELS) -> str:
+    r"""The eight forms of ``[X_{A,B},[X_{C,D},X_{E,F}]]`` (Eqs. 1AX-2BY) as one ``aligned`` block, aligned at ``=``."""
+    from .printing import aligned
+
+    lhs = "[X_{A,B},[X_{C,D},X_{E,F}]]"
+    return aligned([(lhs, rf"\overset{{\rm {lab}}}{{=}}", fi_form_tokens(lab)) for lab in labels])
+
+
+def fi_representations_latex(title: str, coefficient, commutator, forms) -> str:
+    r"""One ``h^2`` double commutator and its FI representations (Eqs. CL5-CL8) as an ``aligned`` block.
+
+    ``title`` is user text (word, system name) and goes through :func:`nambu_bch.printing.latex_text`;
+    ``commutator`` is ``(a, b, d)`` of slot tuples, ``forms`` ``{label: [LiouvilleTerm, ...]}``.
+    """
+    from .printing import aligned, latex_text, signed
+
+    a, b, d = ("X_{" + ", ".join(sympy.latex(sympy.factor(s)) for s in t) + "}" for t in commutator)
+    head = latex_text(title) + r":\quad h^{2}\," + signed(coefficient, first=True) + rf" [{a}, [{b}, {d}]]"
+
+    def tokens(terms):
+        toks = [t.to_latex() for t in terms] or ["0"]
+        return [tok if i == 0 or tok.startswith("-") else "+ " + tok for i, tok in enumerate(toks)]
+
+    return aligned([("", "", [head])] + [("", rf"\overset{{\rm {lab}}}{{=}}", tokens(terms)) for lab, terms in forms.items()])
 
 
 def fi_form_latex(label: str) -> str:

@@ -44,7 +44,7 @@ from sympy.polys.domains import QQ
 from ..errors import InvalidCompositionError, InvalidOrderError
 from ..integrators.composition import Composition
 from ..integrators.composition import composition as make_composition
-from ..printing import Printable, aligned
+from ..printing import Printable, bracket_sum
 from .lyndon import (
     lyndon_expansion,
     lyndon_words,
@@ -457,17 +457,10 @@ class FormalBCH(Printable):
             With a step symbol the series is printed as ``X_eff`` (degree ``d`` carries
             ``step^(d-1)``, Eq. BCH2); with ``None`` as ``log Phi`` of the bare generators.
         """
-        tokens = []
-        for d in range(1, self.max_degree + 1):
-            power = sympy.Symbol(step) ** (d - 1) if step else sympy.Integer(1)
-            for c, tree in self._terms.get(d, ()):
-                tok = terms_to_latex([(c, tree, power)], names)
-                tokens.append(tok if not tokens else ("- " + tok[1:] if tok.startswith("-") else "+ " + tok))
+        items = [(c, tree, d - 1 if step else 0) for d in range(1, self.max_degree + 1) for c, tree in self._terms.get(d, ())]
         lhs = r"X_{\rm eff}" if step else r"\log \Phi"
-        if step:
-            next_power = self.composition.remainder_power(self.max_degree - 1)
-            tokens.append(f"+ O({sympy.latex(sympy.Symbol(step) ** next_power)})")
-        return aligned([(lhs, "=", tokens or ["0"])])
+        remainder = self.composition.remainder_power(self.max_degree - 1) if step else None
+        return bracket_sum(lhs, items, names, remainder, sympy.Symbol(step or "h"))
 
     def to_text(self) -> str:
         """``X_eff = X1 + X2 + (-1/24)*h**2*[X1,[X1,X2]] + ... + O(h^4)``, one term per Lyndon bracket."""
