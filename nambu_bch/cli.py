@@ -18,7 +18,9 @@ Synopsis::
     --param NAME=VALUE sets a parameter's value: numeric subcommands use it (default 1 for
                        every parameter), symbolic ones substitute it exactly before the analysis.
     --format latex|text|json (default latex for symbolic results, text for models/check/plot),
-    --output FILE      (written atomically: temporary file in the same directory + os.replace).
+    --output FILE      (written atomically: temporary file in the same directory + os.replace),
+    --standalone       (LaTeX: a complete document; default: align* environments for a document body),
+    --no-progress      (no progress bars on stderr for long runs; docs/latex.md).
 
 With no options ``nambu-bch shadow`` prints the alpha-family of shadow
 Hamiltonians of Phi^{12321} for the paper's N = 3 oscillator at order 2

@@ -4,7 +4,12 @@ JSON convention (DESIGN.md, "Public surface"): every symbolic expression is a
 string that ``sympy.sympify`` reads back with the system's symbol names, e.g.
 ``sympify(data["H_S"], locals={"x1": Symbol("x1"), ..., "h": Symbol("h")})``
 (``str`` of a sympy expression; no floats appear in symbolic output); numbers
-of numeric diagnostics are JSON numbers; absent quantities are ``null``.
+of numeric diagnostics are JSON numbers; absent quantities are ``null``; series
+by order are ``{"k": coefficient of h^k}``.  The format is documented in
+docs/json.md with a JSON Schema (docs/schema/nambu-bch.schema.json).
+
+LaTeX: results are ``aligned`` blocks (:mod:`nambu_bch.printing`); the CLI prints
+them as ``align*`` environments, or a complete document (:func:`latex_document`).
 
 The text format is the JSON content laid out one ``key: value`` per line, for
 reading in a terminal and for ``grep``.
