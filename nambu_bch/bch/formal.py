@@ -463,7 +463,11 @@ class FormalBCH(Printable):
         return bracket_sum(lhs, items, names, remainder, sympy.Symbol(step or "h"))
 
     def to_text(self) -> str:
-        """``X_eff = X1 + X2 + (-1/24)*h**2*[X1,[X1,X2]] + ... + O(h^4)``, one term per Lyndon bracket."""
+        """``X_eff = X1 + X2 + (-1/24)*h**2*[X1,[X1,X2]] + ... + O(h^4)``, one term per Lyndon bracket.
+
+        >>> print(formal_bch("TVT", 3))                                           # Eq. (BCH1)
+        X_eff = X1 + X2 + (-1/24)*h**2*[X1,[X1,X2]] + (1/12)*h**2*[[X1,X2],X2] + O(h^4)
+        """
 
         def bracket(tree):
             return f"[{bracket(tree[0])},{bracket(tree[1])}]" if isinstance(tree, tuple) else f"X{tree}"

@@ -386,7 +386,12 @@ def conserved_quantities(system, word, degree=None) -> ConservedQuantities:
     >>> conserved_quantities(model("ho"), "121").H_c          # Eq. (CQPV)
     -h**2*omega**2*x2**2/(8*m) + m*omega**2*x1**2/2 + x2**2/(2*m)
     >>> conserved_quantities(model("ho3"), "12321").to_dict()  # Eqs. (CQ12321H), (CQ12321G)
-    {'H_c': 'm*omega**2*x3/2 + x2**2/(2*m)', 'G_c': 'h**2*x2**2/(4*m**2) - x1**2 + x3'}
+    {'H_c': 'm*omega**2*x3/2 + x2**2/(2*m)', 'G_c': 'h**2*x2**2/(4*m**2) - x1**2 + x3',
+     'series': {'H_c': {'0': 'm*omega**2*x3/2 + x2**2/(2*m)'}, 'G_c': {'0': '-x1**2 + x3', '2': 'x2**2/(4*m**2)'}}}
+    >>> print(conserved_quantities(model("ho3"), "12321"))        # as Table (table) writes it
+    H_c = H
+    G_c = G + h**2*x2**2/(4*m**2)
+    H = m*omega**2*x3/2 + x2**2/(2*m), G = -x1**2 + x3
     """
     comp = composition(word, len(system.splitting)).check(system.splitting)
     name = word if isinstance(word, str) else _word_name(comp)

@@ -22,11 +22,6 @@ from ..printing import Printable, aligned, h_coefficients, latex_text, series_te
 H_STEP = sympy.Symbol("h")
 
 
-def _corrections(shadow, base, coordinates):
-    """``shadow - base`` by powers of ``h``: ``[(k, expr)]`` (see :func:`nambu_bch.printing.h_coefficients`)."""
-    return h_coefficients(shadow, base, coordinates) or []
-
-
 @dataclass
 class ShadowFamily(Printable):
     """Shadow Hamiltonians of a composition on a system, as a family.
@@ -91,6 +86,14 @@ class ShadowFamily(Printable):
 
         The remainder skips odd powers for symmetric words (Eqs. SH12321c, SG12321c); an
         obstructed family shows the failed order, the ansatz degree and the certificate.
+        Belongs in display math with amsmath (docs/latex.md).
+
+        >>> from nambu_bch import model, shadow_hamiltonians
+        >>> print(shadow_hamiltonians(model("ho"), "TVT").to_latex())          # Eq. (SHPV1)
+        \begin{aligned}
+        H_{S} &= H + h^{2}\Bigl(\frac{m \omega^{4} x_{1}^{2}}{12} - \frac{\omega^{2} x_{2}^{2}}{24 m}\Bigr) + O(h^{4}), \\
+        H &= \frac{m \omega^{2} x_{1}^{2}}{2} + \frac{x_{2}^{2}}{2 m}
+        \end{aligned}
         """
         if not self.exists:
             return aligned(self._obstruction_rows())
@@ -137,7 +140,14 @@ class ShadowFamily(Printable):
         return orders[-1] if orders else None
 
     def to_text(self) -> str:
-        """``H_S = H + h**2*(...) + O(h^4)`` per Hamiltonian, the definitions, free parameters and notes."""
+        """``H_S = H + h**2*(...) + O(h^4)`` per Hamiltonian, the definitions, free parameters and notes.
+
+        >>> from nambu_bch import model, shadow_hamiltonians
+        >>> print(shadow_hamiltonians(model("ho"), "TVT"))                      # Eq. (SHPV1)
+        H_S = H + h**2*(m*omega**4*x1**2/12 - omega**2*x2**2/(24*m)) + O(h^4)
+        H = m*omega**2*x1**2/2 + x2**2/(2*m)
+        h^1: the correction vanishes (odd order of a symmetric word)
+        """
         if not self.exists:
             return f"no polynomial shadow Hamiltonians for {self.composition.name} on {self.system.name}: {self.obstruction}"
         power = self.composition.remainder_power(self.order)
