@@ -49,7 +49,6 @@ from .lyndon import (
     lyndon_expansion,
     lyndon_words,
     standard_bracketing,
-    terms_to_latex,
     tree_leaves,
     witt_dimension,
     word_index,
