@@ -112,23 +112,34 @@ def _ordered_terms(expr):
 
 
 def _term_tokens(term, first) -> list:
-    r"""One term as tokens: itself, or -- when wider than a line -- ``rest \Bigl( p_1 + ... \Bigr)`` split at the
-    terms of its widest polynomial factor ``p`` (long factored coefficients of e.g. the rigid body)."""
+    r"""One term as tokens: itself, or -- when wider than a line -- ``rest \Bigl(p_1 + ...\Bigr) \Bigl(q_1 + ...\Bigr)^{-1}``
+    split at the terms of its long polynomial factors ``p`` (numerator) and ``q`` (denominator): the long factored
+    coefficients of the rigid body, the rational-in-h invariants of triple-jump words."""
     whole = signed(term, first)
     if width(whole) <= WIDTH - 8:
         return [whole]
     sign = term.could_extract_minus_sign()
     body = -term if sign else term
-    factors = [f for f in sympy.Mul.make_args(body) if isinstance(f, sympy.Add)]
-    if not factors:
+    factors = sympy.Mul.make_args(body)
+
+    def long_poly(f):
+        base = f.base if isinstance(f, sympy.Pow) and f.exp == -1 else f
+        return isinstance(base, sympy.Add) and width(sympy.latex(base)) > 12
+
+    split = [f for f in factors if long_poly(f)]
+    if not split:
         return [whole]
-    widest = max(factors, key=lambda f: width(sympy.latex(f)))
-    rest = sympy.Mul(*[f for f in sympy.Mul.make_args(body) if f is not widest])
-    inner = sum_tokens(widest)
-    head = ("- " if sign else ("" if first else "+ ")) + ("" if rest == 1 else sympy.latex(rest))
-    inner[0] = head + r"\Bigl(" + inner[0]
-    inner[-1] += r"\Bigr)"
-    return inner
+    rest = sympy.Mul(*[f for f in factors if not long_poly(f)])
+    split.sort(key=lambda f: isinstance(f, sympy.Pow))  # numerators first
+    tokens = []
+    for f in split:
+        inverse = isinstance(f, sympy.Pow)
+        inner = sum_tokens(f.base if inverse else f)
+        inner[0] = r"\Bigl(" + inner[0]
+        inner[-1] += r"\Bigr)" + ("^{-1}" if inverse else "")
+        tokens += inner
+    tokens[0] = ("- " if sign else ("" if first else "+ ")) + ("" if rest == 1 else sympy.latex(rest)) + tokens[0]
+    return tokens
 
 
 def sum_tokens(expr, first=True) -> list:
@@ -146,8 +157,8 @@ def series_tokens(base_latex, expr, base, coordinates, remainder=None, step=H_ST
     """
     coefficients = h_coefficients(expr, base, coordinates, step)
     tokens = [base_latex]
-    if coefficients is None:
-        tokens += sum_tokens(sympy.expand(sympy.sympify(expr) - sympy.sympify(base)), first=False)
+    if coefficients is None:  # rational in h: by monomials of the coordinates, coefficients factored
+        tokens += sum_tokens(_by_monomial(sympy.expand(sympy.sympify(expr) - sympy.sympify(base)), coordinates), first=False)
     for k, c in coefficients or ():
         inner = sum_tokens(c, first=(k != 0))
         power = sympy.latex(step**k) if k else ""

@@ -55,6 +55,7 @@ CLI = [
     ("shadow", "--model", "lotka-volterra"),
     ("shadow", "--integrator", "32123", "--route", "fi"),
     ("conserved",), ("conserved", "--integrator", "31213"), ("conserved", "--model", "rigid-body"),  # Table (table)
+    ("conserved", "--model", "ho", "--integrator", "forest-ruth"),     # rational in h, radicals: split factors
     ("exact", "--order", "4"), ("exact", "--model", "ho", "--integrator", "lie-trotter", "--order", "3"),
     ("bch",), ("bch", "--field", "--terms"), ("bch", "--model", "ho", "--integrator", "TVT", "--order", "4"),
     ("fi",), ("fi", "--model", "ho3", "--integrator", "12321"),          # Eqs. (1AX)-(2BY), (CL5)-(CL8)
