@@ -44,7 +44,7 @@ def resum(data, series):
 
 def test_schema_is_a_valid_draft_2020_12_schema():
     jsonschema.Draft202012Validator.check_schema(SCHEMA)
-    assert set(SCHEMA["$defs"]) >= {"shadow", "conserved", "exact", "bch"}
+    assert set(SCHEMA["$defs"]) >= {"shadow", "conserved", "exact", "bch", "fi", "models"}
 
 
 def test_shadow_series_by_order_resum_to_H_S_and_G_S(capsys):
@@ -171,3 +171,19 @@ def test_other_models_validate(capsys, kind, argv):
     """No invariant near H (rigid body, Table-style search of degree 2) and a second model validate too."""
     data = run(capsys, *argv)
     validator(kind).validate(data)
+
+
+def test_fi_and_models_validate(capsys):
+    """fi: the eight forms (Eqs. 1AX-2BY), with ho3 the four non-vanishing h^2 terms of Eq. (BCH4); models: the catalogue."""
+    generic = run(capsys, "fi")
+    validator("fi").validate(generic)
+    assert [f["label"] for f in generic["forms"]] == ["1AX", "1AY", "1BX", "1BY", "2AX", "2AY", "2BX", "2BY"]
+    on_ho3 = run(capsys, "fi", "--model", "ho3", "--integrator", "12321")
+    validator("fi").validate(on_ho3)
+    assert len(on_ho3["representations"]) == 4
+    bad = copy.deepcopy(on_ho3)
+    del bad["model"]                       # representations need the system they were computed on
+    assert not validator("fi").is_valid(bad)
+    models = run(capsys, "models")
+    validator("models").validate(models)
+    assert {m["model"] for m in models["models"]} >= {"ho", "ho3", "rigid-body", "lotka-volterra"}
