@@ -4,42 +4,39 @@ The public surface is re-exported here; see README.md for a tour and the archite
 """
 
 from . import errors
-from .algebra import (
-    PolynomialAlgebra,
-    VectorField,
-    is_symplectic,
-    lie_bracket,
-    liouville_field,
-    nambu_bracket,
-    poisson_bracket,
-    satisfies_nambu_condition,
-)
-from .bch import EffectiveField, FormalBCH, effective_field, effective_field_bch, expand_terms, formal_bch
 from .errors import NambuBCHError
-from .exact import (
-    F,
-    ConservedQuantities,
-    ExactShadow,
-    F_series,
-    ModifiedSolution,
-    conserved_quantities,
-    exact_shadow_hamiltonians,
-    is_invariant,
-    modified_equations,
-    modified_solution,
-)
-from .integrators import PAPER_WORDS, Composition, composed_map, composition, exact_flow, step_function
-from .numeric import check, iterate, paper_figures, sample_times
-from .shadow import (
-    LiouvilleSum,
-    LiouvilleTerm,
-    ShadowFamily,
-    direct_route,
-    fi_route,
-    representations,
-    shadow_hamiltonians,
-)
-from .systems import Splitting, System, full_split, model, model_names, separate, single_split
+
+# The public names are imported on first use (PEP 562), so that ``nambu-bch --help`` and argument
+# errors answer without importing sympy, numpy and numba; ``from nambu_bch import X`` works as before.
+_LAZY = {
+    ".algebra": ("PolynomialAlgebra", "VectorField", "is_symplectic", "lie_bracket", "liouville_field", "nambu_bracket",
+                 "poisson_bracket", "satisfies_nambu_condition"),
+    ".bch": ("EffectiveField", "FormalBCH", "effective_field", "effective_field_bch", "expand_terms", "formal_bch"),
+    ".exact": ("F", "ConservedQuantities", "ExactShadow", "F_series", "ModifiedSolution", "conserved_quantities",
+               "exact_shadow_hamiltonians", "is_invariant", "modified_equations", "modified_solution"),
+    ".integrators": ("PAPER_WORDS", "Composition", "composed_map", "composition", "exact_flow", "step_function"),
+    ".numeric": ("check", "iterate", "paper_figures", "sample_times"),
+    ".shadow": ("LiouvilleSum", "LiouvilleTerm", "ShadowFamily", "direct_route", "fi_route", "representations",
+                "shadow_hamiltonians"),
+    ".systems": ("Splitting", "System", "full_split", "model", "model_names", "separate", "single_split"),
+}
+_WHERE = {name: module for module, names in _LAZY.items() for name in names}
+
+
+def __getattr__(name):
+    module = _WHERE.get(name)
+    if module is None:
+        raise AttributeError(f"module 'nambu_bch' has no attribute {name!r}")
+    from importlib import import_module
+
+    value = getattr(import_module(module, __name__), name)
+    globals()[name] = value
+    return value
+
+
+def __dir__():
+    return sorted(set(globals()) | set(_WHERE))
+
 
 __version__ = "0.1.0"
 

@@ -18,7 +18,9 @@ Synopsis::
     --param NAME=VALUE sets a parameter's value: numeric subcommands use it (default 1 for
                        every parameter), symbolic ones substitute it exactly before the analysis.
     --format latex|text|json (default latex for symbolic results, text for models/check/plot),
-    --output FILE      (written atomically: temporary file in the same directory + os.replace).
+    --output FILE      (written atomically: temporary file in the same directory + os.replace),
+    --standalone       (LaTeX: a complete document; default: align* environments for a document body),
+    --no-progress      (no progress bars on stderr for long runs; docs/latex.md).
 
 With no options ``nambu-bch shadow`` prints the alpha-family of shadow
 Hamiltonians of Phi^{12321} for the paper's N = 3 oscillator at order 2
@@ -34,13 +36,25 @@ exception is a bug and propagates with its traceback (exit status 1).
 from __future__ import annotations
 
 import argparse
+import importlib
 import os
 import sys
 
-import sympy
-
-from . import render
 from .errors import NambuBCHError
+
+
+class _Lazy:
+    """A module imported on first attribute access: ``--help`` and argument errors never import sympy."""
+
+    def __init__(self, name):
+        self._name = name
+
+    def __getattr__(self, attr):
+        return getattr(importlib.import_module(self._name), attr)
+
+
+sympy = _Lazy("sympy")
+render = _Lazy("nambu_bch.render")
 
 PROG = "nambu-bch"
 DEFAULT_MODEL = "ho3"
@@ -239,22 +253,19 @@ def integrator_from_args(args, system):
 # --------------------------------------------------------------------------------------------
 # output
 # --------------------------------------------------------------------------------------------
-def emit(args, *, latex=None, text=None, data=None):
+def emit(args, *, latex=None, text=None, data=None, cache=None):
     """Print (or write to ``--output``) the result in the chosen ``--format``.
 
     ``latex`` / ``text`` are callables returning strings, ``data`` a callable
-    returning the JSON-able dict; only the one needed is computed.
+    returning the JSON-able dict; only the one needed is computed.  With ``cache``
+    (a request tuple) the output is kept in :mod:`nambu_bch.cli_cache`.
     """
-    fmt = args.format
-    if fmt == "json":
-        out = render.to_json(data())
-    elif fmt == "latex" and latex is not None:
-        out = render.latex_document(latex())
-    elif text is not None:
-        out = text()
-        out = out if out.endswith("\n") else out + "\n"
+    if cache is not None:
+        from .cli_cache import cached_text
+
+        out = cached_text((*cache, args.format, getattr(args, "standalone", False)), lambda: _formatted(args, latex, text, data))
     else:
-        out = render.to_text(data())
+        out = _formatted(args, latex, text, data)
     if args.output:
         try:
             render.write_output(out, args.output)
@@ -264,6 +275,20 @@ def emit(args, *, latex=None, text=None, data=None):
     else:
         sys.stdout.write(out)
         sys.stdout.flush()
+
+
+def _formatted(args, latex, text, data) -> str:
+    fmt = args.format
+    if fmt == "json":
+        out = render.to_json(data())
+    elif fmt == "latex" and latex is not None:
+        out = render.latex_document(latex(), standalone=getattr(args, "standalone", False))
+    elif text is not None:
+        out = text()
+        out = out if out.endswith("\n") else out + "\n"
+    else:
+        out = render.to_text(data())
+    return out
 
 
 def _base(system, word, **extra):
@@ -277,13 +302,16 @@ def _base(system, word, **extra):
 # subcommands
 # --------------------------------------------------------------------------------------------
 def cmd_models(args):
-    from .systems import model, model_names
+    chosen = any((args.model, args.system, args.H, args.G, args.coords, args.param, args.split, args.name))
 
-    if any((args.model, args.system, args.H, args.G, args.coords, args.param, args.split, args.name)):
-        system, values = system_from_args(args)
-        systems = [substituted(system, values)]
-    else:
-        systems = [model(name) for name in model_names()]
+    @_once
+    def systems():
+        from .systems import model, model_names
+
+        if chosen:
+            system, values = system_from_args(args)
+            return [substituted(system, values)]
+        return [model(name) for name in model_names()]
 
     def piece_dict(system, piece):
         return {
@@ -295,7 +323,7 @@ def cmd_models(args):
 
     def data():
         out = []
-        for s in systems:
+        for s in systems():
             d = render.system_dict(s)
             d.update(N=s.N, split=s.split, description=s.description, citation=s.citation,
                      pieces=[piece_dict(s, p) for p in s.splitting.pieces], default_integrator=default_word(s))
@@ -304,7 +332,7 @@ def cmd_models(args):
 
     def text():
         lines = []
-        for s in systems:
+        for s in systems():
             lines.append(f"{s.name}  (N = {s.N}, split = {s.split}, default integrator {default_word(s)})")
             if s.description:
                 lines.append(f"  {s.description}")
@@ -320,14 +348,30 @@ def cmd_models(args):
         return "\n".join(lines)
 
     def latex():
-        blocks = []
-        for s in systems:
-            rows = [rf"\text{{{s.name}}}:\quad {s.to_latex()}"]
-            rows += [rf"X_{{{p.number}}} = {p.label()} = {p.field.to_latex()}" for p in s.splitting.pieces]
-            blocks.append(" \\\\\n".join(rows))
-        return "\\begin{gathered}\n" + " \\\\[1ex]\n".join(blocks) + "\n\\end{gathered}"
+        from .printing import aligned, latex_text
 
-    emit(args, latex=latex, text=text, data=data)
+        blocks = []
+        for s in systems():
+            rows = [("", "", [latex_text(s.name) + ":"])]
+            labels = ["H", "G"] if len(s.hamiltonians) == 2 else [f"H_{{{k + 1}}}" for k in range(len(s.hamiltonians))]
+            rows += [(lab, "=", [sympy.latex(H)]) for lab, H in zip(labels[: len(s.hamiltonians)] or ["H"], s.hamiltonians)]
+            rows += [(f"X_{{{p.number}}}", "=", [p.label(), "= " + p.field.to_latex()]) for p in s.splitting.pieces]
+            blocks.append(aligned(rows))
+        return blocks
+
+    emit(args, latex=latex, text=text, data=data, cache=None if chosen else ("models",))
+
+
+def _once(func):
+    """``func()`` computed on the first call only."""
+    memo = []
+
+    def wrapper():
+        if not memo:
+            memo.append(func())
+        return memo[0]
+
+    return wrapper
 
 
 def cmd_bch(args):
@@ -340,12 +384,6 @@ def cmd_bch(args):
     order = args.order if args.order is not None else 2
     series = formal_bch(comp, order + 1)
 
-    def tree_text(tree):
-        return tree_to_latex(tree).replace("X_{", "X").replace("}", "")
-
-    def tree_json(tree):
-        return list(map(tree_json, tree)) if isinstance(tree, tuple) else tree
-
     field = effective_field(system.splitting, comp, order) if args.field else None
     expanded = None
     if args.terms:
@@ -355,7 +393,8 @@ def cmd_bch(args):
 
     def data():
         terms = [
-            {"degree": d, "power_of_h": d - 1, "coefficient": render.expression(c), "bracket": tree_text(t), "tree": tree_json(t)}
+            {"degree": d, "power_of_h": d - 1, "coefficient": render.expression(c), "bracket": render.bracket_text(t),
+             "tree": render.bracket_tree(t)}
             for d in range(1, series.max_degree + 1) for c, t in series.terms(d)
         ]
         out = _base(system, word, order=order, max_degree=series.max_degree,
@@ -365,7 +404,8 @@ def cmd_bch(args):
             out["X_eff"] = [[render.expression(c) for c in Z.to_sympy()] for Z in field.coefficients]
         if expanded is not None:
             out["liouville_terms"] = [
-                {"degree": d, "coefficient": render.expression(c), "bracket": tree_to_latex(t)}
+                {"degree": d, "coefficient": render.expression(c), "bracket": render.bracket_text(t),
+                 "tree": render.bracket_tree(t), "latex": tree_to_latex(t)}
                 for d, items in expanded.items() for c, t in items
             ]
         return out
@@ -375,7 +415,7 @@ def cmd_bch(args):
         lines.append(f"X_eff through h^{order} (formal BCH in the Lyndon basis):")
         for d in range(1, series.max_degree + 1):
             for c, t in series.terms(d):
-                lines.append(f"  h^{d - 1}  {c}  {tree_text(t)}")
+                lines.append(f"  h^{d - 1}  {c}  {render.bracket_text(t)}")
         if field is not None:
             for j, Z in enumerate(field.coefficients):
                 comps = ", ".join(str(c) for c in Z.to_sympy())
@@ -384,31 +424,24 @@ def cmd_bch(args):
             lines.append("Liouville terms (zero brackets pruned):")
             for d, items in expanded.items():
                 for c, t in items:
-                    lines.append(f"  h^{d - 1}  {c}  {tree_to_latex(t)}")
+                    lines.append(f"  h^{d - 1}  {c}  {render.bracket_text(t)}")
         return "\n".join(lines)
 
     def latex():
-        rows = [comp.to_latex(), series.to_latex()]
+        from .printing import aligned
+
+        lhs, _, rhs = comp.to_latex().partition(" = ")
+        blocks = [aligned([(lhs, "=", rhs.split(" "))]), series.to_latex()]
         if field is not None:
-            rows.append(field.to_latex())
+            blocks.append(field.to_latex())
         if expanded is not None:
-            for d, items in expanded.items():
-                body = " ".join(_signed_latex(c * sympy.Symbol("h") ** (d - 1)) + " " + tree_to_latex(t) for c, t in items)
-                rows.append(rf"X_{{\rm eff}}\big|_{{h^{{{d - 1}}}}} = {body.lstrip('+ ') or '0'}")
-        return " \\\\\n".join(rows)
+            from .printing import bracket_sum
+
+            blocks += [bracket_sum(rf"X_{{\rm eff}}\big|_{{h^{{{d - 1}}}}}", [(c, t, d - 1) for c, t in items])
+                       for d, items in expanded.items()]
+        return blocks
 
     emit(args, latex=latex, text=text, data=data)
-
-
-def _signed_latex(term) -> str:
-    """``+ \\frac{h^{2}}{12}`` / ``- \\frac{h^{2}}{24}`` / ``+`` for a unit coefficient."""
-    if term == 1:
-        return "+"
-    if term == -1:
-        return "-"
-    if term.could_extract_minus_sign():
-        return "- " + sympy.latex(-term)
-    return "+ " + sympy.latex(term)
 
 
 def cmd_shadow(args):
@@ -452,7 +485,7 @@ def cmd_conserved(args):
         out["model"], out["integrator"] = system.name, word
         return out
 
-    emit(args, latex=result.to_latex, data=data)
+    emit(args, latex=result.to_latex, text=result.to_text, data=data)
 
 
 def cmd_exact(args):
@@ -470,21 +503,15 @@ def cmd_exact(args):
         out["model"], out["integrator"] = system.name, word
         if series is not None:
             out.update(order=args.order, H_S_series=render.expression(series[0]), G_S_series=render.expression(series[1]))
+            out.update({k: v for k, v in result.to_dict(order=args.order).items() if k in ("series", "remainder_power")})
         return out
 
     def latex():
-        text = result.to_latex()
-        if series is not None:
-            O = sympy.latex(sympy.Symbol("h") ** (args.order + 1))
-            text += rf" \\" + "\n" + rf"H_S^e = {sympy.latex(series[0])} + O({O})"
-            if series[1] is not None:
-                text += rf",\quad G_S^e = {sympy.latex(series[1])} + O({O})"
-        return text
+        return result.to_latex(order=args.order)
 
-    emit(args, latex=latex, data=data)
+    emit(args, latex=latex, text=lambda: result.to_text(order=args.order), data=data)
 
 
-FI_LABELS = ("1AX", "1AY", "1BX", "1BY", "2AX", "2AY", "2BX", "2BY")
 
 
 def _system_chosen(args) -> bool:
@@ -533,20 +560,8 @@ def cmd_fi(args):
     word, comp = integrator_from_args(args, system)
     reps = fi_representations(system, comp) if _system_chosen(args) else None
 
-    def slot_latex(slot):
-        return sympy.latex(sympy.factor(slot))
-
-    def commutator_latex(c, abd):
-        a, b, d = ("X_{" + ", ".join(slot_latex(s) for s in t) + "}" for t in abd)
-        return _signed_latex(c).lstrip("+ ") + rf" [{a}, [{b}, {d}]]"
-
-    def terms_latex(terms):
-        if not terms:
-            return "0"
-        return " ".join(("+ " + t.to_latex()) if not t.to_latex().startswith("-") else t.to_latex() for t in terms).lstrip("+ ")
-
     def data():
-        out = {"forms": [{"label": lab, "text": render.fi_form_text(lab), "latex": render.fi_form_latex(lab)} for lab in FI_LABELS]}
+        out = {"forms": [{"label": lab, "text": render.fi_form_text(lab), "latex": render.fi_form_latex(lab)} for lab in render.FI_LABELS]}
         if reps is not None:
             out = {**_base(system, word), **out}
             out["representations"] = [
@@ -561,7 +576,7 @@ def cmd_fi(args):
         return out
 
     def text():
-        lines = [f"{lab}: {render.fi_form_text(lab)}" for lab in FI_LABELS]
+        lines = [f"{lab}: {render.fi_form_text(lab)}" for lab in render.FI_LABELS]
         for c, abd, forms in reps or ():
             a, b, d = ("X_{" + ", ".join(str(s) for s in t) + "}" for t in abd)
             lines.append(f"{c} [{a}, [{b}, {d}]] (h^2 term of {word} on {system.name}):")
@@ -569,11 +584,9 @@ def cmd_fi(args):
         return "\n".join(lines)
 
     def latex():
-        rows = [render.fi_form_latex(lab) for lab in FI_LABELS]
-        for c, abd, forms in reps or ():
-            rows.append(r"\text{" + f"{word} on {system.name}" + r"}:\quad h^2\," + commutator_latex(c, abd))
-            rows += [rf"\quad \overset{{\rm {lab}}}{{=}} {terms_latex(terms)}" for lab, terms in forms.items()]
-        return " \\\\\n".join(rows)
+        blocks = [render.fi_forms_latex()]
+        blocks += [render.fi_representations_latex(f"{word} on {system.name}", c, abd, forms) for c, abd, forms in reps or ()]
+        return blocks
 
     emit(args, latex=latex, text=text, data=data)
 
@@ -662,6 +675,15 @@ def _integrator_options(parser, order=False):
 def _output_options(parser, default, choices=_SYMBOLIC):
     parser.add_argument("--format", choices=choices, default=default, help=f"output format (default {default})")
     parser.add_argument("--output", metavar="FILE", help="write the result to FILE (atomically) instead of stdout")
+    if "latex" in choices:
+        parser.add_argument("--standalone", action="store_true",
+                            help="with --format latex: a complete LaTeX document (default: align* environments "
+                                 "for the body of a document with amsmath)")
+
+
+def _progress_option(parser):
+    parser.add_argument("--no-progress", action="store_true",
+                        help="no progress bars on stderr (default: shown for long runs on a terminal or in Jupyter)")
 
 
 def _numeric_options(parser, defaults):
@@ -744,6 +766,7 @@ def build_parser() -> argparse.ArgumentParser:
     _output_options(p, "latex")
 
     p = add("shadow", cmd_shadow)
+    _progress_option(p)
     _system_options(p)
     _integrator_options(p, order=True)
     p.add_argument("--route", choices=("direct", "fi"), default="direct",
@@ -754,6 +777,7 @@ def build_parser() -> argparse.ArgumentParser:
     _output_options(p, "latex")
 
     p = add("conserved", cmd_conserved)
+    _progress_option(p)
     _system_options(p)
     _integrator_options(p)
     p.add_argument("--degree", metavar="D", type=str,
@@ -768,6 +792,7 @@ def build_parser() -> argparse.ArgumentParser:
     _output_options(p, "latex")
 
     p = add("check", cmd_check)
+    _progress_option(p)
     _system_options(p)
     _integrator_options(p, order=True)
     _numeric_options(p, {"h": 0.1, "steps": 1000, "every": 1})
@@ -775,6 +800,7 @@ def build_parser() -> argparse.ArgumentParser:
     _output_options(p, "text", choices=("text", "json"))
 
     p = add("plot", cmd_plot)
+    _progress_option(p)
     _system_options(p)
     _integrator_options(p)
     p.add_argument("--outdir", metavar="DIR", default=".", help="directory for fig1.png .. fig4.png (default .)")
@@ -817,6 +843,21 @@ def _normalise(args):
     return args
 
 
+class _progress_off:
+    """``--no-progress``: ``NAMBU_BCH_PROGRESS=0`` for the run (read by :mod:`nambu_bch.numeric.progress`), then restored."""
+
+    def __enter__(self):
+        self.saved = os.environ.get("NAMBU_BCH_PROGRESS")
+        os.environ["NAMBU_BCH_PROGRESS"] = "0"
+
+    def __exit__(self, *exc):
+        if self.saved is None:
+            os.environ.pop("NAMBU_BCH_PROGRESS", None)
+        else:
+            os.environ["NAMBU_BCH_PROGRESS"] = self.saved
+        return False
+
+
 def main(argv=None) -> int:
     """Run the CLI on ``argv`` (default ``sys.argv[1:]``); returns the exit status.
 
@@ -828,7 +869,11 @@ def main(argv=None) -> int:
         args = parser.parse_args(argv)
         prog = f"{PROG} {args.command}"
         _normalise(args)
-        args.func(args)
+        if getattr(args, "no_progress", False):
+            with _progress_off():
+                args.func(args)
+        else:
+            args.func(args)
     except SystemExit as exc:  # --help, --version
         return exc.code if isinstance(exc.code, int) else 0
     except UsageError as exc:

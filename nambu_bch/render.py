@@ -4,7 +4,12 @@ JSON convention (DESIGN.md, "Public surface"): every symbolic expression is a
 string that ``sympy.sympify`` reads back with the system's symbol names, e.g.
 ``sympify(data["H_S"], locals={"x1": Symbol("x1"), ..., "h": Symbol("h")})``
 (``str`` of a sympy expression; no floats appear in symbolic output); numbers
-of numeric diagnostics are JSON numbers; absent quantities are ``null``.
+of numeric diagnostics are JSON numbers; absent quantities are ``null``; series
+by order are ``{"k": coefficient of h^k}``.  The format is documented in
+docs/json.md with a JSON Schema (docs/schema/nambu-bch.schema.json).
+
+LaTeX: results are ``aligned`` blocks (:mod:`nambu_bch.printing`); the CLI prints
+them as ``align*`` environments, or a complete document (:func:`latex_document`).
 
 The text format is the JSON content laid out one ``key: value`` per line, for
 reading in a terminal and for ``grep``.
@@ -20,7 +25,8 @@ import math
 import numpy as np
 import sympy
 
-__all__ = ["expression", "jsonable", "to_json", "to_text", "system_dict", "write_output", "latex_document"]
+__all__ = ["expression", "jsonable", "to_json", "to_text", "system_dict", "write_output", "latex_document",
+           "bracket_text", "bracket_tree"]
 
 
 def expression(value):
@@ -99,9 +105,48 @@ def system_dict(system) -> dict:
     return data
 
 
-def latex_document(body: str) -> str:
-    """Display math, one result per ``equation*``-free line (ready for ``\\[ ... \\]`` or Jupyter)."""
-    return body.rstrip("\n") + "\n"
+def latex_document(blocks, standalone: bool = False) -> str:
+    r"""LaTeX output of the CLI: each ``aligned`` block in ``\[ ... \]`` (a fragment for a document with
+    ``amsmath``), or with ``standalone`` a complete document (see :mod:`nambu_bch.printing`, docs/latex.md)."""
+    from .printing import display
+    from .printing import standalone as document
+
+    blocks = [blocks] if isinstance(blocks, str) else list(blocks)
+    fragment = display(*blocks)
+    return document(fragment) if standalone else fragment
+
+
+def bracket_text(tree) -> str:
+    """A bracket tree as sympy-readable text: ``[X(a, b),[X(c, d),X(e, f)]]`` (leaves ``X(slots)`` or ``Xk``).
+
+    ``sympy.sympify`` reads it back as nested lists of ``X(...)`` applications, the slots
+    with the system's symbol names.
+
+    >>> import sympy
+    >>> x1, x2 = sympy.symbols("x1 x2")
+    >>> bracket_text(((x2**2 / 2, x1), (x1, 1)))
+    '[X(x2**2/2, x1),X(x1, 1)]'
+    """
+    if _is_tree(tree):
+        return f"[{bracket_text(tree[0])},{bracket_text(tree[1])}]"
+    if isinstance(tree, tuple):
+        return "X(" + ", ".join(expression(e) for e in tree) + ")"
+    return f"X{tree}"
+
+
+def bracket_tree(tree):
+    """A bracket tree as JSON: ``[left, right]`` for a bracket, a list of slot strings (or an int) for a leaf."""
+    if _is_tree(tree):
+        return {"bracket": [bracket_tree(tree[0]), bracket_tree(tree[1])]}
+    if isinstance(tree, tuple):
+        return [expression(e) for e in tree]
+    return tree
+
+
+def _is_tree(node) -> bool:
+    from .bch.lyndon import is_bracket
+
+    return is_bracket(node)
 
 
 def write_output(text: str, path) -> None:
@@ -147,6 +192,46 @@ def fi_form_text(label: str) -> str:
     terms = fi_form(label)
     body = " ".join(("+ " if s > 0 else "- ") + "X_{" + ",".join(slots) + "}" for s, slots in terms)
     return "[X_{A,B},[X_{C,D},X_{E,F}]] = " + body.lstrip("+ ")
+
+
+def fi_form_tokens(label: str) -> list:
+    """The right-hand side of :func:`fi_form_latex` as signed LaTeX terms (for line breaking)."""
+
+    def lx(text):
+        return text.replace("{", r"\{").replace("}", r"\}")
+
+    tokens = [("+ " if s > 0 else "- ") + "X_{" + ",".join(lx(t) for t in slots) + "}" for s, slots in fi_form(label)]
+    tokens[0] = tokens[0][2:] if tokens[0].startswith("+ ") else tokens[0]
+    return tokens
+
+
+FI_LABELS = ("1AX", "1AY", "1BX", "1BY", "2AX", "2AY", "2BX", "2BY")
+
+
+def fi_forms_latex(labels=FI_LABELS) -> str:
+    r"""The eight forms of ``[X_{A,B},[X_{C,D},X_{E,F}]]`` (Eqs. 1AX-2BY) as one ``aligned`` block, aligned at ``=``."""
+    from .printing import aligned
+
+    lhs = "[X_{A,B},[X_{C,D},X_{E,F}]]"
+    return aligned([(lhs, rf"\overset{{\rm {lab}}}{{=}}", fi_form_tokens(lab)) for lab in labels])
+
+
+def fi_representations_latex(title: str, coefficient, commutator, forms) -> str:
+    r"""One ``h^2`` double commutator and its FI representations (Eqs. CL5-CL8) as an ``aligned`` block.
+
+    ``title`` is user text (word, system name) and goes through :func:`nambu_bch.printing.latex_text`;
+    ``commutator`` is ``(a, b, d)`` of slot tuples, ``forms`` ``{label: [LiouvilleTerm, ...]}``.
+    """
+    from .printing import aligned, latex_text, signed
+
+    a, b, d = ("X_{" + ", ".join(sympy.latex(sympy.factor(s)) for s in t) + "}" for t in commutator)
+    head = latex_text(title) + r":\quad h^{2}\," + signed(coefficient, first=True) + rf" [{a}, [{b}, {d}]]"
+
+    def tokens(terms):
+        toks = [t.to_latex() for t in terms] or ["0"]
+        return [tok if i == 0 or tok.startswith("-") else "+ " + tok for i, tok in enumerate(toks)]
+
+    return aligned([("", "", [head])] + [("", rf"\overset{{\rm {lab}}}{{=}}", tokens(terms)) for lab, terms in forms.items()])
 
 
 def fi_form_latex(label: str) -> str:

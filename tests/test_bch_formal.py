@@ -116,14 +116,16 @@ def test_BCH2_for_all_six_paper_words(word):
 
 def test_BCH2_latex_term_by_term():
     """Eq. (BCH2) printed as LaTeX, term by term."""
-    text = formal_bch("12321", 3).to_latex()
+    from nambu_bch.printing import flatten
+
+    text = flatten(formal_bch("12321", 3).to_latex())   # an aligned, line-broken block, compared as one line
     assert text.startswith(r"X_{\rm eff} = X_{1} + X_{2} + X_{3} - \frac{h^{2}}{24} [X_{1},[X_{1},X_{2}]]")
     assert text.count("h^{2}") == 8 and text.endswith("+ O(h^{4})")     # symmetric: no h^3 term
     names = {1: "X_T", 2: "X_V"}
-    assert formal_bch("121", 3).to_latex(names) == (
+    assert flatten(formal_bch("121", 3).to_latex(names)) == (
         r"X_{\rm eff} = X_T + X_V - \frac{h^{2}}{24} [X_T,[X_T,X_V]] + \frac{h^{2}}{12} [[X_T,X_V],X_V] + O(h^{4})"
     )
-    assert formal_bch("12", 2).to_latex(step=None) == r"\log \Phi = X_{1} + X_{2} + \frac{1}{2} [X_{1},X_{2}]"
+    assert flatten(formal_bch("12", 2).to_latex(step=None)) == r"\log \Phi = X_{1} + X_{2} + \frac{1}{2} [X_{1},X_{2}]"
 
 
 def test_classical_bch_two_generators_degree_4():

@@ -121,13 +121,15 @@ def test_default_degree_and_output():
     names = model("ho3").symbols()
     assert sympy.expand(sympy.sympify(d["H_c"], locals=names) - TABLE["12321"][0]) == 0
     assert sympy.expand(sympy.sympify(d["G_c"], locals=names) - TABLE["12321"][1]) == 0
-    assert "H_c =" in cq.to_latex() and cq._repr_latex_().startswith("$")
+    # Table (table), row 12321, as the paper writes it: H_c = H, G_c = G + h^2 x2^2/(4 m^2)
+    assert "H_{c} &= H," in cq.to_latex() and r"G_{c} &= G + \frac{h^{2} x_{2}^{2}}{4 m^{2}}" in cq.to_latex()
+    assert cq._repr_latex_() == "$$" + cq.to_latex() + "$$"
 
 
 def test_no_invariant_near_H_for_rigid_body():
     cq = conserved_quantities(model("rigid-body"), "12321")
     assert cq.H_c is None and cq.G_c is None
-    assert cq.to_dict() == {"H_c": None, "G_c": None}
+    assert cq.to_dict() == {"H_c": None, "G_c": None, "series": {}}
 
 
 def test_user_system_and_composition_object():

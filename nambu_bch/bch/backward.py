@@ -26,6 +26,7 @@ import sympy
 from ..algebra import VectorField
 from ..errors import InvalidOrderError
 from ..integrators.composition import composition as make_composition
+from ..printing import Printable, aligned
 from .fast import FastFields, field_backend
 
 H = sympy.Symbol("h")
@@ -93,7 +94,7 @@ def _exp_apply(series, field, scale, value, degree):
 
 
 @dataclass(frozen=True, eq=False)
-class EffectiveField:
+class EffectiveField(Printable):
     """``X_eff = sum_{j=0}^{order} h^j Z_j`` of a composition.
 
     Attributes
@@ -125,14 +126,32 @@ class EffectiveField:
         return self.field.to_sympy()
 
     def to_latex(self) -> str:
-        parts = []
+        r"""``X_{\rm eff} &= (c_1)\partial_{x_1} + ... + h^{2}\Bigl(...\Bigr) + O(h^4)`` in an ``aligned`` block,
+        one token per component, grouped by powers of ``h`` (Eq. BCH2 evaluated on the system)."""
+        coords = self.coefficients[0].algebra.coordinates
+        tokens = []
         for j, Z in enumerate(self.coefficients):
-            if not Z.is_zero():
-                parts.append((f"h^{{{j}}}" if j > 1 else ("h" if j == 1 else "")) + r"\Big(" + Z.to_latex() + r"\Big)")
-        return r"X_{\rm eff} = " + " + ".join(parts) + rf" + O(h^{{{self.composition.remainder_power(self.order)}}})"
+            comps = [(x, sympy.factor(c)) for x, c in zip(coords, Z.to_sympy()) if c != 0]
+            if not comps:
+                continue
+            inner = [rf"\left({sympy.latex(c)}\right)\frac{{\partial}}{{\partial {sympy.latex(x)}}}" for x, c in comps]
+            inner = [inner[0]] + ["+ " + t for t in inner[1:]]
+            if j:
+                step = "h" if j == 1 else f"h^{{{j}}}"
+                inner[0] = rf"{step}\Bigl({inner[0]}"
+                inner[-1] += r"\Bigr)"
+            if tokens:
+                inner[0] = "+ " + inner[0]
+            tokens += inner
+        tokens.append(rf"+ O(h^{{{self.composition.remainder_power(self.order)}}})")
+        return aligned([(r"X_{\rm eff}", "=", tokens)])
 
-    def _repr_latex_(self):
-        return f"${self.to_latex()}$"
+    def to_text(self) -> str:
+        """``X_eff = Z_0 + h^2 Z_2 + ... + O(h^4)``, one line per non-zero ``Z_j`` (components in the coordinates' order)."""
+        lines = [f"Z_{j} = ({', '.join(str(c) for c in Z.to_sympy())})" for j, Z in enumerate(self.coefficients) if not Z.is_zero()]
+        used = " + ".join(("" if j == 0 else ("h*" if j == 1 else f"h**{j}*")) + f"Z_{j}"
+                          for j, Z in enumerate(self.coefficients) if not Z.is_zero())
+        return "\n".join([f"X_eff = {used or '0'} + O(h^{self.composition.remainder_power(self.order)})", *lines])
 
 
 def effective_field(splitting, comp, order: int = 2, fast: bool = True) -> EffectiveField:

@@ -44,11 +44,11 @@ from sympy.polys.domains import QQ
 from ..errors import InvalidCompositionError, InvalidOrderError
 from ..integrators.composition import Composition
 from ..integrators.composition import composition as make_composition
+from ..printing import Printable, bracket_sum
 from .lyndon import (
     lyndon_expansion,
     lyndon_words,
     standard_bracketing,
-    terms_to_latex,
     tree_leaves,
     witt_dimension,
     word_index,
@@ -349,7 +349,7 @@ def _lyndon_coordinates(vector, d: int, g: int):
 
 
 @dataclass(frozen=True, eq=False)
-class FormalBCH:
+class FormalBCH(Printable):
     """``log(exp(c_1 X_{k_1}) ... exp(c_s X_{k_s}))`` through ``max_degree`` in the Lyndon basis.
 
     Attributes
@@ -444,7 +444,9 @@ class FormalBCH:
         return sum(len(v[1]) for v in self._scaled.values())
 
     def to_latex(self, names=None, step="h") -> str:
-        r"""The series term by term, e.g. ``X_{\rm eff} = X_{1} + X_{2} - \frac{h^{2}}{24}[...] ...``.
+        r"""The series term by term in an ``aligned`` block, e.g. ``X_{\rm eff} &= X_{1} + X_{2} - \frac{h^{2}}{24}[...] ...``.
+
+        Long series continue on ``&\quad`` lines (see :mod:`nambu_bch.printing`).
 
         Parameters
         ----------
@@ -454,19 +456,28 @@ class FormalBCH:
             With a step symbol the series is printed as ``X_eff`` (degree ``d`` carries
             ``step^(d-1)``, Eq. BCH2); with ``None`` as ``log Phi`` of the bare generators.
         """
-        pieces = []
-        for d in range(1, self.max_degree + 1):
-            power = sympy.Symbol(step) ** (d - 1) if step else sympy.Integer(1)
-            for c, tree in self._terms.get(d, ()):
-                pieces.append((c, tree, power))
-        series = terms_to_latex(pieces, names)
+        items = [(c, tree, d - 1 if step else 0) for d in range(1, self.max_degree + 1) for c, tree in self._terms.get(d, ())]
         lhs = r"X_{\rm eff}" if step else r"\log \Phi"
-        next_power = self.composition.remainder_power(self.max_degree - 1)
-        tail = f" + O({sympy.latex(sympy.Symbol(step) ** next_power)})" if step else ""
-        return f"{lhs} = {series}{tail}"
+        remainder = self.composition.remainder_power(self.max_degree - 1) if step else None
+        return bracket_sum(lhs, items, names, remainder, sympy.Symbol(step or "h"))
 
-    def _repr_latex_(self):
-        return f"${self.to_latex()}$"
+    def to_text(self) -> str:
+        """``X_eff = X1 + X2 + (-1/24)*h**2*[X1,[X1,X2]] + ... + O(h^4)``, one term per Lyndon bracket.
+
+        >>> print(formal_bch("TVT", 3))                                           # Eq. (BCH1)
+        X_eff = X1 + X2 + (-1/24)*h**2*[X1,[X1,X2]] + (1/12)*h**2*[[X1,X2],X2] + O(h^4)
+        """
+
+        def bracket(tree):
+            return f"[{bracket(tree[0])},{bracket(tree[1])}]" if isinstance(tree, tuple) else f"X{tree}"
+
+        parts = []
+        for d in range(1, self.max_degree + 1):
+            for c, tree in self._terms.get(d, ()):
+                factor = "" if d == 1 else (f"h*" if d == 2 else f"h**{d - 1}*")
+                parts.append(("" if c == 1 else f"({c})*") + factor + bracket(tree))
+        tail = f" + O(h^{self.composition.remainder_power(self.max_degree - 1)})"
+        return "X_eff = " + (" + ".join(parts) or "0") + tail
 
     def __repr__(self):
         return f"FormalBCH({self.composition.name!r}, max_degree={self.max_degree}, terms={len(self)})"

@@ -39,6 +39,7 @@ from ..errors import NoExactResultError
 from .factor import F, F_series
 from .invariants import ConservedQuantities, conserved_quantities, has_radicals
 from .linear_core import linear_core
+from ..printing import Printable, aligned, series_text, series_tokens
 
 H_STEP = sympy.Symbol("h")
 ALPHA = sympy.Symbol("alpha")
@@ -71,7 +72,7 @@ def factor_power_series(exponent, order: int, x=None):
 
 
 @dataclass(frozen=True, eq=False)
-class ExactShadow:
+class ExactShadow(Printable):
     """The alpha-family of exact shadow Hamiltonians of a linear oscillator.
 
     Attributes
@@ -121,20 +122,67 @@ class ExactShadow:
         Fs = F_series(self.frequency * H_STEP, order)
         return tuple(truncate_h(Fs * c, order) for c in Xc)
 
-    def to_latex(self) -> str:
-        Fx = r"F(x) = \frac{2\arcsin(x/2)}{x\sqrt{1 - x^2/4}}"
+    def remainder_power(self, order: int) -> int:
+        """The power ``p`` of the remainder ``O(h^p)`` after ``series(order)``: ``order + 2`` when the
+        ``h^(order+1)`` coefficients vanish (checked exactly; an even series such as ho3's), else ``order + 1``."""
+        nxt = self.series(order + 1)
+        zero = all(S is None or sympy.expand(S).coeff(H_STEP, order + 1) == 0 for S in nxt)
+        return order + 2 if zero else order + 1
+
+    def _rows(self):
+        """``[(latex name, text name, exact, invariant, Hamiltonian, exponent)]``."""
+        hams = self.conserved.system.hamiltonians
         if self.G_S is None:
-            return rf"H_S^e = F(\omega h)\Big({sympy.latex(self.H_c)}\Big),\quad {Fx}"
-        return (rf"H_S^e = F(\omega h)^{{\alpha}}\Big({sympy.latex(self.H_c)}\Big),\quad "
-                rf"G_S^e = F(\omega h)^{{1-\alpha}}\Big({sympy.latex(self.G_c)}\Big),\quad {Fx}")
+            return [("H", "H", self.H_S, self.H_c, hams[0], None)]
+        return [("H", "H", self.H_S, self.H_c, hams[0], r"\alpha"), ("G", "G", self.G_S, self.G_c, hams[1], r"1-\alpha")]
 
-    def _repr_latex_(self):
-        return f"${self.to_latex()}$"
+    def _factor_latex(self, exponent):
+        arg = r"\omega h" if self.frequency == OMEGA else rf"\left({sympy.latex(self.frequency * H_STEP)}\right)"
+        return f"F({arg})" + ("" if exponent is None else f"^{{{exponent}}}")
 
-    def to_dict(self) -> dict:
-        return {"H_S": str(self.H_S), "G_S": None if self.G_S is None else str(self.G_S),
-                "H_c": str(self.H_c), "G_c": None if self.G_c is None else str(self.G_c),
-                "free_parameters": [] if self.G_S is None else ["alpha"]}
+    def to_latex(self, order=None) -> str:
+        r"""``H_S^e = F(\omega h)^\alpha H_c``, ``G_S^e = F(\omega h)^{1-\alpha} G_c`` (Eq. Xeff2), ``H_c``, ``G_c`` as
+        ``H + h^2(...)`` (Table (table)) and ``F(x)``; with ``order`` also the expansions through ``h^order``
+        (Eqs. ESH12321, ESG12321), their remainder ``O(h^p)`` checked (:meth:`remainder_power`)."""
+        coords = self.conserved.system.coordinates
+        rows = [(rf"{lx}_{{S}}^{{e}}", "=", [self._factor_latex(e) + rf"\, {lx}_{{c}}"]) for lx, _, _, _, _, e in self._rows()]
+        rows += [(rf"{lx}_{{c}}", "=", series_tokens(lx, Ic, H, coords)) for lx, _, _, Ic, H, _ in self._rows()]
+        rows.append(("F(x)", "=", [r"\frac{2\arcsin(x/2)}{x\sqrt{1 - x^2/4}}"]))
+        if order is not None:
+            power = self.remainder_power(order)
+            rows += [(rf"{lx}_{{S}}^{{e}}", "=", series_tokens(lx, S, H, coords, power))
+                     for (lx, _, _, _, H, _), S in zip(self._rows(), self.series(order))]
+        rows += [(lx, "=", series_tokens("0", H, 0, coords)) for lx, _, _, _, H, _ in self._rows()]
+        for row in rows[:-1]:
+            row[2][-1] += ","
+        return aligned(rows)
+
+    def to_text(self, order=None) -> str:
+        """Plain-text twin of :meth:`to_latex`."""
+        coords = self.conserved.system.coordinates
+        arg = "omega*h" if self.frequency == OMEGA else f"{self.frequency * H_STEP}"
+        lines = [f"{tx}_S^e = F({arg})" + ("" if e is None else f"**({e.replace(chr(92), '')})") + f" * {tx}_c"
+                 for _, tx, _, _, _, e in self._rows()]
+        lines += [f"{tx}_c = " + series_text(tx, Ic, H, coords) for _, tx, _, Ic, H, _ in self._rows()]
+        lines.append("F(x) = 2*asin(x/2)/(x*sqrt(1 - x**2/4))")
+        if order is not None:
+            power = self.remainder_power(order)
+            lines += [f"{tx}_S^e = " + series_text(tx, S, H, coords, power)
+                      for (_, tx, _, _, H, _), S in zip(self._rows(), self.series(order))]
+        lines.append(", ".join(f"{tx} = {H}" for _, tx, _, _, H, _ in self._rows()))
+        return "\n".join(lines)
+
+    def to_dict(self, order=None) -> dict:
+        """JSON-ready dict; with ``order`` also ``series`` ``{"H_S": {"0": ..., "2": ...}, ...}`` through ``h^order``."""
+        out = {"H_S": str(self.H_S), "G_S": None if self.G_S is None else str(self.G_S),
+               "H_c": str(self.H_c), "G_c": None if self.G_c is None else str(self.G_c),
+               "free_parameters": [] if self.G_S is None else ["alpha"]}
+        if order is not None:
+            names = [f"{tx}_S" for _, tx, *_ in self._rows()]
+            out["series"] = {name: {str(k): str(S.coeff(H_STEP, k)) for k in range(order + 1) if S.coeff(H_STEP, k) != 0}
+                             for name, S in zip(names, (sympy.expand(S) for S in self.series(order) if S is not None))}
+            out["remainder_power"] = self.remainder_power(order)
+        return out
 
 
 def exact_shadow_hamiltonians(system, word) -> ExactShadow:

@@ -47,6 +47,7 @@ from sympy.polys.rings import ring
 
 from ..errors import InvalidOrderError, InvalidSystemError, NoExactResultError
 from ..integrators import composed_map, composition
+from ..printing import Printable, aligned, series_text, series_tokens
 
 H_STEP = sympy.Symbol("h")
 #: Most candidate pivot sets (r-subsets of monomials, in graded order) tried by the normalisation.
@@ -262,7 +263,7 @@ def _clean(expr, coords=()):
 
 
 @dataclass(frozen=True, eq=False)
-class ConservedQuantities:
+class ConservedQuantities(Printable):
     """Exact polynomial invariants of a composed map, normalised to the Hamiltonians.
 
     Attributes
@@ -286,18 +287,57 @@ class ConservedQuantities:
     hamiltonians_c: tuple = ()
 
     def to_dict(self) -> dict:
-        """``{"H_c": str, "G_c": str}`` (``sympy.sympify`` reads them back; ``None`` where absent)."""
-        return {"H_c": None if self.H_c is None else str(self.H_c), "G_c": None if self.G_c is None else str(self.G_c)}
+        """``{"H_c": str, "G_c": str, "series": {"H_c": {"0": str, "2": str}, ...}}`` (``sympy.sympify`` reads them back;
+        ``None`` where absent; a series is ``None`` when the invariant is not polynomial in ``h``)."""
+        out = {"H_c": None if self.H_c is None else str(self.H_c), "G_c": None if self.G_c is None else str(self.G_c)}
+        out["series"] = {name: None if coefficients is None else {str(k): str(c) for k, c in coefficients.items()}
+                         for name, coefficients in self.series().items()}
+        return out
+
+    def _pairs(self):
+        """``[(latex name, text name, invariant or None, Hamiltonian)]``, one per Hamiltonian."""
+        hams = self.system.hamiltonians
+        values = self.hamiltonians_c or (self.H_c, self.G_c)[: len(hams)]
+        if len(hams) <= 2:
+            names = [("H", "H"), ("G", "G")][: len(hams)]
+        else:
+            names = [(f"H_{{{a + 1}}}", f"H{a + 1}") for a in range(len(hams))]
+        return [(lx, tx, v, H) for (lx, tx), v, H in zip(names, values, hams)]
 
     def to_latex(self) -> str:
-        parts = []
-        for name, value in (("H_c", self.H_c), ("G_c", self.G_c)):
-            if value is not None:
-                parts.append(f"{name} = {sympy.latex(value)}")
-        return r",\quad ".join(parts) if parts else r"\text{no polynomial invariant of degree } \le " + str(self.degree)
+        r"""``H_c &= H + h^2(...)`` per Hamiltonian as the rows of Table (table), then ``H &= ...``."""
+        coords = self.system.coordinates
+        rows = []
+        for lx, _, value, base in self._pairs():
+            if value is None:
+                rows.append((f"{lx}_{{c}}", ":", [rf"\text{{no polynomial invariant of degree }} \le {self.degree}"
+                                                   rf"\text{{ tends to }} {lx}"]))
+            else:
+                rows.append((f"{lx}_{{c}}", "=", series_tokens(lx, value, base, coords)))
+        rows += [(lx, "=", series_tokens("0", base, 0, coords)) for lx, _, _, base in self._pairs()]
+        for row in rows[:-1]:
+            row[2][-1] += ","
+        return aligned(rows)
 
-    def _repr_latex_(self):
-        return f"${self.to_latex()}$"
+    def to_text(self) -> str:
+        """``H_c = H + h**2*(...)`` per Hamiltonian, then the definitions."""
+        coords = self.system.coordinates
+        lines = [f"{tx}_c = " + (series_text(tx, value, base, coords) if value is not None
+                                 else f"(no polynomial invariant of degree <= {self.degree} tends to {tx})")
+                 for _, tx, value, base in self._pairs()]
+        lines.append(", ".join(f"{tx} = {base}" for _, tx, _, base in self._pairs()))
+        return "\n".join(lines)
+
+    def series(self) -> dict:
+        """``{"H_c": {k: c_k}, ...}``: the coefficient of ``h^k`` of each invariant (``None`` if not polynomial in h)."""
+        from ..printing import h_coefficients
+
+        out = {}
+        for _, tx, value, _ in self._pairs():
+            if value is not None:
+                coefficients = h_coefficients(value, 0, self.system.coordinates)
+                out[f"{tx}_c"] = None if coefficients is None else {k: sympy.expand(c) for k, c in coefficients}
+        return out
 
     def check(self) -> bool:
         """Every quantity is exactly invariant under the composed map (re-derived by substitution)."""
@@ -346,7 +386,12 @@ def conserved_quantities(system, word, degree=None) -> ConservedQuantities:
     >>> conserved_quantities(model("ho"), "121").H_c          # Eq. (CQPV)
     -h**2*omega**2*x2**2/(8*m) + m*omega**2*x1**2/2 + x2**2/(2*m)
     >>> conserved_quantities(model("ho3"), "12321").to_dict()  # Eqs. (CQ12321H), (CQ12321G)
-    {'H_c': 'm*omega**2*x3/2 + x2**2/(2*m)', 'G_c': 'h**2*x2**2/(4*m**2) - x1**2 + x3'}
+    {'H_c': 'm*omega**2*x3/2 + x2**2/(2*m)', 'G_c': 'h**2*x2**2/(4*m**2) - x1**2 + x3',
+     'series': {'H_c': {'0': 'm*omega**2*x3/2 + x2**2/(2*m)'}, 'G_c': {'0': '-x1**2 + x3', '2': 'x2**2/(4*m**2)'}}}
+    >>> print(conserved_quantities(model("ho3"), "12321"))        # as Table (table) writes it
+    H_c = H
+    G_c = G + h**2*x2**2/(4*m**2)
+    H = m*omega**2*x3/2 + x2**2/(2*m), G = -x1**2 + x3
     """
     comp = composition(word, len(system.splitting)).check(system.splitting)
     name = word if isinstance(word, str) else _word_name(comp)

@@ -66,7 +66,7 @@ def _decide(fam, R, existence, params):
 
 
 def shadow_hamiltonians(system, word, order: int = 2, route: str = "direct", degree=None, *,
-                        existence: bool = True, params=None, max_unknowns: int | None = MAX_UNKNOWNS) -> ShadowFamily:
+                        existence: bool = True, params=None, max_unknowns: int | None = MAX_UNKNOWNS, progress=None) -> ShadowFamily:
     """Shadow Hamiltonians ``H_S, G_S`` of ``word`` on ``system`` through ``h^order``, as a family.
 
     Parameters
@@ -81,6 +81,8 @@ def shadow_hamiltonians(system, word, order: int = 2, route: str = "direct", deg
         orbit averages (:mod:`nambu_bch.shadow.existence`); with False the answer stays undecided
     params : dict, optional -- parameter values for the orbit numerics (default: generic rationals)
     max_unknowns : int or None -- refuse the exact polynomial solve of an order with more unknowns (bounded work)
+    progress : bool or None -- direct route: a progress bar over the orders; None: automatic
+        (a terminal or Jupyter, shown once the run has lasted a second); False: never
 
     Returns
     -------
@@ -105,7 +107,7 @@ def shadow_hamiltonians(system, word, order: int = 2, route: str = "direct", deg
     comp = make_composition(word, len(system.splitting)).check(system.splitting)
     notes = []
     if route == "direct":
-        R = direct_route(system, comp, order, degree, max_unknowns)
+        R = direct_route(system, comp, order, degree, max_unknowns, progress=progress)
         fam = ShadowFamily(system, comp, order, route, R.exists, details=R)
         for o in R.orders:
             if o.status == "vanishes":

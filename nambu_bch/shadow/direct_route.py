@@ -378,7 +378,7 @@ class _Solver:
         return rank(vecs, len(columns), alg.domain) if vecs else 0
 
 
-def direct_route(system, word, order: int = 2, degree=None, max_unknowns=None) -> DirectResult:
+def direct_route(system, word, order: int = 2, degree=None, max_unknowns=None, progress=None) -> DirectResult:
     """Solve ``X_{H_S,G_S} = X_eff + O(h^{order+1})`` order by order (Eq. L2; Eq. L1 for N = 2).
 
     Parameters
@@ -388,6 +388,8 @@ def direct_route(system, word, order: int = 2, degree=None, max_unknowns=None) -
     order : int -- highest power of ``h`` kept
     degree : int, optional -- ansatz degree of the corrections (default: from the field)
     max_unknowns : int, optional -- refuse (status ``"refused"``) an order whose ansatz has more unknowns
+    progress : bool or None -- a progress bar over the orders (tqdm); None: on a terminal or in
+        Jupyter once the run has lasted a second (:func:`nambu_bch.progress.stages`)
 
     Returns
     -------
@@ -410,7 +412,9 @@ def direct_route(system, word, order: int = 2, degree=None, max_unknowns=None) -
     solver = _Solver(system, comp, order, degree, max_unknowns)
     corrections: dict = {}
     orders = []
-    for j in range(1, order + 1):
+    from ..progress import stages
+
+    for j in stages(range(1, order + 1), f"shadow {comp.name} on {system.name}: orders", enabled=progress):
         sol = solver.solve_order(j, corrections)
         orders.append(sol)
         if sol.status in ("obstructed", "refused"):

@@ -17,40 +17,13 @@ from dataclasses import dataclass, field
 
 import sympy
 
+from ..printing import Printable, aligned, h_coefficients, latex_text, series_text, series_tokens
+
 H_STEP = sympy.Symbol("h")
 
 
-def _corrections(shadow, base, coordinates):
-    """``shadow - base`` by powers of ``h``: ``[(k, expr)]``, each coefficient of a monomial factored.
-
-    Factoring per monomial keeps rational functions of the parameters readable
-    (``(I2 - I3)/(I2 I3)`` rather than one long common denominator) and gives the
-    paper's layout, e.g. ``h^2 (alpha omega^2/(12 m) x2^2 + alpha m omega^4/12 x1^2)``.
-    """
-    groups = sympy.collect(sympy.expand(shadow - base), H_STEP, evaluate=False)
-    out = []
-    for key, part in groups.items():
-        power = 0 if key == 1 else sympy.degree(key, H_STEP)
-        poly = sympy.Poly(part, *coordinates)
-        terms = [sympy.factor(c) * sympy.Mul(*(x**e for x, e in zip(coordinates, m))) for m, c in poly.terms()]
-        out.append((power, sympy.Add(*terms, evaluate=False)))
-    return sorted(out, key=lambda item: item[0])
-
-
-def _render(name, base_name, shadow, base, coordinates, tail, latex):
-    show = sympy.latex if latex else str
-    parts = [base_name]
-    for power, expr in _corrections(shadow, base, coordinates):
-        step = show(H_STEP**power) if power else ""
-        if latex:
-            parts.append(rf"{step}\left({show(expr)}\right)")
-        else:
-            parts.append(f"{step}*({show(expr)})" if step else f"({show(expr)})")
-    return f"{name} = " + " + ".join(parts) + tail
-
-
 @dataclass
-class ShadowFamily:
+class ShadowFamily(Printable):
     """Shadow Hamiltonians of a composition on a system, as a family.
 
     Attributes
@@ -93,12 +66,15 @@ class ShadowFamily:
     evidence: dict | None = None
     existence: object = None
 
-    def _outcome_text(self) -> str:
-        """One line for a family without a polynomial pair: the three outcomes of issue 17."""
-        ev = self.evidence or {}
-        what = {True: "shadow Hamiltonians exist in smooth functions but are not polynomial",
+    def _outcome_headline(self) -> str:
+        """The existence outcome of a family without a polynomial pair (the three outcomes of issue 17)."""
+        return {True: "shadow Hamiltonians exist in smooth functions but are not polynomial",
                 False: "no shadow Hamiltonians (certified)", None: "existence undecided"}[self.exists]
-        return f"{what}: {ev.get('reason', '')}; no polynomial pair: {self.obstruction}"
+
+    def _outcome_text(self) -> str:
+        """One line for a family without a polynomial pair: the outcome, its reason, the polynomial obstruction."""
+        ev = self.evidence or {}
+        return f"{self._outcome_headline()}: {ev.get('reason', '')}; no polynomial pair: {self.obstruction}"
 
     @property
     def H_S(self):
@@ -117,39 +93,103 @@ class ShadowFamily:
 
     # -- output ------------------------------------------------------------------
     def _names(self):
+        """LaTeX and text names of the Hamiltonians: ``H``, ``G`` (N = 3) or ``H_{1} .. H_{k}``."""
         k = len(self.system.hamiltonians)
-        if k == 1:
-            return ["H"]
-        if k == 2:
-            return ["H", "G"]
-        return [f"H_{{{a + 1}}}" for a in range(k)]
-
-    def _lines(self, latex: bool) -> list:
-        """``H_S = H + h^2(...) + O(h^k)`` per Hamiltonian, then the definitions ``H = ...``."""
-        power = self.composition.remainder_power(self.order)
-        tail = rf" + O(h^{{{power}}})" if latex else f" + O(h^{power})"
-        coords = self.system.coordinates
-        names = self._names()
-        lines = []
-        for name, S, base in zip(names, self.shadows, self.system.hamiltonians):
-            shadow_name = rf"{name}_{{S}}" if latex else f"{name}_S".replace("{", "").replace("}", "")
-            base_name = name if latex else name.replace("{", "").replace("}", "")
-            lines.append(_render(shadow_name, base_name, S, base, coords, tail, latex))
-        show = sympy.latex if latex else str
-        definitions = [f"{n if latex else n.replace('{', '').replace('}', '')} = {show(b)}" for n, b in zip(names, self.system.hamiltonians)]
-        lines.append((r",\quad " if latex else ", ").join(definitions))
-        return lines
+        if k <= 2:
+            return [("H", "H"), ("G", "G")][:k]
+        return [(f"H_{{{a + 1}}}", f"H{a + 1}") for a in range(k)]
 
     def to_latex(self) -> str:
-        """``H_S = H + h^2(...) + O(h^4)`` (and ``G_S``; the remainder skips odd powers of symmetric words), or the obstruction."""
+        r"""``H_S &= H + h^2(...) + O(h^4)`` per Hamiltonian, then ``H &= ...``, as one ``aligned`` block.
+
+        The remainder skips odd powers for symmetric words (Eqs. SH12321c, SG12321c); an
+        obstructed family shows the failed order, the ansatz degree and the certificate.
+        Belongs in display math with amsmath (docs/latex.md).
+
+        >>> from nambu_bch import model, shadow_hamiltonians
+        >>> print(shadow_hamiltonians(model("ho"), "TVT").to_latex())          # Eq. (SHPV1)
+        \begin{aligned}
+        H_{S} &= H + h^{2}\Bigl(\frac{m \omega^{4} x_{1}^{2}}{12} - \frac{\omega^{2} x_{2}^{2}}{24 m}\Bigr) + O(h^{4}), \\
+        H &= \frac{m \omega^{2} x_{1}^{2}}{2} + \frac{x_{2}^{2}}{2 m}
+        \end{aligned}
+        """
+        if not self.shadows:
+            rows = self._obstruction_rows()
+            if self.evidence is not None:
+                rows.insert(0, ("", "", [latex_text(self._outcome_headline())]))
+            return aligned(rows)
+        power = self.composition.remainder_power(self.order)
+        coords = self.system.coordinates
+        rows = []
+        for (name, _), S, base in zip(self._names(), self.shadows, self.system.hamiltonians):
+            rows.append((f"{name}_{{S}}", "=", series_tokens(name, S, base, coords, power)))
+        for (name, _), base in zip(self._names(), self.system.hamiltonians):
+            rows.append((name, "=", series_tokens("0", base, 0, coords)))
+        for row in rows[:-1]:
+            row[2][-1] += ","
+        return aligned(rows)
+
+    def _obstruction_rows(self):
+        """The obstruction as ``aligned`` rows: headline, then the certificate functional (direct route)."""
+        order, degree = self.failed_order, self.degree.get(self.failed_order)
+        head = [r"\text{no polynomial shadow Hamiltonians of }" + latex_text(self.composition.name),
+                r"\text{on }" + latex_text(self.system.name),
+                r"\text{at order }" + sympy.latex(H_STEP**order)
+                + (rf"\text{{ with corrections of degree }} \le {degree}" if degree is not None else "") + ":"]
+        rows = [("", "", head)]
+        cert = self.certificate or {}
+        if cert and all(isinstance(k, tuple) for k in cert):
+            terms = sorted(cert.items(), key=lambda kv: (str(kv[0][0]), sympy.default_sort_key(kv[0][1])))
+            tokens = []
+            for i, ((x, mono), c) in enumerate(terms):
+                piece = rf"\left[{sympy.latex(mono)}\right] Y^{{{sympy.latex(x)}}}"
+                c = sympy.factor(c)
+                tok = piece if c == 1 else (rf"- {piece}" if c == -1 else rf"\left({sympy.latex(c)}\right) {piece}")
+                tokens.append(tok if i == 0 or tok.startswith("- ") else "+ " + tok)
+            rows.append((r"\ell(Y)", "=", tokens))
+            value = getattr(self._failed_solution(), "obstruction_value", None)
+            rows.append(("", "", [r"\text{vanishes on every admissible correction field, but}"]))
+            if value is not None:
+                rows.append((r"\ell(\text{right-hand side})", "=", [sympy.latex(value) + r" \neq 0"]))
+        elif cert:
+            rows.append(("", "", [r"\text{no affine combination of the FI representations}",
+                                  r"\text{solves the equation (certificate in the JSON output)}"]))
+        return rows
+
+    def _failed_solution(self):
+        orders = getattr(self.details, "orders", None)
+        return orders[-1] if orders else None
+
+    def to_text(self) -> str:
+        """``H_S = H + h**2*(...) + O(h^4)`` per Hamiltonian, the definitions, free parameters and notes.
+
+        >>> from nambu_bch import model, shadow_hamiltonians
+        >>> print(shadow_hamiltonians(model("ho"), "TVT"))                      # Eq. (SHPV1)
+        H_S = H + h**2*(m*omega**4*x1**2/12 - omega**2*x2**2/(24*m)) + O(h^4)
+        H = m*omega**2*x1**2/2 + x2**2/(2*m)
+        h^1: the correction vanishes (odd order of a symmetric word)
+        """
         if not self.shadows:
             if self.evidence is None:
-                return rf"\text{{no polynomial shadow Hamiltonians: {self.obstruction}}}"
-            return rf"\text{{{self._outcome_text()}}}"
-        return ",\\\\\n".join(self._lines(latex=True))
+                return f"no polynomial shadow Hamiltonians for {self.composition.name} on {self.system.name}: {self.obstruction}"
+            return f"{self.composition.name} on {self.system.name}: {self._outcome_text()}"
+        power = self.composition.remainder_power(self.order)
+        coords = self.system.coordinates
+        lines = [f"{name}_S = " + series_text(name, S, base, coords, power)
+                 for (_, name), S, base in zip(self._names(), self.shadows, self.system.hamiltonians)]
+        lines.append(", ".join(f"{name} = {base}" for (_, name), base in zip(self._names(), self.system.hamiltonians)))
+        if self.free_parameters:
+            lines.append("free parameters: " + ", ".join(self.free_parameters))
+        lines += self.notes
+        return "\n".join(lines)
 
-    def _repr_latex_(self):
-        return "$$" + self.to_latex().replace(",\\\\\n", r",\quad ") + "$$"
+    def series(self) -> dict:
+        """``{"H_S": {k: c_k}, "G_S": {...}}``: the coefficient of ``h^k`` of each shadow Hamiltonian (k = 0 is H)."""
+        out = {}
+        for (_, name), S in zip(self._names(), self.shadows):
+            coefficients = h_coefficients(S, 0, self.system.coordinates) or []
+            out[f"{name}_S"] = {k: sympy.expand(c) for k, c in coefficients}
+        return out
 
     def to_dict(self) -> dict:
         """JSON-ready dict (DESIGN.md): expressions as strings ``sympy.sympify`` reads back."""
@@ -178,18 +218,32 @@ class ShadowFamily:
             out["degree"] = self.degree.get(self.failed_order)
         if self.notes:
             out["notes"] = list(self.notes)
+        out["series"] = {name: {str(k): str(c) for k, c in coefficients.items()} for name, coefficients in self.series().items()}
+        names = [name for _, name in self._names()]
+        out["gauge"] = {str(k): [dict(zip((f"d{n}" for n in names), map(str, direction))) for direction in directions
+                                 if any(sympy.sympify(c) != 0 for c in direction)]  # weight-only FI directions dropped
+                        for k, directions in sorted(self.gauge.items())}
+        out["certificate"] = self._certificate_data()
         return out
 
-    def to_text(self) -> str:
-        if self.exists is False and self.evidence is None:
-            return f"no polynomial shadow Hamiltonians for {self.composition.name} on {self.system.name}: {self.obstruction}"
-        if not self.shadows:
-            return f"{self.composition.name} on {self.system.name}: {self._outcome_text()}"
-        lines = self._lines(latex=False)
-        if self.free_parameters:
-            lines.append("free parameters: " + ", ".join(self.free_parameters))
-        lines += self.notes
-        return "\n".join(lines)
+    def _certificate_data(self):
+        """The obstruction certificate as data (``None`` when the family exists).
+
+        Direct route: the functional ``l(Y) = sum c [monomial] Y^x`` (one term per component
+        ``x`` and monomial) with ``value = l(right-hand side) != 0``; FI route: the weight of
+        each representation row.
+        """
+        if self.exists or not self.certificate:
+            return None
+        cert = self.certificate
+        if all(isinstance(key, tuple) for key in cert):
+            terms = sorted(cert.items(), key=lambda kv: (str(kv[0][0]), sympy.default_sort_key(kv[0][1])))
+            value = getattr(self._failed_solution(), "obstruction_value", None)
+            return {"kind": "left-null-functional", "order": self.failed_order, "degree": self.degree.get(self.failed_order),
+                    "terms": [{"component": str(x), "monomial": str(mono), "coefficient": str(c)} for (x, mono), c in terms],
+                    "value": None if value is None else str(value)}
+        return {"kind": "fi-rows", "order": self.failed_order, "degree": self.degree.get(self.failed_order),
+                "terms": [{"row": str(key), "coefficient": str(c)} for key, c in cert.items()], "value": None}
 
     def __repr__(self):
         state = ("exists" if self.shadows else f"exists (smooth, not polynomial at h^{self.failed_order})") if self.exists \
