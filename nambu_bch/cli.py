@@ -107,11 +107,15 @@ def order_value(text, flag="--order", limit=MAX_CLI_ORDER, low=0):
 
 def parse_params(items):
     """``--param NAME`` / ``--param NAME=VALUE`` -> ``(names in order, {name: exact value})``."""
+    from .systems.system import MAX_PARAMETERS, SYMBOL_NAME
+
     names, values = [], {}
+    if len(items or ()) > MAX_PARAMETERS:
+        raise NambuBCHError(f"--param is given {len(items)} times; at most {MAX_PARAMETERS} parameters are accepted")
     for item in items or ():
         name, sep, value = item.partition("=")
         name = name.strip()
-        if not name.isidentifier() or name.startswith("_"):
+        if not SYMBOL_NAME.match(name):
             raise NambuBCHError(
                 f"--param {item!r}: {name!r} is not a parameter name; write --param m (declare) or --param m=1 (value)"
             )
@@ -154,13 +158,25 @@ def system_from_args(args):
     if user_flags and not args.H:
         raise NambuBCHError(f"{user_flags[0]} needs --H EXPR (the first Hamiltonian)")
     if args.H:
+        from .systems.system import MAX_COORDINATES, check_name
+
         hams = [args.H] + list(args.G or [])
+        if len(hams) > MAX_COORDINATES - 1:  # before any parsing: the bracket of n Hamiltonians has (n+1)! terms
+            raise NambuBCHError(
+                f"--H and {len(hams) - 1} --G give {len(hams)} Hamiltonians; at most {MAX_COORDINATES - 1} are accepted "
+                f"(a system on at most {MAX_COORDINATES} coordinates)"
+            )
+        name = check_name(args.name, "--name") if args.name else "custom"
         if args.coords:
             coords = args.coords.replace(",", " ").split()
         else:
             coords = [f"x{i}" for i in range(1, (len(hams) + 1 if len(hams) > 1 else 2) + 1)]
+        from .systems.system import SYMBOL_NAME
+
+        if len(coords) > MAX_COORDINATES:
+            raise NambuBCHError(f"--coords gives {len(coords)} coordinates; at most {MAX_COORDINATES} are accepted")
         for c in coords:
-            if not c.isidentifier() or c.startswith("_"):
+            if not SYMBOL_NAME.match(c):
                 raise NambuBCHError(f"--coords {args.coords!r}: {c!r} is not a symbol name; write e.g. --coords 'x1 x2 x3'")
             if c in ("h", "alpha"):
                 raise NambuBCHError(f"--coords {args.coords!r}: {c!r} is reserved (the step h, the family parameter alpha)")
@@ -173,7 +189,7 @@ def system_from_args(args):
         symbols = [sympy.Symbol(s) for s in (*coords, *names)]
         flags = ["--H"] + ["--G"] * (len(hams) - 1)
         parsed = [parse_expression(text, symbols, what=flag) for text, flag in zip(hams, flags)]
-        system = System(coords, parsed, names, name=args.name or "custom", split=args.split or "full")
+        system = System(coords, parsed, names, name=name, split=args.split or "full")
         return system, values
     if args.system:
         file_values: dict = {}
@@ -213,26 +229,31 @@ def substituted(system, values):
     """The system with the given parameter values substituted exactly (symbolic subcommands)."""
     if not values:
         return system
+    from .systems.system import SYSTEM_NAME
+
     subs = {p: values[p.name] for p in system.parameters if p.name in values}
     rest = tuple(p for p in system.parameters if p.name not in values)
     hams = tuple(sympy.sympify(H).subs(subs) for H in system.hamiltonians)
     label = ",".join(f"{k}={v}" for k, v in values.items())
-    return _with(system, hamiltonians=hams, parameters=rest, name=f"{system.name}[{label}]")
+    name = f"{system.name}[{label}]"
+    if not SYSTEM_NAME.match(name):  # a long or unusual value: keep the name short and safe
+        name = f"{system.name}[{','.join(values)} substituted]"
+    return _with(system, hamiltonians=hams, parameters=rest, name=name)
 
 
 def default_word(system) -> str:
     """The Strang word ``12..n..21`` of the system's splitting (``12321`` for ho3, ``121`` for ho)."""
-    n = len(system.splitting)
-    word = "".join(str(k) for k in range(1, n + 1))
-    return word + word[-2::-1] if n > 1 else "1"
+    from .integrators import strang_word
+
+    return strang_word(len(system.splitting))
 
 
 def integrator_from_args(args, system):
-    """``(word, Composition)`` checked against the system's splitting."""
-    from .integrators import composition
+    """``(word, Composition)`` checked against the system's splitting (:func:`~nambu_bch.integrators.composition_for`)."""
+    from .integrators import composition_for
 
     word = args.integrator or default_word(system)
-    comp = composition(word, len(system.splitting)).check(system.splitting)
+    comp = composition_for(word, system)
     return word, comp
 
 
@@ -256,14 +277,30 @@ def emit(args, *, latex=None, text=None, data=None):
     else:
         out = render.to_text(data())
     if args.output:
-        try:
-            render.write_output(out, args.output)
-        except OSError as exc:
-            raise NambuBCHError(f"--output {args.output}: cannot write the file ({exc.strerror or exc})") from None
+        render.write_output(out, args.output)  # OutputError: one line naming the path
         print(f"wrote {args.output}", file=sys.stderr)
     else:
-        sys.stdout.write(out)
-        sys.stdout.flush()
+        write_stdout(out)
+
+
+def write_stdout(text: str) -> None:
+    """Write ``text`` to stdout completely, as UTF-8.
+
+    Through the file descriptor when there is one: a partial ``write`` (a reader
+    that went away, ``PYTHONUNBUFFERED``) is continued or ends in
+    ``BrokenPipeError``, never in silently truncated output.
+    """
+    stream = sys.stdout
+    try:
+        fd = stream.fileno()
+    except (AttributeError, OSError, ValueError):  # a captured or in-memory stream
+        stream.write(text)
+        stream.flush()
+        return
+    stream.flush()
+    data = memoryview(text.encode("utf-8"))
+    while data:
+        data = data[os.write(fd, data):]
 
 
 def _base(system, word, **extra):
@@ -812,17 +849,47 @@ def _normalise(args):
         value = getattr(args, flag, None)
         if value is not None and (not value.strip() or len(value) > 200):
             raise NambuBCHError(f"--{flag} {value[:40]!r} must be a non-empty string of at most 200 characters")
+    if getattr(args, "name", None) is not None:
+        from .systems.system import check_name
+
+        check_name(args.name, "--name")  # LaTeX- and source-safe, before anything uses it
     return args
+
+
+def _stdout_closed() -> None:
+    """After EPIPE: point stdout at /dev/null so that the interpreter's final flush stays quiet."""
+    try:
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, sys.stdout.fileno())
+        os.close(devnull)
+    except (OSError, ValueError, AttributeError):  # stdout without a file descriptor (captured in tests)
+        pass
+
+
+def _say(line: str) -> None:
+    """One line on stderr; a closed stderr is ignored."""
+    try:
+        print(line, file=sys.stderr)
+        sys.stderr.flush()
+    except (OSError, ValueError):
+        pass
 
 
 def main(argv=None) -> int:
     """Run the CLI on ``argv`` (default ``sys.argv[1:]``); returns the exit status.
 
-    0 on success, 2 on bad input (one line on stderr), 130 on Ctrl-C.
+    0 on success, 2 on bad input (one line on stderr), 130 on Ctrl-C (one line),
+    141 quietly when stdout is closed early (``nambu-bch shadow | head -c1``),
+    1 with one line when memory or the interpreter's recursion limit runs out.
+    Nothing a user types produces a traceback; any other exception is a bug and
+    propagates with its traceback.
     """
-    parser = build_parser()
+    from . import _startup
+
+    _startup.cli_started()  # from here on Ctrl-C is a KeyboardInterrupt handled below
     prog = PROG
     try:
+        parser = build_parser()
         args = parser.parse_args(argv)
         prog = f"{PROG} {args.command}"
         _normalise(args)
@@ -831,21 +898,24 @@ def main(argv=None) -> int:
         return exc.code if isinstance(exc.code, int) else 0
     except UsageError as exc:
         hint = exc.prog if exc.prog != PROG else PROG
-        print(f"{exc.prog}: error: {exc}; see '{hint} --help'", file=sys.stderr)
+        _say(f"{exc.prog}: error: {' '.join(str(exc).split())}; see '{hint} --help'")
         return 2
     except NambuBCHError as exc:
         message = " ".join(str(exc).split())
-        print(f"{prog}: error: {message}", file=sys.stderr)
+        _say(f"{prog}: error: {message}")
         return 2
     except KeyboardInterrupt:
-        print(f"{prog}: interrupted", file=sys.stderr)
+        _say(f"{prog}: interrupted")
         return 130
     except BrokenPipeError:
-        try:
-            sys.stdout = open(os.devnull, "w")
-        except OSError:
-            pass
-        return 0
+        _stdout_closed()
+        return 141  # as a shell reports a process ended by SIGPIPE; nothing printed
+    except MemoryError:
+        _say(f"{prog}: error: out of memory; the request is too large for this machine (reduce --order, --degree or --steps)")
+        return 1
+    except RecursionError:
+        _say(f"{prog}: error: the input is nested too deeply to process (recursion limit)")
+        return 1
     return 0
 
 

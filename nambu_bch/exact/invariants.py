@@ -46,7 +46,7 @@ from sympy.polys.matrices import DomainMatrix
 from sympy.polys.rings import ring
 
 from ..errors import InvalidOrderError, InvalidSystemError, NoExactResultError
-from ..integrators import composed_map, composition
+from ..integrators import composed_map, composition_for
 
 H_STEP = sympy.Symbol("h")
 #: Most candidate pivot sets (r-subsets of monomials, in graded order) tried by the normalisation.
@@ -348,7 +348,7 @@ def conserved_quantities(system, word, degree=None) -> ConservedQuantities:
     >>> conserved_quantities(model("ho3"), "12321").to_dict()  # Eqs. (CQ12321H), (CQ12321G)
     {'H_c': 'm*omega**2*x3/2 + x2**2/(2*m)', 'G_c': 'h**2*x2**2/(4*m**2) - x1**2 + x3'}
     """
-    comp = composition(word, len(system.splitting)).check(system.splitting)
+    comp = composition_for(word, system)
     name = word if isinstance(word, str) else _word_name(comp)
     auto = max(_total_degree(Hk, system.coordinates) for Hk in system.hamiltonians)
     if degree is None:

@@ -11,7 +11,7 @@ import sympy
 
 from ..bch.backward import check_order
 from ..errors import InvalidOrderError, NambuBCHError
-from ..integrators.composition import composition as make_composition
+from ..integrators.composition import composition_for
 from .direct_route import ALPHA, direct_route
 from .family import ShadowFamily
 from .fi_route import fi_route
@@ -77,7 +77,7 @@ def shadow_hamiltonians(system, word, order: int = 2, route: str = "direct", deg
     if route not in ROUTES:
         raise NambuBCHError(f"route must be one of {', '.join(ROUTES)}, got {route!r}")
     order = check_order(order)
-    comp = make_composition(word, len(system.splitting)).check(system.splitting)
+    comp = composition_for(word, system.splitting)
     notes = []
     if route == "direct":
         R = direct_route(system, comp, order, degree)

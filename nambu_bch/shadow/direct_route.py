@@ -66,7 +66,7 @@ from ..algebra import liouville_field
 from ..bch.backward import check_order
 from ..bch.concrete import effective_field_bch
 from ..errors import InvalidOrderError, NambuBCHError
-from ..integrators.composition import composition as make_composition
+from ..integrators.composition import composition_for
 from .linear import rank, solve_affine
 
 H_STEP = sympy.Symbol("h")
@@ -399,7 +399,7 @@ def direct_route(system, word, order: int = 2, degree=None) -> DirectResult:
     if degree is not None:
         if isinstance(degree, bool) or not isinstance(degree, int) or degree < 1:
             raise InvalidOrderError(f"degree must be a positive integer (the ansatz degree) or None, got {degree!r}")
-    comp = make_composition(word, len(system.splitting)).check(system.splitting)
+    comp = composition_for(word, system.splitting)
     solver = _Solver(system, comp, order, degree)
     corrections: dict = {}
     orders = []

@@ -37,7 +37,7 @@ import sympy
 from ..bch import expand_terms, formal_bch
 from ..bch.lyndon import is_bracket
 from ..errors import InvalidOrderError, NambuBCHError
-from ..integrators.composition import composition as make_composition
+from ..integrators.composition import composition_for
 from .direct_route import ALPHA, H_STEP, _monomials
 from .fundamental_identity import representations, single_representations
 from .linear import kernel_rref, normal_form, solve_affine
@@ -262,7 +262,7 @@ def fi_route(system, word, order: int = 2, degree=None, terms=None) -> FIResult:
     ('1AX', '1BX')
     """
     splitting = system.splitting
-    comp = make_composition(word, len(splitting)).check(splitting)
+    comp = composition_for(word, splitting)
     power = 2 if comp.symmetric else 1
     if order != power and terms is None:
         raise InvalidOrderError(
