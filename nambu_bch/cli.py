@@ -46,6 +46,10 @@ PROG = "nambu-bch"
 DEFAULT_MODEL = "ho3"
 MAX_STEPS = 100_000_000
 MAX_CLI_ORDER = 12
+#: Longest error line printed (a huge input echoed back is shortened).
+MAX_MESSAGE = 600
+#: Longest accepted path (--system, --output, --outdir).
+MAX_PATH = 4096
 _SYMBOLIC = ("latex", "text", "json")
 
 
@@ -85,9 +89,16 @@ def positive_float(text, flag="--h"):
     return out
 
 
+def _ascii_int(text):
+    """``int(text)`` for ASCII digits only (Python's ``int`` also reads '３' and '٣')."""
+    if not isinstance(text, str) or not text.strip().lstrip("+-").isdigit() or not text.isascii() or len(text) > 30:
+        raise ValueError(text)
+    return int(text, 10)
+
+
 def positive_int(text, flag, limit):
     try:
-        value = int(text, 10)
+        value = _ascii_int(text)
     except (TypeError, ValueError):
         raise NambuBCHError(f"{flag} {text!r} must be a positive integer such as 1000") from None
     if not 1 <= value <= limit:
@@ -97,7 +108,7 @@ def positive_int(text, flag, limit):
 
 def order_value(text, flag="--order", limit=MAX_CLI_ORDER, low=0):
     try:
-        value = int(text, 10)
+        value = _ascii_int(text)
     except (TypeError, ValueError):
         raise NambuBCHError(f"{flag} {text!r} must be an integer between {low} and {limit}") from None
     if not low <= value <= limit:
@@ -151,13 +162,13 @@ def system_from_args(args):
     from .systems import System, model
 
     names, values = parse_params(getattr(args, "param", None))
-    user_flags = [f for f, v in (("--H", args.H), ("--G", args.G), ("--coords", args.coords)) if v]
+    user_flags = [f for f, v in (("--H", args.H), ("--G", args.G), ("--coords", args.coords)) if v is not None]
     chosen = [f for f, v in (("--model", args.model), ("--system", args.system)) if v] + (["--H"] if user_flags else [])
     if len(chosen) > 1:
         raise NambuBCHError(f"{' and '.join(chosen)} both choose the system; give only one of --model, --system, --H/--G")
-    if user_flags and not args.H:
+    if user_flags and args.H is None:
         raise NambuBCHError(f"{user_flags[0]} needs --H EXPR (the first Hamiltonian)")
-    if args.H:
+    if args.H is not None:
         from .systems.system import MAX_COORDINATES, check_name
 
         hams = [args.H] + list(args.G or [])
@@ -291,6 +302,8 @@ def write_stdout(text: str) -> None:
     ``BrokenPipeError``, never in silently truncated output.
     """
     stream = sys.stdout
+    if stream is None:  # started with stdout closed (nambu-bch ... >&-)
+        raise BrokenPipeError("stdout is closed")
     try:
         fd = stream.fileno()
     except (AttributeError, OSError, ValueError):  # a captured or in-memory stream
@@ -316,7 +329,7 @@ def _base(system, word, **extra):
 def cmd_models(args):
     from .systems import model, model_names
 
-    if any((args.model, args.system, args.H, args.G, args.coords, args.param, args.split, args.name)):
+    if any(v is not None for v in (args.model, args.system, args.H, args.G, args.coords, args.param, args.split, args.name)):
         system, values = system_from_args(args)
         systems = [substituted(system, values)]
     else:
@@ -620,7 +633,7 @@ def numeric_inputs(args, system, values):
 
     params = {k: float(v) for k, v in {**getattr(args, "file_values", {}), **values}.items()}
     parameter_values(system, params)  # raises naming an unknown parameter
-    x0 = parse_x0(args.x0, system.N) if args.x0 else [1.0] * system.N
+    x0 = parse_x0(args.x0, system.N) if args.x0 is not None else [1.0] * system.N
     return params, x0
 
 
@@ -648,7 +661,7 @@ def cmd_plot(args):
     if not os.path.isdir(outdir):
         try:
             os.makedirs(outdir, exist_ok=True)
-        except OSError as exc:
+        except (OSError, ValueError) as exc:
             raise NambuBCHError(f"--outdir {outdir}: cannot create the directory ({exc.strerror or exc})") from None
     system, values = system_from_args(args)
     if args.integrator is None and system.name == "ho3":
@@ -845,6 +858,8 @@ def _normalise(args):
         value = getattr(args, flag, None)
         if value is not None and not value.strip():
             raise NambuBCHError(f"--{flag} is empty; give a file or directory path")
+        if value is not None and ("\x00" in value or len(value) > MAX_PATH):
+            raise NambuBCHError(f"--{flag} {value[:40]!r}...: a path has no NUL character and at most {MAX_PATH} characters")
     for flag in ("integrator", "coords", "name", "model"):
         value = getattr(args, flag, None)
         if value is not None and (not value.strip() or len(value) > 200):
@@ -898,10 +913,15 @@ def main(argv=None) -> int:
         return exc.code if isinstance(exc.code, int) else 0
     except UsageError as exc:
         hint = exc.prog if exc.prog != PROG else PROG
-        _say(f"{exc.prog}: error: {' '.join(str(exc).split())}; see '{hint} --help'")
+        message = " ".join(str(exc).split())
+        if len(message) > MAX_MESSAGE:
+            message = message[: MAX_MESSAGE - 3] + "..."
+        _say(f"{exc.prog}: error: {message}; see '{hint} --help'")
         return 2
     except NambuBCHError as exc:
         message = " ".join(str(exc).split())
+        if len(message) > MAX_MESSAGE:  # a huge input echoed back: keep the line readable
+            message = message[: MAX_MESSAGE - 3] + "..."
         _say(f"{prog}: error: {message}")
         return 2
     except KeyboardInterrupt:

@@ -146,6 +146,8 @@ def _read_regular_file(shown) -> bytes:
     flags = os.O_RDONLY | getattr(os, "O_NONBLOCK", 0) | getattr(os, "O_CLOEXEC", 0)
     try:
         fd = os.open(shown, flags)  # O_NONBLOCK: opening a FIFO does not wait for a writer
+    except ValueError:  # an embedded NUL
+        raise InvalidSystemError(f"--system {shown[:40]!r}: not a usable file name") from None
     except OSError as exc:
         raise InvalidSystemError(f"--system {shown}: cannot read the file ({exc.strerror or exc})") from None
     try:

@@ -348,6 +348,9 @@ def conserved_quantities(system, word, degree=None) -> ConservedQuantities:
     >>> conserved_quantities(model("ho3"), "12321").to_dict()  # Eqs. (CQ12321H), (CQ12321G)
     {'H_c': 'm*omega**2*x3/2 + x2**2/(2*m)', 'G_c': 'h**2*x2**2/(4*m**2) - x1**2 + x3'}
     """
+    from ..systems.system import as_system
+
+    system = as_system(system)
     comp = composition_for(word, system)
     name = word if isinstance(word, str) else _word_name(comp)
     auto = max(_total_degree(Hk, system.coordinates) for Hk in system.hamiltonians)

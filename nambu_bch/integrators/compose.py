@@ -25,8 +25,8 @@ def composed_map(splitting, comp, h=H) -> tuple:
     >>> composed_map(model("ho").splitting, "121")[1]     # position Verlet, momentum
     -h**2*omega**2*x2/2 - h*m*omega**2*x1 + x2
     """
-    system = splitting.system
     comp = composition_for(comp, splitting)
+    system = splitting.system
     coords = system.coordinates
     flows = [(exact_flow(splitting[k], coords), c) for k, c in comp.factors()]
     if all(f.polynomial for f, _ in flows):

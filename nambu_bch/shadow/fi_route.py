@@ -261,6 +261,9 @@ def fi_route(system, word, order: int = 2, degree=None, terms=None) -> FIResult:
     >>> R.commutators[0].representations[0].labels                # Eq. (CL5), first alternative
     ('1AX', '1BX')
     """
+    from ..systems.system import as_system
+
+    system = as_system(system)
     splitting = system.splitting
     comp = composition_for(word, splitting)
     power = 2 if comp.symmetric else 1

@@ -52,6 +52,17 @@ def check_name(name, what: str = "name", strict: bool = True) -> str:
     return name
 
 
+def as_system(system, what: str = "system") -> "System":
+    """``system`` itself, or the built-in model of that name; else :class:`InvalidSystemError` in one line."""
+    if isinstance(system, System):
+        return system
+    if isinstance(system, str):
+        from .catalog import model
+
+        return model(system)
+    raise InvalidSystemError(f"{what} must be a System or a built-in model name such as 'ho3', got {type(system).__name__}")
+
+
 def _as_symbols(names, what):
     if isinstance(names, str):
         names = names.replace(",", " ").split()
