@@ -18,17 +18,23 @@ Synopsis::
     --param NAME=VALUE sets a parameter's value: numeric subcommands use it (default 1 for
                        every parameter), symbolic ones substitute it exactly before the analysis.
     --format latex|text|json (default latex for symbolic results, text for models/check/plot),
-    --output FILE      (written atomically: temporary file in the same directory + os.replace).
+    --output FILE      (a regular file is written atomically: temporary file in the same directory +
+                       os.replace, keeping its mode; a symlink is followed; a device or FIFO such as
+                       /dev/stdout is written through as a stream; see nambu_bch.atomic).
 
 With no options ``nambu-bch shadow`` prints the alpha-family of shadow
 Hamiltonians of Phi^{12321} for the paper's N = 3 oscillator at order 2
 (Horikoshi, Eqs. SH12321c, SG12321c) as LaTeX.
 
-Bad input (an unknown model, a malformed word or expression, a missing file,
-an invalid flag) prints one line on stderr naming the input and what is
+Bad input (an unknown model, a malformed word or expression, a word that
+leaves out a piece of the splitting, a missing file, an invalid flag, a request
+too large to finish) prints one line on stderr naming the input and what is
 accepted, and exits with status 2; user expressions are parsed by
-:func:`nambu_bch.parsing.parse_expression`, never evaluated.  Any other
-exception is a bug and propagates with its traceback (exit status 1).
+:func:`nambu_bch.parsing.parse_expression`, never evaluated, and names are
+checked against a LaTeX- and source-safe pattern.  Ctrl-C prints one line and
+exits 130 (also during the imports); a reader that closes stdout early ends the
+run quietly with status 141.  See ``docs/hardening.md``.  Any other exception
+is a bug and propagates with its traceback (exit status 1).
 """
 
 from __future__ import annotations
@@ -703,15 +709,17 @@ def _system_options(parser):
 
 def _integrator_options(parser, order=False):
     parser.add_argument("--integrator", metavar="WORD",
-                        help="word such as 12321, alias (TVT, VTV, lie-trotter, strang, forest-ruth, yoshida:WORD) "
-                             "or 'piece:coeff,...' (default: the Strang word 12..n..21)")
+                        help="word over every piece such as 12321, alias (TVT/VTV for two pieces, lie-trotter, strang, "
+                             "forest-ruth, yoshida, yoshida:WORD, suzuki) or 'piece:coeff,...' (default: the Strang word 12..n..21)")
     if order:
         parser.add_argument("--order", metavar="K", type=str, help=f"highest power of h kept (default 2, at most {MAX_CLI_ORDER})")
 
 
 def _output_options(parser, default, choices=_SYMBOLIC):
     parser.add_argument("--format", choices=choices, default=default, help=f"output format (default {default})")
-    parser.add_argument("--output", metavar="FILE", help="write the result to FILE (atomically) instead of stdout")
+    parser.add_argument("--output", metavar="FILE",
+                        help="write the result to FILE instead of stdout (a regular file atomically, keeping its mode; "
+                             "a device or FIFO as a stream)")
 
 
 def _numeric_options(parser, defaults):
