@@ -311,8 +311,10 @@ def write_stdout(text: str) -> None:
     if stream is None:  # started with stdout closed (nambu-bch ... >&-)
         raise BrokenPipeError("stdout is closed")
     try:
-        fd = stream.fileno()
-    except (AttributeError, OSError, ValueError):  # a captured or in-memory stream
+        fd = stream.fileno() if stream is sys.__stdout__ else None
+    except (AttributeError, OSError, ValueError):
+        fd = None
+    if fd is None:  # a replaced stream (pytest capture, Jupyter, io.StringIO): its own write
         stream.write(text)
         stream.flush()
         return
