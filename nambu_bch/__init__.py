@@ -3,6 +3,7 @@
 The public surface is re-exported here; see README.md for a tour and the architecture.
 """
 
+from . import _startup  # noqa: F401  (first: Ctrl-C during the command line's imports is one line, exit 130)
 from . import errors
 from .errors import NambuBCHError
 

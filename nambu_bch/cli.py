@@ -18,7 +18,9 @@ Synopsis::
     --param NAME=VALUE sets a parameter's value: numeric subcommands use it (default 1 for
                        every parameter), symbolic ones substitute it exactly before the analysis.
     --format latex|text|json (default latex for symbolic results, text for models/check/plot),
-    --output FILE      (written atomically: temporary file in the same directory + os.replace),
+    --output FILE      (a regular file is written atomically: temporary file in the same directory +
+                       os.replace, keeping its mode; a symlink is followed; a device or FIFO such as
+                       /dev/stdout is written through as a stream; see nambu_bch.atomic).
     --standalone       (LaTeX: a complete document; default: align* environments for a document body),
     --no-progress      (no progress bars on stderr for long runs; docs/latex.md).
 
@@ -26,11 +28,15 @@ With no options ``nambu-bch shadow`` prints the alpha-family of shadow
 Hamiltonians of Phi^{12321} for the paper's N = 3 oscillator at order 2
 (Horikoshi, Eqs. SH12321c, SG12321c) as LaTeX.
 
-Bad input (an unknown model, a malformed word or expression, a missing file,
-an invalid flag) prints one line on stderr naming the input and what is
+Bad input (an unknown model, a malformed word or expression, a word that
+leaves out a piece of the splitting, a missing file, an invalid flag, a request
+too large to finish) prints one line on stderr naming the input and what is
 accepted, and exits with status 2; user expressions are parsed by
-:func:`nambu_bch.parsing.parse_expression`, never evaluated.  Any other
-exception is a bug and propagates with its traceback (exit status 1).
+:func:`nambu_bch.parsing.parse_expression`, never evaluated, and names are
+checked against a LaTeX- and source-safe pattern.  Ctrl-C prints one line and
+exits 130 (also during the imports); a reader that closes stdout early ends the
+run quietly with status 141.  See ``docs/hardening.md``.  Any other exception
+is a bug and propagates with its traceback (exit status 1).
 """
 
 from __future__ import annotations
@@ -60,6 +66,10 @@ PROG = "nambu-bch"
 DEFAULT_MODEL = "ho3"
 MAX_STEPS = 100_000_000
 MAX_CLI_ORDER = 12
+#: Longest error line printed (a huge input echoed back is shortened).
+MAX_MESSAGE = 600
+#: Longest accepted path (--system, --output, --outdir).
+MAX_PATH = 4096
 _SYMBOLIC = ("latex", "text", "json")
 
 
@@ -99,9 +109,16 @@ def positive_float(text, flag="--h"):
     return out
 
 
+def _ascii_int(text):
+    """``int(text)`` for ASCII digits only (Python's ``int`` also reads '３' and '٣')."""
+    if not isinstance(text, str) or not text.strip().lstrip("+-").isdigit() or not text.isascii() or len(text) > 30:
+        raise ValueError(text)
+    return int(text, 10)
+
+
 def positive_int(text, flag, limit):
     try:
-        value = int(text, 10)
+        value = _ascii_int(text)
     except (TypeError, ValueError):
         raise NambuBCHError(f"{flag} {text!r} must be a positive integer such as 1000") from None
     if not 1 <= value <= limit:
@@ -111,7 +128,7 @@ def positive_int(text, flag, limit):
 
 def order_value(text, flag="--order", limit=MAX_CLI_ORDER, low=0):
     try:
-        value = int(text, 10)
+        value = _ascii_int(text)
     except (TypeError, ValueError):
         raise NambuBCHError(f"{flag} {text!r} must be an integer between {low} and {limit}") from None
     if not low <= value <= limit:
@@ -121,11 +138,15 @@ def order_value(text, flag="--order", limit=MAX_CLI_ORDER, low=0):
 
 def parse_params(items):
     """``--param NAME`` / ``--param NAME=VALUE`` -> ``(names in order, {name: exact value})``."""
+    from .systems.system import MAX_PARAMETERS, SYMBOL_NAME
+
     names, values = [], {}
+    if len(items or ()) > MAX_PARAMETERS:
+        raise NambuBCHError(f"--param is given {len(items)} times; at most {MAX_PARAMETERS} parameters are accepted")
     for item in items or ():
         name, sep, value = item.partition("=")
         name = name.strip()
-        if not name.isidentifier() or name.startswith("_"):
+        if not SYMBOL_NAME.match(name):
             raise NambuBCHError(
                 f"--param {item!r}: {name!r} is not a parameter name; write --param m (declare) or --param m=1 (value)"
             )
@@ -161,20 +182,32 @@ def system_from_args(args):
     from .systems import System, model
 
     names, values = parse_params(getattr(args, "param", None))
-    user_flags = [f for f, v in (("--H", args.H), ("--G", args.G), ("--coords", args.coords)) if v]
+    user_flags = [f for f, v in (("--H", args.H), ("--G", args.G), ("--coords", args.coords)) if v is not None]
     chosen = [f for f, v in (("--model", args.model), ("--system", args.system)) if v] + (["--H"] if user_flags else [])
     if len(chosen) > 1:
         raise NambuBCHError(f"{' and '.join(chosen)} both choose the system; give only one of --model, --system, --H/--G")
-    if user_flags and not args.H:
+    if user_flags and args.H is None:
         raise NambuBCHError(f"{user_flags[0]} needs --H EXPR (the first Hamiltonian)")
-    if args.H:
+    if args.H is not None:
+        from .systems.system import MAX_COORDINATES, check_name
+
         hams = [args.H] + list(args.G or [])
+        if len(hams) > MAX_COORDINATES - 1:  # before any parsing: the bracket of n Hamiltonians has (n+1)! terms
+            raise NambuBCHError(
+                f"--H and {len(hams) - 1} --G give {len(hams)} Hamiltonians; at most {MAX_COORDINATES - 1} are accepted "
+                f"(a system on at most {MAX_COORDINATES} coordinates)"
+            )
+        name = check_name(args.name, "--name") if args.name else "custom"
         if args.coords:
             coords = args.coords.replace(",", " ").split()
         else:
             coords = [f"x{i}" for i in range(1, (len(hams) + 1 if len(hams) > 1 else 2) + 1)]
+        from .systems.system import SYMBOL_NAME
+
+        if len(coords) > MAX_COORDINATES:
+            raise NambuBCHError(f"--coords gives {len(coords)} coordinates; at most {MAX_COORDINATES} are accepted")
         for c in coords:
-            if not c.isidentifier() or c.startswith("_"):
+            if not SYMBOL_NAME.match(c):
                 raise NambuBCHError(f"--coords {args.coords!r}: {c!r} is not a symbol name; write e.g. --coords 'x1 x2 x3'")
             if c in ("h", "alpha"):
                 raise NambuBCHError(f"--coords {args.coords!r}: {c!r} is reserved (the step h, the family parameter alpha)")
@@ -187,7 +220,7 @@ def system_from_args(args):
         symbols = [sympy.Symbol(s) for s in (*coords, *names)]
         flags = ["--H"] + ["--G"] * (len(hams) - 1)
         parsed = [parse_expression(text, symbols, what=flag) for text, flag in zip(hams, flags)]
-        system = System(coords, parsed, names, name=args.name or "custom", split=args.split or "full")
+        system = System(coords, parsed, names, name=name, split=args.split or "full")
         return system, values
     if args.system:
         file_values: dict = {}
@@ -227,26 +260,31 @@ def substituted(system, values):
     """The system with the given parameter values substituted exactly (symbolic subcommands)."""
     if not values:
         return system
+    from .systems.system import SYSTEM_NAME
+
     subs = {p: values[p.name] for p in system.parameters if p.name in values}
     rest = tuple(p for p in system.parameters if p.name not in values)
     hams = tuple(sympy.sympify(H).subs(subs) for H in system.hamiltonians)
     label = ",".join(f"{k}={v}" for k, v in values.items())
-    return _with(system, hamiltonians=hams, parameters=rest, name=f"{system.name}[{label}]")
+    name = f"{system.name}[{label}]"
+    if not SYSTEM_NAME.match(name):  # a long or unusual value: keep the name short and safe
+        name = f"{system.name}[{','.join(values)} substituted]"
+    return _with(system, hamiltonians=hams, parameters=rest, name=name)
 
 
 def default_word(system) -> str:
     """The Strang word ``12..n..21`` of the system's splitting (``12321`` for ho3, ``121`` for ho)."""
-    n = len(system.splitting)
-    word = "".join(str(k) for k in range(1, n + 1))
-    return word + word[-2::-1] if n > 1 else "1"
+    from .integrators import strang_word
+
+    return strang_word(len(system.splitting))
 
 
 def integrator_from_args(args, system):
-    """``(word, Composition)`` checked against the system's splitting."""
-    from .integrators import composition
+    """``(word, Composition)`` checked against the system's splitting (:func:`~nambu_bch.integrators.composition_for`)."""
+    from .integrators import composition_for
 
     word = args.integrator or default_word(system)
-    comp = composition(word, len(system.splitting)).check(system.splitting)
+    comp = composition_for(word, system)
     return word, comp
 
 
@@ -267,14 +305,34 @@ def emit(args, *, latex=None, text=None, data=None, cache=None):
     else:
         out = _formatted(args, latex, text, data)
     if args.output:
-        try:
-            render.write_output(out, args.output)
-        except OSError as exc:
-            raise NambuBCHError(f"--output {args.output}: cannot write the file ({exc.strerror or exc})") from None
+        render.write_output(out, args.output)  # OutputError: one line naming the path
         print(f"wrote {args.output}", file=sys.stderr)
     else:
-        sys.stdout.write(out)
-        sys.stdout.flush()
+        write_stdout(out)
+
+
+def write_stdout(text: str) -> None:
+    """Write ``text`` to stdout completely, as UTF-8.
+
+    Through the file descriptor when there is one: a partial ``write`` (a reader
+    that went away, ``PYTHONUNBUFFERED``) is continued or ends in
+    ``BrokenPipeError``, never in silently truncated output.
+    """
+    stream = sys.stdout
+    if stream is None:  # started with stdout closed (nambu-bch ... >&-)
+        raise BrokenPipeError("stdout is closed")
+    try:
+        fd = stream.fileno() if stream is sys.__stdout__ else None
+    except (AttributeError, OSError, ValueError):
+        fd = None
+    if fd is None:  # a replaced stream (pytest capture, Jupyter, io.StringIO): its own write
+        stream.write(text)
+        stream.flush()
+        return
+    stream.flush()
+    data = memoryview(text.encode("utf-8"))
+    while data:
+        data = data[os.write(fd, data):]
 
 
 def _formatted(args, latex, text, data) -> str:
@@ -302,7 +360,7 @@ def _base(system, word, **extra):
 # subcommands
 # --------------------------------------------------------------------------------------------
 def cmd_models(args):
-    chosen = any((args.model, args.system, args.H, args.G, args.coords, args.param, args.split, args.name))
+    chosen = any(v is not None for v in (args.model, args.system, args.H, args.G, args.coords, args.param, args.split, args.name))
 
     @_once
     def systems():
@@ -596,7 +654,7 @@ def numeric_inputs(args, system, values):
 
     params = {k: float(v) for k, v in {**getattr(args, "file_values", {}), **values}.items()}
     parameter_values(system, params)  # raises naming an unknown parameter
-    x0 = parse_x0(args.x0, system.N) if args.x0 else [1.0] * system.N
+    x0 = parse_x0(args.x0, system.N) if args.x0 is not None else [1.0] * system.N
     return params, x0
 
 
@@ -624,7 +682,7 @@ def cmd_plot(args):
     if not os.path.isdir(outdir):
         try:
             os.makedirs(outdir, exist_ok=True)
-        except OSError as exc:
+        except (OSError, ValueError) as exc:
             raise NambuBCHError(f"--outdir {outdir}: cannot create the directory ({exc.strerror or exc})") from None
     system, values = system_from_args(args)
     if args.integrator is None and system.name == "ho3":
@@ -666,15 +724,17 @@ def _system_options(parser):
 
 def _integrator_options(parser, order=False):
     parser.add_argument("--integrator", metavar="WORD",
-                        help="word such as 12321, alias (TVT, VTV, lie-trotter, strang, forest-ruth, yoshida:WORD) "
-                             "or 'piece:coeff,...' (default: the Strang word 12..n..21)")
+                        help="word over every piece such as 12321, alias (TVT/VTV for two pieces, lie-trotter, strang, "
+                             "forest-ruth, yoshida, yoshida:WORD, suzuki) or 'piece:coeff,...' (default: the Strang word 12..n..21)")
     if order:
         parser.add_argument("--order", metavar="K", type=str, help=f"highest power of h kept (default 2, at most {MAX_CLI_ORDER})")
 
 
 def _output_options(parser, default, choices=_SYMBOLIC):
     parser.add_argument("--format", choices=choices, default=default, help=f"output format (default {default})")
-    parser.add_argument("--output", metavar="FILE", help="write the result to FILE (atomically) instead of stdout")
+    parser.add_argument("--output", metavar="FILE",
+                        help="write the result to FILE instead of stdout (a regular file atomically, keeping its mode; "
+                             "a device or FIFO as a stream)")
     if "latex" in choices:
         parser.add_argument("--standalone", action="store_true",
                             help="with --format latex: a complete LaTeX document (default: align* environments "
@@ -836,10 +896,16 @@ def _normalise(args):
         value = getattr(args, flag, None)
         if value is not None and not value.strip():
             raise NambuBCHError(f"--{flag} is empty; give a file or directory path")
+        if value is not None and ("\x00" in value or len(value) > MAX_PATH):
+            raise NambuBCHError(f"--{flag} {value[:40]!r}...: a path has no NUL character and at most {MAX_PATH} characters")
     for flag in ("integrator", "coords", "name", "model"):
         value = getattr(args, flag, None)
         if value is not None and (not value.strip() or len(value) > 200):
             raise NambuBCHError(f"--{flag} {value[:40]!r} must be a non-empty string of at most 200 characters")
+    if getattr(args, "name", None) is not None:
+        from .systems.system import check_name
+
+        check_name(args.name, "--name")  # LaTeX- and source-safe, before anything uses it
     return args
 
 
@@ -858,14 +924,40 @@ class _progress_off:
         return False
 
 
+def _stdout_closed() -> None:
+    """After EPIPE: point stdout at /dev/null so that the interpreter's final flush stays quiet."""
+    try:
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, sys.stdout.fileno())
+        os.close(devnull)
+    except (OSError, ValueError, AttributeError):  # stdout without a file descriptor (captured in tests)
+        pass
+
+
+def _say(line: str) -> None:
+    """One line on stderr; a closed stderr is ignored."""
+    try:
+        print(line, file=sys.stderr)
+        sys.stderr.flush()
+    except (OSError, ValueError):
+        pass
+
+
 def main(argv=None) -> int:
     """Run the CLI on ``argv`` (default ``sys.argv[1:]``); returns the exit status.
 
-    0 on success, 2 on bad input (one line on stderr), 130 on Ctrl-C.
+    0 on success, 2 on bad input (one line on stderr), 130 on Ctrl-C (one line),
+    141 quietly when stdout is closed early (``nambu-bch shadow | head -c1``),
+    1 with one line when memory or the interpreter's recursion limit runs out.
+    Nothing a user types produces a traceback; any other exception is a bug and
+    propagates with its traceback.
     """
-    parser = build_parser()
+    from . import _startup
+
+    _startup.cli_started()  # from here on Ctrl-C is a KeyboardInterrupt handled below
     prog = PROG
     try:
+        parser = build_parser()
         args = parser.parse_args(argv)
         prog = f"{PROG} {args.command}"
         _normalise(args)
@@ -878,21 +970,29 @@ def main(argv=None) -> int:
         return exc.code if isinstance(exc.code, int) else 0
     except UsageError as exc:
         hint = exc.prog if exc.prog != PROG else PROG
-        print(f"{exc.prog}: error: {exc}; see '{hint} --help'", file=sys.stderr)
+        message = " ".join(str(exc).split())
+        if len(message) > MAX_MESSAGE:
+            message = message[: MAX_MESSAGE - 3] + "..."
+        _say(f"{exc.prog}: error: {message}; see '{hint} --help'")
         return 2
     except NambuBCHError as exc:
         message = " ".join(str(exc).split())
-        print(f"{prog}: error: {message}", file=sys.stderr)
+        if len(message) > MAX_MESSAGE:  # a huge input echoed back: keep the line readable
+            message = message[: MAX_MESSAGE - 3] + "..."
+        _say(f"{prog}: error: {message}")
         return 2
     except KeyboardInterrupt:
-        print(f"{prog}: interrupted", file=sys.stderr)
+        _say(f"{prog}: interrupted")
         return 130
     except BrokenPipeError:
-        try:
-            sys.stdout = open(os.devnull, "w")
-        except OSError:
-            pass
-        return 0
+        _stdout_closed()
+        return 141  # as a shell reports a process ended by SIGPIPE; nothing printed
+    except MemoryError:
+        _say(f"{prog}: error: out of memory; the request is too large for this machine (reduce --order, --degree or --steps)")
+        return 1
+    except RecursionError:
+        _say(f"{prog}: error: the input is nested too deeply to process (recursion limit)")
+        return 1
     return 0
 
 

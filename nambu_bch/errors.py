@@ -60,3 +60,11 @@ class NoExactResultError(NambuBCHError):
 
 class InvalidRunError(NambuBCHError):
     """An argument of a numeric run (step count, sampling, initial-state shape, backend, precision) that is not accepted."""
+
+
+class OutputError(NambuBCHError):
+    """An output path that cannot be written (a directory, a dangling link, no space left, no permission)."""
+
+
+class ResourceLimitError(NambuBCHError):
+    """A request whose size, estimated from the input before any work, exceeds what can finish (refused up front)."""

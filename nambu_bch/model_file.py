@@ -23,9 +23,11 @@ silently.
 from __future__ import annotations
 
 import os
+import stat
 
 from .errors import InvalidSystemError
 from .parsing import parse_expression
+from .systems.system import USER_NAME, check_name
 
 try:  # Python >= 3.11
     import tomllib
@@ -74,18 +76,15 @@ def load_system(path, values: dict | None = None):
     shown = os.fspath(path)
     if tomllib is None:  # pragma: no cover
         raise InvalidSystemError("--system needs Python >= 3.11 (tomllib) or the 'tomli' package")
+    raw = _read_regular_file(shown)
     try:
-        size = os.path.getsize(shown)
-        if size > MAX_FILE_SIZE:
-            raise InvalidSystemError(f"--system {shown}: file is {size} bytes; at most {MAX_FILE_SIZE} are accepted")
-        with open(shown, "rb") as handle:
-            data = tomllib.load(handle)
-    except OSError as exc:
-        raise InvalidSystemError(f"--system {shown}: cannot read the file ({exc.strerror or exc})") from None
+        data = tomllib.loads(raw.decode("utf-8"))
     except tomllib.TOMLDecodeError as exc:
-        raise InvalidSystemError(f"--system {shown}: not valid TOML ({exc})") from None
+        raise InvalidSystemError(f"--system {shown}: not valid TOML ({' '.join(str(exc).split())})") from None
     except UnicodeDecodeError:
         raise InvalidSystemError(f"--system {shown}: not valid TOML (not UTF-8 text)") from None
+    except RecursionError:
+        raise InvalidSystemError(f"--system {shown}: not accepted (arrays or tables nested too deeply)") from None
     unknown = sorted(set(data) - set(KEYS))
     if unknown:
         raise InvalidSystemError(f"--system {shown}: unknown key(s) {', '.join(unknown)}; accepted keys are {', '.join(KEYS)}")
@@ -124,7 +123,11 @@ def load_system(path, values: dict | None = None):
     for key in ("name", "split", "description", "citation"):
         if key in data and not isinstance(data[key], str):
             raise InvalidSystemError(f"--system {shown}: {key} must be a string, got {data[key]!r}")
-    name = data.get("name", os.path.splitext(os.path.basename(shown))[0])
+    if "name" in data:
+        name = check_name(data["name"], f"--system {shown}: name")
+    else:  # the file's base name when it is a valid name, else 'custom'
+        stem = os.path.splitext(os.path.basename(shown))[0]
+        name = stem if USER_NAME.match(stem) else "custom"
     symbols = _symbols(coordinates, names, shown)
     parsed = [parse_expression(H, symbols, what=f"--system {shown}: {label}") for H, label in zip(hams, _labels(len(hams)))]
     system = System(
@@ -132,6 +135,42 @@ def load_system(path, values: dict | None = None):
         description=data.get("description", ""), citation=data.get("citation", ""),
     )
     return system
+
+
+def _read_regular_file(shown) -> bytes:
+    """The bytes of the regular file ``shown``, at most :data:`MAX_FILE_SIZE`; devices, FIFOs, directories refused.
+
+    The size is checked on the open file (``fstat``) and enforced while reading, so
+    ``/dev/zero`` or a file that grows while it is read cannot exhaust memory.
+    """
+    flags = os.O_RDONLY | getattr(os, "O_NONBLOCK", 0) | getattr(os, "O_CLOEXEC", 0)
+    try:
+        fd = os.open(shown, flags)  # O_NONBLOCK: opening a FIFO does not wait for a writer
+    except ValueError:  # an embedded NUL
+        raise InvalidSystemError(f"--system {shown[:40]!r}: not a usable file name") from None
+    except OSError as exc:
+        raise InvalidSystemError(f"--system {shown}: cannot read the file ({exc.strerror or exc})") from None
+    try:
+        info = os.fstat(fd)
+        if not stat.S_ISREG(info.st_mode):
+            kind = "a directory" if stat.S_ISDIR(info.st_mode) else "not a regular file (device, FIFO or socket)"
+            raise InvalidSystemError(f"--system {shown}: {kind}; give a TOML file")
+        if info.st_size > MAX_FILE_SIZE:
+            raise InvalidSystemError(f"--system {shown}: file is {info.st_size} bytes; at most {MAX_FILE_SIZE} are accepted")
+        chunks, total = [], 0
+        while True:
+            chunk = os.read(fd, 65536)
+            if not chunk:
+                break
+            total += len(chunk)
+            if total > MAX_FILE_SIZE:
+                raise InvalidSystemError(f"--system {shown}: file is larger than {MAX_FILE_SIZE} bytes, the most accepted")
+            chunks.append(chunk)
+        return b"".join(chunks)
+    except OSError as exc:
+        raise InvalidSystemError(f"--system {shown}: cannot read the file ({exc.strerror or exc})") from None
+    finally:
+        os.close(fd)
 
 
 def _labels(count):

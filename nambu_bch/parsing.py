@@ -12,6 +12,10 @@ the tree is walked with a whitelist:
 * calls of the functions in :data:`ALLOWED_FUNCTIONS`, positional arguments
   only.
 
+Only printable ASCII is read (letters, digits, spaces and ``+-*/^().,_``):
+a ``#`` (which Python's tokenizer would silently drop as a comment), a
+backslash, quotes, braces, control characters and non-ASCII letters (which
+Python would NFKC-normalise into other names) are refused before parsing.
 Anything else -- attribute access, subscripts, undeclared names (including
 ``__import__``, ``eval``, ``open``), keyword or starred arguments, lambdas,
 strings, comparisons, comprehensions -- raises
@@ -20,8 +24,11 @@ the input (``what``) and lists what is accepted.  So do inputs that would only
 cost time or memory: text longer than :data:`MAX_LENGTH` characters, nesting
 deeper than :data:`MAX_DEPTH`, exponents larger than :data:`MAX_EXPONENT` in
 absolute value, exact numbers of more than :data:`MAX_BITS` bits, decimal
-literals with an exponent beyond ``1e±``:data:`MAX_DECIMAL_EXPONENT`, and
-results that are not finite (``1/0``, ``log(0)``, ``Rational(1, 0)``).
+literals with an exponent beyond ``1e±``:data:`MAX_DECIMAL_EXPONENT`, results
+that are not finite (``1/0``, ``log(0)``, ``Rational(1, 0)``), and polynomials
+whose expansion would have more than :data:`MAX_TERMS` terms or total degree
+above :data:`MAX_DEGREE` (``(x1+x2+1)**1000``: estimated from the number of
+terms and the exponent, before anything is expanded).
 
 Long sums and products (``x1 + x1**2 + ... + x1**300``) are walked
 iteratively, so they count as one level of nesting however many terms they
@@ -31,6 +38,7 @@ have.
 from __future__ import annotations
 
 import ast
+import math
 import warnings
 from decimal import Decimal, InvalidOperation
 
@@ -44,8 +52,14 @@ MAX_LENGTH = 2000
 MAX_DEPTH = 60
 #: Largest accepted absolute value of a numeric exponent.
 MAX_EXPONENT = 1000
-#: Largest accepted size of an exact integer, numerator or denominator, in bits.
-MAX_BITS = 20000
+#: Largest accepted size of an exact integer, numerator or denominator, in bits (about 420 digits).
+MAX_BITS = 1400
+#: Most terms the expanded polynomial may have (estimated before expansion).
+MAX_TERMS = 5000
+#: Highest total degree of the expanded polynomial.
+MAX_DEGREE = 1000
+#: The only characters an expression may contain (besides letters and digits).
+ALLOWED_PUNCTUATION = " +-*/^().,_"
 #: Largest accepted decimal exponent of a literal such as ``1e300``.
 MAX_DECIMAL_EXPONENT = 300
 
@@ -110,10 +124,14 @@ def parse_expression(text: str, symbols, what: str = "expression") -> sympy.Expr
     x1**2/(2*m)
     >>> parse_expression("0.1*x1 + 2.5e-1", [x1])
     x1/10 + 1/4
-    >>> parse_expression("__import__('os')", [x1], what="--H")  # doctest: +ELLIPSIS
+    >>> parse_expression("__import__(x1)", [x1], what="--H")  # doctest: +ELLIPSIS
     Traceback (most recent call last):
     ...
-    nambu_bch.errors.ExpressionParseError: --H "__import__('os')": the call of '__import__' is not allowed; ...
+    nambu_bch.errors.ExpressionParseError: --H '__import__(x1)': the call of '__import__' is not allowed; ...
+    >>> parse_expression("1/2 # a comment Python would drop", [], what="--h")  # doctest: +ELLIPSIS
+    Traceback (most recent call last):
+    ...
+    nambu_bch.errors.ExpressionParseError: --h '1/2 # a comment Python would drop' contains '#', not accepted; ...
     """
     if not isinstance(text, str):
         raise ExpressionParseError(f"{what} must be a string, got {type(text).__name__}")
@@ -123,10 +141,14 @@ def parse_expression(text: str, symbols, what: str = "expression") -> sympy.Expr
         )
     if not text.strip():
         raise ExpressionParseError(f"{what} is empty; give an expression such as 'x2^2/2 + x1^2/2'")
-    if isinstance(symbols, dict):
-        names = dict(symbols)
-    else:
-        names = {s.name: s for s in symbols}
+    bad = sorted({ch for ch in text if not (ch.isascii() and (ch.isalnum() or ch in ALLOWED_PUNCTUATION))})
+    if bad:
+        shown = "".join(bad) if all(ch.isprintable() for ch in bad) else ascii("".join(bad))
+        raise ExpressionParseError(
+            f"{what} {_shown(text)} contains {shown!r}, not accepted; expressions use ASCII letters, digits, "
+            f"spaces and {ALLOWED_PUNCTUATION.strip()}"
+        )
+    names = _symbol_table(symbols, what)
     original = text
     # '^' means power to physicists; Python would parse it as xor with the wrong precedence
     source = text.replace("^", "**").strip()
@@ -150,7 +172,70 @@ def parse_expression(text: str, symbols, what: str = "expression") -> sympy.Expr
         builder.fail("it is not an algebraic expression")
     if result.has(*_NON_FINITE):
         builder.fail("it is not finite (division by zero, log(0) or similar)")
+    terms, degree = expansion_size(result)
+    if terms > MAX_TERMS or degree > MAX_DEGREE:
+        builder.fail(
+            f"expanded it would have about {terms if terms < 10**15 else '> 10^15'} terms of degree up to {degree} "
+            f"(at most {MAX_TERMS} terms and degree {MAX_DEGREE} are accepted)"
+        )
     return result
+
+
+def _symbol_table(symbols, what):
+    if isinstance(symbols, dict):
+        table = dict(symbols)
+    elif isinstance(symbols, (list, tuple, set, frozenset)) or hasattr(symbols, "__iter__") and not isinstance(symbols, (str, bytes)):
+        table = {}
+        for s in symbols:
+            if not isinstance(s, sympy.Symbol):
+                raise ExpressionParseError(f"{what}: symbols must be sympy Symbols, got {s!r}")
+            table[s.name] = s
+    else:
+        raise ExpressionParseError(f"{what}: symbols must be a list of sympy Symbols or a dict name -> Symbol, got {type(symbols).__name__}")
+    if not all(isinstance(k, str) and isinstance(v, sympy.Basic) for k, v in table.items()):
+        raise ExpressionParseError(f"{what}: the symbol table must map names to sympy Symbols")
+    return table
+
+
+_CAP = 10**18
+
+
+def expansion_size(expr) -> tuple:
+    """``(terms, degree)``: an upper estimate of the size of ``expr`` fully expanded, without expanding it.
+
+    Sums add term counts, products multiply them, and a power ``p**n`` of a
+    ``t``-term polynomial has at most ``binomial(n + t - 1, t - 1)`` terms (the
+    number of monomials of degree ``n`` in ``t`` letters); degrees add in
+    products and multiply in powers.  Non-polynomial parts (``sin(x1)``,
+    ``sqrt(x1)``) count as one term of degree one.  Capped at ``10**18``.
+
+    >>> import sympy
+    >>> x1, x2 = sympy.symbols("x1 x2")
+    >>> expansion_size((x1 + x2 + 1)**1000)
+    (501501, 1000)
+    >>> expansion_size(x1**2/2 + x2**2/2)
+    (2, 2)
+    """
+    if expr.is_Atom:
+        return (1, 1 if expr.is_Symbol else 0)
+    if expr.is_Add:
+        sizes = [expansion_size(a) for a in expr.args]
+        return (min(_CAP, sum(t for t, _ in sizes)), max(d for _, d in sizes))
+    if expr.is_Mul:
+        terms, degree = 1, 0
+        for a in expr.args:
+            t, d = expansion_size(a)
+            terms, degree = min(_CAP, terms * t), degree + d
+        return terms, degree
+    if expr.is_Pow and expr.exp.is_Integer:
+        t, d = expansion_size(expr.base)
+        n = abs(int(expr.exp))
+        if t == 1:
+            return (1, d * n)
+        # monomials of degree n in t letters; computed only while it stays below the cap
+        terms = math.comb(n + t - 1, t - 1) if min(n, t - 1) < 64 else _CAP
+        return (min(_CAP, terms), d * n)
+    return (1, 1)
 
 
 class _Builder:

@@ -17,7 +17,7 @@ reading in a terminal and for ``grep``.
 
 from __future__ import annotations
 
-from .atomic import write_atomic
+from . import atomic
 
 import json
 import math
@@ -150,8 +150,8 @@ def _is_tree(node) -> bool:
 
 
 def write_output(text: str, path) -> None:
-    """Write ``text`` to ``path`` atomically (see :func:`nambu_bch.atomic.write_atomic`)."""
-    write_atomic(path, text)
+    """Write ``text`` to ``path``: atomically for a regular file, as a stream through a device or FIFO (:func:`nambu_bch.atomic.write_output`)."""
+    atomic.write_output(path, text)
 
 
 # --------------------------------------------------------------------------------------------

@@ -75,51 +75,51 @@ def test_floats_stay_exact():
 # rejected input
 # -------------------------------------------------------------------------------------------
 REJECTED = {
-    "__import__('os').system('touch /tmp/pwned')": "__import__",
-    "().__class__.__bases__[0].__subclasses__()": "whitelisted",
+    "__import__('os').system('touch /tmp/pwned')": "not accepted",  # character whitelist (was: __import__)
+    "().__class__.__bases__[0].__subclasses__()": "not accepted",  # character whitelist (was: whitelisted)
     "x1.__class__": "attribute",
-    "x1[0]": "subscript",
-    "(lambda: 1)()": "call",
-    "lambda: 1": "lambda",
-    "eval('1')": "eval",
-    "exec('1')": "exec",
-    "open('/etc/passwd').read()": "whitelisted",
-    "open('/etc/passwd')": "'open' is not allowed",
-    "getattr(x1, 'real')": "getattr",
+    "x1[0]": "not accepted",  # character whitelist (was: subscript)
+    "(lambda: 1)()": "not accepted",  # character whitelist (was: call)
+    "lambda: 1": "not accepted",  # character whitelist (was: lambda)
+    "eval('1')": "not accepted",  # character whitelist (was: eval)
+    "exec('1')": "not accepted",  # character whitelist (was: exec)
+    "open('/etc/passwd').read()": "not accepted",  # character whitelist (was: whitelisted)
+    "open('/etc/passwd')": "not accepted",  # character whitelist (was: 'open' is not allowed)
+    "getattr(x1, 'real')": "not accepted",  # character whitelist (was: getattr)
     "globals()": "globals",
-    "sympify('x1')": "sympify",
-    "Symbol('y')": "Symbol",
+    "sympify('x1')": "not accepted",  # character whitelist (was: sympify)
+    "Symbol('y')": "not accepted",  # character whitelist (was: Symbol)
     "y + x1": "'y' is not declared",
     "__builtins__": "not declared",
-    "'abc'": "not a number",
-    "b'abc'": "not a number",
+    "'abc'": "not accepted",  # character whitelist (was: not a number)
+    "b'abc'": "not accepted",  # character whitelist (was: not a number)
     "1j": "not a number",
     "True": "not a number",
     "None": "not a number",
-    "[x1]": "List",
+    "[x1]": "not accepted",  # character whitelist (was: List)
     "(x1, x2)": "Tuple",
-    "{x1: 1}": "Dict",
+    "{x1: 1}": "not accepted",  # character whitelist (was: Dict)
     "x1 if x1 else 0": "IfExp",
-    "x1 < 2": "Compare",
+    "x1 < 2": "not accepted",  # character whitelist (was: Compare)
     "x1 and x2": "BoolOp",
-    "x1 % 2": "'%'",
+    "x1 % 2": "not accepted",  # character whitelist (was: '%')
     "x1 // 2": "'//'",
-    "x1 @ x2": "'@'",
-    "~x1": "'~'",
-    "x1 << 2": "'<<'",
-    "sin(x=x1)": "keyword",
-    "sin(*[x1])": "Starred",
+    "x1 @ x2": "not accepted",  # character whitelist (was: '@')
+    "~x1": "not accepted",  # character whitelist (was: '~')
+    "x1 << 2": "not accepted",  # character whitelist (was: '<<')
+    "sin(x=x1)": "not accepted",  # character whitelist (was: keyword)
+    "sin(*[x1])": "not accepted",  # character whitelist (was: Starred)
     "sin": "must be called",
     "sin(x1, x2)": "invalid",
     "Rational(x1, 2)": "invalid",
-    "[x for x in ()]": "ListComp",
-    "f'{x1}'": "JoinedStr",
-    "(y := 1)": "NamedExpr",
+    "[x for x in ()]": "not accepted",  # character whitelist (was: ListComp)
+    "f'{x1}'": "not accepted",  # character whitelist (was: JoinedStr)
+    "(y := 1)": "not accepted",  # character whitelist (was: NamedExpr)
     "x1 +": "not a valid expression",
-    "x1 = 1": "not a valid expression",
+    "x1 = 1": "not accepted",  # character whitelist (was: not a valid expression)
     "import os": "not a valid expression",
-    "x1; x2": "not a valid expression",
-    "x1\x00": "not a valid expression",
+    "x1; x2": "not accepted",  # character whitelist (was: not a valid expression)
+    "x1\x00": "not accepted",  # character whitelist (was: not a valid expression)
     "": "empty",
     "   ": "empty",
     "x1 ** 100000": "exponent",
@@ -139,6 +139,23 @@ REJECTED = {
     "-" * 1500 + "x1": "nested",
     "(" * 300 + "x1" + ")" * 300: "not a valid expression",
     "x1+" * 700 + "x1": "characters long",
+    "1/2 # comment": "'#', not accepted",  # the tokenizer would drop the comment (issue 10, item 5)
+    "x1 # __import__('os')": "not accepted",
+    "x1 \\\n + x2": "not accepted",
+    "\uff581": "not accepted",  # fullwidth x: NFKC would make it x1
+    "(x1 + x2 + 1)**1000": "501501 terms",  # binomial(1002, 2) monomials (issue 10, item 8)
+    "(x1 + x2 + x3)**100": "5151 terms",  # binomial(102, 2)
+    "x1**600 * x2**600": "degree up to 1200",
+    "99999999^500": "bits",  # 13500 bits; str() of it would exceed Python's 4300-digit limit
+    "10**500": "bits",
+    # the AST whitelist is the second line of defence, behind the character whitelist
+    "__import__(x1)": "'__import__' is not allowed",
+    "open(x1)": "'open' is not allowed",
+    "eval(x1)": "'eval' is not allowed",
+    "getattr(x1, x2)": "'getattr' is not allowed",
+    "x1.real": "attribute",
+    "lambda x1: x1": "lambda",
+    "(x1).conjugate()": "whitelisted",
 }
 
 

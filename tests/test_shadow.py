@@ -381,9 +381,9 @@ def test_rigid_body_non_symmetric_word_is_obstructed_at_h1():
     assert d["exists"] is False and d["H_S"] is None and "h^1" in d["obstruction"]
 
 
-@pytest.mark.parametrize("word", ["123", "lie-trotter", "12"])
+@pytest.mark.parametrize("word", ["123", "lie-trotter", "132"])
 def test_ho3_non_symmetric_words_are_obstructed_at_h1(word):
-    """ho3, Phi^{123} / Lie-Trotter / Phi^{12}: odd orders appear, and already the h^1 term admits NO polynomial shadow
+    """ho3, Phi^{123} / Lie-Trotter / Phi^{132}: odd orders appear, and already the h^1 term admits NO polynomial shadow
     pair (degree 2 tried; the same certificate works at degrees 4 and 6)."""
     S = model("ho3")
     F = shadow_hamiltonians(S, word, 2)

@@ -25,7 +25,7 @@ import sympy
 
 from ..algebra import VectorField
 from ..errors import InvalidOrderError
-from ..integrators.composition import composition as make_composition
+from ..integrators.composition import composition_for
 from ..printing import Printable, aligned
 from .fast import FastFields, field_backend
 
@@ -178,7 +178,7 @@ def effective_field(splitting, comp, order: int = 2, fast: bool = True) -> Effec
     (-omega**2*x2/(12*m), -m*omega**4*x1/6)
     """
     order = check_order(order)
-    comp = make_composition(comp, len(splitting)).check(splitting)
+    comp = composition_for(comp, splitting)
     algebra = splitting.system.algebra.with_constants(H, extension=comp.extension)
     fields = [VectorField(algebra, p.field.to_sympy()) if comp.extension else p.field for p in splitting.pieces]
     engine = field_backend(algebra, dict(enumerate(fields, 1)), fast)

@@ -22,7 +22,7 @@ import sympy
 from sympy.polys.domains import QQ
 
 from ..algebra import VectorField
-from ..integrators.composition import composition as make_composition
+from ..integrators.composition import composition_for
 from .backward import H, EffectiveField, check_order
 from .evaluation import BracketEvaluator
 from .fast import field_backend
@@ -58,7 +58,7 @@ def effective_field_bch(splitting, comp, order: int = 2, fast: bool = True) -> E
     (-omega**2*x2/(12*m), -m*omega**4*x1/6)
     """
     order = check_order(order)
-    comp = make_composition(comp, len(splitting)).check(splitting)
+    comp = composition_for(comp, splitting)
     algebra = splitting.system.algebra.with_constants(H, extension=comp.extension)
     series = formal_bch(comp, order + 1)
     engine, evaluator, combine = _evaluator(splitting, algebra, comp.extension, fast)

@@ -174,7 +174,10 @@ def F(x):
     if isinstance(x, (bool, complex)) or isinstance(x, mpmath.mpc):
         raise NambuBCHError(f"F(x) takes a real x (sympy, float, numpy array or mpmath mpf), got {x!r}")
     if isinstance(x, Real) and not isinstance(x, np.generic):
-        value = float(x)
+        try:
+            value = float(x)
+        except OverflowError:  # an int beyond the float range
+            raise NumericalRangeError(f"F(x) needs a finite x, got a {type(x).__name__} beyond the float range") from None
         if not math.isfinite(value):
             raise NumericalRangeError(f"F(x) needs a finite x, got {x!r}")
         if abs(value) >= 2:

@@ -46,7 +46,7 @@ from sympy.polys.matrices import DomainMatrix
 from sympy.polys.rings import ring
 
 from ..errors import InvalidOrderError, InvalidSystemError, NoExactResultError
-from ..integrators import composed_map, composition
+from ..integrators import composed_map, composition_for
 from ..printing import Printable, aligned, series_text, series_tokens
 
 H_STEP = sympy.Symbol("h")
@@ -393,7 +393,10 @@ def conserved_quantities(system, word, degree=None) -> ConservedQuantities:
     G_c = G + h**2*x2**2/(4*m**2)
     H = m*omega**2*x3/2 + x2**2/(2*m), G = -x1**2 + x3
     """
-    comp = composition(word, len(system.splitting)).check(system.splitting)
+    from ..systems.system import as_system
+
+    system = as_system(system)
+    comp = composition_for(word, system)
     name = word if isinstance(word, str) else _word_name(comp)
     auto = max(_total_degree(Hk, system.coordinates) for Hk in system.hamiltonians)
     if degree is None:

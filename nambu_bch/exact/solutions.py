@@ -39,7 +39,7 @@ import sympy
 
 from ..algebra import liouville_field
 from ..errors import NambuBCHError, NoExactResultError, UnstableStepError
-from ..integrators import composition
+from ..integrators import composition_for
 from ..integrators.step import parameter_values
 from .exact_shadow import OMEGA, exact_shadow_hamiltonians, frequency
 from .invariants import conserved_quantities
@@ -56,7 +56,7 @@ def _check_kind(kind):
 
 
 def _word(system, word) -> str:
-    comp = composition(word, len(system.splitting)).check(system.splitting)
+    comp = composition_for(word, system)
     return word if isinstance(word, str) else (comp.name or "".join(map(str, comp.pieces)))
 
 

@@ -1,7 +1,7 @@
 """Compositions as data, exact sub-flows, the composed map and a numeric step."""
 
 from .compose import composed_map
-from .composition import PAPER_WORDS, Composition, composition
+from .composition import PAPER_WORDS, Composition, composition, composition_for, strang_word
 from .flows import ExactFlow, exact_flow
 from .step import parameter_values, step_function, subflow_functions
 
@@ -11,8 +11,10 @@ __all__ = [
     "ExactFlow",
     "composed_map",
     "composition",
+    "composition_for",
     "exact_flow",
     "parameter_values",
     "step_function",
+    "strang_word",
     "subflow_functions",
 ]

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import sympy
 
-from .composition import composition as make_composition
+from .composition import composition_for
 from .flows import TIME, exact_flow
 
 H = sympy.Symbol("h")
@@ -25,8 +25,8 @@ def composed_map(splitting, comp, h=H) -> tuple:
     >>> composed_map(model("ho").splitting, "121")[1]     # position Verlet, momentum
     -h**2*omega**2*x2/2 - h*m*omega**2*x1 + x2
     """
+    comp = composition_for(comp, splitting)
     system = splitting.system
-    comp = make_composition(comp, len(splitting)).check(splitting)
     coords = system.coordinates
     flows = [(exact_flow(splitting[k], coords), c) for k, c in comp.factors()]
     if all(f.polynomial for f, _ in flows):

@@ -23,17 +23,25 @@ Words
   letter (Eqs. PV1, 12321);
 * any other digit word (``"123"``, ``"12"``): a plain product of full steps;
 * aliases: ``TVT`` / ``PV`` (position Verlet, ``121``), ``VTV`` / ``VV``
-  (velocity Verlet, ``212``), ``lie-trotter`` (``12...n``), ``strang``
-  (``12..n..21``), ``yoshida:WORD`` / ``triple-jump:WORD`` and
-  ``forest-ruth`` (the fourth-order triple jump of a symmetric word);
+  (velocity Verlet, ``212``) -- two-piece splittings only; ``lie-trotter``
+  (``12...n``), ``strang`` (``12..n..21``); ``forest-ruth`` / ``yoshida``
+  (Yoshida's triple jump of the splitting's Strang word), ``yoshida:WORD`` /
+  ``triple-jump:WORD`` (triple jump of a symmetric WORD), ``suzuki`` /
+  ``suzuki:WORD`` (Suzuki's fractal five-jump) -- all fourth order.  The aliases
+  expand over the pieces of the splitting they are used with (``n_pieces``).
 * an explicit list of ``(piece, coefficient)`` pairs, ``"1:1/2,2:1,1:1/2"``.
 
-Every piece's coefficients must sum to one (consistency).
+Consistency, checked in one place (:meth:`Composition.check`, reached by every
+route through :func:`composition_for`): every piece ``1..n`` of the splitting
+occurs, and each piece's coefficients sum to one.  A word that leaves a piece
+out (``121`` on a three-piece splitting) is not an integrator of the system's
+flow and is refused, naming the missing pieces.
 
 References
 ----------
 Horikoshi, Eqs. (PV1), (12321), (ST2); Yoshida, Phys. Lett. A 150 (1990) 262,
 Eq. (5.19) (triple jump); Forest & Ruth, Physica D 43 (1990) 105;
+Suzuki, Phys. Lett. A 146 (1990) 319, Eq. (3.14) (five-jump);
 Hairer, Lubich, Wanner, *Geometric Numerical Integration*, Sect. II.4.
 """
 
@@ -49,6 +57,13 @@ from sympy.polys.domains import QQ
 from ..errors import InconsistentCoefficientsError, InvalidCompositionError, UnknownPieceError
 
 _ALIASES = {"tvt": "121", "pv": "121", "position-verlet": "121", "vtv": "212", "vv": "212", "velocity-verlet": "212"}
+_JUMPS = ("forest-ruth", "yoshida", "triple-jump", "suzuki")
+#: Most factors a composition may have (bounded work downstream: BCH, kernels).
+MAX_FACTORS = 200
+#: Most characters of a composition given as text.
+MAX_TEXT = 400
+#: Most pieces a splitting may have for the digit-word aliases (pieces are the digits 1-9).
+MAX_PIECES = 9
 
 
 @dataclass(frozen=True)
@@ -77,9 +92,15 @@ class Composition:
             raise InvalidCompositionError(
                 f"{len(self.pieces)} pieces but {len(self.coefficients)} coefficients in composition {self.name!r}"
             )
+        if len(self.pieces) > MAX_FACTORS:
+            raise InvalidCompositionError(
+                f"composition {_shown(self.name)} has {len(self.pieces)} factors; at most {MAX_FACTORS} are accepted"
+            )
         for k in self.pieces:
-            if not isinstance(k, int) or k < 1:
-                raise UnknownPieceError(f"piece numbers are positive integers, got {k!r} in composition {self.name!r}")
+            if isinstance(k, bool) or not isinstance(k, int) or not 1 <= k <= MAX_FACTORS:
+                raise UnknownPieceError(
+                    f"piece numbers are integers 1..{MAX_FACTORS}, got {k!r} in composition {_shown(self.name)}"
+                )
         coeffs = tuple(_exact(c, self.name) for c in self.coefficients)
         object.__setattr__(self, "coefficients", coeffs)
         sums = {k: sympy.nsimplify(sum(c for p, c in zip(self.pieces, coeffs) if p == k)) for k in set(self.pieces)}
@@ -128,13 +149,38 @@ class Composition:
         return list(zip(self.pieces, self.coefficients))
 
     def check(self, splitting) -> "Composition":
-        """Raise :class:`UnknownPieceError` if a piece is not in ``splitting``."""
+        """``self`` if it is an integrator of ``splitting``'s flow; the one consistency check of the package.
+
+        A composition approximates ``exp(h (X_1 + ... + X_n))`` only if every piece
+        ``1..n`` of the splitting occurs and each piece's coefficients sum to one
+        (the latter is checked on construction).  Raises
+        :class:`UnknownPieceError` for a piece the splitting does not have, and
+        :class:`InconsistentCoefficientsError` naming the pieces the word leaves out.
+
+        >>> from nambu_bch import model
+        >>> composition("121").check(model("ho3").splitting)
+        Traceback (most recent call last):
+        ...
+        nambu_bch.errors.InconsistentCoefficientsError: composition '121' never applies piece(s) [3] of the splitting of ho3 (pieces 1..3); every piece must occur with total coefficient 1, e.g. the Strang word 12321
+        """
+        from ..systems.splitting import Splitting
+
+        if not isinstance(splitting, Splitting):
+            raise InvalidCompositionError(
+                f"a composition is checked against a Splitting (e.g. model('ho3').splitting), got {type(splitting).__name__}"
+            )
         n = len(splitting)
-        missing = sorted({k for k in self.pieces if k > n})
-        if missing:
+        name = getattr(splitting.system, "name", "the system")
+        extra = sorted({k for k in self.pieces if k > n})
+        if extra:
             raise UnknownPieceError(
-                f"composition {self.name!r} uses piece(s) {missing}, but the splitting of "
-                f"{getattr(splitting.system, 'name', 'the system')} has pieces 1..{n}"
+                f"composition {_shown(self.name)} uses piece(s) {extra}, but the splitting of {name} has pieces 1..{n}"
+            )
+        missing = sorted(set(range(1, n + 1)) - set(self.pieces))
+        if missing:
+            raise InconsistentCoefficientsError(
+                f"composition {_shown(self.name)} never applies piece(s) {missing} of the splitting of {name} "
+                f"(pieces 1..{n}); every piece must occur with total coefficient 1, e.g. the Strang word {strang_word(n)}"
             )
         return self
 
@@ -155,7 +201,49 @@ class Composition:
         return self.name or ",".join(f"{k}:{c}" for k, c in self.factors())
 
 
+def _shown(text, limit: int = 60) -> str:
+    text = str(text)
+    return repr(text if len(text) <= limit else text[: limit - 3] + "...")
+
+
+def strang_word(n: int) -> str:
+    """The Strang word ``12..n..21`` of an ``n``-piece splitting (``"1"`` for one piece).
+
+    >>> strang_word(3), strang_word(2), strang_word(1)
+    ('12321', '121', '1')
+    """
+    word = "".join(str(k) for k in range(1, n + 1))
+    return word + word[-2::-1]
+
+
+def composition_for(spec, target) -> Composition:
+    """The composition ``spec`` for a splitting (or a system's splitting), checked: the one entry of every route.
+
+    Aliases expand over the splitting's own pieces (``strang``, ``forest-ruth``,
+    ``suzuki``); the result passes :meth:`Composition.check` (every piece used, each
+    with total coefficient one) or an :class:`~nambu_bch.errors.InvalidCompositionError`
+    is raised naming what is wrong.
+
+    >>> from nambu_bch import model
+    >>> composition_for("forest-ruth", model("ho3")).pieces
+    (1, 2, 3, 2, 1, 2, 3, 2, 1, 2, 3, 2, 1)
+    """
+    from ..systems.splitting import Splitting
+    from ..systems.system import System
+
+    splitting = target.splitting if isinstance(target, System) else target
+    if not isinstance(splitting, Splitting):
+        raise InvalidCompositionError(
+            f"a composition is used with a System or a Splitting (e.g. model('ho3')), got {type(target).__name__}"
+        )
+    return composition(spec, len(splitting)).check(splitting)
+
+
 def _exact(c, name):
+    if c is None or isinstance(c, (bool, bytes, dict, list, tuple, set)):
+        raise InvalidCompositionError(
+            f"coefficient {c!r} of composition {_shown(name)} is not a number; give exact numbers such as '1/2' or sympy.Rational(1, 2)"
+        )
     if isinstance(c, float):
         raise InvalidCompositionError(
             f"coefficient {c!r} of composition {name!r} is a float; give exact numbers such as '1/2' or sympy.Rational(1, 2)"
@@ -166,8 +254,11 @@ def _exact(c, name):
         from ..parsing import parse_expression
 
         c = parse_expression(c, [], what=f"coefficient of composition {name!r}")
-    c = sympy.sympify(c)
-    if not c.is_number or c.has(sympy.Float) or not c.is_real:
+    try:
+        c = sympy.sympify(c, strict=True)
+    except (sympy.SympifyError, TypeError, ValueError):
+        raise InvalidCompositionError(f"coefficient {c!r} of composition {_shown(name)} is not an exact number") from None
+    if not isinstance(c, sympy.Expr) or not c.is_number or c.has(sympy.Float) or not c.is_real:
         raise InvalidCompositionError(f"coefficient {c} of composition {name!r} must be an exact real number")
     return c
 
@@ -179,31 +270,62 @@ def _strang(word: str) -> Composition:
     return Composition(tuple(int(ch) for ch in word), tuple(coeffs), word, 2, "Horikoshi, Eqs. (PV1), (12321), (ST2)")
 
 
-def _triple_jump(base: Composition) -> Composition:
-    """Yoshida's triple jump ``Phi_{g1 h} Phi_{g0 h} Phi_{g1 h}``, order + 2 for symmetric ``base``."""
+def _jump_base(base: Composition, what: str) -> int:
+    """``p = order + 1`` of a symmetric base with rational coefficients, else one line saying why not."""
     if not base.symmetric or base.order % 2:
-        raise InvalidCompositionError(f"the triple jump needs a symmetric base scheme of even order, got {base.name!r}")
-    p = base.order + 1
-    root = sympy.Integer(2) ** sympy.Rational(1, p)
-    g1 = 1 / (2 - root)
-    g0 = -root / (2 - root)
+        raise InvalidCompositionError(f"the {what} needs a symmetric base scheme of even order, got {base.name!r}")
+    if not all(c.is_Rational for c in base.coefficients):
+        raise InvalidCompositionError(
+            f"the {what} of {_shown(base.name)} is refused: its base already has irrational coefficients "
+            "(nested jumps, order >= 6, are not supported); give a word with rational coefficients such as 12321"
+        )
+    return base.order + 1
+
+
+def _jump(base: Composition, gammas, root, name: str, citation: str) -> Composition:
+    """``Phi_{g_1 h} ... Phi_{g_m h}`` of ``base``, adjacent sub-flows of one piece merged, coefficients in QQ(root)."""
     field = QQ.algebraic_field(root)
 
-    def canonical(c):  # a + b 2^(1/p) + ... : one normal form per number
+    def canonical(c):  # a + b r + c r^2 ... : one normal form per number
         return field.to_sympy(field.from_sympy(sympy.expand(c)))
 
     pieces, coeffs = [], []
-    for g in (g1, g0, g1):
+    for g in gammas:
         for k, c in base.factors():
             if pieces and pieces[-1] == k:  # merge adjacent sub-flows of one piece
                 coeffs[-1] = canonical(coeffs[-1] + g * c)
             else:
                 pieces.append(k)
                 coeffs.append(canonical(g * c))
-    return Composition(
-        tuple(pieces), tuple(coeffs), f"triple-jump:{base.name}", base.order + 2,
-        "Yoshida, Phys. Lett. A 150 (1990) 262; Forest & Ruth, Physica D 43 (1990) 105",
-    )
+    return Composition(tuple(pieces), tuple(coeffs), name, base.order + 2, citation)
+
+
+def _triple_jump(base: Composition) -> Composition:
+    """Yoshida's triple jump ``Phi_{g1 h} Phi_{g0 h} Phi_{g1 h}``, order + 2 for symmetric ``base``.
+
+    ``g1 = 1/(2 - 2^(1/p))``, ``g0 = -2^(1/p)/(2 - 2^(1/p))``, ``p = order + 1``
+    (Yoshida 1990, Eq. 5.19).
+    """
+    p = _jump_base(base, "triple jump")
+    root = sympy.Integer(2) ** sympy.Rational(1, p)
+    g1 = 1 / (2 - root)
+    g0 = -root / (2 - root)
+    return _jump(base, (g1, g0, g1), root, f"triple-jump:{base.name}",
+                 "Yoshida, Phys. Lett. A 150 (1990) 262; Forest & Ruth, Physica D 43 (1990) 105")
+
+
+def _five_jump(base: Composition) -> Composition:
+    """Suzuki's fractal five-jump ``Phi_{g h} Phi_{g h} Phi_{(1-4g) h} Phi_{g h} Phi_{g h}``, order + 2.
+
+    ``g = 1/(4 - 4^(1/p))``, ``p = order + 1`` (Suzuki, Phys. Lett. A 146 (1990) 319,
+    Eq. 3.14): for a second-order base ``g1 = g2 = g4 = g5 = 1/(4 - 4^(1/3))`` and
+    ``g3 = 1 - 4 g1``.  The coefficients lie in ``QQ(2^(2/p))``.
+    """
+    p = _jump_base(base, "five-jump")
+    root = sympy.Integer(4) ** sympy.Rational(1, p)
+    g = 1 / (4 - root)
+    return _jump(base, (g, g, 1 - 4 * g, g, g), root, f"suzuki:{base.name}",
+                 "Suzuki, Phys. Lett. A 146 (1990) 319")
 
 
 def composition(spec, n_pieces: int | None = None) -> Composition:
@@ -213,7 +335,11 @@ def composition(spec, n_pieces: int | None = None) -> Composition:
     ----------
     spec : str, Composition, or sequence of (piece, coefficient)
     n_pieces : int, optional
-        Number of pieces of the splitting (needed by ``lie-trotter`` and ``strang``).
+        Number of pieces of the splitting the composition is for: the aliases
+        ``lie-trotter``, ``strang``, ``forest-ruth``, ``yoshida`` and ``suzuki`` expand
+        over pieces ``1..n_pieces`` (without it ``forest-ruth``/``yoshida``/``suzuki``
+        mean two pieces, ``121``), and ``TVT``/``VTV`` need ``n_pieces`` 2.
+        Use :func:`composition_for` to also check the result against a splitting.
 
     Examples
     --------
@@ -224,7 +350,12 @@ def composition(spec, n_pieces: int | None = None) -> Composition:
     >>> composition("123").order, composition("123").symmetric
     (1, False)
     """
+    if n_pieces is not None:
+        if isinstance(n_pieces, bool) or not isinstance(n_pieces, int) or not 1 <= n_pieces <= MAX_FACTORS:
+            raise InvalidCompositionError(f"n_pieces must be a positive integer (the number of pieces), got {n_pieces!r}")
     if isinstance(spec, str):
+        if len(spec) > MAX_TEXT:
+            raise InvalidCompositionError(f"composition {_shown(spec)} is {len(spec)} characters long; at most {MAX_TEXT} are accepted")
         # compositions are immutable and radical coefficients are slow to normalise: build each once
         return _composition_from_text(spec, n_pieces)
     return _build(spec, n_pieces)
@@ -239,45 +370,85 @@ def _build(spec, n_pieces):
     if isinstance(spec, Composition):
         return spec
     if isinstance(spec, (list, tuple)):
+        if len(spec) > MAX_FACTORS:
+            raise InvalidCompositionError(f"an explicit composition has at most {MAX_FACTORS} factors, got {len(spec)}")
         try:
-            pieces = tuple(int(k) for k, _ in spec)
-            coeffs = tuple(c for _, c in spec)
+            pairs = [(k, c) for k, c in spec]
         except (TypeError, ValueError):
-            raise InvalidCompositionError(f"an explicit composition is a list of (piece, coefficient) pairs, got {spec!r}") from None
-        return _with_order(Composition(pieces, coeffs, ",".join(f"{k}:{c}" for k, c in spec)))
+            raise InvalidCompositionError(f"an explicit composition is a list of (piece, coefficient) pairs, got {_shown(spec)}") from None
+        for k, _ in pairs:  # no silent coercion: 1.5, True or "1" is not a piece number
+            if isinstance(k, bool) or not isinstance(k, (int, sympy.Integer)):
+                raise UnknownPieceError(
+                    f"piece {k!r} of composition {_shown(spec)} is not an integer; pieces are numbered 1, 2, ..."
+                )
+        pieces = tuple(int(k) for k, _ in pairs)
+        coeffs = tuple(c for _, c in pairs)
+        return _with_order(Composition(pieces, coeffs, ",".join(f"{k}:{c}" for k, c in pairs)))
     if not isinstance(spec, str) or not spec.strip():
-        raise InvalidCompositionError(f"a composition is a word such as '12321', an alias or 'k:c,...' list, got {spec!r}")
+        raise InvalidCompositionError(f"a composition is a word such as '12321', an alias or 'k:c,...' list, got {_shown(spec)}")
     text = spec.strip()
+    bad = sorted(set(ch for ch in text if not (ch.isascii() and (ch.isalnum() or ch in _TEXT_PUNCTUATION))))
+    if bad:
+        raise InvalidCompositionError(
+            f"composition {_shown(text)} contains {''.join(bad)!r}; accepted are letters, digits, spaces and {_TEXT_PUNCTUATION.strip()}"
+        )
     low = text.lower()
     if low in _ALIASES:
+        if n_pieces is not None and n_pieces != 2:
+            raise InvalidCompositionError(
+                f"{text!r} is {_ALIASES[low]} and exists only for two-piece splittings; this splitting has {n_pieces} "
+                f"pieces (use the Strang word {strang_word(n_pieces)} or 'strang')"
+            )
         comp = _strang(_ALIASES[low])
         return Composition(comp.pieces, comp.coefficients, text, 2, comp.citation)
     if low in ("lie-trotter", "strang"):
         if not n_pieces:
             raise InvalidCompositionError(f"{text!r} needs the number of pieces of the splitting")
+        _digit_pieces(text, n_pieces)
         word = "".join(str(k) for k in range(1, n_pieces + 1))
-        return composition(word if low == "lie-trotter" else word + word[-2::-1])
-    if low == "forest-ruth":
-        return _triple_jump(composition("121"))
-    if low.startswith(("yoshida:", "triple-jump:")):
-        return _triple_jump(composition(text.split(":", 1)[1], n_pieces))
+        return composition(word if low == "lie-trotter" else strang_word(n_pieces))
+    if low in _JUMPS or low.startswith(tuple(j + ":" for j in _JUMPS[1:])):
+        head, _, base = low.partition(":")
+        if not base:  # over the splitting's own Strang word (two pieces, 121, when unknown)
+            base = strang_word(_digit_pieces(text, n_pieces) if n_pieces else 2)
+        else:
+            base = text.split(":", 1)[1].strip()
+            if base.lower().startswith(tuple(j + ":" for j in _JUMPS[1:])) or base.lower() in _JUMPS:
+                raise InvalidCompositionError(
+                    f"composition {_shown(text)}: nested jumps (order >= 6) are not supported; "
+                    "give one jump of a symmetric second-order word, e.g. yoshida:12321"
+                )
+        inner = composition(base, n_pieces)
+        return _five_jump(inner) if head == "suzuki" else _triple_jump(inner)
     if ":" in text:
         pairs = []
         for item in text.split(","):
             k, sep, c = item.partition(":")
-            if not sep or not k.strip().isdigit():
-                raise InvalidCompositionError(f"composition item {item!r} of {text!r} is not of the form 'piece:coefficient'")
+            if not sep or not k.strip().isdigit() or not c.strip():
+                raise InvalidCompositionError(f"composition item {_shown(item)} of {_shown(text)} is not of the form 'piece:coefficient'")
             pairs.append((int(k), c.strip()))
         return composition(pairs)
     if not text.isdigit() or "0" in text:
         raise InvalidCompositionError(
             f"unknown composition {text!r}; use a word of piece digits 1-9 such as '12321', "
-            f"an alias ({', '.join(sorted(_ALIASES))}, lie-trotter, strang, forest-ruth, yoshida:WORD) "
+            f"an alias ({', '.join(sorted(_ALIASES))}, lie-trotter, strang, forest-ruth, yoshida, yoshida:WORD, suzuki, suzuki:WORD) "
             "or an explicit list 'piece:coefficient,...'"
         )
     if len(text) % 2 == 1 and text == text[::-1] and len(text) > 1:
         return _strang(text)
     return Composition(tuple(int(ch) for ch in text), (sympy.Integer(1),) * len(text), text, 1, "plain product (Lie-Trotter)")
+
+
+_TEXT_PUNCTUATION = " :,/.+-*()^_"
+
+
+def _digit_pieces(text, n_pieces):
+    if n_pieces > MAX_PIECES:
+        raise InvalidCompositionError(
+            f"{text!r} is a word over pieces 1..{MAX_PIECES}; this splitting has {n_pieces} pieces "
+            "(give an explicit 'piece:coefficient,...' list)"
+        )
+    return n_pieces
 
 
 def _with_order(comp: Composition) -> Composition:

@@ -12,7 +12,7 @@ import numpy as np
 import sympy
 
 from ..errors import InvalidSystemError
-from .composition import composition as make_composition
+from .composition import composition_for
 from .flows import TIME, exact_flow
 
 
@@ -31,7 +31,7 @@ def parameter_values(system, params=None) -> dict:
 
 def subflow_functions(splitting, comp, params=None):
     """``[(f, c), ...]`` with ``f(x1, ..., xN, t) -> new state`` (numpy), ``c`` the float coefficient."""
-    comp = make_composition(comp, len(splitting)).check(splitting)
+    comp = composition_for(comp, splitting)
     system = splitting.system
     values = parameter_values(system, params)
     out = []

@@ -11,13 +11,13 @@ import sympy
 
 from ..bch.backward import check_order
 from ..errors import InvalidOrderError, NambuBCHError
-from ..integrators.composition import composition as make_composition
+from ..integrators.composition import composition_for
 from .direct_route import ALPHA, direct_route
 from .family import ShadowFamily
 from .fi_route import fi_route
 
 ROUTES = ("direct", "fi")
-MAX_UNKNOWNS = 800  # the direct route's exact solve is refused up front above this many unknowns per order
+SOLVE_UNKNOWNS = 800  # default: above this many unknowns per order the exact solve is skipped and existence decided by averages
 
 
 def _system(system):
@@ -66,7 +66,7 @@ def _decide(fam, R, existence, params):
 
 
 def shadow_hamiltonians(system, word, order: int = 2, route: str = "direct", degree=None, *,
-                        existence: bool = True, params=None, max_unknowns: int | None = MAX_UNKNOWNS, progress=None) -> ShadowFamily:
+                        existence: bool = True, params=None, max_unknowns: int | None = SOLVE_UNKNOWNS, progress=None) -> ShadowFamily:
     """Shadow Hamiltonians ``H_S, G_S`` of ``word`` on ``system`` through ``h^order``, as a family.
 
     Parameters
@@ -104,7 +104,7 @@ def shadow_hamiltonians(system, word, order: int = 2, route: str = "direct", deg
     if route not in ROUTES:
         raise NambuBCHError(f"route must be one of {', '.join(ROUTES)}, got {route!r}")
     order = check_order(order)
-    comp = make_composition(word, len(system.splitting)).check(system.splitting)
+    comp = composition_for(word, system.splitting)
     notes = []
     if route == "direct":
         R = direct_route(system, comp, order, degree, max_unknowns, progress=progress)

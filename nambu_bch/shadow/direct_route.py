@@ -57,6 +57,7 @@ Horikoshi, Eqs. (L1), (L2), (SHPV), (SHPV1), (BCH5), (SH12321a)-(SG12321c),
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 from itertools import product
 
@@ -65,8 +66,8 @@ import sympy
 from ..algebra import liouville_field
 from ..bch.backward import check_order
 from ..bch.concrete import effective_field_bch
-from ..errors import InvalidOrderError, NambuBCHError
-from ..integrators.composition import composition as make_composition
+from ..errors import InvalidOrderError, NambuBCHError, ResourceLimitError
+from ..integrators.composition import composition_for
 from .linear import rank, solve_affine
 
 H_STEP = sympy.Symbol("h")
@@ -144,6 +145,21 @@ class DirectResult:
                     total += H_STEP**j * self.algebra.to_sympy(c)
             out.append(sympy.expand(total))
         return tuple(out)
+
+
+#: Most unknowns (slots x monomials of degree <= D) of one order's linear solve; refused above, up front.
+MAX_UNKNOWNS = 4000
+
+
+def _check_ansatz_size(slots, n, degree):
+    """Refuse, before any work, an ansatz of ``slots * binomial(D + n, n)`` unknowns above :data:`MAX_UNKNOWNS`."""
+    unknowns = slots * math.comb(degree + n, n) if degree < 10**4 else math.inf
+    if unknowns > MAX_UNKNOWNS:
+        shown = unknowns if unknowns != math.inf else "> 10^12"
+        raise ResourceLimitError(
+            f"an ansatz of degree {degree} in {n} coordinates has {shown} unknowns; at most {MAX_UNKNOWNS} are accepted "
+            "(lower the degree or the order)"
+        )
 
 
 def _monomials(n, degree):
@@ -257,11 +273,12 @@ class _Solver:
                 f"ansatz degree {D} cannot match the h^{j} field of degree {rhs_deg} "
                 f"(corrections need degree >= {needed}); pass degree >= {needed} or None"
             )
-        monos = _monomials(self.n, D)
-        columns = [(a, e) for a in range(self.slots) for e in monos]
-        if self.max_unknowns is not None and len(columns) > self.max_unknowns:
+        if self.max_unknowns is not None and self.slots * math.comb(D + self.n, self.n) > self.max_unknowns:
             # bounded work (issue 17): the exact solve is refused up front, the order stays undecided
             return OrderSolution(j, "refused", degree=D, rhs=rhs)
+        _check_ansatz_size(self.slots, self.n, D)
+        monos = _monomials(self.n, D)
+        columns = [(a, e) for a in range(self.slots) for e in monos]
         row_index: dict = {}
 
         def row(i, mono):
@@ -402,11 +419,15 @@ def direct_route(system, word, order: int = 2, degree=None, max_unknowns=None, p
     >>> sympy.expand(R.shadow()[0] - model("ho").H)
     h**2*m*omega**4*x1**2/12 - h**2*omega**2*x2**2/(24*m)
     """
+    from ..systems.system import as_system
+
+    system = as_system(system)
     order = check_order(order)
     if degree is not None:
         if isinstance(degree, bool) or not isinstance(degree, int) or degree < 1:
             raise InvalidOrderError(f"degree must be a positive integer (the ansatz degree) or None, got {degree!r}")
-    comp = make_composition(word, len(system.splitting)).check(system.splitting)
+        _check_ansatz_size(len(system.hamiltonians), system.N, degree)
+    comp = composition_for(word, system.splitting)
     if max_unknowns is not None and (isinstance(max_unknowns, bool) or not isinstance(max_unknowns, int) or max_unknowns < 1):
         raise InvalidOrderError(f"max_unknowns must be a positive integer or None, got {max_unknowns!r}")
     solver = _Solver(system, comp, order, degree, max_unknowns)

@@ -37,7 +37,7 @@ import sympy
 from ..bch import expand_terms, formal_bch
 from ..bch.lyndon import is_bracket
 from ..errors import InvalidOrderError, NambuBCHError
-from ..integrators.composition import composition as make_composition
+from ..integrators.composition import composition_for
 from .direct_route import ALPHA, H_STEP, _monomials
 from .fundamental_identity import representations, single_representations
 from .linear import kernel_rref, normal_form, solve_affine
@@ -261,8 +261,11 @@ def fi_route(system, word, order: int = 2, degree=None, terms=None) -> FIResult:
     >>> R.commutators[0].representations[0].labels                # Eq. (CL5), first alternative
     ('1AX', '1BX')
     """
+    from ..systems.system import as_system
+
+    system = as_system(system)
     splitting = system.splitting
-    comp = make_composition(word, len(splitting)).check(splitting)
+    comp = composition_for(word, splitting)
     power = 2 if comp.symmetric else 1
     if order != power and terms is None:
         raise InvalidOrderError(

@@ -75,7 +75,7 @@ def model(name: str) -> System:
     >>> model("ho3").hamiltonians
     (m*omega**2*x3/2 + x2**2/(2*m), -x1**2 + x3)
     """
-    if name not in _MODELS:
+    if not isinstance(name, str) or name not in _MODELS:
         raise UnknownModelError(f"unknown model {name!r}; built-in models are {', '.join(_MODELS)}")
     if name not in _CACHE:
         _CACHE[name] = _MODELS[name]()

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import keyword
+import re
 from dataclasses import dataclass, field
 from functools import cached_property
 
@@ -12,21 +14,83 @@ from ..errors import InvalidSystemError
 
 #: Symbols reserved by the package: the step and the family parameter.
 RESERVED_SYMBOLS = ("h", "alpha")
+#: Most coordinates of a system: the Nambu bracket of N - 1 Hamiltonians is an N x N
+#: determinant (N! terms), and the splittings and words grow with N.
+MAX_COORDINATES = 8
+#: Most parameters of a system (each is a generator of the coefficient field).
+MAX_PARAMETERS = 16
+#: A symbol name: ASCII letters, digits and underscores (no NFKC look-alikes, no LaTeX or source syntax).
+SYMBOL_NAME = re.compile(r"[A-Za-z][A-Za-z0-9_]{0,31}\Z")
+#: A name given by a user (``--name``, the TOML ``name``): LaTeX-safe and source-safe.
+USER_NAME = re.compile(r"[A-Za-z][A-Za-z0-9_-]{0,63}\Z")
+#: Any system name (also the derived ``ho3[m=1/2]``): no quote, backslash, brace, ``#``, ``$``, ``%``, ``&``, ``~``, ``^`` or newline.
+SYSTEM_NAME = re.compile(r"[A-Za-z][A-Za-z0-9_.+\-=/,*()\[\] ]{0,199}\Z")
+
+
+def check_name(name, what: str = "name", strict: bool = True) -> str:
+    r"""``name`` if it is a safe system name, else :class:`InvalidSystemError` in one line.
+
+    ``strict`` (user input): ``^[A-Za-z][A-Za-z0-9_-]{0,63}$``.  Otherwise also the
+    characters ``. + = / , * ( ) [ ]`` and spaces of derived names such as
+    ``ho3[m=1/2]``.  Names appear in LaTeX (``\text{...}``), JSON and generated
+    source, so a backslash, brace, quote or ``#`` never passes
+    (``\input{/etc/passwd}`` is refused).
+
+    >>> check_name("my-ho3")
+    'my-ho3'
+    >>> check_name("\\input{/etc/passwd}", "--name")
+    Traceback (most recent call last):
+    ...
+    nambu_bch.errors.InvalidSystemError: --name '\\input{/etc/passwd}' is not accepted; a name is a letter followed by at most 63 letters, digits, '_' or '-'
+    """
+    pattern = USER_NAME if strict else SYSTEM_NAME
+    if not isinstance(name, str) or not pattern.match(name):
+        shown = repr(name if not isinstance(name, str) or len(name) <= 60 else name[:57] + "...")
+        rule = ("a letter followed by at most 63 letters, digits, '_' or '-'" if strict else
+                "a letter followed by at most 199 letters, digits, spaces or . _ + - = / , * ( ) [ ]")
+        raise InvalidSystemError(f"{what} {shown} is not accepted; a name is {rule}")
+    return name
+
+
+def as_system(system, what: str = "system") -> "System":
+    """``system`` itself, or the built-in model of that name; else :class:`InvalidSystemError` in one line."""
+    if isinstance(system, System):
+        return system
+    if isinstance(system, str):
+        from .catalog import model
+
+        return model(system)
+    raise InvalidSystemError(f"{what} must be a System or a built-in model name such as 'ho3', got {type(system).__name__}")
 
 
 def _as_symbols(names, what):
     if isinstance(names, str):
         names = names.replace(",", " ").split()
+    if isinstance(names, sympy.Symbol):
+        names = (names,)
+    try:
+        names = list(names)
+    except TypeError:
+        raise InvalidSystemError(f"{what}s must be a string such as 'x1 x2 x3' or a list of names/Symbols, got {names!r}") from None
     out = []
     for n in names:
         if isinstance(n, str):
-            if not n.isidentifier():
-                raise InvalidSystemError(f"{what} name {n!r} is not a valid symbol name")
-            n = sympy.Symbol(n)
+            n = sympy.Symbol(_symbol_name(n, what))
         if not isinstance(n, sympy.Symbol):
             raise InvalidSystemError(f"{what} must be symbols or names, got {n!r}")
+        _symbol_name(n.name, what)
         out.append(n)
     return tuple(out)
+
+
+def _symbol_name(name, what):
+    if not SYMBOL_NAME.match(name) or keyword.iskeyword(name):
+        shown = repr(name if len(name) <= 40 else name[:37] + "...")
+        raise InvalidSystemError(
+            f"{what} name {shown} is not a valid symbol name; use ASCII letters, digits and '_', "
+            "starting with a letter, at most 32 characters (e.g. x1, omega)"
+        )
+    return name
 
 
 @dataclass(frozen=True, eq=False)
@@ -67,6 +131,18 @@ class System:
         params = _as_symbols(self.parameters, "parameter")
         object.__setattr__(self, "coordinates", coords)
         object.__setattr__(self, "parameters", params)
+        check_name(self.name, "system name", strict=False)
+        for key in ("description", "citation"):
+            text = getattr(self, key)
+            if not isinstance(text, str) or len(text) > 500 or not text.isprintable():
+                raise InvalidSystemError(f"{key} of a system must be printable text of at most 500 characters, got {str(text)[:40]!r}")
+        if len(coords) > MAX_COORDINATES:
+            raise InvalidSystemError(
+                f"a system on {len(coords)} coordinates is refused: at most {MAX_COORDINATES} are accepted "
+                f"(the Nambu bracket of N - 1 Hamiltonians has N! terms)"
+            )
+        if len(params) > MAX_PARAMETERS:
+            raise InvalidSystemError(f"a system with {len(params)} parameters is refused: at most {MAX_PARAMETERS} are accepted")
         if len(coords) < 2:
             raise InvalidSystemError(f"a system needs at least 2 coordinates, got {len(coords)}")
         if len(set(coords)) != len(coords) or set(coords) & set(params):
@@ -77,6 +153,10 @@ class System:
         hams = self.hamiltonians
         if isinstance(hams, (str, sympy.Basic)):
             hams = (hams,)
+        if not isinstance(hams, (list, tuple)):
+            raise InvalidSystemError(f"hamiltonians must be a list of expressions (strings or sympy), got {type(hams).__name__}")
+        if len(hams) > MAX_COORDINATES:
+            raise InvalidSystemError(f"{len(hams)} Hamiltonians are refused: at most {MAX_COORDINATES - 1} are accepted")
         hams = tuple(self._parse(H) for H in hams)
         expected = 1 if len(coords) == 2 else len(coords) - 1
         if len(hams) != expected:
@@ -94,7 +174,7 @@ class System:
             if not H.free_symbols & set(coords):
                 raise InvalidSystemError(f"Hamiltonian {self._ham_name(k, len(hams))} = {H} does not depend on any coordinate")
         object.__setattr__(self, "hamiltonians", hams)
-        if self.split not in ("full", "single"):
+        if not isinstance(self.split, str) or self.split not in ("full", "single"):
             raise InvalidSystemError(f"split must be 'full' or 'single', got {self.split!r}")
 
     def _parse(self, H):
@@ -104,8 +184,10 @@ class System:
             return parse_expression(H, symbols=(*self.coordinates, *self.parameters))
         try:
             H = sympy.sympify(H, strict=True)
-        except (sympy.SympifyError, TypeError) as exc:
-            raise InvalidSystemError(f"Hamiltonian {H!r} is not a sympy expression") from exc
+        except (sympy.SympifyError, TypeError, ValueError):
+            raise InvalidSystemError(f"Hamiltonian {H!r} is not a sympy expression") from None
+        if not isinstance(H, sympy.Expr):
+            raise InvalidSystemError(f"Hamiltonian {H!r} is not an algebraic expression")
         # symbolic code never sees floats: read 0.5 as 1/2 (the decimal the user wrote)
         return sympy.nsimplify(H, rational=True) if H.has(sympy.Float) else H
 
