@@ -16,7 +16,7 @@ import pytest
 import sympy
 
 from nambu_bch import System, model
-from nambu_bch.errors import NambuBCHError
+from nambu_bch.errors import InconsistentCoefficientsError, NambuBCHError
 from nambu_bch.numeric.iterate import iterate
 from nambu_bch.shadow import shadow_hamiltonians
 from nambu_bch.shadow.averaging import orbit_average, orbit_functions, section_integral
@@ -122,12 +122,11 @@ def test_issue_example_non_symmetric_word_drifts(ex17):
     _check_drift(F, 1)
 
 
-def test_inconsistent_word_is_not_an_obstruction_but_no_method():
-    """ho3 with Phi^{12} (README: 'none at h^1'): piece 3 is missing, Z_0 != X_{H,G}: the word does not integrate
-    this system at all; reported as such (no shadow pair H + O(h) can exist), not as an averaging certificate."""
-    F = shadow_hamiltonians(model("ho3"), "12", 1)
-    assert F.exists is False and F.evidence["order"] == 0 and "not consistent" in F.evidence["reason"]
-    assert "pieces [3] are missing" in F.evidence["reason"] and F.drift is None
+def test_inconsistent_word_is_refused_not_reported_as_an_obstruction():
+    """ho3 with Phi^{12} (the README once said 'none at h^1'): piece 3 is missing, Z_0 != X_{H,G}; the word
+    does not integrate this system at all, so it is refused up front (issue 10, item 1), never answered."""
+    with pytest.raises(InconsistentCoefficientsError, match=r"never applies piece\(s\) \[3\]"):
+        shadow_hamiltonians(model("ho3"), "12", 1)
 
 
 # -- smooth, not polynomial: the issue's example --------------------------------------------------------------

@@ -376,14 +376,6 @@ def decide(result, params=None, points=None, orbits: int = DEFAULT_ORBITS, measu
         pts = np.asarray(points, dtype=float)
         if pts.ndim != 2 or pts.shape[1] != n or len(pts) > 64 or not np.all(np.isfinite(pts)):
             raise NambuBCHError(f"points must be at most 64 finite points of {n} coordinates, got shape {pts.shape}")
-    Z0 = [sympy.expand(c) for c in result.effective[0].to_sympy()]
-    X0 = [sympy.expand(c) for c in system.equations_of_motion()]
-    if any(sympy.expand(a - b) != 0 for a, b in zip(Z0, X0)):
-        missing = sorted({k for k in range(1, len(system.splitting) + 1)} - set(result.composition.pieces))
-        return Existence("none", False, 0, method="exact", params=params, names=names,
-                         reason=(f"the word is not consistent with X_{{H,G}}: its h^0 field {tuple(Z0)} is not "
-                                 f"{tuple(X0)}" + (f" (pieces {missing} are missing)" if missing else "") +
-                                 "; no shadow pair H + O(h), G + O(h) exists"))
     F = orbit_functions(system, gs, params, names)
     found = [orbit_average(F, x, rtol=rtol) for x in pts]
     closed = [o for o in found if o.closed]
