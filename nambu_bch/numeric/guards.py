@@ -138,27 +138,20 @@ def linear_part(program):
 
 
 def step_matrix(kernel, K, S):
-    """The matrix of the (affine) step restricted to the coordinates ``S`` (the constant part dropped)."""
-    import sympy
+    """The matrix of the (affine) step restricted to the coordinates ``S`` (the constant part dropped).
 
-    program = kernel.program
-    ks = [k for k, _ in program.constants]
-    subs = dict(zip(ks, [float(v) for v in K]))
-    index = {s: n for n, s in enumerate(S)}
-    M = np.eye(len(S))
-    for u in program.updates:
-        U = np.eye(len(S))
-        touched = False
-        for i, d in u.increments:
-            if i not in index:
-                continue
-            touched = True
-            for j in S:
-                coeff = float(sympy.diff(d, program.state[j]).xreplace(subs))
-                U[index[i], index[j]] += coeff
-        if touched:
-            M = U @ M
-    return M
+    Measured on the kernel itself (no sympy): column ``j`` is ``Phi(e_j) - Phi(0)`` on ``S``, with
+    the other coordinates at 0.  The increments of ``S`` are affine in ``x_S`` alone
+    (:func:`linear_part`), so this is the exact product of the sub-flows' matrices up to rounding.
+    """
+    S = list(S)
+    N = kernel.N
+    X = np.zeros((N, len(S) + 1))
+    for col, i in enumerate(S):
+        X[i, col + 1] = 1.0
+    with np.errstate(all="ignore"):
+        kernel.run_batch(X, K, 1, 1, np.zeros((2, N, len(S) + 1)), backend="numpy")
+    return X[S, 1:] - X[S, :1]
 
 
 def check_stability(kernel, h, K, params=None):
@@ -175,7 +168,7 @@ def check_stability(kernel, h, K, params=None):
     ...
     nambu_bch.errors.UnstableStepError: h = 2.0 is outside the stability interval of 32123 on ho3 (omega*h = 2, must be < 2): ...
     """
-    S = linear_part(kernel.program)
+    S = kernel.linear
     if not S:
         return
     M = step_matrix(kernel, K, S)
@@ -205,12 +198,12 @@ def check_stability(kernel, h, K, params=None):
         values = parameter_values(kernel.system, params)
         omega = {p.name: v for p, v in values.items()}.get("omega")
         hint = f" (omega*h = {omega * float(h):.6g}, must be < 2)" if omega is not None else ""
-        raise UnstableStepError(f"h = {h!r} is outside the stability interval of {kernel.program.word} on "
-                                f"{kernel.program.system_name}{hint}: {reason}; take a smaller step")
+        raise UnstableStepError(f"h = {h!r} is outside the stability interval of {kernel.word} on "
+                                f"{kernel.system.name}{hint}: {reason}; take a smaller step")
 
 
 def _names(kernel, S):
-    return "(" + ", ".join(str(kernel.program.coordinates[i]) for i in S) + ")"
+    return "(" + ", ".join(str(kernel.system.coordinates[i]) for i in S) + ")"
 
 
 # -- float64 range -----------------------------------------------------------------------------------------
@@ -274,8 +267,8 @@ def check_range(kernel, x0, K, max_mpmath=64):
         limit = f"the largest float64 is {np.finfo(np.float64).max:.3g}" if big else f"the smallest normal float64 is {TINY:.3g}"
         where = f"from x0 = {X[:, b].tolist()}" if B > 1 else f"from x0 = {X[:, 0].tolist()}"
         raise NumericalRangeError(
-            f"one step of {kernel.program.word} on {kernel.program.system_name} {where} {kind} float64 in "
-            f"{kernel.program.coordinates[i]} (about {_fmt(value)}; {limit}); rescale the initial state or use dps=... (mpmath)"
+            f"one step of {kernel.word} on {kernel.system.name} {where} {kind} float64 in "
+            f"{kernel.system.coordinates[i]} (about {_fmt(value)}; {limit}); rescale the initial state or use dps=... (mpmath)"
         )
 
 

@@ -27,20 +27,24 @@ parameter value.
 
 from __future__ import annotations
 
-import importlib.util
+import hashlib
+import json
 import os
+import re
+import stat
 import sys
 import tempfile
 import time
+import types
 from functools import lru_cache
 from pathlib import Path
 
 import numpy as np
 
-from ..errors import InvalidRunError
+from ..errors import InvalidRunError, NumericalRangeError
 from ..integrators.composition import composition as make_composition
 from ..integrators.step import parameter_values
-from .codegen import python_source, source_hash, step_program
+from .codegen import TEMPLATE_VERSION, python_source, source_hash, step_program
 
 BACKENDS = ("auto", "numba", "numpy")
 #: States per chunk of a batch: the chunk's arrays stay in L1/L2 while all steps run.
@@ -49,28 +53,78 @@ NUMPY_CHUNK = 16384
 
 
 _CACHE_DIRS: dict = {}
+#: Why the cache is not where it was asked to be (empty when it is): ``{requested root: reason}``.
+CACHE_NOTES: dict = {}
 
 
 def cache_dir() -> Path:
-    """The kernel cache directory (``$NAMBU_BCH_CACHE/kernels`` or ``~/.cache/nambu_bch/kernels``)."""
+    """The kernel cache directory (``$NAMBU_BCH_CACHE/kernels`` or ``~/.cache/nambu_bch/kernels``).
+
+    Every directory of the cache (the root, ``kernels``, numba's ``kernels/__pycache__``) must be a
+    real directory (not a symlink) owned by the effective user and not writable by group or
+    others; one that is not is refused and a private fallback is used instead: the per-user
+    ``$TMPDIR/nambu_bch-<uid>`` if it passes the same checks, else a fresh ``mkdtemp`` directory
+    (mode 0700).  The reason is kept in :data:`CACHE_NOTES`.
+    """
     root = os.environ.get("NAMBU_BCH_CACHE") or os.path.join(os.path.expanduser("~"), ".cache", "nambu_bch")
     known = _CACHE_DIRS.get(root)
-    if known is not None and known.is_dir():
+    if known is not None and _secure(known) is None:
         return known
-    _CACHE_DIRS[root] = path = _usable_dir(Path(root) / "kernels")
+    _CACHE_DIRS[root] = path = _usable_dir(Path(root))
     return path
 
 
-def _usable_dir(path: Path) -> Path:
-    """``path`` created and writable, else a per-user directory under the system temp dir."""
+def _secure(path: Path):
+    """None if ``path`` is a directory we own that nobody else may write; else the reason (one phrase)."""
     try:
-        path.mkdir(parents=True, exist_ok=True)
-        probe = path / f".probe-{os.getpid()}"
+        st = os.lstat(path)
+    except OSError as exc:
+        return f"{path} is not accessible ({exc.strerror})"
+    if stat.S_ISLNK(st.st_mode):
+        return f"{path} is a symbolic link"
+    if not stat.S_ISDIR(st.st_mode):
+        return f"{path} is not a directory"
+    if hasattr(os, "geteuid") and st.st_uid != os.geteuid():
+        return f"{path} is owned by uid {st.st_uid}, not by this user ({os.geteuid()})"
+    if st.st_mode & (stat.S_IWGRP | stat.S_IWOTH):
+        return f"{path} is writable by group or others (mode {stat.S_IMODE(st.st_mode):o})"
+    return None
+
+
+def _prepare(root: Path):
+    """``root/kernels`` with every level created (mode 0700) and checked; the kernels dir or a reason."""
+    levels = [root, root / "kernels", root / "kernels" / "__pycache__"]
+    for level in levels:
+        try:
+            level.mkdir(mode=0o700, parents=True, exist_ok=True)
+        except OSError as exc:
+            return None, f"cannot create {level} ({exc.strerror})"
+        reason = _secure(level)
+        if reason:
+            return None, reason
+    probe = levels[1] / f".probe-{os.getpid()}"
+    try:
         probe.write_text("")
         probe.unlink()
-    except OSError:
-        path = Path(tempfile.gettempdir()) / f"nambu_bch-{os.getuid() if hasattr(os, 'getuid') else 'user'}" / "kernels"
-        path.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        return None, f"{levels[1]} is not writable ({exc.strerror})"
+    return levels[1], None
+
+
+def _usable_dir(root: Path) -> Path:
+    """``root/kernels`` if safe, else the per-user temp dir if safe, else a fresh private temp dir."""
+    path, reason = _prepare(root)
+    if path is not None:
+        return path
+    CACHE_NOTES[str(root)] = reason
+    uid = os.geteuid() if hasattr(os, "geteuid") else "user"
+    path, reason2 = _prepare(Path(tempfile.gettempdir()) / f"nambu_bch-{uid}")
+    if path is not None:
+        return path
+    CACHE_NOTES[str(root)] = f"{reason}; {reason2}"
+    path, reason3 = _prepare(Path(tempfile.mkdtemp(prefix="nambu_bch-")))
+    if path is None:  # pragma: no cover - a fresh mkdtemp directory is always ours
+        raise InvalidRunError(f"no safe kernel cache directory: {reason}; {reason2}; {reason3}")
     return path
 
 
@@ -97,23 +151,72 @@ def resolve_backend(backend: str = "auto") -> str:
     return backend
 
 
-def _write_once(path: Path, text: str):
-    """Create ``path`` with ``text`` atomically unless it exists (keeps its mtime, which numba's cache checks)."""
-    if path.exists():
-        return
-    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=".tmp-", suffix=".py")
-    with os.fdopen(fd, "w") as fh:
-        fh.write(text)
+#: Largest cache file read back (a kernel module is a few kB; anything bigger is not ours).
+MAX_CACHE_FILE = 4 * 2**20
+_MODULE_NAME = re.compile(r"nambu_bch_kernel_[0-9a-f]{20}")
+_INDEX_FIELDS = {"template": str, "module": str, "sha256": str, "N": int, "n_constants": int,
+                 "n_parameters": int, "linear": list}
+_FUNCTIONS = ("constants", "run", "run_kahan", "run_batch", "run_batch_kahan", "run_numpy", "run_numpy_kahan")
+
+
+def input_key(system, comp) -> str:
+    """The digest of everything a kernel is generated from (exact inputs, not names).
+
+    The coordinates, parameters, each piece's vector field and moving coordinates (``srepr``),
+    the composition's pieces and exact coefficients, and the template version.  Equal keys
+    mean equal generated source, so a cached source can be used without sympy.
+    """
+    import sympy
+
+    parts = [TEMPLATE_VERSION, sympy.srepr(tuple(system.coordinates)), sympy.srepr(tuple(system.parameters))]
+    for piece in system.splitting:
+        parts.append(sympy.srepr(tuple(piece.field.to_sympy())) + repr(tuple(piece.moving)))
+    parts.append(repr([(int(k), sympy.srepr(c)) for k, c in comp.factors()]))
+    return hashlib.sha256("\x1f".join(parts).encode()).hexdigest()[:32]
+
+
+def _read_small(path: Path) -> bytes:
+    """The bytes of a regular file we own (no symlink), at most :data:`MAX_CACHE_FILE`; OSError otherwise."""
+    fd = os.open(path, os.O_RDONLY | getattr(os, "O_NOFOLLOW", 0))
+    with os.fdopen(fd, "rb") as fh:
+        st = os.fstat(fh.fileno())
+        if not stat.S_ISREG(st.st_mode) or (hasattr(os, "geteuid") and st.st_uid != os.geteuid()) \
+                or st.st_mode & (stat.S_IWGRP | stat.S_IWOTH):
+            raise OSError(f"{path} is not a private regular file")
+        data = fh.read(MAX_CACHE_FILE + 1)
+    if len(data) > MAX_CACHE_FILE:
+        raise OSError(f"{path} is too large")
+    return data
+
+
+def _write_file(path: Path, data: bytes):
+    """Make ``path`` hold ``data``: kept untouched if it already does (numba's cache checks its mtime),
+    else replaced atomically (a private temp file, mode 0600, then ``os.replace``)."""
     try:
-        os.link(tmp, path)
-    except FileExistsError:
+        if _read_small(path) == data:
+            return
+    except OSError:
         pass
-    except OSError:  # no hard links on this file system
-        if not path.exists():
-            os.replace(tmp, path)
+    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=".tmp-")
+    try:
+        with os.fdopen(fd, "wb") as fh:
+            fh.write(data)
+        os.replace(tmp, path)
     finally:
         if os.path.exists(tmp):
             os.unlink(tmp)
+
+
+def _load_module(name: str, path: Path, source: str):
+    """Execute ``source`` (already verified) as module ``name`` whose functions report ``path`` as their file."""
+    module = types.ModuleType(name)
+    module.__file__ = str(path)
+    exec(compile(source, str(path), "exec"), module.__dict__)  # noqa: S102 - our own generated, digest-checked source
+    missing = [f for f in _FUNCTIONS if not callable(module.__dict__.get(f))]
+    if missing:
+        raise ValueError(f"generated module lacks {missing}")
+    sys.modules[name] = module
+    return module
 
 
 class Kernel:
@@ -131,33 +234,91 @@ class Kernel:
     def __init__(self, system, comp):
         self.system = system
         self.composition = comp
-        self.program = step_program(system, comp)
-        self.source = python_source(self.program)
-        key = source_hash(self.source)
-        self.path = cache_dir() / f"nambu_bch_kernel_{key}.py"
-        _write_once(self.path, self.source)
-        name = f"nambu_bch_kernel_{key}"
-        spec = importlib.util.spec_from_file_location(name, self.path)
-        module = importlib.util.module_from_spec(spec)
-        sys.modules.setdefault(name, module)
-        spec.loader.exec_module(module)
-        self.module = module
+        self.word = str(comp)
+        self.N = system.N
+        self.key = input_key(system, comp)
+        self.directory = cache_dir()
+        self.index_path = self.directory / f"nambu_bch_index_{self.key}.json"
+        self.from_cache = self._load_cached()
+        if not self.from_cache:
+            self._generate()
         self._constants = {}
         self._jitted = {}
         self.compile_seconds = {}
 
+    def _load_cached(self) -> bool:
+        """Use the cached source if its index is intact and the file matches the recorded digest."""
+        try:
+            meta = json.loads(_read_small(self.index_path).decode("utf-8"))
+            if not isinstance(meta, dict) or any(not isinstance(meta.get(k), t) for k, t in _INDEX_FIELDS.items()):
+                return False
+            if meta["template"] != TEMPLATE_VERSION or not _MODULE_NAME.fullmatch(meta["module"]):
+                return False
+            if meta["N"] != self.N or meta["n_parameters"] != len(self.system.parameters):
+                return False
+            path = self.directory / f"{meta['module']}.py"
+            data = _read_small(path)
+            if hashlib.sha256(data).hexdigest() != meta["sha256"]:
+                return False
+            source = data.decode("utf-8")
+            if f"nambu_bch_kernel_{source_hash(source)}" != meta["module"]:
+                return False
+            linear = tuple(int(i) for i in meta["linear"] if isinstance(i, int) and 0 <= i < self.N)
+            module = _load_module(meta["module"], path, source)
+        except (OSError, ValueError, SyntaxError, UnicodeDecodeError):  # absent, corrupt or modified: regenerate
+            return False
+        self.source, self.path, self.module = source, path, module
+        self.n_constants, self.linear = meta["n_constants"], linear
+        return True
+
+    def _generate(self):
+        """Generate the source from the exact sub-flows (sympy), write it and its index, load it."""
+        from .guards import linear_part
+
+        program = self.program
+        self.source = python_source(program)
+        name = f"nambu_bch_kernel_{source_hash(self.source)}"
+        self.path = self.directory / f"{name}.py"
+        data = self.source.encode("utf-8")
+        self.n_constants, self.linear = len(program.constants), tuple(linear_part(program))
+        meta = {"template": TEMPLATE_VERSION, "module": name, "sha256": hashlib.sha256(data).hexdigest(),
+                "N": self.N, "n_constants": self.n_constants, "n_parameters": len(self.system.parameters),
+                "linear": list(self.linear)}
+        try:
+            _write_file(self.path, data)
+            _write_file(self.index_path, json.dumps(meta, sort_keys=True).encode("utf-8"))
+        except OSError:  # a read-only cache still runs: the module below comes from memory, not the file
+            pass
+        self.module = _load_module(name, self.path, self.source)
+
+    @property
+    def program(self):
+        """The :class:`~nambu_bch.numeric.codegen.StepProgram` (derived with sympy on first access)."""
+        return step_program(self.system, self.composition)
+
     def __repr__(self):
-        return f"Kernel({self.program.system_name!r}, {self.program.word!r}, {self.path.name})"
+        return f"Kernel({self.system.name!r}, {self.word!r}, {self.path.name})"
 
     # -- constants ----------------------------------------------------------------------------------
     def constants(self, h, params=None) -> np.ndarray:
-        """``K = [k_0(h, params), ...]`` as float64 (computed once per run, in Python)."""
+        """``K = [k_0(h, params), ...]`` as float64 (computed once per run, in Python, by the generated
+        ``constants``); a coefficient that is not a finite float64 raises :class:`NumericalRangeError`."""
         values = parameter_values(self.system, params)
-        f = self._constants.get("math")
-        if f is None:
-            f = self._constants["math"] = self.program.constant_function("math")
-        K = [float(v) for v in f(float(h), *(values[p] for p in self.program.parameters))]
-        return np.array(K, dtype=np.float64)
+        P = [values[p] for p in self.system.parameters]
+        given = ", ".join(f"{p} = {v:g}" for p, v in values.items())
+        where = f"h = {float(h):g}" + (f" with {given}" if given else "")
+        try:
+            K = np.array([float(v) for v in self.module.constants(float(h), P)], dtype=np.float64)
+        except ZeroDivisionError:
+            raise NumericalRangeError(f"{where}: a coefficient of the step divides by zero; "
+                                      "give non-zero values to the parameters in denominators") from None
+        except (OverflowError, ValueError) as exc:
+            raise NumericalRangeError(f"{where}: a coefficient of the step is out of the float64 range ({exc}); "
+                                      "rescale the parameters or the step") from None
+        if not np.all(np.isfinite(K)):
+            raise NumericalRangeError(f"{where}: a coefficient of the step overflows float64; "
+                                      "rescale the parameters or the step")
+        return K
 
     # -- functions ----------------------------------------------------------------------------------
     def function(self, name: str, backend: str = "numba"):
@@ -180,9 +341,21 @@ class Kernel:
         if name in self.compile_seconds:
             return self.compile_seconds[name]
         fn = self.function(name, "numba")
-        N = self.program.N
-        K = np.zeros(max(1, len(self.program.constants)))
         start = time.perf_counter()
+        try:
+            self._first_call(fn, kahan, batch)
+        except Exception:  # noqa: BLE001 - a corrupt or truncated numba cache entry (.nbi/.nbc): regenerate it
+            self._purge_numba_cache(fn)
+            self._jitted.pop(name, None)
+            fn = self.function(name, "numba")
+            start = time.perf_counter()
+            self._first_call(fn, kahan, batch)
+        self.compile_seconds[name] = time.perf_counter() - start
+        return self.compile_seconds[name]
+
+    def _first_call(self, fn, kahan, batch):
+        N = self.N
+        K = np.zeros(max(1, self.n_constants))
         if batch:
             X = np.zeros((N, 1))
             out = np.zeros((2, N, 1))
@@ -193,8 +366,21 @@ class Kernel:
             out = np.zeros((2, N))
             args = (x, np.zeros(N)) if kahan else (x,)
             fn(*args, K, 1, 1, out)
-        self.compile_seconds[name] = time.perf_counter() - start
-        return self.compile_seconds[name]
+
+    def _purge_numba_cache(self, fn):
+        """Delete numba's cache files of this kernel module (``<module>.*.nbi`` / ``.nbc``)."""
+        where = getattr(getattr(fn, "_cache", None), "_cache_path", None) or str(self.directory / "__pycache__")
+        stem = self.path.stem + "."
+        try:
+            names = os.listdir(where)
+        except OSError:
+            return
+        for entry in names:
+            if entry.startswith(stem) and entry.endswith((".nbi", ".nbc")):
+                try:
+                    os.unlink(os.path.join(where, entry))
+                except OSError:
+                    pass
 
     # -- running ------------------------------------------------------------------------------------
     def run(self, x, K, steps, every, out, *, kahan=False, comp=None, backend="numba") -> int:
