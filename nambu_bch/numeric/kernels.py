@@ -74,7 +74,12 @@ def cache_dir() -> Path:
     return path
 
 
-def _secure(path: Path):
+def _euid():
+    """The effective user id (None where the platform has none)."""
+    return os.geteuid() if hasattr(os, "geteuid") else None
+
+
+def _secure(path: Path, check_owner=True):
     """None if ``path`` is a directory we own that nobody else may write; else the reason (one phrase)."""
     try:
         st = os.lstat(path)
@@ -84,22 +89,25 @@ def _secure(path: Path):
         return f"{path} is a symbolic link"
     if not stat.S_ISDIR(st.st_mode):
         return f"{path} is not a directory"
-    if hasattr(os, "geteuid") and st.st_uid != os.geteuid():
-        return f"{path} is owned by uid {st.st_uid}, not by this user ({os.geteuid()})"
+    if check_owner and _euid() is not None and st.st_uid != _euid():
+        return f"{path} is owned by uid {st.st_uid}, not by this user ({_euid()})"
     if st.st_mode & (stat.S_IWGRP | stat.S_IWOTH):
         return f"{path} is writable by group or others (mode {stat.S_IMODE(st.st_mode):o})"
     return None
 
 
-def _prepare(root: Path):
-    """``root/kernels`` with every level created (mode 0700) and checked; the kernels dir or a reason."""
+def _prepare(root: Path, fresh=False):
+    """``root/kernels`` with every level created (mode 0700) and checked; the kernels dir or a reason.
+
+    ``fresh``: ``root`` was just made by ``mkdtemp`` (ours by construction), so ownership is not re-checked.
+    """
     levels = [root, root / "kernels", root / "kernels" / "__pycache__"]
     for level in levels:
         try:
             level.mkdir(mode=0o700, parents=True, exist_ok=True)
         except OSError as exc:
             return None, f"cannot create {level} ({exc.strerror})"
-        reason = _secure(level)
+        reason = _secure(level, check_owner=not fresh)
         if reason:
             return None, reason
     probe = levels[1] / f".probe-{os.getpid()}"
@@ -117,12 +125,12 @@ def _usable_dir(root: Path) -> Path:
     if path is not None:
         return path
     CACHE_NOTES[str(root)] = reason
-    uid = os.geteuid() if hasattr(os, "geteuid") else "user"
+    uid = _euid() if _euid() is not None else "user"
     path, reason2 = _prepare(Path(tempfile.gettempdir()) / f"nambu_bch-{uid}")
     if path is not None:
         return path
     CACHE_NOTES[str(root)] = f"{reason}; {reason2}"
-    path, reason3 = _prepare(Path(tempfile.mkdtemp(prefix="nambu_bch-")))
+    path, reason3 = _prepare(Path(tempfile.mkdtemp(prefix="nambu_bch-")), fresh=True)
     if path is None:  # pragma: no cover - a fresh mkdtemp directory is always ours
         raise InvalidRunError(f"no safe kernel cache directory: {reason}; {reason2}; {reason3}")
     return path
@@ -180,8 +188,7 @@ def _read_small(path: Path) -> bytes:
     fd = os.open(path, os.O_RDONLY | getattr(os, "O_NOFOLLOW", 0))
     with os.fdopen(fd, "rb") as fh:
         st = os.fstat(fh.fileno())
-        if not stat.S_ISREG(st.st_mode) or (hasattr(os, "geteuid") and st.st_uid != os.geteuid()) \
-                or st.st_mode & (stat.S_IWGRP | stat.S_IWOTH):
+        if not stat.S_ISREG(st.st_mode) or st.st_mode & (stat.S_IWGRP | stat.S_IWOTH):
             raise OSError(f"{path} is not a private regular file")
         data = fh.read(MAX_CACHE_FILE + 1)
     if len(data) > MAX_CACHE_FILE:
