@@ -104,13 +104,14 @@ def test_hostile_name_and_word_execute_nothing(fresh_cache, tmp_path):
         kern = K.kernel(system, "121")
         assert payload not in kern.source and "PWNED" not in kern.source
         iterate(system, "121", 0.1, 10, [1.0, 0.0], backend="numpy")
-    word = f"[(1, 1/2), (2, 1), (1, 1/2)]  # open({str(marker)!r}, 'w')"
+    word = f"1:1/2,2:1,1:1/2 # __import__('os').system('touch {marker}')"  # the comment survived the parser
     try:
         kern = K.kernel(base, word)
     except NambuBCHError:
         kern = None
     if kern is not None:
         assert "PWNED" not in kern.source and "#" not in kern.source
+        iterate(base, word, 0.1, 10, [1.0, 0.0], backend="numpy")
     assert not marker.exists()
 
 
