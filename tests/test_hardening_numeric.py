@@ -401,3 +401,57 @@ def test_check_label_names_the_difference():
     """Issue 16 item 7: check prints max |x1^o - x1|, not max |x1_o|."""
     text = str(check("ho3", "32123", 0.1, 50, [1.0, 1.0, 1.0], include=("H", "o")))
     assert "max |x1^o - x1|" in text and "x1_o" not in text and "max |H(t) - H(0)|" in text
+
+
+# -- item 7 (plot) and issue 16 item 6: figures as a set, returned, streamed ----------------------------------
+
+
+def test_paper_figures_returns_figures_with_parameters(tmp_path):
+    """Issue 16 item 6: the matplotlib figures come back with the paths; titles show h, the parameters, x(0)."""
+    from matplotlib.figure import Figure
+
+    from nambu_bch.numeric.figures import paper_figures
+
+    fs = paper_figures(tmp_path, t_short=5.0, t_long=200.0, every_long=10, dpi=40, params={"omega": 0.5})
+    assert sorted(fs) == sorted(fs.figures) == ["fig1", "fig2", "fig3", "fig4"]
+    assert all(isinstance(f, Figure) for f in fs.figures.values()) and all(p.is_file() for p in fs.values())
+    title = fs.figures["fig1"].axes[0].get_title()
+    assert "h = 0.1" in title and r"\omega = 0.5" in title and "x(0) = (1, 1, 1)" in title
+    drawn = paper_figures(None, t_short=5.0, t_long=200.0, every_long=10)
+    assert dict(drawn) == {} and len(drawn.figures) == 4
+
+
+def test_paper_figures_all_or_nothing(tmp_path):
+    """Item 7: a figure that cannot be written leaves every existing file as it was and no temp file."""
+    from nambu_bch.numeric.figures import paper_figures
+
+    (tmp_path / "fig1.png").write_bytes(b"old figure 1")
+    (tmp_path / "fig3.png").mkdir()  # os.replace onto a directory fails
+    with pytest.raises(NambuBCHError, match="no figure was written"):
+        paper_figures(tmp_path, t_short=5.0, t_long=200.0, every_long=10, dpi=40)
+    assert (tmp_path / "fig1.png").read_bytes() == b"old figure 1"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["fig1.png", "fig3.png"]
+
+
+def test_cli_plot_file_error_one_line(tmp_path):
+    (tmp_path / "fig2.png").mkdir()
+    proc = _cli("plot", "--outdir", str(tmp_path), "--steps", "2000", "--every", "10", "--short-steps", "50")
+    assert proc.returncode == 2 and len(proc.stderr.strip().splitlines()) == 1 and "Traceback" not in proc.stderr
+    assert not (tmp_path / "fig1.png").exists()
+    helptext = _cli("plot", "--help").stdout
+    assert "32123 on ho3" in " ".join(helptext.split())
+
+
+def test_long_plot_is_an_envelope_of_the_run(monkeypatch):
+    """Item 9 (plot): beyond MAX_POINTS a curve is the per-bucket min/max; it keeps the run's extremes exactly."""
+    from nambu_bch.numeric import figures
+
+    monkeypatch.setattr(figures, "MAX_POINTS", 400)
+    steps = 20_000
+    env, size = figures._stream(model("ho3"), "32123", 0.1, steps, 1, (1.0, 1.0, 1.0), None, kinds="o")
+    t, y = env["o"].arrays()
+    assert size > 1 and len(y) <= 2 * (400 // 2) + 2
+    sol = nambu_bch.exact.modified_solution(model("ho3"), "32123", "o").numeric(h=0.1)
+    run = iterate("ho3", "32123", 0.1, steps, [1.0, 1.0, 1.0])
+    diff = sol(0.1 * np.arange(steps + 1), np.ones(3))[2] - run[:, 2]
+    assert y.max() == diff.max() and y.min() == diff.min() and env["o"].max_abs == np.abs(diff).max()
