@@ -1,4 +1,4 @@
-"""Helper of bench_iterate.py: the C reference loop, generated from the same step program and compiled with gcc -O2.
+"""Helper of bench_iterate.py: the C reference loop, generated from the same step program (built -O3 -march=native by the benchmark).
 
 The C source comes from :func:`nambu_bch.numeric.codegen.c_source` (sympy's C99 printer on the
 hoisted increments), so it performs the same floating-point operations in the same order as the

@@ -345,6 +345,7 @@ _atan, _asin, _acos, _isfinite = math.atan, math.asin, math.acos, math.isfinite
 _np_exp, _np_expm1, _np_log, _np_sqrt = np.exp, np.expm1, np.log, np.sqrt
 _np_sin, _np_cos, _np_tan, _np_sinh, _np_cosh, _np_tanh = np.sin, np.cos, np.tan, np.sinh, np.cosh, np.tanh
 _np_atan, _np_asin, _np_acos = np.arctan, np.arcsin, np.arccos
+_INF, _MAX, _TINY = math.inf, 1.7976931348623157e308, 2.2250738585072014e-308
 '''
 
 
@@ -455,7 +456,36 @@ def {name}({args}):
 {_indent(vstore, 8)}
     return steps
 """)
+    src.append(_SCAN)
     return "\n".join(src)
+
+
+#: One pass over a batch ``X`` (N, B): what the input guards need, compiled with the kernel.
+_SCAN = """
+def scan(X, res):
+    B = X.shape[1]
+    big = np.zeros(B)
+    prod = np.ones(B)
+    small = np.full(B, _INF)
+    nonfinite = 0
+    subnormal = 0
+    for i in range(X.shape[0]):
+        for b in range(B):
+            a = abs(X[i, b])
+            nonfinite += 0 if a <= _MAX else 1
+            subnormal += 1 if (a < _TINY and a > 0.0) else 0
+            big[b] = max(big[b], a)
+            prod[b] *= a
+            small[b] = min(small[b], a if a > 0.0 else _INF)
+    res[0] = nonfinite
+    res[1] = subnormal
+    res[2] = np.argmax(big)
+    res[3] = np.argmin(big)
+    res[4] = np.argmax(prod)
+    res[5] = np.argmin(prod)
+    res[6] = np.argmin(small)
+    return nonfinite + subnormal
+"""
 
 
 def mpmath_source(program: StepProgram) -> str:

@@ -28,7 +28,7 @@ import numpy as np
 
 from ..errors import InvalidRunError, InvalidSystemError, NumericalRangeError
 from ..systems import System, model
-from .guards import check_inputs, check_range, check_result, check_stability
+from .guards import check_count, check_inputs, check_range, check_result, check_stability
 from .kernels import kernel, resolve_backend
 from .precision import check_dps, run_mpmath
 from .progress import Progress, progress_wanted
@@ -150,7 +150,7 @@ def iterate(system, word, h, steps, x0, params=None, every=1, *, kahan=False, dp
         raise InvalidRunError(f"{count} samples of {system.N} x {batch} states need {nbytes / 2**30:.1f} GiB "
                               f"(limit {MAX_SAMPLE_BYTES / 2**30:.0f} GiB); sample less often (larger every)")
     out = np.empty((count, system.N) if single else (count, system.N, batch), dtype=np.float64)
-    state = np.array(X, dtype=np.float64, order="C")
+    state = X  # check_inputs made a fresh C-ordered float64 copy: advanced in place
     out[0] = state
     comp = np.zeros_like(state) if kahan else None
 
@@ -197,22 +197,34 @@ class _Run:
 
 def _prepare(system, kern, h, steps, every, x0, params, backend, chunk, check_stable) -> _Run:
     """Validate a float64 run, choose the backend, compute the constants, check stability and range."""
-    h, steps, every, X, _ = check_inputs(system, h, steps, every, x0, params)
     be = resolve_backend(backend)
+    steps = check_count(steps, "steps", 0)
+    shape = np.shape(x0)
     if backend == "auto" and be == "numba" and not kern.compile_seconds and "numba" not in sys.modules:
-        small = steps <= SMALL_RUN_STEPS if X.ndim == 1 else (steps <= SMALL_BATCH_STEPS and X.shape[1] <= SMALL_BATCH_STATES)
+        small = (steps <= SMALL_RUN_STEPS if len(shape) == 1 else
+                 (steps <= SMALL_BATCH_STEPS and len(shape) == 2 and shape[1] <= SMALL_BATCH_STATES))
         if small:
             be = "numpy"
+    # a large batch on numba: one compiled pass finds non-finite, subnormal and extreme states
+    scanned = {}
+    if be == "numba" and len(shape) == 2 and shape[1] > SCAN_BATCH:
+        def scan(arr):
+            scanned["result"] = kern.scan(arr)
+            return scanned["result"]
+    else:
+        scan = None
+    h, steps, every, X, _ = check_inputs(system, h, steps, every, x0, params, scan=scan)
     if chunk is not None:
-        from .guards import check_count
-
         chunk = check_count(chunk, "chunk", 1)
     K = kern.constants(float(h), params)
     if check_stable:
         check_stability(kern, h, K, params)
-    check_range(kern, X, K)
+    check_range(kern, X, K, columns=scanned["result"][2] if scanned else None)
     return _Run(h=h, steps=steps, every=every, X=X, backend=be, K=K, chunk=chunk)
 
+
+#: Batches with more states than this are scanned by the compiled kernel (one pass) instead of numpy.
+SCAN_BATCH = 4096
 
 #: Samples per block of :func:`iterate_chunks` (a few MB per block for N = 3).
 CHUNK_SAMPLES = 1 << 16
