@@ -455,3 +455,30 @@ def test_long_plot_is_an_envelope_of_the_run(monkeypatch):
     run = iterate("ho3", "32123", 0.1, steps, [1.0, 1.0, 1.0])
     diff = sol(0.1 * np.arange(steps + 1), np.ones(3))[2] - run[:, 2]
     assert y.max() == diff.max() and y.min() == diff.min() and env["o"].max_abs == np.abs(diff).max()
+
+
+# -- issue 14: the batch guards in one compiled pass ------------------------------------------------------------
+
+
+def test_compiled_scan_agrees_with_numpy_guards():
+    """The kernel's one-pass scan finds the same extreme states as the numpy extreme_states, and the
+    same bad inputs (non-finite, subnormal) as check_inputs' numpy passes."""
+    pytest.importorskip("numba")
+    from nambu_bch.numeric.guards import extreme_states
+
+    kern = K.kernel(model("ho3"), "32123")
+    rng = np.random.default_rng(3)
+    X = rng.uniform(0.5, 1.5, size=(3, 6000)) * 10.0 ** rng.integers(-100, 100, size=(3, 6000))
+    X[2, 17] = 0.0
+    bad, sub, cols = kern.scan(X)
+    assert (bad, sub) == (0, 0) and set(cols) == set(extreme_states(X))
+    for value, phrase in [(np.nan, "non-finite"), (np.inf, "non-finite"), (1e-310, "underflows")]:
+        Y = np.ones((3, 6000))
+        Y[1, 4321] = value
+        assert sum(kern.scan(Y)[:2]) == 1
+        with pytest.raises(NumericalRangeError, match=phrase):
+            iterate("ho3", "32123", 0.1, 5, Y, backend="numba")
+    Y = np.ones((3, 6000))
+    Y[1, 4000] = 1e200  # x3 += k x1 x2 ... overflows in one step: found among the scanned extremes
+    with pytest.raises(NumericalRangeError, match="overflows float64"):
+        iterate("ho3", "32123", 0.1, 5, Y, backend="numba")
