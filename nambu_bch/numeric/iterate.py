@@ -26,7 +26,7 @@ import sys
 
 import numpy as np
 
-from ..errors import InvalidRunError, InvalidSystemError, NumericalRangeError
+from ..errors import InvalidRunError, InvalidSystemError
 from ..systems import System, model
 from .guards import check_count, check_inputs, check_range, check_result, check_stability
 from .kernels import kernel, resolve_backend

@@ -7,9 +7,27 @@ directory under a hash of its source, imported, and its loop functions are
 compiled with ``numba.njit(cache=True)`` on first use -- so a second process
 loads the machine code from disk instead of compiling again.
 
-Cache directory: ``$NAMBU_BCH_CACHE`` if set, else ``~/.cache/nambu_bch``
-(a temporary directory if neither is writable); kernels live in
-``<cache>/kernels``.  Deleting it is always safe.
+Cache directory: ``$NAMBU_BCH_CACHE`` if set, else ``~/.cache/nambu_bch``;
+kernels live in ``<cache>/kernels``.  Deleting it is always safe.
+
+What is cached, and how it is trusted (issue 10 item 6, issue 14):
+
+* ``nambu_bch_index_<key>.json`` -- ``key`` is :func:`input_key`, a digest of the
+  exact inputs (fields of the pieces, exact coefficients, the generator's own code);
+  the index records the module name, the SHA-256 of its source and the small
+  metadata a run needs (number of constants, the linear coordinates of the
+  stability check), so a cached kernel runs without sympy;
+* ``nambu_bch_kernel_<hash>.py`` -- the generated source; before it is executed
+  its bytes are checked against the recorded SHA-256 (a modified, truncated or
+  garbage file is regenerated), and the verified bytes themselves are compiled,
+  so the file is never read twice;
+* ``__pycache__/*.nbi, *.nbc`` -- numba's machine code; an entry numba cannot
+  load is deleted and compiled again.
+
+Every directory of the cache must be a real directory owned by the effective
+user and not writable by group or others (:func:`cache_dir`), otherwise a
+private fallback is used, so another local user cannot plant a kernel.  The
+generated source contains no user text at all (:mod:`~nambu_bch.numeric.codegen`).
 
 Backends:
 
