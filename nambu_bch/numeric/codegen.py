@@ -54,18 +54,33 @@ from ..integrators.flows import TIME, exact_flow
 STEP = sympy.Symbol("h")
 
 #: Bump when the generated source changes meaning (part of the cache key).
-TEMPLATE_VERSION = "2"
+TEMPLATE_VERSION = "3"
 
 _FUNCTIONS = ("exp", "expm1", "log", "sin", "cos", "tan", "sinh", "cosh", "tanh", "sqrt", "atan", "asin", "acos")
 
 
 @dataclass(frozen=True)
 class Update:
-    """One sub-flow ``exp(c h X_k)`` as increments ``((i, d_i), ...)`` in the state symbols and constants."""
+    """One sub-flow ``exp(c h X_k)`` as increments ``((i, d_i), ...)`` in the state symbols and constants.
+
+    ``pairs`` are shared exponentials ``(u_j, e_j, f_j, u)``: when a sub-flow needs both
+    ``expm1(u)`` and ``expm1(-u)`` (a Lotka-Volterra piece scales one coordinate by ``e^u`` and
+    another by ``e^-u``) one ``expm1`` serves both: ``e = expm1(|u|)``, ``f = -e / (1 + e)``
+    ``= expm1(-|u|)`` (no cancellation, since ``1 + e >= 1``), swapped when ``u < 0``; the
+    increments then use ``e_j = expm1(u)`` and ``f_j = expm1(-u)``.
+    """
 
     piece: int
     coefficient: sympy.Expr
     increments: tuple
+    pairs: tuple = ()
+
+    def expanded(self) -> tuple:
+        """The increments with the shared exponentials written out (``e_j -> expm1(u)``, ``f_j -> expm1(-u)``)."""
+        back = {}
+        for _, e, f, u in self.pairs:
+            back[e], back[f] = expm1(u), expm1(-u)
+        return tuple((i, d.xreplace(back)) for i, d in self.increments)
 
 
 @dataclass(frozen=True, eq=False)
@@ -135,9 +150,10 @@ def _step_program(system, comp) -> StepProgram:
     to_state = dict(zip(coords, state))
     hoister = _Hoister(state)
     updates = []
+    n_pairs = 0
     for k, c in comp.factors():
         flow = exact_flow(system.splitting[k], coords)
-        incs = []
+        raw = []
         for i, (x, e) in enumerate(zip(coords, flow.expressions)):
             d = sympy.sympify(e) - x
             if d == 0:
@@ -146,13 +162,40 @@ def _step_program(system, comp) -> StepProgram:
             stray = d.free_symbols - set(coords) - set(system.parameters) - {STEP}
             if stray:
                 raise InvalidSystemError(f"the flow of piece {k} of {system.name} uses unknown symbols {sorted(map(str, stray))}")
-            incs.append((i, hoister.polynomial(d.xreplace(to_state))))
+            raw.append((i, d.xreplace(to_state)))
+        raw, found = _pair_expm1(raw, n_pairs)
+        n_pairs += len(found)
+        pairs = []
+        for u_sym, e_sym, f_sym, u in found:
+            hoister.state |= {e_sym, f_sym}
+            pairs.append((u_sym, e_sym, f_sym, hoister.polynomial(u)))
+        incs = [(i, hoister.polynomial(d)) for i, d in raw]
         if incs:
-            updates.append(Update(k, c, tuple(incs)))
+            updates.append(Update(k, c, tuple(incs), tuple(pairs)))
     program = StepProgram(system.name, str(comp), len(coords), coords, tuple(system.parameters), state,
                           tuple(hoister.constants), tuple(updates))
     _validate(program, system)
     return program
+
+
+def _pair_expm1(raw, start):
+    """Share ``expm1(u)`` and ``expm1(-u)`` within one sub-flow: ``(increments, [(u_j, e_j, f_j, u), ...])``."""
+    args = []
+    for _, d in raw:
+        for a in d.atoms(expm1):
+            if a.args[0] not in args:
+                args.append(a.args[0])
+    found, subs = [], {}
+    for a in args:
+        if a.could_extract_minus_sign() or -a not in args or expm1(a) in subs:
+            continue
+        j = start + len(found)
+        u_sym, e_sym, f_sym = (sympy.Symbol(f"{p}{j}", nambu_internal=True) for p in "uef")
+        subs[expm1(a)], subs[expm1(-a)] = e_sym, f_sym
+        found.append((u_sym, e_sym, f_sym, a))
+    if not found:
+        return raw, []
+    return [(i, d.xreplace(subs)) for i, d in raw], found
 
 
 #: The only functions generated source may call (each printed as ``_<name>`` / ``_np_<name>`` / ``_mp_<name>``).
@@ -168,6 +211,8 @@ def _validate(program, system):
     (issue 10, item 5): parameters enter through ``P[i]``, coordinates through ``x[i]``.
     """
     allowed = set(program.state) | {k for k, _ in program.constants}
+    for u in program.updates:
+        allowed |= {sym for pair in u.pairs for sym in pair[1:3]}
     params = set(program.parameters) | {STEP}
     singular = (sympy.zoo, sympy.nan, sympy.oo, -sympy.oo)
 
@@ -185,6 +230,8 @@ def _validate(program, system):
     for u in program.updates:
         for _, d in u.increments:
             check(d, allowed, f"the flow of piece {u.piece}")
+        for pair in u.pairs:
+            check(pair[3], allowed, f"the flow of piece {u.piece}")
     for k, e in program.constants:
         check(e, params, f"the step coefficient {k}")
 
@@ -297,12 +344,27 @@ def print_c(expr) -> str:
 # -- loop bodies ----------------------------------------------------------------------------------------
 
 
-def body_lines(program: StepProgram, printer, kahan=False, c_syntax=False):
-    """Statements of one step, ``s_i`` / ``k_j`` / ``d_j`` / ``c_i`` named as in the generated kernels."""
+def body_lines(program: StepProgram, printer, kahan=False, c_syntax=False, vector=False, prefix="_"):
+    """Statements of one step, ``s_i`` / ``k_j`` / ``d_j`` / ``c_i`` named as in the generated kernels.
+
+    ``vector``: numpy arrays (the shared-exponential swap is a ``np.where``); ``prefix``: of the
+    function names (``_``, ``_np_``, ``_mp_``); ``c_syntax``: C99.
+    """
     end = ";" if c_syntax else ""
     decl = "double " if c_syntax else ""
     lines = []
     for u in program.updates:
+        for us, es, fs, ue in u.pairs:
+            if c_syntax:
+                lines += [f"double {us} = {printer(ue)};", f"double {es} = expm1(fabs({us}));",
+                          f"double {fs} = -{es} / (1.0 + {es});",
+                          f"if ({us} < 0) {{ double w_ = {es}; {es} = {fs}; {fs} = w_; }}"]
+            elif vector:
+                lines += [f"{us} = {printer(ue)}", f"{es} = {prefix}expm1(np.abs({us}))", f"{fs} = -{es} / (1.0 + {es})",
+                          f"{es}, {fs} = np.where({us} >= 0, {es}, {fs}), np.where({us} >= 0, {fs}, {es})"]
+            else:
+                lines += [f"{us} = {printer(ue)}", f"{es} = {prefix}expm1(abs({us}))", f"{fs} = -{es} / (1.0 + {es})",
+                          f"if {us} < 0: {es}, {fs} = {fs}, {es}"]
         names = []
         for j, (i, d) in enumerate(u.increments):
             lines.append(f"{decl}d{j} = {printer(d)}{end}")
@@ -323,7 +385,7 @@ def _c_scoped(program, lines, kahan):
     it = iter(lines)
     for u in program.updates:
         n = len(u.increments)
-        count = n + n * (4 if kahan else 1)
+        count = 4 * len(u.pairs) + n + n * (4 if kahan else 1)
         block = [next(it) for _ in range(count)]
         out.append("{ " + " ".join(block) + " }")
     return out
@@ -442,7 +504,7 @@ def {name}({args}):
 """)
         # numpy fallback: the same statements on chunk arrays
         name = "run_numpy_kahan" if kahan else "run_numpy"
-        vbody = body_lines(program, vector, kahan)
+        vbody = body_lines(program, vector, kahan, vector=True, prefix="_np_")
         vload = [f"s{i} = X[{i}, b0:b1].copy()" for i in range(N)] + ([f"c{i} = C[{i}, b0:b1].copy()" for i in range(N)] if kahan else [])
         vstore = [f"X[{i}, b0:b1] = s{i}" for i in range(N)] + ([f"C[{i}, b0:b1] = c{i}" for i in range(N)] if kahan else [])
         src.append(f"""
@@ -493,7 +555,7 @@ def mpmath_source(program: StepProgram) -> str:
     N = program.N
     s = [f"s{i}" for i in range(N)]
     consts = [f"k{j} = K[{j}]" for j in range(len(program.constants))] or ["pass"]
-    body = body_lines(program, lambda e: print_python(e, "_mp_"))
+    body = body_lines(program, lambda e: print_python(e, "_mp_"), prefix="_mp_")
     sample = ["; ".join(f"out[j, {i}] = {v}" for i, v in enumerate(s))]
     checks = ["if progress is not None:", "    progress(n)",
               f"if not ({' and '.join(f'_mp_isfinite({v})' for v in s)}):", "    break"]

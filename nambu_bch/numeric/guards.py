@@ -134,7 +134,7 @@ def linear_part(program):
     while changed:
         changed = False
         for u in program.updates:
-            for i, d in u.increments:
+            for i, d in u.expanded():
                 if i not in S:
                     continue
                 used = {state.index(s) for s in d.free_symbols & set(state)}
