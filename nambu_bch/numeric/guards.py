@@ -293,14 +293,17 @@ def _fmt(value):
         return str(value)
 
 
-def check_result(samples, steps_of_samples, what="the state"):
-    """Raise :class:`NumericalRangeError` at the first non-finite sample (overflow during the run)."""
-    finite = np.isfinite(samples)
-    if finite.all():
+def check_result(samples, steps_of_samples, what="the state", start=None):
+    """Raise :class:`NumericalRangeError` at the first non-finite sample (overflow during the run).
+
+    ``start``: the step of the sample before ``samples[0]`` (when the samples given are a tail).
+    """
+    if np.isfinite(samples).all():
         return
+    finite = np.isfinite(samples)
     axes = tuple(range(1, samples.ndim))
     first = int(np.argmin(finite.all(axis=axes)))
-    lo = int(steps_of_samples[first - 1]) if first > 0 else 0
+    lo = int(steps_of_samples[first - 1]) if first > 0 else (start or 0)
     hi = int(steps_of_samples[first])
     raise NumericalRangeError(
         f"{what} overflowed float64 (became inf/nan) between steps {lo} and {hi}; the initial state is too large "
