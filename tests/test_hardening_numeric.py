@@ -482,3 +482,18 @@ def test_compiled_scan_agrees_with_numpy_guards():
     Y[1, 4000] = 1e200  # x3 += k x1 x2 ... overflows in one step: found among the scanned extremes
     with pytest.raises(NumericalRangeError, match="overflows float64"):
         iterate("ho3", "32123", 0.1, 5, Y, backend="numba")
+
+
+def test_unwritable_source_file_still_runs(fresh_cache, monkeypatch):
+    """Item 6: when the source cannot be written (full disk, read-only file system) the kernel runs from
+    memory, compiled without numba's disk cache, and gives the same states."""
+    pytest.importorskip("numba")
+
+    def refuse(path, data):
+        raise OSError(28, "No space left on device")
+
+    monkeypatch.setattr(K, "_write_file", refuse)
+    kern = K.kernel(model("ho"), "121")
+    assert not kern.path.exists() and not kern.from_cache
+    x = iterate(model("ho"), "121", 0.125, 500, [1.0, 0.5], backend="numba", every=500)[-1]
+    assert np.allclose(x, _exact_verlet(500, Fraction(1, 8), (1, Fraction(1, 2))), rtol=0, atol=1e-13)

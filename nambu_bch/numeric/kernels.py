@@ -377,7 +377,8 @@ class Kernel:
         if fn is None:
             import numba
 
-            fn = numba.njit(cache=True, nogil=True, fastmath=False, error_model="numpy")(getattr(self.module, name))
+            on_disk = self.path.is_file()  # numba caches next to a source file; without one, compile in memory
+            fn = numba.njit(cache=on_disk, nogil=True, fastmath=False, error_model="numpy")(getattr(self.module, name))
             self._jitted[name] = fn
         return fn
 
