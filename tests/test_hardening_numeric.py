@@ -497,3 +497,12 @@ def test_unwritable_source_file_still_runs(fresh_cache, monkeypatch):
     assert not kern.path.exists() and not kern.from_cache
     x = iterate(model("ho"), "121", 0.125, 500, [1.0, 0.5], backend="numba", every=500)[-1]
     assert np.allclose(x, _exact_verlet(500, Fraction(1, 8), (1, Fraction(1, 2))), rtol=0, atol=1e-13)
+
+
+def test_figure_titles_carry_no_user_markup(tmp_path):
+    """Item 5 (figures): a system name or parameter name with TeX commands reaches no title as markup."""
+    from nambu_bch.numeric.figures import _param_tex, _plain
+
+    assert _plain(r"$\input{/etc/passwd}$") == "inputetcpasswd"
+    assert _param_tex(sympy.Symbol(r"\input{/etc/passwd}")) == r"\mathrm{inputetcpasswd}"
+    assert _param_tex(sympy.Symbol("omega")) == r"\omega"

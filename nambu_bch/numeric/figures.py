@@ -172,7 +172,8 @@ def paper_figures(outdir=None, *, word="32123", h=0.1, x0=(1.0, 1.0, 1.0), param
     n_short = max(1, int(round(t_short / h)))
     n_long = max(every_long, int(round(t_long / h)) // every_long * every_long)
     values = parameter_values(system, params)
-    setting = ", ".join([f"$h = {h:g}$"] + [f"${sympy.latex(p)} = {v:g}$" for p, v in values.items()] +
+    name = _plain(system.name)
+    setting = ", ".join([f"$h = {h:g}$"] + [f"${_param_tex(p)} = {v:g}$" for p, v in values.items()] +
                         [rf"$x(0) = ({', '.join(f'{float(v):g}' for v in x0)})$"])
     scheme = rf"$\Phi^{{{_tex_word(word)}}}_h$"
     figures = {}
@@ -190,7 +191,7 @@ def paper_figures(outdir=None, *, word="32123", h=0.1, x0=(1.0, 1.0, 1.0), param
             ax.plot(tb, yb, "--", lw=1.2, color="C3", label=f"${sub}(t) - {sub}(0)$")
         ax.set_xlabel("$t$")
         ax.set_ylabel("error")
-        ax.set_title(f"{system.name}, {scheme}: {setting}", fontsize=9)
+        ax.set_title(f"{name}, {scheme}: {setting}", fontsize=9)
         ax.axhline(0, color="0.7", lw=0.5, zorder=0)
         _headroom(ax)
         ax.legend(loc="upper right", fontsize=9, ncol=2)
@@ -208,7 +209,7 @@ def paper_figures(outdir=None, *, word="32123", h=0.1, x0=(1.0, 1.0, 1.0), param
         ax.plot(t, y, "-", lw=0.4, color="C0", label=f"${tex}^{{\\rm o}}(t) - {run}$ ({drawn})")
         ax.set_xlabel("$t$")
         ax.set_ylabel("difference")
-        ax.set_title(f"the beat, {system.name}, {scheme}: {setting}", fontsize=9)
+        ax.set_title(f"the beat, {name}, {scheme}: {setting}", fontsize=9)
         _headroom(ax, 0.2)
         ax.legend(loc="upper right", fontsize=9)
         ax.set_xlim(t[0], t[-1])
@@ -221,7 +222,7 @@ def paper_figures(outdir=None, *, word="32123", h=0.1, x0=(1.0, 1.0, 1.0), param
         ax.plot(ts, ys, "--", lw=1.5, color="C3", label=f"${tex}^{{\\rm s}}(t) - {run}$")
         ax.set_xlabel("$t$")
         ax.set_ylabel("difference")
-        ax.set_title(f"{system.name}, {scheme}: {setting}", fontsize=8)
+        ax.set_title(f"{name}, {scheme}: {setting}", fontsize=8)
         _headroom(ax, 0.3)
         ax.legend(loc="upper right", fontsize=8, ncol=2)
         ax.set_xlim(tc[0], tc[-1])
@@ -236,6 +237,19 @@ def paper_figures(outdir=None, *, word="32123", h=0.1, x0=(1.0, 1.0, 1.0), param
         figures["fig4"] = fig
     paths = _write_set(outdir, figures, fmt, dpi) if outdir is not None else {}
     return FigureSet(paths, figures)
+
+
+def _plain(text):
+    """A name for a title: letters, digits, ``-`` and ``_`` only (never ``$`` or ``\\``: no mathtext or LaTeX)."""
+    return "".join(ch for ch in str(text) if ch.isalnum() or ch in "-_")[:40] or "system"
+
+
+def _param_tex(symbol):
+    """A parameter for mathtext: sympy's LaTeX of a plain identifier (``omega`` -> ``\\omega``), else its letters."""
+    text = str(symbol)
+    if text.isidentifier() and text.isascii():
+        return sympy.latex(sympy.Symbol(text))
+    return r"\mathrm{" + _plain(text) + "}"
 
 
 def _tex_word(word):
