@@ -722,10 +722,11 @@ def _system_options(parser):
     group.add_argument("--name", metavar="NAME", help="name of a user system in the output (default custom)")
 
 
-def _integrator_options(parser, order=False):
+def _integrator_options(parser, order=False, default="the Strang word 12..n..21"):
     parser.add_argument("--integrator", metavar="WORD",
                         help="word over every piece such as 12321, alias (TVT/VTV for two pieces, lie-trotter, strang, "
-                             "forest-ruth, yoshida, yoshida:WORD, suzuki) or 'piece:coeff,...' (default: the Strang word 12..n..21)")
+                             "forest-ruth, yoshida, yoshida:WORD, suzuki) or 'piece:coeff,...' "
+                             f"(default: {default})")
     if order:
         parser.add_argument("--order", metavar="K", type=str, help=f"highest power of h kept (default 2, at most {MAX_CLI_ORDER})")
 
@@ -862,7 +863,7 @@ def build_parser() -> argparse.ArgumentParser:
     p = add("plot", cmd_plot)
     _progress_option(p)
     _system_options(p)
-    _integrator_options(p)
+    _integrator_options(p, default="32123 on ho3 (the paper's Figs. 1-4), else the Strang word 12..n..21")
     p.add_argument("--outdir", metavar="DIR", default=".", help="directory for fig1.png .. fig4.png (default .)")
     _numeric_options(p, {"h": 0.1, "steps": "200000 (t = 20000 at h = 0.1)", "every": 100})
     p.add_argument("--short-steps", metavar="N", help="steps of the Figs. 1-2 run (default 1000, t = 100 at h = 0.1)")

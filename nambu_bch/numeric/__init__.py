@@ -6,9 +6,10 @@ predicts; ``paper_figures`` redraws Figs. 1-4; the studies answer speed-versus-a
 """
 
 from .codegen import StepProgram, step_program
-from .diagnostics import CheckResult, DriftFit, OrderFit, check, drift_rate, fit_order, observed_order, quantities
-from .figures import paper_figures
-from .iterate import iterate, n_samples, sample_steps, sample_times
+from .diagnostics import (CheckResult, DriftFit, OrderFit, RunningStats, check, drift_rate, fit_order, observed_order,
+                          quantities)
+from .figures import FigureSet, paper_figures
+from .iterate import iterate, iterate_chunks, n_samples, sample_steps, sample_times
 from .kernels import Kernel, cache_dir, kernel, numba_available
 from .progress import Progress
 from .studies import HScan, PrecisionStudy, TruncationStudy, h_scan, precision_study, truncation_study
@@ -16,11 +17,13 @@ from .studies import HScan, PrecisionStudy, TruncationStudy, h_scan, precision_s
 __all__ = [
     "CheckResult",
     "DriftFit",
+    "FigureSet",
     "HScan",
     "Kernel",
     "OrderFit",
     "PrecisionStudy",
     "Progress",
+    "RunningStats",
     "StepProgram",
     "TruncationStudy",
     "cache_dir",
@@ -29,6 +32,7 @@ __all__ = [
     "fit_order",
     "h_scan",
     "iterate",
+    "iterate_chunks",
     "kernel",
     "n_samples",
     "numba_available",

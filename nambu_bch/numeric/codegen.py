@@ -54,18 +54,33 @@ from ..integrators.flows import TIME, exact_flow
 STEP = sympy.Symbol("h")
 
 #: Bump when the generated source changes meaning (part of the cache key).
-TEMPLATE_VERSION = "1"
+TEMPLATE_VERSION = "3"
 
 _FUNCTIONS = ("exp", "expm1", "log", "sin", "cos", "tan", "sinh", "cosh", "tanh", "sqrt", "atan", "asin", "acos")
 
 
 @dataclass(frozen=True)
 class Update:
-    """One sub-flow ``exp(c h X_k)`` as increments ``((i, d_i), ...)`` in the state symbols and constants."""
+    """One sub-flow ``exp(c h X_k)`` as increments ``((i, d_i), ...)`` in the state symbols and constants.
+
+    ``pairs`` are shared exponentials ``(u_j, e_j, f_j, u)``: when a sub-flow needs both
+    ``expm1(u)`` and ``expm1(-u)`` (a Lotka-Volterra piece scales one coordinate by ``e^u`` and
+    another by ``e^-u``) one ``expm1`` serves both: ``e = expm1(|u|)``, ``f = -e / (1 + e)``
+    ``= expm1(-|u|)`` (no cancellation, since ``1 + e >= 1``), swapped when ``u < 0``; the
+    increments then use ``e_j = expm1(u)`` and ``f_j = expm1(-u)``.
+    """
 
     piece: int
     coefficient: sympy.Expr
     increments: tuple
+    pairs: tuple = ()
+
+    def expanded(self) -> tuple:
+        """The increments with the shared exponentials written out (``e_j -> expm1(u)``, ``f_j -> expm1(-u)``)."""
+        back = {}
+        for _, e, f, u in self.pairs:
+            back[e], back[f] = expm1(u), expm1(-u)
+        return tuple((i, d.xreplace(back)) for i, d in self.increments)
 
 
 @dataclass(frozen=True, eq=False)
@@ -135,9 +150,10 @@ def _step_program(system, comp) -> StepProgram:
     to_state = dict(zip(coords, state))
     hoister = _Hoister(state)
     updates = []
+    n_pairs = 0
     for k, c in comp.factors():
         flow = exact_flow(system.splitting[k], coords)
-        incs = []
+        raw = []
         for i, (x, e) in enumerate(zip(coords, flow.expressions)):
             d = sympy.sympify(e) - x
             if d == 0:
@@ -146,11 +162,78 @@ def _step_program(system, comp) -> StepProgram:
             stray = d.free_symbols - set(coords) - set(system.parameters) - {STEP}
             if stray:
                 raise InvalidSystemError(f"the flow of piece {k} of {system.name} uses unknown symbols {sorted(map(str, stray))}")
-            incs.append((i, hoister.polynomial(d.xreplace(to_state))))
+            raw.append((i, d.xreplace(to_state)))
+        raw, found = _pair_expm1(raw, n_pairs)
+        n_pairs += len(found)
+        pairs = []
+        for u_sym, e_sym, f_sym, u in found:
+            hoister.state |= {e_sym, f_sym}
+            pairs.append((u_sym, e_sym, f_sym, hoister.polynomial(u)))
+        incs = [(i, hoister.polynomial(d)) for i, d in raw]
         if incs:
-            updates.append(Update(k, c, tuple(incs)))
-    return StepProgram(system.name, str(comp), len(coords), coords, tuple(system.parameters), state,
-                       tuple(hoister.constants), tuple(updates))
+            updates.append(Update(k, c, tuple(incs), tuple(pairs)))
+    program = StepProgram(system.name, str(comp), len(coords), coords, tuple(system.parameters), state,
+                          tuple(hoister.constants), tuple(updates))
+    _validate(program, system)
+    return program
+
+
+def _pair_expm1(raw, start):
+    """Share ``expm1(u)`` and ``expm1(-u)`` within one sub-flow: ``(increments, [(u_j, e_j, f_j, u), ...])``."""
+    args = []
+    for _, d in raw:
+        for a in d.atoms(expm1):
+            if a.args[0] not in args:
+                args.append(a.args[0])
+    found, subs = [], {}
+    for a in args:
+        if a.could_extract_minus_sign() or -a not in args or expm1(a) in subs:
+            continue
+        j = start + len(found)
+        u_sym, e_sym, f_sym = (sympy.Symbol(f"{p}{j}", nambu_internal=True) for p in "uef")
+        subs[expm1(a)], subs[expm1(-a)] = e_sym, f_sym
+        found.append((u_sym, e_sym, f_sym, a))
+    if not found:
+        return raw, []
+    return [(i, d.xreplace(subs)) for i, d in raw], found
+
+
+#: The only functions generated source may call (each printed as ``_<name>`` / ``_np_<name>`` / ``_mp_<name>``).
+ALLOWED_FUNCTIONS = frozenset(_FUNCTIONS)
+
+
+def _validate(program, system):
+    """Refuse a program whose printed source could contain anything but internal names and numbers.
+
+    The increments may use only the state ``s_i``, the constants ``k_j`` and the whitelisted
+    functions; the constants only the parameters, ``h`` and those functions; neither may be
+    singular (``zoo``, ``nan``, ``oo``).  So no name a user chose ever reaches a kernel
+    (issue 10, item 5): parameters enter through ``P[i]``, coordinates through ``x[i]``.
+    """
+    allowed = set(program.state) | {k for k, _ in program.constants}
+    for u in program.updates:
+        allowed |= {sym for pair in u.pairs for sym in pair[1:3]}
+    params = set(program.parameters) | {STEP}
+    singular = (sympy.zoo, sympy.nan, sympy.oo, -sympy.oo)
+
+    def check(expr, symbols, where):
+        if any(expr.has(z) for z in singular):
+            raise InvalidSystemError(f"{where} of {system.name} is singular ({expr}); check the parameters of the model")
+        stray = expr.free_symbols - symbols
+        if stray:
+            raise InvalidSystemError(f"{where} of {system.name} uses unknown symbols {sorted(map(str, stray))}")
+        for f in expr.atoms(sympy.Function):
+            if type(f).__name__ not in ALLOWED_FUNCTIONS:
+                raise InvalidSystemError(f"{where} of {system.name} calls {type(f).__name__}, which numeric kernels "
+                                         f"do not support (supported: {', '.join(sorted(ALLOWED_FUNCTIONS))})")
+
+    for u in program.updates:
+        for _, d in u.increments:
+            check(d, allowed, f"the flow of piece {u.piece}")
+        for pair in u.pairs:
+            check(pair[3], allowed, f"the flow of piece {u.piece}")
+    for k, e in program.constants:
+        check(e, params, f"the step coefficient {k}")
 
 
 def _with_expm1(expr):
@@ -261,12 +344,27 @@ def print_c(expr) -> str:
 # -- loop bodies ----------------------------------------------------------------------------------------
 
 
-def body_lines(program: StepProgram, printer, kahan=False, c_syntax=False):
-    """Statements of one step, ``s_i`` / ``k_j`` / ``d_j`` / ``c_i`` named as in the generated kernels."""
+def body_lines(program: StepProgram, printer, kahan=False, c_syntax=False, vector=False, prefix="_"):
+    """Statements of one step, ``s_i`` / ``k_j`` / ``d_j`` / ``c_i`` named as in the generated kernels.
+
+    ``vector``: numpy arrays (the shared-exponential swap is a ``np.where``); ``prefix``: of the
+    function names (``_``, ``_np_``, ``_mp_``); ``c_syntax``: C99.
+    """
     end = ";" if c_syntax else ""
     decl = "double " if c_syntax else ""
     lines = []
     for u in program.updates:
+        for us, es, fs, ue in u.pairs:
+            if c_syntax:
+                lines += [f"double {us} = {printer(ue)};", f"double {es} = expm1(fabs({us}));",
+                          f"double {fs} = -{es} / (1.0 + {es});",
+                          f"if ({us} < 0) {{ double w_ = {es}; {es} = {fs}; {fs} = w_; }}"]
+            elif vector:
+                lines += [f"{us} = {printer(ue)}", f"{es} = {prefix}expm1(np.abs({us}))", f"{fs} = -{es} / (1.0 + {es})",
+                          f"{es}, {fs} = np.where({us} >= 0, {es}, {fs}), np.where({us} >= 0, {fs}, {es})"]
+            else:
+                lines += [f"{us} = {printer(ue)}", f"{es} = {prefix}expm1(abs({us}))", f"{fs} = -{es} / (1.0 + {es})",
+                          f"if {us} < 0: {es}, {fs} = {fs}, {es}"]
         names = []
         for j, (i, d) in enumerate(u.increments):
             lines.append(f"{decl}d{j} = {printer(d)}{end}")
@@ -287,7 +385,7 @@ def _c_scoped(program, lines, kahan):
     it = iter(lines)
     for u in program.updates:
         n = len(u.increments)
-        count = n + n * (4 if kahan else 1)
+        count = 4 * len(u.pairs) + n + n * (4 if kahan else 1)
         block = [next(it) for _ in range(count)]
         out.append("{ " + " ".join(block) + " }")
     return out
@@ -295,10 +393,10 @@ def _c_scoped(program, lines, kahan):
 
 # -- module source --------------------------------------------------------------------------------------
 
-_HEADER = '''"""Generated by nambu_bch.numeric.codegen from the exact sub-flows of {name!r}, word {word!r}.
+_HEADER = '''"""Generated by nambu_bch.numeric.codegen (template {version}); do not edit.
 
-Do not edit: the file name is a hash of this source; delete the directory to clear the cache.
-{program}
+Every name below is internal (s_i state, k_j constants, P[i] parameters); the cache
+verifies this file against the digest recorded when it was generated.
 """
 import math
 import numpy as np
@@ -309,6 +407,7 @@ _atan, _asin, _acos, _isfinite = math.atan, math.asin, math.acos, math.isfinite
 _np_exp, _np_expm1, _np_log, _np_sqrt = np.exp, np.expm1, np.log, np.sqrt
 _np_sin, _np_cos, _np_tan, _np_sinh, _np_cosh, _np_tanh = np.sin, np.cos, np.tan, np.sinh, np.cosh, np.tanh
 _np_atan, _np_asin, _np_acos = np.arctan, np.arcsin, np.arccos
+_INF, _MAX, _TINY = math.inf, 1.7976931348623157e308, 2.2250738585072014e-308
 '''
 
 
@@ -329,7 +428,7 @@ def _sampling_loop(step, sample, checks=()):
         "while n < steps:",
         "    m = every if steps - n >= every else steps - n",
         "    for _ in range(m):",
-        *("        " + line for line in step),
+        *("        " + line for line in (step or ["pass"])),  # every piece zero: the step is the identity
         "    n += m",
         *("    " + line for line in sample),
         "    j += 1",
@@ -361,7 +460,7 @@ def python_source(program: StepProgram) -> str:
     store = "; ".join(f"x[{i}] = {v}" for i, v in enumerate(s))
     finite = " and ".join(f"_isfinite({v})" for v in s)
     sample = "; ".join(f"out[j, {i}] = {v}" for i, v in enumerate(s))
-    src = [_HEADER.format(name=program.system_name, word=program.word, program=_describe(program))]
+    src = [_HEADER.format(version=TEMPLATE_VERSION), constants_source(program)]
 
     for kahan in (False, True):
         body = body_lines(program, scalar, kahan)
@@ -405,7 +504,7 @@ def {name}({args}):
 """)
         # numpy fallback: the same statements on chunk arrays
         name = "run_numpy_kahan" if kahan else "run_numpy"
-        vbody = body_lines(program, vector, kahan)
+        vbody = body_lines(program, vector, kahan, vector=True, prefix="_np_")
         vload = [f"s{i} = X[{i}, b0:b1].copy()" for i in range(N)] + ([f"c{i} = C[{i}, b0:b1].copy()" for i in range(N)] if kahan else [])
         vstore = [f"X[{i}, b0:b1] = s{i}" for i in range(N)] + ([f"C[{i}, b0:b1] = c{i}" for i in range(N)] if kahan else [])
         src.append(f"""
@@ -419,7 +518,36 @@ def {name}({args}):
 {_indent(vstore, 8)}
     return steps
 """)
+    src.append(_SCAN)
     return "\n".join(src)
+
+
+#: One pass over a batch ``X`` (N, B): what the input guards need, compiled with the kernel.
+_SCAN = """
+def scan(X, res):
+    B = X.shape[1]
+    big = np.zeros(B)
+    prod = np.ones(B)
+    small = np.full(B, _INF)
+    nonfinite = 0
+    subnormal = 0
+    for i in range(X.shape[0]):
+        for b in range(B):
+            a = abs(X[i, b])
+            nonfinite += 0 if a <= _MAX else 1
+            subnormal += 1 if (a < _TINY and a > 0.0) else 0
+            big[b] = max(big[b], a)
+            prod[b] *= a
+            small[b] = min(small[b], a if a > 0.0 else _INF)
+    res[0] = nonfinite
+    res[1] = subnormal
+    res[2] = np.argmax(big)
+    res[3] = np.argmin(big)
+    res[4] = np.argmax(prod)
+    res[5] = np.argmin(prod)
+    res[6] = np.argmin(small)
+    return nonfinite + subnormal
+"""
 
 
 def mpmath_source(program: StepProgram) -> str:
@@ -427,7 +555,7 @@ def mpmath_source(program: StepProgram) -> str:
     N = program.N
     s = [f"s{i}" for i in range(N)]
     consts = [f"k{j} = K[{j}]" for j in range(len(program.constants))] or ["pass"]
-    body = body_lines(program, lambda e: print_python(e, "_mp_"))
+    body = body_lines(program, lambda e: print_python(e, "_mp_"), prefix="_mp_")
     sample = ["; ".join(f"out[j, {i}] = {v}" for i, v in enumerate(s))]
     checks = ["if progress is not None:", "    progress(n)",
               f"if not ({' and '.join(f'_mp_isfinite({v})' for v in s)}):", "    break"]
@@ -459,7 +587,7 @@ def c_source(program: StepProgram) -> str:
     scatter = " ".join(f"X[{i} * B + b0 + b] = S{i}[b];" for i in range(N))
     inner_load = " ".join(f"double s{i} = S{i}[b];" for i in range(N))
     inner_store = " ".join(f"S{i}[b] = s{i};" for i in range(N))
-    return f"""/* Generated by nambu_bch.numeric.codegen: {program.system_name} {program.word} */
+    return f"""/* Generated by nambu_bch.numeric.codegen (template {TEMPLATE_VERSION}) */
 #include <math.h>
 
 long run(double *restrict x, const double *restrict K, long steps) {{
@@ -491,7 +619,28 @@ void run_batch(double *restrict X, const double *restrict K, long steps, long B,
 """
 
 
-def _describe(program):
+def constants_source(program: StepProgram) -> str:
+    """``constants(h, P) -> [k_0, ...]`` as Python source: the parameters enter as ``P[i]`` (no names).
+
+    Division by a zero parameter raises ``ZeroDivisionError`` and an overflowing ``exp``
+    ``OverflowError``; :meth:`~nambu_bch.numeric.kernels.Kernel.constants` turns both into
+    one :class:`~nambu_bch.errors.NumericalRangeError` line.
+    """
+    inner = [sympy.Symbol(f"p{i}", nambu_internal=True) for i in range(len(program.parameters))]
+    rename = dict(zip(program.parameters, inner))
+    lines = [f"p{i} = P[{i}]" for i in range(len(inner))]
+    lines += [f"{k} = {print_python(sympy.sympify(e).xreplace(rename), '_')}" for k, e in program.constants]
+    names = ", ".join(str(k) for k, _ in program.constants)
+    return f"""
+
+def constants(h, P):
+{_indent(lines or ["pass"], 4)}
+    return [{names}]
+"""
+
+
+def describe(program: StepProgram) -> str:
+    """A readable account of the program (state, constants, updates) -- for people, never for source."""
     lines = [f"state {', '.join(f's{i} = {c}' for i, c in enumerate(program.coordinates))}"]
     lines += [f"{k} = {e}" for k, e in program.constants]
     for u in program.updates:

@@ -33,7 +33,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import sympy
 
-from ..errors import InvalidRunError, NambuBCHError
+from ..errors import InvalidOrderError, InvalidRunError, NambuBCHError, NumericalRangeError
 from ..integrators.composition import composition as make_composition
 from ..integrators.step import parameter_values
 from .iterate import as_system, iterate, sample_times
@@ -48,13 +48,16 @@ QUANTITY_NAMES = ("H", "G", "H_c", "G_c", "H_S", "G_S", "H_S_exact", "G_S_exact"
 # -- the quantities ---------------------------------------------------------------------------------------
 
 
-def quantities(system, word, h, params=None, order=2, alpha=0.5, which=QUANTITY_NAMES) -> dict:
+def quantities(system, word, h, params=None, order=2, alpha=0.5, which=QUANTITY_NAMES, skipped=None) -> dict:
     """``{name: sympy expression in the coordinates}`` with ``h``, the parameters and ``alpha`` substituted.
 
     ``H``, ``G`` (the system), ``H_c``, ``G_c`` (:func:`nambu_bch.exact.conserved_quantities`),
     ``H_S``, ``G_S`` (truncated BCH shadow Hamiltonians of ``order``, family parameters set to
     ``alpha``), ``H_S_exact``, ``G_S_exact`` (:func:`nambu_bch.exact.exact_shadow_hamiltonians`).
-    Names a system or word does not have are absent.
+    Names a system or word does not have are absent, and so are those that are singular at
+    these parameter values (e.g. ``H_c`` of the rigid body has ``I1 - I2`` in a denominator,
+    so at ``I1 = I2`` it is not defined): ``skipped`` (a dict, if given) receives
+    ``{name: reason}`` for them.
 
     Examples
     --------
@@ -72,7 +75,13 @@ def quantities(system, word, h, params=None, order=2, alpha=0.5, which=QUANTITY_
 
     def put(name, expr):
         if name in which and expr is not None:
-            out[name] = sympy.sympify(expr).xreplace(subs)
+            value = sympy.sympify(expr).xreplace(subs)
+            if value.has(sympy.zoo, sympy.nan, sympy.oo, -sympy.oo):
+                if skipped is not None:
+                    given = ", ".join(f"{p} = {v:g}" for p, v in values.items())
+                    skipped[name] = f"singular at {given}" if given else "singular"
+                return
+            out[name] = value
 
     put("H", system.H)
     put("G", system.G)
@@ -122,10 +131,7 @@ def evaluate(expr, coordinates, samples, dps=None) -> np.ndarray:
     With ``dps`` (object samples from an mpmath run) the evaluation is done in mpmath.
     """
     if dps is None:
-        fn = sympy.lambdify(coordinates, expr, modules="numpy")
-        cols = [np.asarray(samples[:, i], dtype=np.float64) for i in range(len(coordinates))]
-        value = fn(*cols)
-        return np.broadcast_to(np.asarray(value, dtype=np.float64), cols[0].shape).copy()
+        return numpy_function(expr, coordinates)(samples)
     import mpmath
 
     fn = sympy.lambdify(coordinates, expr, modules="mpmath")
@@ -136,6 +142,18 @@ def evaluate(expr, coordinates, samples, dps=None) -> np.ndarray:
             for b in range(flat.shape[2]):
                 res[n, b] = fn(*flat[n, :, b])
         return res.reshape((samples.shape[0],) + samples.shape[2:])
+
+
+def numpy_function(expr, coordinates):
+    """``f(samples) -> float64 array``: ``expr`` lambdified once (numpy) and evaluated on sample rows."""
+    fn = sympy.lambdify(coordinates, expr, modules="numpy")
+    n = len(coordinates)
+
+    def f(samples):
+        cols = [np.asarray(samples[:, i], dtype=np.float64) for i in range(n)]
+        return np.broadcast_to(np.asarray(fn(*cols), dtype=np.float64), cols[0].shape).copy()
+
+    return f
 
 
 def errors_along(samples, exprs: dict, coordinates, dps=None) -> dict:
@@ -191,6 +209,7 @@ class CheckResult:
         per ``x{i}_{k}`` (k = o, c, s)
     drift_rate : dict -- slope of a straight-line fit of ``Q(t) - Q(0)`` (per unit time)
     seconds : float -- wall time of the run and its diagnostics
+    skipped : dict -- quantities left out because they are singular at these parameters, with the reason
     """
 
     model: str
@@ -205,6 +224,7 @@ class CheckResult:
     max_abs_error: dict = field(default_factory=dict)
     drift_rate: dict = field(default_factory=dict)
     seconds: float = 0.0
+    skipped: dict = field(default_factory=dict)
 
     def to_dict(self) -> dict:
         """JSON-ready: ``{"model", "integrator", "h", "steps", ..., "max_abs_error": {...}, "drift_rate": {...}}``."""
@@ -215,13 +235,22 @@ class CheckResult:
             "alpha": float(self.alpha),
             "max_abs_error": {k: _json_float(v) for k, v in self.max_abs_error.items()},
             "drift_rate": {k: _json_float(v) for k, v in self.drift_rate.items()},
+            **({"skipped": dict(self.skipped)} if self.skipped else {}),
         }
 
     def __str__(self):
         lines = [f"{self.model} {self.integrator}: h = {self.h}, {self.steps} steps"]
-        lines += [f"  max |{k}(t) - {k}(0)| = {v:.3e}" if not k.startswith("x") else f"  max |{k}| = {v:.3e}"
-                  for k, v in self.max_abs_error.items()]
+        lines += [f"  max |{_label(k)}| = {v:.3e}" for k, v in self.max_abs_error.items()]
+        lines += [f"  {k}: not evaluated ({why})" for k, why in self.skipped.items()]
         return "\n".join(lines)
+
+
+def _label(key):
+    """``H`` -> ``H(t) - H(0)``; ``x1_o`` -> ``x1^o - x1`` (the closed-form solution minus the run)."""
+    coord, _, kind = key.rpartition("_")
+    if kind in ("o", "c", "s") and coord and not coord.startswith(("H", "G")):
+        return f"{coord}^{kind} - {coord}"
+    return f"{key}(t) - {key}(0)"
 
 
 def _json_float(v):
@@ -229,9 +258,72 @@ def _json_float(v):
     return v if math.isfinite(v) else None
 
 
+class RunningStats:
+    """Streaming ``max |y|`` and least-squares slope of ``y`` against ``t``, fed block by block.
+
+    Blocks are merged with the pairwise update of Chan, Golub and LeVeque (*Algorithms for
+    computing the sample variance*, Am. Stat. 37 (1983), Eq. 2.1 generalised to the
+    co-moment): the means and the centred sums ``Stt = sum (t - tbar)^2``,
+    ``Sty = sum (t - tbar)(y - ybar)`` of two blocks combine exactly, so the slope
+    ``Sty / Stt`` equals :func:`drift_rate` of the whole series to rounding, while only one
+    block is ever held.
+
+    Examples
+    --------
+    >>> t = np.arange(10.0); y = 2 * t + np.sin(t)
+    >>> acc = RunningStats(); acc.add(t[:4], y[:4]); acc.add(t[4:], y[4:])
+    >>> bool(abs(acc.rate - drift_rate(t, y).rate) < 1e-12), acc.count, bool(acc.max_abs == abs(y).max())
+    (True, 10, True)
+    """
+
+    def __init__(self):
+        self.count = 0
+        self.max_abs = 0.0
+        self.mean_t = self.mean_y = self.stt = self.sty = 0.0
+        self.finite = True
+
+    def add(self, t, y):
+        t = np.asarray(t, dtype=np.float64).ravel()
+        y = np.asarray(y, dtype=np.float64).ravel()
+        if not y.size:
+            return
+        if not np.all(np.isfinite(y)):
+            self.finite = False
+            return
+        self.max_abs = max(self.max_abs, float(np.max(np.abs(y))))
+        nb = y.size
+        mt, my = float(t.mean()), float(y.mean())
+        dt = t - mt
+        stt, sty = float(dt @ dt), float(dt @ (y - my))
+        na, n = self.count, self.count + nb
+        delta_t, delta_y = mt - self.mean_t, my - self.mean_y
+        self.stt += stt + delta_t * delta_t * na * nb / n
+        self.sty += sty + delta_t * delta_y * na * nb / n
+        self.mean_t += delta_t * nb / n
+        self.mean_y += delta_y * nb / n
+        self.count = n
+
+    @property
+    def rate(self) -> float:
+        """The least-squares slope (0 with fewer than 3 points or one distinct time)."""
+        return self.sty / self.stt if self.count > 2 and self.stt > 0 else 0.0
+
+
+def _finite_real(value, what):
+    if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)):
+        raise InvalidRunError(f"{what} must be a real number, got {value!r}")
+    if not math.isfinite(float(value)):
+        raise NumericalRangeError(f"{what} = {value!r} is not finite; give a finite real number")
+    return float(value)
+
+
 def check(system, word, h, steps, x0, params=None, *, order=2, alpha=0.5, every=1, kahan=False,
-          backend="auto", include=None) -> CheckResult:
+          backend="auto", include=None, chunk_samples=None) -> CheckResult:
     """Run ``word`` on ``system`` and measure every error the package can predict.
+
+    The run is streamed (:func:`~nambu_bch.numeric.iterate.iterate_chunks`): each block of
+    samples is evaluated and folded into running maxima and drift fits (:class:`RunningStats`),
+    so memory stays bounded whatever ``steps / every`` is.
 
     Parameters
     ----------
@@ -244,11 +336,18 @@ def check(system, word, h, steps, x0, params=None, *, order=2, alpha=0.5, every=
     kahan, backend : as for :func:`~nambu_bch.numeric.iterate`
     include : iterable of names, optional -- restrict to these quantities (default: all of
         :data:`QUANTITY_NAMES`) -- and solution kinds ``"o"``, ``"c"``, ``"s"``
+    chunk_samples : int, optional -- samples per streamed block (tuning and tests)
 
     Returns
     -------
     CheckResult -- ``.to_dict()["max_abs_error"]`` has ``H, G, H_c, G_c, H_S, G_S, H_S_exact,
-    G_S_exact`` and ``x1_o .. xN_s`` where they are defined.
+    G_S_exact`` and ``x1_o .. xN_s`` where they are defined; ``skipped`` names the quantities
+    that are singular at the given parameters.
+
+    Raises
+    ------
+    NumericalRangeError -- a non-finite ``alpha``, or a quantity that is not finite along the run
+    (float64 overflow in evaluating it, e.g. ``x0 = (1e154, 1e154, 1)``).
 
     References
     ----------
@@ -264,27 +363,66 @@ def check(system, word, h, steps, x0, params=None, *, order=2, alpha=0.5, every=
     """
     import time
 
+    from .iterate import CHUNK_SAMPLES, iterate_chunks
+
     start = time.perf_counter()
     system = as_system(system)
     comp = make_composition(word, len(system.splitting))
     name = word if isinstance(word, str) else str(comp)
+    alpha = _finite_real(alpha, "alpha")
+    if isinstance(order, bool) or not isinstance(order, (int, np.integer)) or order < 0:
+        raise InvalidOrderError(f"order must be a non-negative integer, got {order!r}")
     if np.ndim(x0) != 1:
         raise InvalidRunError(f"check takes one initial state of shape ({system.N},), got shape {np.shape(x0)}")
-    samples = iterate(system, word, h, steps, x0, params, every, kahan=kahan, backend=backend)
     include = tuple(include) if include is not None else QUANTITY_NAMES + tuple("ocs")
-    exprs = quantities(system, word, h, params, order, alpha, which=[q for q in include if q in QUANTITY_NAMES])
-    errs = errors_along(samples, exprs, system.coordinates)
-    kinds = "".join(k for k in "ocs" if k in include)
-    diffs = solution_differences(system, word, h, steps, every, x0, samples, params, kinds) if kinds else {}
-    t = sample_times(h, steps, every)
+    blocks = iterate_chunks(system, word, h, steps, x0, params, every, kahan=kahan, backend=backend,
+                            chunk_samples=chunk_samples or CHUNK_SAMPLES)
+    first_numbers, first = next(blocks)  # validates the run before any symbolic work
+    skipped = {}
+    exprs = quantities(system, word, h, params, order, alpha, which=[q for q in include if q in QUANTITY_NAMES],
+                       skipped=skipped)
+    fns = {q: numpy_function(e, system.coordinates) for q, e in exprs.items()}
+    x0f = np.asarray(x0, dtype=np.float64)
+    sols = {}
+    for kind in (k for k in "ocs" if k in include):
+        sol = _try(lambda k=kind: _exact().modified_solution(system, word, k).numeric(params=params, h=float(h)))
+        if sol is not None:
+            sols[kind] = sol
+    stats = {q: RunningStats() for q in fns}
+    stats.update({f"{c}_{k}": RunningStats() for k in sols for c in system.coordinates})
+    hf = float(h)
+    with np.errstate(all="ignore"):
+        start_values = {q: fn(first)[0] for q, fn in fns.items()}
+        for numbers, block in _chain([(first_numbers, first)], blocks):
+            t = hf * numbers.astype(np.float64)
+            for q, fn in fns.items():
+                stats[q].add(t, fn(block) - start_values[q])
+            for kind, sol in sols.items():
+                ref = sol(t, x0f)
+                for i, c in enumerate(system.coordinates):
+                    stats[f"{c}_{kind}"].add(t, ref[i] - block[:, i])
+    bad = [q for q, acc in stats.items() if not acc.finite]
+    if bad:
+        raise NumericalRangeError(
+            f"{', '.join(bad)} {'is' if len(bad) == 1 else 'are'} not finite along the run of {name} on {system.name} "
+            f"from x0 = {x0f.tolist()} (float64 overflow in evaluating {'it' if len(bad) == 1 else 'them'}"
+            f"{f', alpha = {alpha:g}' if any(q.endswith(('_S', '_S_exact')) for q in bad) else ''}); "
+            "rescale the initial state or the parameters"
+        )
     result = CheckResult(system.name, name, float(h), int(steps), int(every), [float(v) for v in x0],
                          {p.name: v for p, v in parameter_values(system, params).items()}, int(order), float(alpha))
-    for key, series in {**errs, **diffs}.items():
-        result.max_abs_error[key] = float(np.max(np.abs(series)))
-    for key, series in errs.items():
-        result.drift_rate[key] = drift_rate(t, series).rate if len(t) > 2 else 0.0
+    for key, acc in stats.items():
+        result.max_abs_error[key] = acc.max_abs
+    for q in fns:
+        result.drift_rate[q] = stats[q].rate
+    result.skipped = skipped
     result.seconds = time.perf_counter() - start
     return result
+
+
+def _chain(*iterables):
+    for it in iterables:
+        yield from it
 
 
 # -- fits ---------------------------------------------------------------------------------------------------

@@ -75,11 +75,13 @@ def check_count(value, what, minimum):
     return int(value)
 
 
-def check_inputs(system, h, steps, every, x0, params=None, exact=False):
+def check_inputs(system, h, steps, every, x0, params=None, exact=False, scan=None):
     """Validate a run's arguments; returns ``(h, steps, every, x0 array, params dict)``.
 
     ``x0`` must have shape ``(N,)`` or ``(N, batch)``; with ``exact=True`` (the mpmath
-    path) strings and mpf values are kept as they are (object array).
+    path) strings and mpf values are kept as they are (object array).  ``scan``: a compiled
+    one-pass scan of a batch (:meth:`~nambu_bch.numeric.kernels.Kernel.scan`) used instead of
+    numpy passes for the finiteness and underflow checks.
     """
     h = _real(h, "step h")
     steps = check_count(steps, "steps", 0)
@@ -89,8 +91,8 @@ def check_inputs(system, h, steps, every, x0, params=None, exact=False):
     for k, v in (params or {}).items():
         _real(v, f"parameter {k}")
     values = parameter_values(system, params)  # unknown names -> InvalidSystemError
-    try:
-        arr = np.array(x0, dtype=object if exact else np.float64)
+    try:  # a fresh C-ordered copy: the float64 run advances it in place
+        arr = np.array(x0, dtype=object if exact else np.float64, order="C")
     except (TypeError, ValueError):
         raise InvalidRunError(f"x0 must be an array of {system.N} real numbers (or shape ({system.N}, batch)), got {x0!r}") from None
     if arr.ndim not in (1, 2) or arr.shape[0] != system.N or (arr.ndim == 2 and arr.shape[1] == 0):
@@ -98,15 +100,21 @@ def check_inputs(system, h, steps, every, x0, params=None, exact=False):
             f"x0 has shape {arr.shape}, but {system.name} has {system.N} coordinates "
             f"{tuple(str(c) for c in system.coordinates)}: give shape ({system.N},) or ({system.N}, batch)"
         )
+    if scan is not None and arr.ndim == 2 and not exact:
+        nonfinite, subnormal, _ = scan(arr)
+        if not (nonfinite or subnormal):
+            return h, steps, every, arr, values
     floats = np.array([float(v) for v in arr.ravel()]).reshape(arr.shape) if exact else arr
-    if not np.all(np.isfinite(floats)):
+    flat = floats.reshape(-1)
+    if not np.isfinite(np.max(flat) - np.min(flat)):  # nan propagates, +-inf gives inf or nan
         bad = floats[~np.isfinite(floats)].ravel()[0]
         raise NumericalRangeError(f"x0 contains the non-finite value {bad}; initial states must be finite")
     if not exact:
-        sub = (floats != 0) & (np.abs(floats) < TINY)
+        magnitude = np.abs(flat)
+        sub = (magnitude < TINY) & (magnitude > 0)
         if np.any(sub):
             raise NumericalRangeError(
-                f"x0 contains {floats[sub].ravel()[0]:.3g}, below the smallest normal float64 ({TINY:.3g}): it underflows; "
+                f"x0 contains {flat[sub][0]:.3g}, below the smallest normal float64 ({TINY:.3g}): it underflows; "
                 "rescale the initial state or use dps=... (mpmath)"
             )
     return h, steps, every, arr, values
@@ -126,7 +134,7 @@ def linear_part(program):
     while changed:
         changed = False
         for u in program.updates:
-            for i, d in u.increments:
+            for i, d in u.expanded():
                 if i not in S:
                     continue
                 used = {state.index(s) for s in d.free_symbols & set(state)}
@@ -138,27 +146,20 @@ def linear_part(program):
 
 
 def step_matrix(kernel, K, S):
-    """The matrix of the (affine) step restricted to the coordinates ``S`` (the constant part dropped)."""
-    import sympy
+    """The matrix of the (affine) step restricted to the coordinates ``S`` (the constant part dropped).
 
-    program = kernel.program
-    ks = [k for k, _ in program.constants]
-    subs = dict(zip(ks, [float(v) for v in K]))
-    index = {s: n for n, s in enumerate(S)}
-    M = np.eye(len(S))
-    for u in program.updates:
-        U = np.eye(len(S))
-        touched = False
-        for i, d in u.increments:
-            if i not in index:
-                continue
-            touched = True
-            for j in S:
-                coeff = float(sympy.diff(d, program.state[j]).xreplace(subs))
-                U[index[i], index[j]] += coeff
-        if touched:
-            M = U @ M
-    return M
+    Measured on the kernel itself (no sympy): column ``j`` is ``Phi(e_j) - Phi(0)`` on ``S``, with
+    the other coordinates at 0.  The increments of ``S`` are affine in ``x_S`` alone
+    (:func:`linear_part`), so this is the exact product of the sub-flows' matrices up to rounding.
+    """
+    S = list(S)
+    N = kernel.N
+    X = np.zeros((N, len(S) + 1))
+    for col, i in enumerate(S):
+        X[i, col + 1] = 1.0
+    with np.errstate(all="ignore"):
+        kernel.run_batch(X, K, 1, 1, np.zeros((2, N, len(S) + 1)), backend="numpy")
+    return X[S, 1:] - X[S, :1]
 
 
 def check_stability(kernel, h, K, params=None):
@@ -175,7 +176,7 @@ def check_stability(kernel, h, K, params=None):
     ...
     nambu_bch.errors.UnstableStepError: h = 2.0 is outside the stability interval of 32123 on ho3 (omega*h = 2, must be < 2): ...
     """
-    S = linear_part(kernel.program)
+    S = kernel.linear
     if not S:
         return
     M = step_matrix(kernel, K, S)
@@ -205,12 +206,12 @@ def check_stability(kernel, h, K, params=None):
         values = parameter_values(kernel.system, params)
         omega = {p.name: v for p, v in values.items()}.get("omega")
         hint = f" (omega*h = {omega * float(h):.6g}, must be < 2)" if omega is not None else ""
-        raise UnstableStepError(f"h = {h!r} is outside the stability interval of {kernel.program.word} on "
-                                f"{kernel.program.system_name}{hint}: {reason}; take a smaller step")
+        raise UnstableStepError(f"h = {h!r} is outside the stability interval of {kernel.word} on "
+                                f"{kernel.system.name}{hint}: {reason}; take a smaller step")
 
 
 def _names(kernel, S):
-    return "(" + ", ".join(str(kernel.program.coordinates[i]) for i in S) + ")"
+    return "(" + ", ".join(str(kernel.system.coordinates[i]) for i in S) + ")"
 
 
 # -- float64 range -----------------------------------------------------------------------------------------
@@ -221,21 +222,25 @@ MAX_CHECKED = 64
 
 
 def extreme_states(X, k=MAX_CHECKED):
-    """Column indices of the most extreme states of ``X`` (N, B) (all of them if ``B <= k``), judged by
-    binary exponents: largest and smallest max-norm, largest and smallest product of magnitudes,
-    smallest non-zero component."""
+    """Column indices of the most extreme states of ``X`` (N, B) (all of them if ``B <= k``): largest
+    and smallest max-norm, largest and smallest product of magnitudes, smallest non-zero component."""
     B = X.shape[1]
     if B <= k:
         return np.arange(B)
-    E = np.frexp(X)[1]                                   # int32 exponents, 0 for zeros
-    maxe = E.max(axis=0)
-    sume = E.sum(axis=0, dtype=np.int64)
-    mine = np.where(X != 0, E, np.int32(1 << 20)).min(axis=0)
-    picks = [maxe.argmax(), maxe.argmin(), sume.argmax(), sume.argmin(), mine.argmin(), 0, B - 1]
+    with np.errstate(all="ignore"):  # row by row: elementwise passes over contiguous rows, no (N, B) temporaries
+        big = np.abs(X[0])
+        prod = big.copy()
+        small = np.where(big > 0, big, np.inf)
+        for row in X[1:]:
+            a = np.abs(row)
+            np.maximum(big, a, out=big)
+            np.multiply(prod, a, out=prod)               # saturates at 0 / inf: still the extreme
+            np.minimum(small, np.where(a > 0, a, np.inf), out=small)
+    picks = [big.argmax(), big.argmin(), prod.argmax(), prod.argmin(), small.argmin(), 0, B - 1]
     return np.unique(np.array(picks, dtype=np.int64))
 
 
-def check_range(kernel, x0, K, max_mpmath=64):
+def check_range(kernel, x0, K, max_mpmath=64, columns=None):
     """Raise :class:`NumericalRangeError` if one float64 step over- or underflows from ``x0`` (shape (N,) or (N, B)).
 
     For a batch of more than 64 states only the :func:`extreme_states` are checked; an overflow of
@@ -243,7 +248,7 @@ def check_range(kernel, x0, K, max_mpmath=64):
     """
     X = np.asarray(x0, dtype=np.float64)
     X = X.reshape(X.shape[0], -1)
-    X = X[:, extreme_states(X)]
+    X = X[:, extreme_states(X) if columns is None or X.shape[1] <= MAX_CHECKED else columns]
     N, B = X.shape
     out = np.zeros((2, N, B))
     f64 = X.copy()
@@ -274,8 +279,8 @@ def check_range(kernel, x0, K, max_mpmath=64):
         limit = f"the largest float64 is {np.finfo(np.float64).max:.3g}" if big else f"the smallest normal float64 is {TINY:.3g}"
         where = f"from x0 = {X[:, b].tolist()}" if B > 1 else f"from x0 = {X[:, 0].tolist()}"
         raise NumericalRangeError(
-            f"one step of {kernel.program.word} on {kernel.program.system_name} {where} {kind} float64 in "
-            f"{kernel.program.coordinates[i]} (about {_fmt(value)}; {limit}); rescale the initial state or use dps=... (mpmath)"
+            f"one step of {kernel.word} on {kernel.system.name} {where} {kind} float64 in "
+            f"{kernel.system.coordinates[i]} (about {_fmt(value)}; {limit}); rescale the initial state or use dps=... (mpmath)"
         )
 
 
@@ -288,14 +293,17 @@ def _fmt(value):
         return str(value)
 
 
-def check_result(samples, steps_of_samples, what="the state"):
-    """Raise :class:`NumericalRangeError` at the first non-finite sample (overflow during the run)."""
-    finite = np.isfinite(samples)
-    if finite.all():
+def check_result(samples, steps_of_samples, what="the state", start=None):
+    """Raise :class:`NumericalRangeError` at the first non-finite sample (overflow during the run).
+
+    ``start``: the step of the sample before ``samples[0]`` (when the samples given are a tail).
+    """
+    if np.isfinite(samples).all():
         return
+    finite = np.isfinite(samples)
     axes = tuple(range(1, samples.ndim))
     first = int(np.argmin(finite.all(axis=axes)))
-    lo = int(steps_of_samples[first - 1]) if first > 0 else 0
+    lo = int(steps_of_samples[first - 1]) if first > 0 else (start or 0)
     hi = int(steps_of_samples[first])
     raise NumericalRangeError(
         f"{what} overflowed float64 (became inf/nan) between steps {lo} and {hi}; the initial state is too large "

@@ -22,11 +22,13 @@ Horikoshi, Sect. 5.5: ``x^{32123}(t) = (Phi^{32123}_h)^n x(0)``, ``t = n h``.
 
 from __future__ import annotations
 
+import sys
+
 import numpy as np
 
-from ..errors import InvalidRunError, InvalidSystemError, NumericalRangeError
+from ..errors import InvalidRunError, InvalidSystemError
 from ..systems import System, model
-from .guards import check_inputs, check_range, check_result, check_stability
+from .guards import check_count, check_inputs, check_range, check_result, check_stability
 from .kernels import kernel, resolve_backend
 from .precision import check_dps, run_mpmath
 from .progress import Progress, progress_wanted
@@ -131,24 +133,14 @@ def iterate(system, word, h, steps, x0, params=None, every=1, *, kahan=False, dp
         if check_stable:
             check_stability(kern, h, kern.constants(float(h), params), params)
         batch = 1 if X.ndim == 1 else X.shape[1]
-        reporter = Progress(steps * batch, f"iterate {system.name} {kern.program.word} (mpmath, dps={dps})",
+        reporter = Progress(steps * batch, f"iterate {system.name} {kern.word} (mpmath, dps={dps})",
                             enabled=_enabled(progress, steps * batch * 1000))
         with reporter:
             return run_mpmath(kern, X, h, steps, every, params, dps, reporter.update if reporter.enabled else None)
 
-    h, steps, every, X, _ = check_inputs(system, h, steps, every, x0, params)
-    be = resolve_backend(backend)
-    if chunk is not None:
-        from .guards import check_count
-
-        chunk = check_count(chunk, "chunk", 1)
-    with np.errstate(over="ignore", invalid="ignore"):
-        K = kern.constants(float(h), params)
-    if not np.all(np.isfinite(K)):
-        raise NumericalRangeError(f"h = {h!r} with params {params or {}} makes the step's coefficients overflow float64")
-    if check_stable:
-        check_stability(kern, h, K, params)
-    check_range(kern, X, K)
+    run = _prepare(system, kern, h, steps, every, x0, params, backend, chunk, check_stable)
+    h, steps, every, X, be, K = run.h, run.steps, run.every, run.X, run.backend, run.K
+    chunk = run.chunk
 
     single = X.ndim == 1
     batch = 1 if single else X.shape[1]
@@ -158,11 +150,11 @@ def iterate(system, word, h, steps, x0, params=None, every=1, *, kahan=False, dp
         raise InvalidRunError(f"{count} samples of {system.N} x {batch} states need {nbytes / 2**30:.1f} GiB "
                               f"(limit {MAX_SAMPLE_BYTES / 2**30:.0f} GiB); sample less often (larger every)")
     out = np.empty((count, system.N) if single else (count, system.N, batch), dtype=np.float64)
-    state = np.ascontiguousarray(X, dtype=np.float64).copy()
+    state = X  # check_inputs made a fresh C-ordered float64 copy: advanced in place
     out[0] = state
     comp = np.zeros_like(state) if kahan else None
 
-    reporter = Progress(steps * batch, f"iterate {system.name} {kern.program.word}",
+    reporter = Progress(steps * batch, f"iterate {system.name} {kern.word}",
                         enabled=_enabled(progress, steps * batch * (30 if be == "numpy" and single else 1)))
     segment = steps if not reporter.enabled else max(every, (_SEGMENT_WORK // batch) // every * every)
     done, j = 0, 0
@@ -181,8 +173,111 @@ def iterate(system, word, h, steps, x0, params=None, every=1, *, kahan=False, dp
             done += seg
             j += nseg - 1
             reporter.update(done * batch)
-    check_result(out, sample_steps(steps, every), f"{system.name} under {kern.program.word} with h = {h!r}")
+    if count > 1:  # sample 0 is x0, checked before the run
+        check_result(out[1:], sample_steps(steps, every)[1:], f"{system.name} under {kern.word} with h = {h!r}",
+                     start=0)
     return out
+
+
+#: Runs at most this long (trajectory-steps of one state) take the interpreter when ``backend="auto"``
+#: and numba has not been loaded yet: loading numba and a cached kernel costs ~0.3-0.5 s, more than
+#: the interpreter needs for a few thousand steps (~1-3 us a step).
+SMALL_RUN_STEPS = 4000
+#: Batches of at most this many steps (and states) likewise run on numpy arrays when numba is not loaded.
+SMALL_BATCH_STEPS, SMALL_BATCH_STATES = 100, 16384
+
+
+class _Run:
+    """The validated inputs of one float64 run."""
+
+    __slots__ = ("h", "steps", "every", "X", "backend", "K", "chunk")
+
+    def __init__(self, **kw):
+        for k, v in kw.items():
+            setattr(self, k, v)
+
+
+def _prepare(system, kern, h, steps, every, x0, params, backend, chunk, check_stable) -> _Run:
+    """Validate a float64 run, choose the backend, compute the constants, check stability and range."""
+    be = resolve_backend(backend)
+    steps = check_count(steps, "steps", 0)
+    shape = np.shape(x0)
+    if backend == "auto" and be == "numba" and not kern.compile_seconds and "numba" not in sys.modules:
+        small = (steps <= SMALL_RUN_STEPS if len(shape) == 1 else
+                 (steps <= SMALL_BATCH_STEPS and len(shape) == 2 and shape[1] <= SMALL_BATCH_STATES))
+        if small:
+            be = "numpy"
+    # a large batch on numba: one compiled pass finds non-finite, subnormal and extreme states
+    scanned = {}
+    if be == "numba" and len(shape) == 2 and shape[1] > SCAN_BATCH:
+        def scan(arr):
+            scanned["result"] = kern.scan(arr)
+            return scanned["result"]
+    else:
+        scan = None
+    h, steps, every, X, _ = check_inputs(system, h, steps, every, x0, params, scan=scan)
+    if chunk is not None:
+        chunk = check_count(chunk, "chunk", 1)
+    K = kern.constants(float(h), params)
+    if check_stable:
+        check_stability(kern, h, K, params)
+    check_range(kern, X, K, columns=scanned["result"][2] if scanned else None)
+    return _Run(h=h, steps=steps, every=every, X=X, backend=be, K=K, chunk=chunk)
+
+
+#: Batches with more states than this are scanned by the compiled kernel (one pass) instead of numpy.
+SCAN_BATCH = 4096
+
+#: Samples per block of :func:`iterate_chunks` (a few MB per block for N = 3).
+CHUNK_SAMPLES = 1 << 16
+
+
+def iterate_chunks(system, word, h, steps, x0, params=None, every=1, *, kahan=False, backend="auto",
+                   chunk_samples=CHUNK_SAMPLES, check_stable=True):
+    """Iterate like :func:`iterate` (one trajectory) but yield the samples block by block.
+
+    Yields ``(numbers, samples)``: the step numbers of the block's samples (int64) and the samples
+    (shape ``(len(numbers), N)``, float64).  The first block starts with sample 0 (``x0``); the
+    blocks together are exactly :func:`sample_steps` and the samples :func:`iterate` returns
+    (the state and Kahan compensation carry over from block to block), but at most
+    ``chunk_samples`` of them are held at a time -- so diagnostics of ``10^8`` steps sampled at
+    every step run in bounded memory (issue 10, item 9).
+
+    Raises
+    ------
+    NumericalRangeError -- at the first block with a non-finite sample (the blocks before it were yielded).
+    """
+    system = as_system(system)
+    kern = kernel(system, word)
+    chunk_samples = _count(chunk_samples, "chunk_samples", 2)
+    run = _prepare(system, kern, h, steps, every, x0, params, backend, None, check_stable)
+    if run.X.ndim != 1:
+        raise InvalidRunError(f"iterate_chunks takes one initial state of shape ({system.N},), got shape {run.X.shape}")
+    steps, every, be = run.steps, run.every, run.backend
+    state = np.array(run.X, dtype=np.float64)
+    comp = np.zeros_like(state) if kahan else None
+    yield np.zeros(1, dtype=np.int64), state.copy()[None, :]
+    block = (chunk_samples - 1) * every  # steps per block
+    done = 0
+    with np.errstate(over="ignore", invalid="ignore"):
+        while done < steps:
+            seg = min(block, steps - done)
+            nseg = n_samples(seg, every)
+            out = np.empty((nseg, system.N))
+            out[0] = state
+            n = kern.run(state, run.K, seg, every, out, kahan=kahan, comp=comp, backend=be)
+            numbers = done + sample_steps(seg, every)
+            if n < seg:
+                out[n_samples(n, every):] = np.nan
+            check_result(out, numbers, f"{system.name} under {kern.word} with h = {run.h!r}")
+            done += seg
+            yield numbers[1:], out[1:]
+
+
+def _count(value, what, minimum):
+    from .guards import check_count
+
+    return check_count(value, what, minimum)
 
 
 def _enabled(progress, work):

@@ -7,9 +7,27 @@ directory under a hash of its source, imported, and its loop functions are
 compiled with ``numba.njit(cache=True)`` on first use -- so a second process
 loads the machine code from disk instead of compiling again.
 
-Cache directory: ``$NAMBU_BCH_CACHE`` if set, else ``~/.cache/nambu_bch``
-(a temporary directory if neither is writable); kernels live in
-``<cache>/kernels``.  Deleting it is always safe.
+Cache directory: ``$NAMBU_BCH_CACHE`` if set, else ``~/.cache/nambu_bch``;
+kernels live in ``<cache>/kernels``.  Deleting it is always safe.
+
+What is cached, and how it is trusted (issue 10 item 6, issue 14):
+
+* ``nambu_bch_index_<key>.json`` -- ``key`` is :func:`input_key`, a digest of the
+  exact inputs (fields of the pieces, exact coefficients, the generator's own code);
+  the index records the module name, the SHA-256 of its source and the small
+  metadata a run needs (number of constants, the linear coordinates of the
+  stability check), so a cached kernel runs without sympy;
+* ``nambu_bch_kernel_<hash>.py`` -- the generated source; before it is executed
+  its bytes are checked against the recorded SHA-256 (a modified, truncated or
+  garbage file is regenerated), and the verified bytes themselves are compiled,
+  so the file is never read twice;
+* ``__pycache__/*.nbi, *.nbc`` -- numba's machine code; an entry numba cannot
+  load is deleted and compiled again.
+
+Every directory of the cache must be a real directory owned by the effective
+user and not writable by group or others (:func:`cache_dir`), otherwise a
+private fallback is used, so another local user cannot plant a kernel.  The
+generated source contains no user text at all (:mod:`~nambu_bch.numeric.codegen`).
 
 Backends:
 
@@ -27,20 +45,25 @@ parameter value.
 
 from __future__ import annotations
 
+import hashlib
 import importlib.util
+import json
 import os
+import re
+import stat
 import sys
 import tempfile
 import time
+import types
 from functools import lru_cache
 from pathlib import Path
 
 import numpy as np
 
-from ..errors import InvalidRunError
+from ..errors import InvalidRunError, NumericalRangeError
 from ..integrators.composition import composition as make_composition
 from ..integrators.step import parameter_values
-from .codegen import python_source, source_hash, step_program
+from .codegen import TEMPLATE_VERSION, python_source, source_hash, step_program
 
 BACKENDS = ("auto", "numba", "numpy")
 #: States per chunk of a batch: the chunk's arrays stay in L1/L2 while all steps run.
@@ -49,40 +72,100 @@ NUMPY_CHUNK = 16384
 
 
 _CACHE_DIRS: dict = {}
+#: Why the cache is not where it was asked to be (empty when it is): ``{requested root: reason}``.
+CACHE_NOTES: dict = {}
 
 
 def cache_dir() -> Path:
-    """The kernel cache directory (``$NAMBU_BCH_CACHE/kernels`` or ``~/.cache/nambu_bch/kernels``)."""
+    """The kernel cache directory (``$NAMBU_BCH_CACHE/kernels`` or ``~/.cache/nambu_bch/kernels``).
+
+    Every directory of the cache (the root, ``kernels``, numba's ``kernels/__pycache__``) must be a
+    real directory (not a symlink) owned by the effective user and not writable by group or
+    others; one that is not is refused and a private fallback is used instead: the per-user
+    ``$TMPDIR/nambu_bch-<uid>`` if it passes the same checks, else a fresh ``mkdtemp`` directory
+    (mode 0700).  The reason is kept in :data:`CACHE_NOTES`.
+    """
     root = os.environ.get("NAMBU_BCH_CACHE") or os.path.join(os.path.expanduser("~"), ".cache", "nambu_bch")
     known = _CACHE_DIRS.get(root)
-    if known is not None and known.is_dir():
+    if known is not None and _secure(known) is None:
         return known
-    _CACHE_DIRS[root] = path = _usable_dir(Path(root) / "kernels")
+    _CACHE_DIRS[root] = path = _usable_dir(Path(root))
     return path
 
 
-def _usable_dir(path: Path) -> Path:
-    """``path`` created and writable, else a per-user directory under the system temp dir."""
+def _euid():
+    """The effective user id (None where the platform has none)."""
+    return os.geteuid() if hasattr(os, "geteuid") else None
+
+
+def _secure(path: Path, check_owner=True):
+    """None if ``path`` is a directory we own that nobody else may write; else the reason (one phrase)."""
     try:
-        path.mkdir(parents=True, exist_ok=True)
-        probe = path / f".probe-{os.getpid()}"
+        st = os.lstat(path)
+    except OSError as exc:
+        return f"{path} is not accessible ({exc.strerror})"
+    if stat.S_ISLNK(st.st_mode):
+        return f"{path} is a symbolic link"
+    if not stat.S_ISDIR(st.st_mode):
+        return f"{path} is not a directory"
+    if check_owner and _euid() is not None and st.st_uid != _euid():
+        return f"{path} is owned by uid {st.st_uid}, not by this user ({_euid()})"
+    if st.st_mode & (stat.S_IWGRP | stat.S_IWOTH):
+        return f"{path} is writable by group or others (mode {stat.S_IMODE(st.st_mode):o})"
+    return None
+
+
+def _prepare(root: Path, fresh=False):
+    """``root/kernels`` with every level created (mode 0700) and checked; the kernels dir or a reason.
+
+    ``fresh``: ``root`` was just made by ``mkdtemp`` (ours by construction), so ownership is not re-checked.
+    """
+    levels = [root, root / "kernels", root / "kernels" / "__pycache__"]
+    for level in levels:
+        try:
+            level.mkdir(mode=0o700, parents=True, exist_ok=True)
+        except OSError as exc:
+            return None, f"cannot create {level} ({exc.strerror})"
+        reason = _secure(level, check_owner=not fresh)
+        if reason:
+            return None, reason
+    probe = levels[1] / f".probe-{os.getpid()}"
+    try:
         probe.write_text("")
         probe.unlink()
-    except OSError:
-        path = Path(tempfile.gettempdir()) / f"nambu_bch-{os.getuid() if hasattr(os, 'getuid') else 'user'}" / "kernels"
-        path.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        return None, f"{levels[1]} is not writable ({exc.strerror})"
+    return levels[1], None
+
+
+def _usable_dir(root: Path) -> Path:
+    """``root/kernels`` if safe, else the per-user temp dir if safe, else a fresh private temp dir."""
+    path, reason = _prepare(root)
+    if path is not None:
+        return path
+    CACHE_NOTES[str(root)] = reason
+    uid = _euid() if _euid() is not None else "user"
+    path, reason2 = _prepare(Path(tempfile.gettempdir()) / f"nambu_bch-{uid}")
+    if path is not None:
+        return path
+    CACHE_NOTES[str(root)] = f"{reason}; {reason2}"
+    path, reason3 = _prepare(Path(tempfile.mkdtemp(prefix="nambu_bch-")), fresh=True)
+    if path is None:  # pragma: no cover - a fresh mkdtemp directory is always ours
+        raise InvalidRunError(f"no safe kernel cache directory: {reason}; {reason2}; {reason3}")
     return path
 
 
 def numba_available() -> bool:
-    """numba importable and not disabled by ``NAMBU_BCH_DISABLE_NUMBA=1`` (read at every call)."""
+    """numba installed and not disabled by ``NAMBU_BCH_DISABLE_NUMBA=1`` (read at every call; numba is
+    located, not imported: importing it costs ~0.3 s, paid only when a kernel is compiled)."""
     if os.environ.get("NAMBU_BCH_DISABLE_NUMBA", "").strip().lower() in ("1", "true", "yes", "on"):
         return False
+    if "numba" in sys.modules:
+        return True
     try:
-        import numba  # noqa: F401
-    except ImportError:
+        return importlib.util.find_spec("numba") is not None
+    except (ImportError, ValueError):
         return False
-    return True
 
 
 def resolve_backend(backend: str = "auto") -> str:
@@ -97,23 +180,89 @@ def resolve_backend(backend: str = "auto") -> str:
     return backend
 
 
-def _write_once(path: Path, text: str):
-    """Create ``path`` with ``text`` atomically unless it exists (keeps its mtime, which numba's cache checks)."""
-    if path.exists():
-        return
-    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=".tmp-", suffix=".py")
-    with os.fdopen(fd, "w") as fh:
-        fh.write(text)
+#: Largest cache file read back (a kernel module is a few kB; anything bigger is not ours).
+MAX_CACHE_FILE = 4 * 2**20
+_MODULE_NAME = re.compile(r"nambu_bch_kernel_[0-9a-f]{20}")
+_INDEX_FIELDS = {"template": str, "module": str, "sha256": str, "N": int, "n_constants": int,
+                 "n_parameters": int, "linear": list}
+_FUNCTIONS = ("constants", "run", "run_kahan", "run_batch", "run_batch_kahan", "run_numpy", "run_numpy_kahan", "scan")
+
+
+def input_key(system, comp) -> str:
+    """The digest of everything a kernel is generated from (exact inputs, not names).
+
+    The coordinates, parameters, each piece's vector field and moving coordinates (``srepr``),
+    the composition's pieces and exact coefficients, the template version and a digest of the
+    generator's own code (:func:`_generator_digest`).  Equal keys
+    mean equal generated source, so a cached source can be used without sympy.
+    """
+    import sympy
+
+    parts = [TEMPLATE_VERSION, _generator_digest(), sympy.srepr(tuple(system.coordinates)),
+             sympy.srepr(tuple(system.parameters))]
+    for piece in system.splitting:
+        parts.append(sympy.srepr(tuple(piece.field.to_sympy())) + repr(tuple(piece.moving)))
+    parts.append(repr([(int(k), sympy.srepr(c)) for k, c in comp.factors()]))
+    return hashlib.sha256("\x1f".join(parts).encode()).hexdigest()[:32]
+
+
+@lru_cache(maxsize=1)
+def _generator_digest() -> str:
+    """A digest of the code that turns exact inputs into source (codegen and the exact flows), so an
+    upgraded package never reuses a source generated by an older one."""
+    from ..integrators import flows
+    from . import codegen
+
+    h = hashlib.sha256()
+    for module in (codegen, flows):
+        try:
+            h.update(Path(module.__file__).read_bytes())
+        except OSError:  # no source on disk (frozen): the template version alone
+            h.update(TEMPLATE_VERSION.encode())
+    return h.hexdigest()[:16]
+
+
+def _read_small(path: Path) -> bytes:
+    """The bytes of a regular file we own (no symlink), at most :data:`MAX_CACHE_FILE`; OSError otherwise."""
+    fd = os.open(path, os.O_RDONLY | getattr(os, "O_NOFOLLOW", 0))
+    with os.fdopen(fd, "rb") as fh:
+        st = os.fstat(fh.fileno())
+        if not stat.S_ISREG(st.st_mode) or st.st_mode & (stat.S_IWGRP | stat.S_IWOTH):
+            raise OSError(f"{path} is not a private regular file")
+        data = fh.read(MAX_CACHE_FILE + 1)
+    if len(data) > MAX_CACHE_FILE:
+        raise OSError(f"{path} is too large")
+    return data
+
+
+def _write_file(path: Path, data: bytes):
+    """Make ``path`` hold ``data``: kept untouched if it already does (numba's cache checks its mtime),
+    else replaced atomically (a private temp file, mode 0600, then ``os.replace``)."""
     try:
-        os.link(tmp, path)
-    except FileExistsError:
+        if _read_small(path) == data:
+            return
+    except OSError:
         pass
-    except OSError:  # no hard links on this file system
-        if not path.exists():
-            os.replace(tmp, path)
+    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=".tmp-")
+    try:
+        with os.fdopen(fd, "wb") as fh:
+            fh.write(data)
+        os.replace(tmp, path)
     finally:
         if os.path.exists(tmp):
             os.unlink(tmp)
+
+
+def _load_module(name: str, path: Path, source: str):
+    """Execute ``source`` (already verified) as module ``name`` whose functions report ``path`` as their file."""
+    module = types.ModuleType(name)
+    module.__file__ = str(path)
+    exec(compile(source, str(path), "exec"), module.__dict__)  # noqa: S102 - our own generated, digest-checked source
+    missing = [f for f in _FUNCTIONS if not callable(module.__dict__.get(f))]
+    if missing:
+        raise ValueError(f"generated module lacks {missing}")
+    sys.modules[name] = module
+    return module
 
 
 class Kernel:
@@ -131,33 +280,91 @@ class Kernel:
     def __init__(self, system, comp):
         self.system = system
         self.composition = comp
-        self.program = step_program(system, comp)
-        self.source = python_source(self.program)
-        key = source_hash(self.source)
-        self.path = cache_dir() / f"nambu_bch_kernel_{key}.py"
-        _write_once(self.path, self.source)
-        name = f"nambu_bch_kernel_{key}"
-        spec = importlib.util.spec_from_file_location(name, self.path)
-        module = importlib.util.module_from_spec(spec)
-        sys.modules.setdefault(name, module)
-        spec.loader.exec_module(module)
-        self.module = module
+        self.word = str(comp)
+        self.N = system.N
+        self.key = input_key(system, comp)
+        self.directory = cache_dir()
+        self.index_path = self.directory / f"nambu_bch_index_{self.key}.json"
+        self.from_cache = self._load_cached()
+        if not self.from_cache:
+            self._generate()
         self._constants = {}
         self._jitted = {}
         self.compile_seconds = {}
 
+    def _load_cached(self) -> bool:
+        """Use the cached source if its index is intact and the file matches the recorded digest."""
+        try:
+            meta = json.loads(_read_small(self.index_path).decode("utf-8"))
+            if not isinstance(meta, dict) or any(not isinstance(meta.get(k), t) for k, t in _INDEX_FIELDS.items()):
+                return False
+            if meta["template"] != TEMPLATE_VERSION or not _MODULE_NAME.fullmatch(meta["module"]):
+                return False
+            if meta["N"] != self.N or meta["n_parameters"] != len(self.system.parameters):
+                return False
+            path = self.directory / f"{meta['module']}.py"
+            data = _read_small(path)
+            if hashlib.sha256(data).hexdigest() != meta["sha256"]:
+                return False
+            source = data.decode("utf-8")
+            if f"nambu_bch_kernel_{source_hash(source)}" != meta["module"]:
+                return False
+            linear = tuple(int(i) for i in meta["linear"] if isinstance(i, int) and 0 <= i < self.N)
+            module = _load_module(meta["module"], path, source)
+        except (OSError, ValueError, SyntaxError, UnicodeDecodeError):  # absent, corrupt or modified: regenerate
+            return False
+        self.source, self.path, self.module = source, path, module
+        self.n_constants, self.linear = meta["n_constants"], linear
+        return True
+
+    def _generate(self):
+        """Generate the source from the exact sub-flows (sympy), write it and its index, load it."""
+        from .guards import linear_part
+
+        program = self.program
+        self.source = python_source(program)
+        name = f"nambu_bch_kernel_{source_hash(self.source)}"
+        self.path = self.directory / f"{name}.py"
+        data = self.source.encode("utf-8")
+        self.n_constants, self.linear = len(program.constants), tuple(linear_part(program))
+        meta = {"template": TEMPLATE_VERSION, "module": name, "sha256": hashlib.sha256(data).hexdigest(),
+                "N": self.N, "n_constants": self.n_constants, "n_parameters": len(self.system.parameters),
+                "linear": list(self.linear)}
+        try:
+            _write_file(self.path, data)
+            _write_file(self.index_path, json.dumps(meta, sort_keys=True).encode("utf-8"))
+        except OSError:  # a read-only cache still runs: the module below comes from memory, not the file
+            pass
+        self.module = _load_module(name, self.path, self.source)
+
+    @property
+    def program(self):
+        """The :class:`~nambu_bch.numeric.codegen.StepProgram` (derived with sympy on first access)."""
+        return step_program(self.system, self.composition)
+
     def __repr__(self):
-        return f"Kernel({self.program.system_name!r}, {self.program.word!r}, {self.path.name})"
+        return f"Kernel({self.system.name!r}, {self.word!r}, {self.path.name})"
 
     # -- constants ----------------------------------------------------------------------------------
     def constants(self, h, params=None) -> np.ndarray:
-        """``K = [k_0(h, params), ...]`` as float64 (computed once per run, in Python)."""
+        """``K = [k_0(h, params), ...]`` as float64 (computed once per run, in Python, by the generated
+        ``constants``); a coefficient that is not a finite float64 raises :class:`NumericalRangeError`."""
         values = parameter_values(self.system, params)
-        f = self._constants.get("math")
-        if f is None:
-            f = self._constants["math"] = self.program.constant_function("math")
-        K = [float(v) for v in f(float(h), *(values[p] for p in self.program.parameters))]
-        return np.array(K, dtype=np.float64)
+        P = [values[p] for p in self.system.parameters]
+        given = ", ".join(f"{p} = {v:g}" for p, v in values.items())
+        where = f"h = {float(h):g}" + (f" with {given}" if given else "")
+        try:
+            K = np.array([float(v) for v in self.module.constants(float(h), P)], dtype=np.float64)
+        except ZeroDivisionError:
+            raise NumericalRangeError(f"{where}: a coefficient of the step divides by zero; "
+                                      "give non-zero values to the parameters in denominators") from None
+        except (OverflowError, ValueError) as exc:
+            raise NumericalRangeError(f"{where}: a coefficient of the step is out of the float64 range ({exc}); "
+                                      "rescale the parameters or the step") from None
+        if not np.all(np.isfinite(K)):
+            raise NumericalRangeError(f"{where}: a coefficient of the step overflows float64; "
+                                      "rescale the parameters or the step")
+        return K
 
     # -- functions ----------------------------------------------------------------------------------
     def function(self, name: str, backend: str = "numba"):
@@ -170,9 +377,28 @@ class Kernel:
         if fn is None:
             import numba
 
-            fn = numba.njit(cache=True, nogil=True, fastmath=False, error_model="numpy")(getattr(self.module, name))
+            on_disk = self.path.is_file()  # numba caches next to a source file; without one, compile in memory
+            fn = numba.njit(cache=on_disk, nogil=True, fastmath=False, error_model="numpy")(getattr(self.module, name))
             self._jitted[name] = fn
         return fn
+
+    def scan(self, X):
+        """One compiled pass over a batch ``X`` (N, B): ``(non-finite count, subnormal count, columns)``.
+
+        ``columns`` are the extreme states of :func:`~nambu_bch.numeric.guards.extreme_states`
+        (largest / smallest max-norm and product of magnitudes, smallest non-zero component).
+        """
+        if "scan" not in self.compile_seconds:
+            self.compile_seconds["scan"] = 0.0
+            fn = self.function("scan")
+            try:
+                fn(np.zeros((1, 1)), np.zeros(7, dtype=np.int64))
+            except Exception:  # noqa: BLE001 - a corrupt numba cache entry: purge and compile again
+                self._purge_numba_cache(fn)
+                self._jitted.pop("scan", None)
+        res = np.zeros(7, dtype=np.int64)
+        self.function("scan")(X, res)
+        return int(res[0]), int(res[1]), np.unique(np.concatenate([res[2:], [0, X.shape[1] - 1]]))
 
     def compile(self, kahan: bool = False, batch: bool = False) -> float:
         """Compile (or load from the disk cache) one loop now; the wall time in seconds."""
@@ -180,9 +406,21 @@ class Kernel:
         if name in self.compile_seconds:
             return self.compile_seconds[name]
         fn = self.function(name, "numba")
-        N = self.program.N
-        K = np.zeros(max(1, len(self.program.constants)))
         start = time.perf_counter()
+        try:
+            self._first_call(fn, kahan, batch)
+        except Exception:  # noqa: BLE001 - a corrupt or truncated numba cache entry (.nbi/.nbc): regenerate it
+            self._purge_numba_cache(fn)
+            self._jitted.pop(name, None)
+            fn = self.function(name, "numba")
+            start = time.perf_counter()
+            self._first_call(fn, kahan, batch)
+        self.compile_seconds[name] = time.perf_counter() - start
+        return self.compile_seconds[name]
+
+    def _first_call(self, fn, kahan, batch):
+        N = self.N
+        K = np.zeros(max(1, self.n_constants))
         if batch:
             X = np.zeros((N, 1))
             out = np.zeros((2, N, 1))
@@ -193,8 +431,21 @@ class Kernel:
             out = np.zeros((2, N))
             args = (x, np.zeros(N)) if kahan else (x,)
             fn(*args, K, 1, 1, out)
-        self.compile_seconds[name] = time.perf_counter() - start
-        return self.compile_seconds[name]
+
+    def _purge_numba_cache(self, fn):
+        """Delete numba's cache files of this kernel module (``<module>.*.nbi`` / ``.nbc``)."""
+        where = getattr(getattr(fn, "_cache", None), "_cache_path", None) or str(self.directory / "__pycache__")
+        stem = self.path.stem + "."
+        try:
+            names = os.listdir(where)
+        except OSError:
+            return
+        for entry in names:
+            if entry.startswith(stem) and entry.endswith((".nbi", ".nbc")):
+                try:
+                    os.unlink(os.path.join(where, entry))
+                except OSError:
+                    pass
 
     # -- running ------------------------------------------------------------------------------------
     def run(self, x, K, steps, every, out, *, kahan=False, comp=None, backend="numba") -> int:
