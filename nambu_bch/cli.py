@@ -4,7 +4,7 @@ Synopsis::
 
     nambu-bch models   [--model NAME] [--format text|latex|json]
     nambu-bch bch      [SYSTEM] [--integrator WORD] [--order K] [--field] [--terms]
-    nambu-bch fi       [SYSTEM] [--integrator WORD]
+    nambu-bch fi       [SYSTEM] [--integrator WORD] [--order K] [--limit N]
     nambu-bch shadow   [SYSTEM] [--integrator WORD] [--order K] [--route direct|fi] [--degree D]
     nambu-bch conserved [SYSTEM] [--integrator WORD]
     nambu-bch exact    [SYSTEM] [--integrator WORD]
@@ -531,6 +531,8 @@ def cmd_fi(args):
     system, values = system_from_args(args)
     system = substituted(system, values)
     word, comp = integrator_from_args(args, system)
+    if args.order is not None and args.order > (2 if comp.symmetric else 1):
+        return _cmd_fi_nested(args, system, word, comp)
     reps = fi_representations(system, comp) if _system_chosen(args) else None
 
     def slot_latex(slot):
@@ -574,6 +576,30 @@ def cmd_fi(args):
             rows.append(r"\text{" + f"{word} on {system.name}" + r"}:\quad h^2\," + commutator_latex(c, abd))
             rows += [rf"\quad \overset{{\rm {lab}}}{{=}} {terms_latex(terms)}" for lab, terms in forms.items()]
         return " \\\\\n".join(rows)
+
+    emit(args, latex=latex, text=text, data=data)
+
+
+def _cmd_fi_nested(args, system, word, comp):
+    """``fi --order K``: the brackets at ``h^K`` with the affine hulls of their FI representations (issue 13)."""
+    from .shadow.fi_route import fi_brackets
+
+    limit = positive_int(args.limit, "--limit", 10**6) if args.limit is not None else None
+    brackets = fi_brackets(system, comp, args.order)
+    shown = brackets[:limit] if limit is not None else brackets
+    more = f"... {len(brackets) - len(shown)} more brackets (raise --limit)" if len(shown) < len(brackets) else None
+    head = f"h^{args.order} brackets of {word} on {system.name}: {len(brackets)}"
+
+    def data():
+        return {**_base(system, word, order=args.order), "total": len(brackets),
+                "brackets": [b.to_dict(limit) for b in shown]}
+
+    def text():
+        return "\n".join([head, *(b.to_text(limit) for b in shown), *([more] if more else [])])
+
+    def latex():
+        title = r"\text{" + f"{word} on {system.name}, {len(brackets)} brackets at" + "} " + f"h^{{{args.order}}}"
+        return " \\\\\n".join([title, *(b.to_latex(limit) for b in shown), *([r"\text{" + more + "}"] if more else [])])
 
     emit(args, latex=latex, text=text, data=data)
 
@@ -740,7 +766,8 @@ def build_parser() -> argparse.ArgumentParser:
 
     p = add("fi", cmd_fi)
     _system_options(p)
-    _integrator_options(p)
+    _integrator_options(p, order=True)
+    p.add_argument("--limit", metavar="N", type=str, help="with --order K > 2: show at most N brackets and N directions each")
     _output_options(p, "latex")
 
     p = add("shadow", cmd_shadow)

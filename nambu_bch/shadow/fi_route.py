@@ -34,14 +34,19 @@ from itertools import product
 
 import sympy
 
+from ..algebra import liouville_field
 from ..bch import expand_terms, formal_bch
 from ..bch.lyndon import is_bracket
 from ..errors import InvalidOrderError, NambuBCHError
 from ..integrators.composition import composition as make_composition
 from .direct_route import ALPHA, H_STEP, _monomials
+from .fi_nested import Echelon, RawOps, nested_hull
 from .fundamental_identity import representations, single_representations
-from .linear import kernel_rref, normal_form, solve_affine
+from .linear import kernel_rref, normal_form, rank, solve_affine
 from .liouville_terms import LiouvilleSum
+
+#: Highest power of ``h`` the FI route solves (the hulls of degree-9 brackets are not bounded cheaply).
+MAX_FI_ORDER = 6
 
 
 @dataclass
@@ -87,6 +92,109 @@ class FIMember:
 
 
 @dataclass
+class FINested:
+    """``coefficient * tree`` (a BCH bracket of Liouville terms, any depth) with the affine hull of its FI forms.
+
+    The representations of ``tree`` are ``base + sum_k w_k d_k`` (any weights), ``hull.directions``
+    the ``(label, d_k)``; :mod:`~nambu_bch.shadow.fi_nested` explains the labels.
+    """
+
+    coefficient: object
+    tree: object
+    hull: object  # fi_nested.NestedHull
+    ops: object = field(default=None, repr=False)  # fi_nested.RawOps, for output
+
+    def label(self, latex: bool = False) -> str:
+        show_slot = sympy.latex if latex else str
+
+        def show(t):
+            if is_bracket(t):
+                return f"[{show(t[0])}, {show(t[1])}]"
+            return "X_{" + ", ".join(show_slot(s) for s in t) + "}"
+
+        return show(self.tree)
+
+    def to_dict(self, limit=None) -> dict:
+        """JSON-able: coefficient, bracket (nested lists of slots), base and directions as ``[{coefficient, slots}]``."""
+        from ..render import expression
+
+        def tree(t):
+            return [tree(t[0]), tree(t[1])] if is_bracket(t) else [expression(s) for s in t]
+
+        def terms(raw, c=None):
+            return [{"coefficient": expression(k), "slots": [expression(x) for x in slots]} for k, slots in self.ops.items(raw, c)]
+
+        dirs = self.hull.directions[:limit] if limit is not None else self.hull.directions
+        return {
+            "coefficient": expression(self.coefficient),
+            "bracket": tree(self.tree),
+            "dimension": self.hull.dimension,
+            "base": terms(self.hull.base, self.coefficient),
+            "directions": [{"label": lab, "terms": terms(d, self.coefficient)} for lab, d in dirs],
+        }
+
+    def to_text(self, limit=None) -> str:
+        lines = [f"({self.coefficient}) {self.label()}   (affine hull of dimension {self.hull.dimension})",
+                 f"  base (Eq. CL2a at every pair): {self.ops.to_text(self.hull.base, self.coefficient)}"]
+        dirs = self.hull.directions if limit is None else self.hull.directions[:limit]
+        lines += [f"  + w * [{lab}]: {self.ops.to_text(d, self.coefficient)}" for lab, d in dirs]
+        if len(dirs) < self.hull.dimension:
+            lines.append(f"  ... {self.hull.dimension - len(dirs)} more directions (raise --limit)")
+        return "\n".join(lines)
+
+    def to_latex(self, limit=None) -> str:
+        rows = [rf"\left({sympy.latex(self.coefficient)}\right) {self.label(latex=True)}",
+                rf"\quad \overset{{\rm a}}{{=}} {self.ops.to_latex(self.hull.base, self.coefficient)}"]
+        dirs = self.hull.directions if limit is None else self.hull.directions[:limit]
+        rows += [rf"\quad + w \cdot [\text{{{lab}}}]: {self.ops.to_latex(d, self.coefficient)}" for lab, d in dirs]
+        return " \\\\\n".join(rows)
+
+
+@dataclass
+class FIOrder:
+    """The FI route at one power ``h^j`` above the lowest: ``sum_t c_t Aff(T_t)`` against the target with cross terms.
+
+    Attributes
+    ----------
+    order : int
+    status : ``"solved"``, ``"vanishes"`` or ``"obstructed"``
+    degree : int or None -- ansatz degree of the corrections
+    commutators : list of FINested -- the BCH brackets at ``h^j`` with their hulls
+    directions : list of ``(commutator index, label)`` -- the independent directions kept (one weight each)
+    corrections : tuple -- the alpha-family ``(dH_j, dG_j, ...)``
+    members : (tuple, tuple) -- the ``alpha = 0`` and ``alpha = 1`` members
+    kernel : list of tuples -- a basis of the corrections of the homogeneous FI solutions
+    fi_dim : int -- dimension of that space (corrections reached through FI representations)
+    direct_dim : int -- dimension of the direct route's kernel at the same ansatz degree (computed on first use)
+    certificate : dict or None
+    """
+
+    order: int
+    status: str
+    degree: int | None = None
+    commutators: list = field(default_factory=list)
+    directions: list = field(default_factory=list)
+    corrections: tuple = ()
+    members: tuple = ()
+    kernel: list = field(default_factory=list)
+    fi_dim: int = 0
+    certificate: dict | None = None
+    _direct: tuple = field(default=(), repr=False)
+    _direct_dim: int | None = field(default=None, repr=False)
+
+    @property
+    def direct_dim(self) -> int | None:
+        if self._direct_dim is None and self._direct:
+            self._direct_dim = _direct_kernel_dim(*self._direct)
+        return self._direct_dim
+
+    @property
+    def whole(self) -> bool:
+        """Is the FI solution set the whole solution space of the direct route at this order and degree?"""
+        return self.status == "solved" and self.fi_dim == self.direct_dim
+
+
+@dataclass
 class FIResult:
     """The FI-route solution family for one system, composition and power of ``h``.
 
@@ -112,6 +220,8 @@ class FIResult:
     corrections: tuple = ()
     kernel: list = field(default_factory=list)
     certificate: dict | None = None
+    orders: list = field(default_factory=list)  # FIOrder, the powers above ``power``
+    failed_order: int | None = None
     _ctx: dict = field(default_factory=dict, repr=False)
 
     @property
@@ -120,10 +230,15 @@ class FIResult:
         return len(self.kernel)
 
     def shadow(self) -> tuple:
-        """``(H_S, G_S)`` of the alpha-family through ``h^power``."""
-        return tuple(
-            sympy.expand(Hk + H_STEP**self.power * c) for Hk, c in zip(self.system.hamiltonians, self.corrections)
-        )
+        """``(H_S, G_S)`` of the alpha-family through the highest power solved."""
+        out = []
+        for a, Hk in enumerate(self.system.hamiltonians):
+            total = Hk + H_STEP**self.power * self.corrections[a]
+            for o in self.orders:
+                if o.status == "solved":
+                    total += H_STEP**o.order * o.corrections[a]
+            out.append(sympy.expand(total))
+        return tuple(out)
 
     def combination(self, weights) -> LiouvilleSum:
         """``sum_t c_t sum_r w_{t,r} R_{t,r}``; ``weights[t]`` maps a label (or rep index) to its weight."""
@@ -180,6 +295,11 @@ class FIResult:
                 w0 = self.members[0].weights[t][r] if self.members else "-"
                 w1 = self.members[1].weights[t][r] if self.members else "-"
                 lines.append(f"     {'/'.join(rep.labels)}: {rep}   weights (alpha=0, 1): {w0}, {w1}")
+        for o in self.orders:
+            lines.append(f"FI route, {self.composition.name}, h^{o.order}: {o.status}"
+                         + (f", {len(o.commutators)} brackets, {len(o.directions)} independent FI directions, "
+                            f"FI family dimension {o.fi_dim} of the direct route's {o.direct_dim}"
+                            if o.status == "solved" else ""))
         return "\n".join(lines)
 
 
@@ -197,6 +317,20 @@ def _atoms(system):
             return (), [[Hb] for Hb in system.hamiltonians]  # pieces do not rebuild H: plain monomial bookkeeping
     atoms = tuple(dict.fromkeys(f for slot in per_slot for f in slot))
     return atoms, per_slot
+
+
+_MONOMIAL_COLUMNS: dict = {}
+
+
+def _monomial_column(ctx, a, e) -> LiouvilleSum:
+    """:func:`_target_term` of the monomial ``x^e`` in slot ``a``, memoised (shared by all orders and words)."""
+    alg = ctx["algebra"]
+    key = (alg.ring, alg.coordinates, ctx["atoms"], tuple(map(tuple, ctx["per_slot"])), a, e)
+    if key not in _MONOMIAL_COLUMNS:
+        if len(_MONOMIAL_COLUMNS) > 20000:
+            _MONOMIAL_COLUMNS.clear()
+        _MONOMIAL_COLUMNS[key] = _target_term(ctx, a, sympy.Mul(*(x**p for x, p in zip(alg.coordinates, e))))
+    return _MONOMIAL_COLUMNS[key]
 
 
 def _target_term(ctx, a, correction) -> LiouvilleSum:
@@ -264,11 +398,13 @@ def fi_route(system, word, order: int = 2, degree=None, terms=None) -> FIResult:
     splitting = system.splitting
     comp = make_composition(word, len(splitting)).check(splitting)
     power = 2 if comp.symmetric else 1
-    if order != power and terms is None:
+    if isinstance(order, bool) or not isinstance(order, int) or not power <= order <= MAX_FI_ORDER:
         raise InvalidOrderError(
-            f"the FI route solves the lowest correction, h^{power} for {'symmetric' if comp.symmetric else 'non-symmetric'} "
+            f"the FI route solves h^{power}..h^{MAX_FI_ORDER} for {'symmetric' if comp.symmetric else 'non-symmetric'} "
             f"word {comp.name!r}; got order={order!r} -- use route='direct' for other orders"
         )
+    if terms is not None and order != power:
+        raise InvalidOrderError(f"terms= gives the h^{power} brackets only; got order={order!r}")
     alg = system.algebra
     atoms, per_slot = _atoms(system)
     ctx = {"algebra": alg, "atoms": atoms, "per_slot": per_slot}
@@ -305,6 +441,7 @@ def fi_route(system, word, order: int = 2, degree=None, terms=None) -> FIResult:
         commutators.append(FICommutator(coef, leaves, distinct))
     hams = system.hamiltonians
     slots = len(hams)
+    user_degree = degree is not None
     if degree is None:
         degree = max((sum(v) for c in commutators for r in c.representations for key in r.formal.terms
                       for kind, v in key if kind == 0), default=1)
@@ -330,7 +467,7 @@ def fi_route(system, word, order: int = 2, degree=None, terms=None) -> FIResult:
         vec[row(("w", t))] = alg.domain.one
         columns.append(vec)
     for a, e in ccols:
-        formal = _target_term(ctx, a, sympy.Mul(*(x**p for x, p in zip(alg.coordinates, e))))
+        formal = _monomial_column(ctx, a, e)
         columns.append({row(("k", k)): -v for k, v in formal.terms.items()})
     rhs = {row(("w", t)): alg.domain.one for t in range(len(commutators))}
     sol = solve_affine(columns, [rhs], len(keys), alg.domain)
@@ -370,4 +507,210 @@ def fi_route(system, word, order: int = 2, degree=None, terms=None) -> FIResult:
     result.corrections = tuple(sympy.expand((1 - ALPHA) * c0 + ALPHA * c1)
                                for c0, c1 in zip(members[0].corrections, members[1].corrections))
     result.kernel = kernel_rref(sol.kernel, priority(range(slots)), alg.domain)
+    if order > power:
+        _higher_orders(result, order, degree if user_degree else None)
     return result
+
+
+# -- higher orders -----------------------------------------------------------------------------------
+
+
+def _alpha_parts(alg, expr) -> dict:
+    """``{k: ring element}``: the coefficient of ``alpha^k`` of a correction (sympy), in the algebra's ring."""
+    expr = sympy.expand(expr)
+    if expr == 0:
+        return {}
+    if not expr.has(ALPHA):
+        return {0: alg.convert(expr)}
+    return {m[0]: alg.convert(c) for m, c in sympy.Poly(expr, ALPHA).terms() if c != 0}
+
+
+def _cross_terms(ops, per_slot, j, corrections, slots) -> dict:
+    """``{k: LiouvilleSum}``: the alpha^k part of the products of lower-order corrections at ``h^j`` (formal).
+
+    ``corrections[(a, o)]`` is ``{k: ring element}`` (alpha^k parts of the slot-``a`` correction at ``h^o``).
+    """
+    raw: dict = {}
+    for orders in product(range(j), repeat=slots):
+        if sum(orders) != j or sum(1 for o in orders if o) < 2:
+            continue
+        choices = []
+        for a, o in enumerate(orders):
+            if o == 0:  # a Hamiltonian slot: the sum of its atoms
+                atoms = [ops.from_slots((f,)) for f in per_slot[a]]
+                choices.append([(0, [(k[0], c) for A in atoms for k, c in A.items()])])
+            else:
+                choices.append([(k, ops.monomials(p)) for k, p in corrections.get((a, o), {}).items()])
+        for pick in product(*choices):
+            k = sum(p for p, _ in pick)
+            part = raw.setdefault(k, {})
+            for key, v in ops.from_expanded([e for _, e in pick]).items():
+                part[key] = part.get(key, ops.domain.zero) + v
+    out = {k: ops.reduce(v) for k, v in raw.items()}
+    return {k: v for k, v in out.items() if not v.is_zero()}
+
+
+def _max_degree(sums) -> int:
+    return max((sum(v) for f in sums for key in f.terms for kind, v in key if kind == 0), default=1)
+
+
+def _direct_kernel_dim(alg, hams, monos) -> int:
+    """``dim ker (dH, dG) -> X_{dH,G} + X_{H,dG}`` on polynomials with these monomials (the direct route's gauge)."""
+    rows: dict = {}
+    vecs = []
+    ring_hams = [alg.convert(Hk) for Hk in hams]
+    for a in range(len(hams)):
+        for e in monos:
+            slots = list(ring_hams)
+            slots[a] = alg.ring.from_dict({e + (0,) * (len(alg.ring.gens) - alg.n): alg.domain.one})
+            vec = {}
+            for i, comp in enumerate(liouville_field(alg, *slots).components):
+                for m, c in comp.items():
+                    vec[rows.setdefault((i, m), len(rows))] = c
+            vecs.append(vec)
+    return len(vecs) - rank(vecs, len(rows), alg.domain)
+
+
+def _higher_orders(result, order, degree) -> None:
+    """Solve ``h^{power+1} .. h^order`` by the recursive hulls (fi_nested), the lower family fed into the cross terms."""
+    system, comp, ctx = result.system, result.composition, result._ctx
+    alg, atoms = ctx["algebra"], ctx["atoms"]
+    hams = system.hamiltonians
+    slots = len(hams)
+    if not result.exists:
+        return
+    corrections = {(a, result.power): _alpha_parts(alg, c) for a, c in enumerate(result.corrections)}
+    ops = RawOps(alg, atoms)
+    memo: dict = {}
+    series = formal_bch(comp, order + 1)
+    for j in range(result.power + 1, order + 1):
+        o = _solve_order(result, ops, memo, series, j, corrections, degree)
+        result.orders.append(o)
+        if o.status == "obstructed":
+            result.exists = False
+            result.failed_order = j
+            return
+        for a, c in enumerate(o.corrections):
+            corrections[(a, j)] = _alpha_parts(alg, c)
+    ctx["ops"] = ops
+
+
+def _brackets(system, series, j, ops, memo) -> list:
+    """The BCH brackets at ``h^j`` (Liouville-term trees, vanishing ones pruned, equal ones merged) with their hulls."""
+    merged: dict = {}
+    for coef, tree in expand_terms(series.terms(j + 1), system.splitting, prune=True):
+        merged[tree] = merged.get(tree, 0) + sympy.sympify(coef)
+    return [FINested(c, tree, nested_hull(ops, tree, memo), ops) for tree, c in merged.items() if c != 0]
+
+
+def fi_brackets(system, word, order: int) -> list:
+    """The brackets of ``X_eff`` at ``h^order``, each with the affine hull of its FI representations.
+
+    Parameters
+    ----------
+    system : System
+    word : composition spec
+    order : int -- the power of ``h`` (1..MAX_FI_ORDER)
+
+    Returns
+    -------
+    list of FINested -- empty when the order vanishes (odd orders of a symmetric word)
+
+    Examples
+    --------
+    >>> from nambu_bch import model
+    >>> B = fi_brackets(model("ho3"), "12321", 4)        # the six degree-5 brackets of Eq. (BCH3) that survive
+    >>> len(B), [b.hull.dimension for b in B]
+    (6, [1, 1, 2, 2, 1, 1])
+    """
+    comp = make_composition(word, len(system.splitting)).check(system.splitting)
+    if isinstance(order, bool) or not isinstance(order, int) or not 1 <= order <= MAX_FI_ORDER:
+        raise InvalidOrderError(f"order must be an integer between 1 and {MAX_FI_ORDER} for the FI brackets, got {order!r}")
+    atoms, _ = _atoms(system)
+    return _brackets(system, formal_bch(comp, order + 1), order, RawOps(system.algebra, atoms), {})
+
+
+def _solve_order(result, ops, memo, series, j, corrections, degree) -> FIOrder:
+    system, ctx = result.system, result._ctx
+    alg, atoms = ctx["algebra"], ctx["atoms"]
+    domain = alg.domain
+    hams = system.hamiltonians
+    slots = len(hams)
+    commutators = _brackets(system, series, j, ops, memo)
+    base = LiouvilleSum.zero(alg, atoms)
+    ech = Echelon(domain)
+    directions, dvecs = [], []
+    for t, comm in enumerate(commutators):
+        c = domain.from_sympy(comm.coefficient)
+        base = base + ops.reduce(comm.hull.base, c)
+        for label, d in comm.hull.directions:
+            vec = ops.reduce(d, c)
+            if not vec.is_zero() and ech.insert(dict(vec.terms)):
+                directions.append((t, label))
+                dvecs.append(vec)
+    cross = _cross_terms(ops, ctx["per_slot"], j, corrections, slots)
+    rhs_sums = dict(cross)
+    rhs_sums[0] = rhs_sums[0] - base if 0 in rhs_sums else -base
+    rhs_sums = {k: v for k, v in rhs_sums.items() if not v.is_zero()}
+    if not rhs_sums and not dvecs:
+        return FIOrder(j, "vanishes", corrections=(sympy.Integer(0),) * slots, commutators=commutators)
+    if degree is None:
+        degree = max(_max_degree([base, *dvecs, *rhs_sums.values()]), 1)
+    monos = _monomials(alg.n, degree)
+    ccols = [(a, e) for a in range(slots) for e in monos]
+    keys: dict = {}
+
+    def vector(f, sign=1):
+        return {keys.setdefault(k, len(keys)): sign * v for k, v in f.terms.items()}
+
+    columns = [vector(v) for v in dvecs]
+    for a, e in ccols:
+        columns.append(vector(_monomial_column(ctx, a, e), -1))
+    powers = sorted(rhs_sums)
+    rhs = [vector(rhs_sums[k]) for k in powers]
+    nw = len(dvecs)
+    sol = solve_affine(columns, rhs, len(keys), domain)
+    out = FIOrder(j, "solved", degree, commutators, directions)
+    if not sol.consistent:
+        inverse = {v: k for k, v in keys.items()}
+        out.status = "obstructed"
+        out.certificate = {str(inverse[r]): domain.to_sympy(v) for r, v in sol.certificate.items()}
+        return out
+    index = {c: nw + k for k, c in enumerate(ccols)}
+    zero = (0,) * alg.n
+
+    def priority(slot_order):
+        prio = [index[(a, zero)] for a in range(slots)]
+        for a in slot_order:
+            own = sorted({m[: alg.n] for m in alg.convert(hams[a]).keys()}, key=lambda e: tuple(reversed(e)), reverse=True)
+            prio += [index[(a, e)] for e in own if (a, e) in index and index[(a, e)] not in prio]
+            prio += [index[c] for c in ccols if c[0] == a and index[c] not in prio]
+        return prio + list(range(nw))
+
+    def mono(e):
+        return sympy.Mul(*(x**p for x, p in zip(alg.coordinates, e)))
+
+    members = []
+    for prio in (priority(range(slots)), priority(reversed(range(slots)))):
+        corr = [sympy.Integer(0)] * slots
+        for k, part in zip(powers, sol.particular):
+            for col, v in normal_form(part, sol.kernel, prio, domain).items():
+                if col >= nw:
+                    a, e = ccols[col - nw]
+                    corr[a] += ALPHA**k * domain.to_sympy(v) * mono(e)
+        members.append(tuple(sympy.expand(c) for c in corr))
+    out.members = tuple(members)
+    out.corrections = tuple(sympy.expand((1 - ALPHA) * c0 + ALPHA * c1) for c0, c1 in zip(*members))
+    projected = [{col: v for col, v in vec.items() if col >= nw} for vec in sol.kernel]
+    projected = [p for p in projected if p]
+    basis = kernel_rref(projected, priority(range(slots))[: len(ccols)], domain) if projected else []
+    out.kernel = []
+    for vec in basis:
+        corr = [sympy.Integer(0)] * slots
+        for col, v in vec.items():
+            a, e = ccols[col - nw]
+            corr[a] += domain.to_sympy(v) * mono(e)
+        out.kernel.append(tuple(corr))
+    out.fi_dim = len(basis)
+    out._direct = (alg, hams, monos)
+    return out
