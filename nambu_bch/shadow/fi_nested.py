@@ -133,6 +133,8 @@ class RawOps:
         self._poly: dict = {}
         self._ways: dict = {}
         self._leaves: dict = {}
+        self._coefficients: dict = {}
+        self._ring_atoms = {algebra.convert(a): _atom_id(sympy.sympify(a)) for a in self.atoms}
 
     def poly(self, entry):
         if entry not in self._poly:
@@ -158,12 +160,20 @@ class RawOps:
         alg = self.algebra
         expanded = []
         for s in slots:
-            expr = alg.to_sympy(s) if alg.is_polynomial(s) else sympy.sympify(s)
-            if expr in self.atoms:
-                expanded.append([((1, _atom_id(expr)), self.domain.one)])
+            p = alg.convert(s)
+            if not alg.is_polynomial(p):
+                raise NambuBCHError(f"formal Liouville sums need polynomial slots, got {s}")
+            if p in self._ring_atoms:
+                expanded.append([((1, self._ring_atoms[p]), self.domain.one)])
             else:
-                expanded.append(self.monomials(alg.convert(s)))
+                expanded.append(self.monomials(p))
         return self.from_expanded(expanded, coefficient)
+
+    def coefficient(self, c):
+        """A number or sympy constant as an element of the coefficient domain (memoised)."""
+        if c not in self._coefficients:
+            self._coefficients[c] = self.domain.from_sympy(sympy.sympify(c))
+        return self._coefficients[c]
 
     def from_expanded(self, expanded, coefficient=None) -> dict:
         """``coefficient * X_{s_1..}`` for slots given as ``[(entry, coefficient), ...]`` each (multilinear expansion)."""

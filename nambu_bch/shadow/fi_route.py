@@ -29,6 +29,7 @@ Horikoshi, Eqs. (BCH2)-(BCH5), (CL5)-(CL8b), (SH12321a)-(SG12321c), (Xeff3).
 
 from __future__ import annotations
 
+import weakref
 from dataclasses import dataclass, field
 from itertools import product
 
@@ -36,6 +37,7 @@ import sympy
 
 from ..algebra import liouville_field
 from ..bch import expand_terms, formal_bch
+from ..bch.expansion import piece_evaluator, term_evaluator
 from ..bch.lyndon import is_bracket
 from ..errors import InvalidOrderError, NambuBCHError
 from ..integrators.composition import composition as make_composition
@@ -409,7 +411,8 @@ def fi_route(system, word, order: int = 2, degree=None, terms=None) -> FIResult:
     atoms, per_slot = _atoms(system)
     ctx = {"algebra": alg, "atoms": atoms, "per_slot": per_slot}
     if terms is None:
-        terms = expand_terms(formal_bch(comp, power + 1).terms(power + 1), splitting, prune=True)
+        terms = expand_terms(formal_bch(comp, power + 1).terms(power + 1), splitting, prune=True,
+                             evaluators=_evaluators(splitting))
     entries = []
     for coef, tree in terms:
         if power == 2:
@@ -419,6 +422,7 @@ def fi_route(system, word, order: int = 2, degree=None, terms=None) -> FIResult:
     entries = _merge(entries)
     commutators = []
     ring_of: dict = {}
+    ops = RawOps(alg, atoms)
 
     def to_ring(term):  # convert each Hamiltonian piece once; brackets then stay in the ring
         return tuple(ring_of.setdefault(f, alg.convert(f)) for f in term)
@@ -428,15 +432,14 @@ def fi_route(system, word, order: int = 2, degree=None, terms=None) -> FIResult:
         reps = representations(alg, *rleaves) if len(leaves) == 3 else single_representations(alg, *rleaves)
         distinct: list = []
         for label, rep_terms in reps.items():
-            formal = LiouvilleSum.zero(alg, atoms)
-            for t in rep_terms:
-                formal = formal + LiouvilleSum.from_slots(alg, t.slots, t.coefficient, atoms=atoms)
+            parts = [ops.reduce(ops.from_slots(t.slots, ops.coefficient(t.coefficient))) for t in rep_terms]
+            formal = sum(parts, LiouvilleSum.zero(alg, atoms))
             for d in distinct:
                 if d.formal == formal:
                     d.labels += (label,)
                     break
             else:
-                shown = tuple(t for t in rep_terms if not LiouvilleSum.from_slots(alg, t.slots, t.coefficient, atoms=atoms).is_zero())
+                shown = tuple(t for t, part in zip(rep_terms, parts) if not part.is_zero())
                 distinct.append(FIRepresentation((label,), shown, formal))
         commutators.append(FICommutator(coef, leaves, distinct))
     hams = system.hamiltonians
@@ -595,10 +598,21 @@ def _higher_orders(result, order, degree) -> None:
     ctx["ops"] = ops
 
 
+_EVALUATORS = weakref.WeakKeyDictionary()
+
+
+def _evaluators(splitting):
+    """The memoised piece and term evaluators of a splitting (pruning of vanishing brackets), shared by all words."""
+    if splitting not in _EVALUATORS:
+        _EVALUATORS[splitting] = (piece_evaluator(splitting), term_evaluator(splitting))
+    return _EVALUATORS[splitting]
+
+
 def _brackets(system, series, j, ops, memo) -> list:
     """The BCH brackets at ``h^j`` (Liouville-term trees, vanishing ones pruned, equal ones merged) with their hulls."""
     merged: dict = {}
-    for coef, tree in expand_terms(series.terms(j + 1), system.splitting, prune=True):
+    for coef, tree in expand_terms(series.terms(j + 1), system.splitting, prune=True,
+                                   evaluators=_evaluators(system.splitting)):
         merged[tree] = merged.get(tree, 0) + sympy.sympify(coef)
     return [FINested(c, tree, nested_hull(ops, tree, memo), ops) for tree, c in merged.items() if c != 0]
 
