@@ -66,6 +66,11 @@ def _canonical(entries):
     return permutation_sign(order), tuple(entries[i] for i in order)
 
 
+def _content_order(key):
+    """A sort key of a raw term by content (atoms by their expression, not by registration order)."""
+    return tuple((kind, v) if kind == 0 else (kind, str(_ATOMS[v])) for kind, v in key)
+
+
 class Echelon:
     """Incremental reduced row echelon form of sparse vectors ``{key: value}`` over a field.
 
@@ -243,7 +248,11 @@ class RawOps:
         """``[(sympy coefficient, (slot functions...)), ...]`` of a raw sum, in key order."""
         to = self.domain.to_sympy
         c0 = sympy.Integer(1) if coefficient is None else sympy.sympify(coefficient)
-        return [(c0 * to(raw[k]), tuple(self.slot(e) for e in k)) for k in sorted(raw)]
+        out = []
+        for k in sorted(raw, key=lambda key: sorted(_content_order(key))):
+            order = sorted(range(len(k)), key=lambda i: _content_order((k[i],)))  # slots by content, sign kept
+            out.append((permutation_sign(order) * c0 * to(raw[k]), tuple(self.slot(k[i]) for i in order)))
+        return out
 
     def to_text(self, raw: dict, coefficient=None) -> str:
         parts = [f"({c})*X_{{{', '.join(map(str, slots))}}}" for c, slots in self.items(raw, coefficient)]
@@ -306,14 +315,14 @@ def nested_hull(ops: RawOps, tree, memo: dict | None = None) -> NestedHull:
     >>> ops = RawOps(S.algebra, (AC[0], BD[0], AC[1], BD[1]))
     >>> H = nested_hull(ops, (AC, (AC, BD)))    # Eq. (CL5): the eight forms 1AX..2BY span a line
     >>> H.dimension, [label for label, _ in H.directions]
-    (1, ['b0.1'])
+    (1, ['b0.0'])
     """
     memo = {} if memo is None else memo
     if tree in memo:
         return memo[tree]
     if not is_bracket(tree):
         raw = ops.leaf(tuple(tree))
-        out = NestedHull(tree, raw, [], tuple(sorted(raw)))
+        out = NestedHull(tree, raw, [], tuple(sorted(raw, key=_content_order)))
         memo[tree] = out
         return out
     H1, H2 = nested_hull(ops, tree[0], memo), nested_hull(ops, tree[1], memo)
@@ -342,7 +351,7 @@ def nested_hull(ops: RawOps, tree, memo: dict | None = None) -> NestedHull:
     support = set(base)
     for _, d in dirs:
         support.update(d)
-    out = NestedHull(tree, base, dirs, tuple(sorted(support)))
+    out = NestedHull(tree, base, dirs, tuple(sorted(support, key=_content_order)))
     memo[tree] = out
     return out
 

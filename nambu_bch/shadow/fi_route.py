@@ -587,7 +587,7 @@ def _higher_orders(result, order, degree) -> None:
     memo: dict = {}
     series = formal_bch(comp, order + 1)
     for j in range(result.power + 1, order + 1):
-        o = _solve_order(result, ops, memo, series, j, corrections, degree)
+        o = _solve_order(system, ctx, ops, memo, series, j, corrections, degree)
         result.orders.append(o)
         if o.status == "obstructed":
             result.exists = False
@@ -644,8 +644,13 @@ def fi_brackets(system, word, order: int) -> list:
     return _brackets(system, formal_bch(comp, order + 1), order, RawOps(system.algebra, atoms), {})
 
 
-def _solve_order(result, ops, memo, series, j, corrections, degree) -> FIOrder:
-    system, ctx = result.system, result._ctx
+def _solve_order(system, ctx, ops, memo, series, j, corrections, degree) -> FIOrder:
+    """One power ``h^j``: ``sum_t c_t (p_t + sum_k w_tk d_tk) = X_{H,dG_j} + X_{dH_j,G} + cross``, linear in ``w, dH_j, dG_j``.
+
+    ``corrections[(a, o)]`` holds the lower orders' alpha-family (``{k: ring element}``); the right-hand
+    side is split by powers of alpha (so the solution is polynomial in alpha), the two members are
+    the normal forms of :func:`fi_route`, and the family is ``(1 - alpha) member_0 + alpha member_1``.
+    """
     alg, atoms = ctx["algebra"], ctx["atoms"]
     domain = alg.domain
     hams = system.hamiltonians
