@@ -327,3 +327,24 @@ def test_cli_fi_order_4_lists_hulls_with_limit(capsys):
 def test_cli_bad_input_is_one_line(capsys, argv, fragment):
     code, out, err = run(capsys, *argv)
     assert code == 2 and len(err.strip().splitlines()) == 1 and fragment in err and "Traceback" not in err
+
+
+# ---------------------------------------------------------------------------------------------
+# 4. The comparison table of docs/fi_route.md is computed, not typed
+# ---------------------------------------------------------------------------------------------
+
+
+def test_doc_table_rows_are_computed():
+    """Recompute rows of the table (docs/fi_route_table.py) and find them verbatim in docs/fi_route.md."""
+    import importlib.util
+    from pathlib import Path
+
+    path = Path(__file__).resolve().parents[1] / "docs" / "fi_route_table.py"
+    spec = importlib.util.spec_from_file_location("fi_route_table", path)
+    script = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(script)
+    doc = script.DOC.read_text()
+    rows = script.main_rows(systems=("ho3", "lotka-volterra"), words=("12321", "32123"), orders=(4,))
+    lines = script.table(rows).splitlines()[2:]
+    assert len(lines) == 4 and all(line in doc for line in lines)
+    assert any("proper part" in line for line in lines)
