@@ -240,6 +240,18 @@ def test_fi_family_h6_and_lotka_volterra(name, order):
     assert [o.status for o in F.details.orders] == ["vanishes", "solved"] * ((order - 2) // 2)
 
 
+@pytest.mark.parametrize("name, word, order", [("ho", "121", 4), ("ho", "12", 3), ("lotka-volterra", "123", 3),
+                                               ("ho3-composite", "121", 4)])
+def test_fi_family_other_words_and_N2(name, word, order):
+    """Non-symmetric words (cross terms X_{dH_1,dG_1} at h^2) and N = 2 (Eq. CL1, one form): the FI family
+    exists iff the direct one does and reproduces X_eff through h^order."""
+    S = model(name)
+    F = shadow_hamiltonians(S, word, order, route="fi")
+    assert F.exists == shadow_hamiltonians(S, word, order).exists is True
+    check_effective(S, word, order, F.shadows)
+    assert [o.order for o in F.details.orders] == list(range(F.details.power + 1, order + 1))
+
+
 def test_rigid_body_fi_route_is_obstructed_at_h2_both_ways():
     """The rigid body has a direct family at h^2 but no FI one: the labelled forms (Eqs. 1AX-2BY) and the
     recursive hulls (generic solver) both find the formal system inconsistent."""

@@ -3,7 +3,7 @@
 from .api import shadow_hamiltonians
 from .direct_route import DirectResult, OrderSolution, direct_route
 from .family import ShadowFamily
-from .fi_route import FICommutator, FIRepresentation, FIResult, fi_route
+from .fi_route import FICommutator, FINested, FIOrder, FIRepresentation, FIResult, fi_brackets, fi_route
 from .fundamental_identity import FI_LABELS, commutator_terms, double_commutator_terms, representations
 from .jets import JetAlgebra
 from .liouville_terms import LiouvilleSum, LiouvilleTerm
@@ -12,6 +12,8 @@ __all__ = [
     "FI_LABELS",
     "DirectResult",
     "FICommutator",
+    "FINested",
+    "FIOrder",
     "FIRepresentation",
     "FIResult",
     "JetAlgebra",
@@ -22,6 +24,7 @@ __all__ = [
     "commutator_terms",
     "direct_route",
     "double_commutator_terms",
+    "fi_brackets",
     "fi_route",
     "representations",
     "shadow_hamiltonians",

@@ -1,4 +1,4 @@
-"""The FI route: shadow Hamiltonians from the representations of the BCH commutators (Sect. 4.2, 5.2).
+"""The FI route: shadow Hamiltonians from the representations of the BCH commutators (Sect. 4.2, 5.2), any order.
 
 Take the lowest non-vanishing correction of ``X_eff`` as a sum of commutators of
 Liouville terms (the formal BCH series, expanded and pruned: Eq. BCH4 for
@@ -21,6 +21,21 @@ The result is the whole solution family (particular + kernel), its two
 canonical members and their alpha-family (same rule as the direct route, see
 :mod:`nambu_bch.shadow.direct_route`), and :meth:`FIResult.check_member` to
 test a given choice, e.g. the paper's Eqs. (CL5a)-(CL8a) with (SH12321a).
+
+Higher orders (``order`` up to ``MAX_FI_ORDER = 6``; issue 13).  At ``h^j`` the
+BCH brackets have depth ``j`` (Lyndon basis, not all right-nested); the FI
+representations of each are kept as their affine hull, built recursively
+(:mod:`nambu_bch.shadow.fi_nested`: base = Eq. CL2a at every pair, labelled
+directions), and the condition
+
+    sum_t c_t (p_t + sum_k w_tk d_tk) = X_{H,dG_j} + X_{dH_j,G} + sum_{i+k=j} X_{dH_i,dG_k}
+
+is linear in the weights and ``dH_j, dG_j``, the lower orders' alpha-family fed
+into the cross terms (right-hand sides split by powers of alpha).  Each
+:class:`FIOrder` reports its family, members, the corrections reached through
+FI representations (``fi_dim``) and the direct route's kernel at the same
+degree (``direct_dim``): every FI solution is a direct one, and ``whole`` says
+whether the FI span is all of it (docs/fi_route.md: for ho3 it is a proper part).
 
 References
 ----------
@@ -124,7 +139,8 @@ class FINested:
             return [tree(t[0]), tree(t[1])] if is_bracket(t) else [expression(s) for s in t]
 
         def terms(raw, c=None):
-            return [{"coefficient": expression(k), "slots": [expression(x) for x in slots]} for k, slots in self.ops.items(raw, c)]
+            return [{"coefficient": expression(k), "slots": [expression(x) for x in slots]}
+                    for k, slots in self.ops.items(raw, c)]
 
         dirs = self.hull.directions[:limit] if limit is not None else self.hull.directions
         return {
@@ -379,10 +395,13 @@ def fi_route(system, word, order: int = 2, degree=None, terms=None) -> FIResult:
     ----------
     system : System
     word : composition spec
-    order : int -- 2 for symmetric words (1 for other words); odd orders of a symmetric word vanish
-    degree : int, optional -- ansatz degree of ``dH, dG`` (default: the largest monomial degree met)
-    terms : list of ``(coefficient, tree)``, optional -- the commutators to represent, with leaves
-        Liouville terms (e.g. the paper's Eq. BCH4); default: the formal BCH series, expanded and pruned.
+    order : int -- highest power of ``h``: from the lowest correction (2 for symmetric words, 1 otherwise)
+        to ``MAX_FI_ORDER``; the powers above the lowest are in ``FIResult.orders``
+    degree : int, optional -- ansatz degree of ``dH, dG`` at every order (default: per order, the largest
+        monomial degree met in the formal sums)
+    terms : list of ``(coefficient, tree)``, optional -- the lowest-order commutators to represent, with
+        leaves Liouville terms (e.g. the paper's Eq. BCH4); default: the formal BCH series, expanded and
+        pruned.  Only with ``order`` the lowest power.
 
     Returns
     -------
@@ -396,6 +415,13 @@ def fi_route(system, word, order: int = 2, degree=None, terms=None) -> FIResult:
     [2, 2, 2, 2]
     >>> R.commutators[0].representations[0].labels                # Eq. (CL5), first alternative
     ('1AX', '1BX')
+    >>> R4 = fi_route(model("ho3"), "12321", 4)                   # h^4: six brackets of depth 4
+    >>> [(o.order, o.status) for o in R4.orders], (R4.orders[1].fi_dim, R4.orders[1].direct_dim)
+    ([(3, 'vanishes'), (4, 'solved')], (3, 5))
+
+    References
+    ----------
+    Horikoshi, Eqs. (BCH2)-(BCH5), (CL2a), (CL2b), (1AX)-(2BY), (CL5)-(CL8), (SH12321c), (Xeff3).
     """
     splitting = system.splitting
     comp = make_composition(word, len(splitting)).check(splitting)
@@ -645,7 +671,7 @@ def fi_brackets(system, word, order: int) -> list:
 
 
 def _solve_order(system, ctx, ops, memo, series, j, corrections, degree) -> FIOrder:
-    """One power ``h^j``: ``sum_t c_t (p_t + sum_k w_tk d_tk) = X_{H,dG_j} + X_{dH_j,G} + cross``, linear in ``w, dH_j, dG_j``.
+    """One power ``h^j``: ``sum_t c_t (p_t + sum_k w_tk d_tk) = X_{H,dG_j} + X_{dH_j,G} + cross``, linear.
 
     ``corrections[(a, o)]`` holds the lower orders' alpha-family (``{k: ring element}``); the right-hand
     side is split by powers of alpha (so the solution is polynomial in alpha), the two members are
