@@ -582,23 +582,25 @@ def cmd_fi(args):
 
 def _cmd_fi_nested(args, system, word, comp):
     """``fi --order K``: the brackets at ``h^K`` with the affine hulls of their FI representations (issue 13)."""
-    from .shadow.fi_route import fi_brackets
+    from .shadow.fi_route import count_brackets, fi_brackets
 
     limit = positive_int(args.limit, "--limit", 10**6) if args.limit is not None else None
-    brackets = fi_brackets(system, comp, args.order)
-    shown = brackets[:limit] if limit is not None else brackets
-    more = f"... {len(brackets) - len(shown)} more brackets (raise --limit)" if len(shown) < len(brackets) else None
-    head = f"h^{args.order} brackets of {word} on {system.name}: {len(brackets)}"
+    total = count_brackets(system, comp, args.order)
+    if limit is None and total > 2000:
+        raise NambuBCHError(f"--order {args.order}: {total} brackets; pass --limit N to list the first N")
+    shown = fi_brackets(system, comp, args.order, limit)
+    more = f"... {total - len(shown)} more brackets (raise --limit)" if len(shown) < total else None
+    head = f"h^{args.order} brackets of {word} on {system.name}: {total}"
 
     def data():
-        return {**_base(system, word, order=args.order), "total": len(brackets),
+        return {**_base(system, word, order=args.order), "total": total,
                 "brackets": [b.to_dict(limit) for b in shown]}
 
     def text():
         return "\n".join([head, *(b.to_text(limit) for b in shown), *([more] if more else [])])
 
     def latex():
-        title = r"\text{" + f"{word} on {system.name}, {len(brackets)} brackets at" + "} " + f"h^{{{args.order}}}"
+        title = r"\text{" + f"{word} on {system.name}, {total} brackets at" + "} " + f"h^{{{args.order}}}"
         return " \\\\\n".join([title, *(b.to_latex(limit) for b in shown), *([r"\text{" + more + "}"] if more else [])])
 
     emit(args, latex=latex, text=text, data=data)
@@ -704,7 +706,8 @@ EXAMPLES = {
            "  nambu-bch bch --field --terms          # also Z_j on ho3 and the Liouville terms (Eq. BCH4)",
     "fi": "examples:\n  nambu-bch fi                           # the eight forms 1AX..2BY of [X_AB,[X_CD,X_EF]]\n"
           "  nambu-bch fi --model ho3 --integrator 12321   # + each h^2 double commutator of Eq. (BCH4) in the\n"
-          "                                                 #   eight forms, vanishing terms dropped (Eqs. CL5-CL8)",
+          "                                                 #   eight forms, vanishing terms dropped (Eqs. CL5-CL8)\n"
+          "  nambu-bch fi --model ho3 --order 4 --limit 2 --format text   # h^4 brackets: FI hulls, labelled directions",
     "shadow": "examples:\n  nambu-bch shadow                       # alpha-family of Phi^{12321}, ho3, order 2 (Eqs. SH12321c, SG12321c)\n"
               "  nambu-bch shadow --integrator 32123 --format json\n"
               "  nambu-bch shadow --model ho --integrator TVT --order 4\n"

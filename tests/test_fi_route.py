@@ -329,12 +329,16 @@ def test_cli_fi_order_4_lists_hulls_with_limit(capsys):
     code, out, _ = run(capsys, "fi", "--model", "ho3", "--integrator", "12321", "--order", "4", "--format", "text",
                        "--limit", "1")
     assert code == 0 and "... 5 more brackets" in out and "base (Eq. CL2a at every pair)" in out
+    limited = fi_brackets(model("ho3"), "12321", 4, limit=2)  # only the hulls asked for are built
+    assert [b.to_dict(2) for b in limited] == data["brackets"]
+    assert fi_module.count_brackets(model("ho3"), "12321", 4) == 6 == len(fi_brackets(model("ho3"), "12321", 4))
 
 
 @pytest.mark.parametrize("argv, fragment", [
     (("fi", "--model", "ho3", "--order", "4", "--limit", "0"), "--limit"),
     (("fi", "--model", "ho3", "--order", "9"), "between"),
     (("shadow", "--model", "ho3", "--route", "fi", "--order", "8"), "direct"),
+    (("fi", "--model", "rigid-body", "--order", "6"), "22272 brackets; pass --limit"),  # bounded work
 ])
 def test_cli_bad_input_is_one_line(capsys, argv, fragment):
     code, out, err = run(capsys, *argv)

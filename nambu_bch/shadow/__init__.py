@@ -3,7 +3,7 @@
 from .api import shadow_hamiltonians
 from .direct_route import DirectResult, OrderSolution, direct_route
 from .family import ShadowFamily
-from .fi_route import FICommutator, FINested, FIOrder, FIRepresentation, FIResult, fi_brackets, fi_route
+from .fi_route import FICommutator, FINested, FIOrder, FIRepresentation, FIResult, count_brackets, fi_brackets, fi_route
 from .fundamental_identity import FI_LABELS, commutator_terms, double_commutator_terms, representations
 from .jets import JetAlgebra
 from .liouville_terms import LiouvilleSum, LiouvilleTerm
@@ -22,6 +22,7 @@ __all__ = [
     "OrderSolution",
     "ShadowFamily",
     "commutator_terms",
+    "count_brackets",
     "direct_route",
     "double_commutator_terms",
     "fi_brackets",
