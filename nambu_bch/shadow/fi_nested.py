@@ -139,6 +139,8 @@ class RawOps:
         self._ways: dict = {}
         self._leaves: dict = {}
         self._coefficients: dict = {}
+        self._exprs: dict = {}
+        self.hulls: dict = {}  # tree -> NestedHull, for callers that share hulls between words
         self._ring_atoms = {algebra.convert(a): _atom_id(sympy.sympify(a)) for a in self.atoms}
 
     def poly(self, entry):
@@ -150,6 +152,12 @@ class RawOps:
             else:
                 self._poly[entry] = alg.ring.from_dict({tuple(v) + (0,) * (len(alg.ring.gens) - self.n): self.domain.one})
         return self._poly[entry]
+
+    def poly_of(self, expr):
+        """A slot function (sympy or ring element) as a ring element, memoised."""
+        if expr not in self._exprs:
+            self._exprs[expr] = self.algebra.convert(expr)
+        return self._exprs[expr]
 
     def monomials(self, p):
         """``[(entry, coefficient)]`` of a ring element (monomial entries)."""

@@ -321,6 +321,52 @@ class FIResult:
         return "\n".join(lines)
 
 
+_RAW_OPS: dict = {}
+_FORMS: dict = {}
+
+
+def clear_cache() -> None:
+    """Forget the memoised FI maps, hulls, labelled forms, formal columns and bracket evaluators."""
+    _RAW_OPS.clear()
+    _FORMS.clear()
+    _MONOMIAL_COLUMNS.clear()
+    _EVALUATORS.clear()
+
+
+def _raw_ops(alg, atoms) -> RawOps:
+    """One :class:`RawOps` (memoised FI maps and brackets) per algebra and atom list, shared by all words."""
+    key = (alg.ring, alg.coordinates, atoms)
+    if key not in _RAW_OPS or len(_RAW_OPS[key]._ways) + len(_RAW_OPS[key].hulls) > 200_000:
+        if len(_RAW_OPS) > 32:
+            _RAW_OPS.clear()
+        _RAW_OPS[key] = RawOps(alg, atoms)
+    return _RAW_OPS[key]
+
+
+def _distinct_forms(ops, leaves) -> list:
+    """``[(labels, shown terms, formal sum)]``: the distinct labelled forms (Eqs. 1AX-2BY or CL2a/b) of ``leaves``, memoised."""
+    key = (ops.algebra.ring, ops.algebra.coordinates, ops.atoms, leaves)
+    if key in _FORMS:
+        return _FORMS[key]
+    alg = ops.algebra
+    rleaves = tuple(tuple(ops.poly_of(f) for f in t) for t in leaves)
+    reps = representations(alg, *rleaves) if len(leaves) == 3 else single_representations(alg, *rleaves)
+    distinct: list = []
+    for label, rep_terms in reps.items():
+        parts = [ops.reduce(ops.from_slots(t.slots, ops.coefficient(t.coefficient))) for t in rep_terms]
+        formal = sum(parts, LiouvilleSum.zero(alg, ops.atoms))
+        for d in distinct:
+            if d[2] == formal:
+                d[0] += (label,)
+                break
+        else:
+            distinct.append([(label,), tuple(t for t, part in zip(rep_terms, parts) if not part.is_zero()), formal])
+    if len(_FORMS) > 20000:
+        _FORMS.clear()
+    _FORMS[key] = [tuple(d) for d in distinct]
+    return _FORMS[key]
+
+
 def _atoms(system):
     """The Hamiltonian pieces of the splitting (kept whole in formal sums) and, per slot, those summing to ``H^a``."""
     per_slot = [[] for _ in system.hamiltonians]
@@ -447,26 +493,9 @@ def fi_route(system, word, order: int = 2, degree=None, terms=None) -> FIResult:
             entries.append((sympy.sympify(coef), tuple(tree)))
     entries = _merge(entries)
     commutators = []
-    ring_of: dict = {}
-    ops = RawOps(alg, atoms)
-
-    def to_ring(term):  # convert each Hamiltonian piece once; brackets then stay in the ring
-        return tuple(ring_of.setdefault(f, alg.convert(f)) for f in term)
-
+    ops = _raw_ops(alg, atoms)
     for coef, leaves in entries:
-        rleaves = tuple(to_ring(t) for t in leaves)
-        reps = representations(alg, *rleaves) if len(leaves) == 3 else single_representations(alg, *rleaves)
-        distinct: list = []
-        for label, rep_terms in reps.items():
-            parts = [ops.reduce(ops.from_slots(t.slots, ops.coefficient(t.coefficient))) for t in rep_terms]
-            formal = sum(parts, LiouvilleSum.zero(alg, atoms))
-            for d in distinct:
-                if d.formal == formal:
-                    d.labels += (label,)
-                    break
-            else:
-                shown = tuple(t for t, part in zip(rep_terms, parts) if not part.is_zero())
-                distinct.append(FIRepresentation((label,), shown, formal))
+        distinct = [FIRepresentation(labels, shown, formal) for labels, shown, formal in _distinct_forms(ops, leaves)]
         commutators.append(FICommutator(coef, leaves, distinct))
     hams = system.hamiltonians
     slots = len(hams)
@@ -609,8 +638,8 @@ def _higher_orders(result, order, degree) -> None:
     if not result.exists:
         return
     corrections = {(a, result.power): _alpha_parts(alg, c) for a, c in enumerate(result.corrections)}
-    ops = RawOps(alg, atoms)
-    memo: dict = {}
+    ops = _raw_ops(alg, atoms)
+    memo = ops.hulls  # hulls of subtrees, shared by all words of the splitting
     series = formal_bch(comp, order + 1)
     for j in range(result.power + 1, order + 1):
         o = _solve_order(system, ctx, ops, memo, series, j, corrections, degree)
