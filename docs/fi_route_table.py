@@ -94,9 +94,28 @@ def table(rows) -> str:
                                 for r in rows)])
 
 
+def family_and_gauge(name="ho3", word="12321", order=6) -> str:
+    """The FI alpha-family through h^order, and at each solved order the FI gauge next to the direct one."""
+    S = model(name)
+    R, D = fi_route(S, word, order), direct_route(S, word, order)
+    lines = [f"{name}, {word}: the FI alpha-family (corrections of H and G by powers of h)"]
+    lines += [f"  h^{R.power}: dH = {sympy.factor(R.corrections[0])},  dG = {sympy.factor(R.corrections[1])}"]
+    for o in R.orders:
+        if o.status == "solved":
+            lines.append(f"  h^{o.order}: dH = {sympy.factor(o.corrections[0])},  dG = {sympy.factor(o.corrections[1])}")
+    for o in R.orders:
+        if o.status == "solved":
+            d = D.orders[o.order - 1]
+            lines.append(f"  gauge at h^{o.order}: FI {[tuple(sympy.factor(c) for c in v) for v in o.kernel]}")
+            lines.append(f"                direct {[tuple(sympy.factor(c) for c in v) for v in d.gauge]}")
+    return "\n".join(lines)
+
+
 def render() -> str:
     parts = ["**FI route (lower orders from the FI route).**", "", table(main_rows()), "",
-             "**Rigid body, FI at h^4 with the direct route's h^2 family fed in.**", "", table(hybrid_rows())]
+             "**Rigid body, FI at h^4 with the direct route's h^2 family fed in.**", "", table(hybrid_rows()), "",
+             "**The ho3 family through h^6 and the gauge, FI against direct.**", "", "```",
+             family_and_gauge(), "```"]
     return "\n".join(parts)
 
 

@@ -228,6 +228,24 @@ def test_ho3_h4_fi_family_reproduces_X_eff_and_equals_direct(word):
     assert any(zero(c) is False for c in o4.kernel[0])
 
 
+def _span_rank(S, pairs) -> int:
+    rows = [{(a, m): c for a, part in enumerate(pair) for m, c in sympy.Poly(sympy.expand(part), *S.coordinates).terms() if c}
+            for pair in pairs]
+    cols = sorted({k for r in rows for k in r}, key=str)
+    return sympy.Matrix([[r.get(k, 0) for k in cols] for r in rows]).rank() if rows and cols else 0
+
+
+def test_ho3_missing_gauge_is_0_H_and_G_0():
+    """ho3, h^4: the direct gauge (5 dims) is the FI gauge (3 dims) plus (0, H) and (G, 0) (X_{H,H} = X_{G,G} = 0)."""
+    S = model("ho3")
+    o = fi_route(S, "12321", 4).orders[-1]
+    gauge = direct_route(S, "12321", 4).orders[3].gauge
+    trivial = [(0, S.H), (S.G, 0)]
+    assert _span_rank(S, o.kernel) == 3 and _span_rank(S, gauge) == 5
+    assert _span_rank(S, [*o.kernel, *trivial]) == 5 == _span_rank(S, [*o.kernel, *trivial, *gauge])
+    assert _span_rank(S, [*o.kernel, trivial[0]]) == 4  # each of the two is missing on its own
+
+
 @pytest.mark.parametrize("name, order", [("ho3", 6), ("lotka-volterra", 4), ("lotka-volterra", 6)])
 def test_fi_family_h6_and_lotka_volterra(name, order):
     S = model(name)
