@@ -270,6 +270,17 @@ def test_fi_family_other_words_and_N2(name, word, order):
     assert [o.order for o in F.details.orders] == list(range(F.details.power + 1, order + 1))
 
 
+def test_lotka_volterra_family_is_direct_at_the_same_degree():
+    """LV, 12321: the FI alpha-family through h^4 (degree 5 at h^4) is the direct route's at ansatz degree 5."""
+    S = model("lotka-volterra")
+    R = fi_route(S, "12321", 4)
+    D = direct_route(S, "12321", 4, degree=5)
+    assert R.orders[-1].degree == 5 and D.orders[3].kernel_dim == R.orders[-1].direct_dim == 11
+    assert all(zero(a - b) for a, b in zip(R.corrections, D.orders[1].corrections))
+    assert all(zero(a - b) for a, b in zip(R.orders[-1].corrections, D.orders[3].corrections))
+    assert not all(zero(a - b) for a, b in zip(R.orders[-1].corrections, direct_route(S, "12321", 4).orders[3].corrections))
+
+
 def test_rigid_body_fi_route_is_obstructed_at_h2_both_ways():
     """The rigid body has a direct family at h^2 but no FI one: the labelled forms (Eqs. 1AX-2BY) and the
     recursive hulls (generic solver) both find the formal system inconsistent."""
