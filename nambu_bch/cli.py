@@ -4,7 +4,7 @@ Synopsis::
 
     nambu-bch models   [--model NAME] [--format text|latex|json]
     nambu-bch bch      [SYSTEM] [--integrator WORD] [--order K] [--field] [--terms]
-    nambu-bch fi       [SYSTEM] [--integrator WORD]
+    nambu-bch fi       [SYSTEM] [--integrator WORD] [--order K] [--limit N]
     nambu-bch shadow   [SYSTEM] [--integrator WORD] [--order K] [--route direct|fi] [--degree D]
     nambu-bch conserved [SYSTEM] [--integrator WORD]
     nambu-bch exact    [SYSTEM] [--integrator WORD]
@@ -616,6 +616,8 @@ def cmd_fi(args):
     system, values = system_from_args(args)
     system = substituted(system, values)
     word, comp = integrator_from_args(args, system)
+    if args.order is not None and args.order > (2 if comp.symmetric else 1):
+        return _cmd_fi_nested(args, system, word, comp)
     reps = fi_representations(system, comp) if _system_chosen(args) else None
 
     def data():
@@ -645,6 +647,32 @@ def cmd_fi(args):
         blocks = [render.fi_forms_latex()]
         blocks += [render.fi_representations_latex(f"{word} on {system.name}", c, abd, forms) for c, abd, forms in reps or ()]
         return blocks
+
+    emit(args, latex=latex, text=text, data=data)
+
+
+def _cmd_fi_nested(args, system, word, comp):
+    """``fi --order K``: the brackets at ``h^K`` with the affine hulls of their FI representations (issue 13)."""
+    from .shadow.fi_route import count_brackets, fi_brackets
+
+    limit = positive_int(args.limit, "--limit", 10**6) if args.limit is not None else None
+    total = count_brackets(system, comp, args.order)
+    if limit is None and total > 2000:
+        raise NambuBCHError(f"--order {args.order}: {total} brackets; pass --limit N to list the first N")
+    shown = fi_brackets(system, comp, args.order, limit)
+    more = f"... {total - len(shown)} more brackets (raise --limit)" if len(shown) < total else None
+    head = f"h^{args.order} brackets of {word} on {system.name}: {total}"
+
+    def data():
+        return {**_base(system, word, order=args.order), "total": total,
+                "brackets": [b.to_dict(limit) for b in shown]}
+
+    def text():
+        return "\n".join([head, *(b.to_text(limit) for b in shown), *([more] if more else [])])
+
+    def latex():
+        title = r"\text{" + f"{word} on {system.name}, {total} brackets at" + "} " + f"h^{{{args.order}}}"
+        return " \\\\\n".join([title, *(b.to_latex(limit) for b in shown), *([r"\text{" + more + "}"] if more else [])])
 
     emit(args, latex=latex, text=text, data=data)
 
@@ -761,7 +789,8 @@ EXAMPLES = {
            "  nambu-bch bch --field --terms          # also Z_j on ho3 and the Liouville terms (Eq. BCH4)",
     "fi": "examples:\n  nambu-bch fi                           # the eight forms 1AX..2BY of [X_AB,[X_CD,X_EF]]\n"
           "  nambu-bch fi --model ho3 --integrator 12321   # + each h^2 double commutator of Eq. (BCH4) in the\n"
-          "                                                 #   eight forms, vanishing terms dropped (Eqs. CL5-CL8)",
+          "                                                 #   eight forms, vanishing terms dropped (Eqs. CL5-CL8)\n"
+          "  nambu-bch fi --model ho3 --order 4 --limit 2 --format text   # h^4 brackets: FI hulls, labelled directions",
     "shadow": "examples:\n  nambu-bch shadow                       # alpha-family of Phi^{12321}, ho3, order 2 (Eqs. SH12321c, SG12321c)\n"
               "  nambu-bch shadow --integrator 32123 --format json\n"
               "  nambu-bch shadow --model ho --integrator TVT --order 4\n"
@@ -823,7 +852,8 @@ def build_parser() -> argparse.ArgumentParser:
 
     p = add("fi", cmd_fi)
     _system_options(p)
-    _integrator_options(p)
+    _integrator_options(p, order=True)
+    p.add_argument("--limit", metavar="N", type=str, help="with --order K > 2: show at most N brackets and N directions each")
     _output_options(p, "latex")
 
     p = add("shadow", cmd_shadow)

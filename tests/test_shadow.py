@@ -456,8 +456,8 @@ def test_bad_input():
         shadow_hamiltonians(ho3, "12321", degree=1)
     with pytest.raises(UnknownPieceError):
         shadow_hamiltonians(ho3, "124")
-    with pytest.raises(InvalidOrderError, match="direct"):
-        shadow_hamiltonians(ho3, "12321", 4, route="fi")
+    with pytest.raises(InvalidOrderError, match="direct"):  # the FI route stops at h^6 (MAX_FI_ORDER)
+        shadow_hamiltonians(ho3, "12321", 7, route="fi")
     with pytest.raises(InvalidOrderError):
         shadow_hamiltonians(ho3, "12321", -1)
     with pytest.raises(NotSeparableError):

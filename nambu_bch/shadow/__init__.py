@@ -4,7 +4,7 @@ from .api import shadow_hamiltonians
 from .direct_route import DirectResult, OrderSolution, direct_route
 from .existence import Existence, decide
 from .family import ShadowFamily
-from .fi_route import FICommutator, FIRepresentation, FIResult, fi_route
+from .fi_route import FICommutator, FINested, FIOrder, FIRepresentation, FIResult, count_brackets, fi_brackets, fi_route
 from .fundamental_identity import FI_LABELS, commutator_terms, double_commutator_terms, representations
 from .jets import JetAlgebra
 from .liouville_terms import LiouvilleSum, LiouvilleTerm
@@ -14,6 +14,8 @@ __all__ = [
     "DirectResult",
     "Existence",
     "FICommutator",
+    "FINested",
+    "FIOrder",
     "FIRepresentation",
     "FIResult",
     "JetAlgebra",
@@ -22,9 +24,11 @@ __all__ = [
     "OrderSolution",
     "ShadowFamily",
     "commutator_terms",
+    "count_brackets",
     "decide",
     "direct_route",
     "double_commutator_terms",
+    "fi_brackets",
     "fi_route",
     "representations",
     "shadow_hamiltonians",

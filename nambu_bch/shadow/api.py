@@ -75,7 +75,8 @@ def shadow_hamiltonians(system, word, order: int = 2, route: str = "direct", deg
     word : composition spec (``"12321"``, ``"TVT"``, ``"lie-trotter"``, ...)
     order : int -- highest power of ``h`` kept in ``H_S, G_S``
     route : ``"direct"`` (order-by-order linear solve, any order) or ``"fi"``
-        (representations of the BCH commutators by the fundamental identity; lowest correction only)
+        (affine hulls of the representations of the BCH commutators by the fundamental identity,
+        through ``h^6``; :func:`~nambu_bch.shadow.fi_route.fi_route`)
     degree : int, optional -- ansatz degree of the corrections (default: from the field)
     existence : bool -- when no polynomial pair is found, decide existence in smooth functions by
         orbit averages (:mod:`nambu_bch.shadow.existence`); with False the answer stays undecided
@@ -135,31 +136,41 @@ def shadow_hamiltonians(system, word, order: int = 2, route: str = "direct", deg
             _decide(fam, R, existence, params)
     else:
         power = 2 if comp.symmetric else 1
-        if order > power + (1 if comp.symmetric else 0):
-            raise InvalidOrderError(
-                f"the FI route solves the lowest correction only (h^{power} for {comp.name!r}); "
-                f"got order={order}, use route='direct' for higher orders"
-            )
         fam = ShadowFamily(system, comp, order, route, True)
         if order < power:
             fam.shadows = tuple(sympy.expand(Hk) for Hk in system.hamiltonians)
             notes.append(f"h^1: the correction vanishes (symmetric word)")
         else:
-            R = fi_route(system, comp, power, degree)
+            R = fi_route(system, comp, order, degree)
             fam.details = R
             fam.exists = R.exists
             fam.degree[power] = R.degree
-            if R.exists:
-                fam.shadows = R.shadow()
-                fam.corrections[power] = R.corrections
-                fam.gauge[power] = R.kernel_corrections()
-                if order > power:
-                    notes.append(f"h^{order}: the correction vanishes (odd order of a symmetric word)")
-            else:
+            if R.certificate is not None:
                 fam.failed_order = power
                 fam.certificate = R.certificate
                 fam.obstruction = (f"at h^{power} no affine combination of the FI representations equals "
                                    f"X_{{H,dG}} + X_{{dH,G}} with corrections of degree <= {R.degree}")
+            else:
+                fam.corrections[power] = R.corrections
+                fam.gauge[power] = R.kernel_corrections()
+                for o in R.orders:
+                    if o.status == "vanishes":
+                        why = " (odd order of a symmetric word)" if comp.symmetric and o.order % 2 else ""
+                        notes.append(f"h^{o.order}: the correction vanishes{why}")
+                        continue
+                    fam.degree[o.order] = o.degree
+                    if o.status == "solved":
+                        fam.corrections[o.order] = o.corrections
+                        fam.gauge[o.order] = list(o.kernel)
+                    else:
+                        fam.failed_order = o.order
+                        fam.certificate = o.certificate
+                        fam.obstruction = (f"at h^{o.order} no affine combination of the FI representations equals "
+                                           f"X_{{H,dG}} + X_{{dH,G}} + (cross terms) with corrections of degree <= {o.degree}")
+            if R.exists:
+                fam.shadows = R.shadow()
+                fam.polynomial = True
+            else:
                 # the FI ansatz failing is no certificate: the direct route and the orbit averages decide
                 fam.polynomial = False
                 if not existence:
@@ -171,8 +182,6 @@ def shadow_hamiltonians(system, word, order: int = 2, route: str = "direct", deg
                         notes.append("the FI ansatz failed; the shadows are the direct route's polynomial pair")
                     else:
                         _decide(fam, D, existence, params)
-            if R.exists:
-                fam.polynomial = True
     fam.notes = notes
     if fam.exists and any(S.has(ALPHA) for S in fam.shadows):
         fam.free_parameters = ["alpha"]
