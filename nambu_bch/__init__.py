@@ -40,6 +40,14 @@ from .shadow import (
     shadow_hamiltonians,
 )
 from .systems import Splitting, System, full_split, model, model_names, separate, single_split
+from .design import (  # issue 15: choosing and designing the integrator
+    compare,
+    composition_order,
+    error_constant,
+    leading_error,
+    optimize_composition,
+    order_conditions,
+)
 
 __version__ = "0.1.0"
 
@@ -62,12 +70,15 @@ __all__ = [
     "System",
     "VectorField",
     "check",
+    "compare",
     "composed_map",
     "composition",
+    "composition_order",
     "conserved_quantities",
     "direct_route",
     "effective_field",
     "effective_field_bch",
+    "error_constant",
     "errors",
     "exact_flow",
     "exact_shadow_hamiltonians",
@@ -78,6 +89,7 @@ __all__ = [
     "is_invariant",
     "is_symplectic",
     "iterate",
+    "leading_error",
     "lie_bracket",
     "liouville_field",
     "model",
@@ -85,6 +97,8 @@ __all__ = [
     "modified_equations",
     "modified_solution",
     "nambu_bracket",
+    "optimize_composition",
+    "order_conditions",
     "paper_figures",
     "poisson_bracket",
     "representations",

@@ -261,6 +261,11 @@ def _build(spec, n_pieces):
         return _triple_jump(composition("121"))
     if low.startswith(("yoshida:", "triple-jump:")):
         return _triple_jump(composition(text.split(":", 1)[1], n_pieces))
+    from ..design.catalog import lookup  # literature methods with citations (issue 15)
+
+    found = lookup(text, n_pieces)
+    if found is not None:
+        return found
     if ":" in text:
         pairs = []
         for item in text.split(","):
@@ -272,7 +277,8 @@ def _build(spec, n_pieces):
     if not text.isdigit() or "0" in text:
         raise InvalidCompositionError(
             f"unknown composition {text!r}; use a word of piece digits 1-9 such as '12321', "
-            f"an alias ({', '.join(sorted(_ALIASES))}, lie-trotter, strang, forest-ruth, yoshida:WORD) "
+            f"an alias ({', '.join(sorted(_ALIASES))}, lie-trotter, strang, forest-ruth, yoshida:WORD, "
+            "suzuki[:WORD], kahan-li[:WORD], yoshida6[:WORD], blanes-moan) "
             "or an explicit list 'piece:coefficient,...'"
         )
     if len(text) % 2 == 1 and text == text[::-1] and len(text) > 1:
