@@ -7,14 +7,17 @@ Algorithm
    ``p + 1`` log defects (``p`` the requested order, raised past degrees whose defects
    vanish identically, e.g. the even ones of symmetric templates).
 2. A maximal independent subset of ``F`` (numerical rank of the Jacobian at a solution).
-3. The critical points of ``f`` on ``{F = 0}``: Newton's method on the Lagrange system
-   ``grad f + J^T lambda = 0, F = 0`` in mpmath (``dps`` digits, default 30) from many
-   seeded starting points (each first projected onto ``{F = 0}`` by Gauss-Newton);
-   converged real points are de-duplicated and the smallest ``f`` wins.  With as many
-   independent conditions as unknowns this is the plain solve, polished by Newton.
+3. The critical points of ``f`` on ``{F = 0}``: from ``starts`` seeded random points, each
+   projected onto ``{F = 0}`` by Gauss-Newton, Newton's method on the Lagrange system
+   ``grad f + J^T lambda = 0, F = 0`` in float64; distinct converged real points are
+   ranked by ``f`` and the three best are polished by Newton in mpmath (``dps`` digits,
+   default 30); the smallest ``f`` wins.  With as many independent conditions as unknowns
+   this is the plain solve, polished by Newton.
 4. An exact form: the ``n - r`` unknowns left free by the conditions are fixed to nearby
    rationals (each choice of free unknowns is tried), the remaining conditions are solved
-   with ``sympy.solve``; a solution counts only if it is real and written in real radicals,
+   exactly through a lex Groebner basis in shape position (a univariate polynomial of degree
+   <= 4, solved in radicals, the lowest degree preferred); a solution counts only if it is
+   real and written in real radicals,
    and it is then *verified exactly* (every log defect of length ``<= p`` is zero in the
    algebraic field of the coefficients).  The exact composition nearest in error constant
    to the numerical optimum is returned.
@@ -33,6 +36,7 @@ Auzinger, Hofstaetter, Ketcheson, Koch, BIT 57 (2017) 55 (LEM, Newton polishing)
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass
 from fractions import Fraction
 from itertools import combinations
@@ -85,46 +89,101 @@ class DesignedComposition(Composition):
         }
 
 
-def _lambdify(exprs, args):
-    return sympy.lambdify(args, exprs, modules="mpmath")
+class _Problem:
+    """``f`` (objective) and ``F`` (conditions) with gradients and Hessians, as float and mpmath callables."""
+
+    def __init__(self, objective, conditions, x):
+        self.x, self.n, self.m = list(x), len(x), len(conditions)
+        fp = sympy.Poly(objective, *x)
+        Fp = [sympy.Poly(e, *x) for e in conditions]
+        grad = [fp.diff(v) for v in x]
+        hess = [[g.diff(v) for v in x] for g in grad]
+        jac = [[P.diff(v) for v in x] for P in Fp]
+        chess = [[[d.diff(v) for v in x] for d in row] for row in jac]
+        exprs = {
+            "f": fp.as_expr(), "F": [P.as_expr() for P in Fp], "g": [g.as_expr() for g in grad],
+            "H": [[h.as_expr() for h in row] for row in hess], "J": [[d.as_expr() for d in row] for row in jac],
+            "C": [[[c.as_expr() for c in row] for row in block] for block in chess],
+        }
+        self.float = {k: sympy.lambdify(x, v, modules="numpy") for k, v in exprs.items()}
+        self.mp = {k: sympy.lambdify(x, v, modules="mpmath") for k, v in exprs.items()}
+
+    def kkt(self, z, lib):
+        """``(G, DG)`` of the Lagrange system at ``z = (x, lambda)``; ``lib`` is ``"float"`` or ``"mp"``."""
+        fn = self.float if lib == "float" else self.mp
+        n, m = self.n, self.m
+        x, lam = list(z[:n]), list(z[n:])
+        F, g, H, J, C = (fn[k](*x) for k in ("F", "g", "H", "J", "C"))
+        G = [g[i] + sum(lam[k] * J[k][i] for k in range(m)) for i in range(n)] + list(F)
+        DG = [[H[i][j] + sum(lam[k] * C[k][i][j] for k in range(m)) for j in range(n)] + [J[k][i] for k in range(m)]
+              for i in range(n)]
+        DG += [[J[k][j] for j in range(n)] + [0] * m for k in range(m)]
+        return G, DG
 
 
-def _independent(jac, tol):
-    """Indices of a maximal set of linearly independent rows of ``jac`` (mpmath matrix), greedily."""
-    rows = []
-    basis = []
-    for i in range(jac.rows):
-        v = [jac[i, j] for j in range(jac.cols)]
-        for b in basis:
-            d = mpmath.fsum(x * y for x, y in zip(v, b))
-            v = [x - d * y for x, y in zip(v, b)]
-        norm = mpmath.sqrt(mpmath.fsum(x * x for x in v))
-        if norm > tol:
-            basis.append([x / norm for x in v])
-            rows.append(i)
-    return rows
-
-
-def _solve_linear(A, b):
-    return mpmath.lu_solve(A, b)
-
-
-def _project(F, J, x, steps=60, tol=None):
-    """Gauss-Newton (minimum-norm steps) onto ``F = 0``; ``None`` if it does not converge."""
+def _newton_float(prob, z, steps=80):
+    """Newton on the Lagrange system in float64, stopped when the step is at round-off level."""
     for _ in range(steps):
-        Fx = mpmath.matrix(F(*x))
-        if mpmath.norm(Fx) < tol:
-            return x
-        Jx = mpmath.matrix(J(*x))
+        G, DG = prob.kkt(z, "float")
+        G = np.asarray(G, float)
+        if not np.all(np.isfinite(G)):
+            return None
         try:
-            y = _solve_linear(Jx * Jx.T, Fx)
+            dz = np.linalg.solve(np.asarray(DG, float), G)
+        except np.linalg.LinAlgError:
+            return None
+        z = z - dz
+        if not np.all(np.isfinite(z)) or np.abs(z).max() > 1e6:
+            return None
+        if np.linalg.norm(dz) < 1e-12 * (1 + np.linalg.norm(z)):
+            return z
+    return None
+
+
+def _newton_mp(prob, z, tol, steps=30):
+    z = [mpmath.mpf(float(v)) for v in z]
+    for _ in range(steps):
+        G, DG = prob.kkt(z, "mp")
+        G = mpmath.matrix(G)
+        if mpmath.norm(G) < tol:
+            return z
+        try:
+            dz = mpmath.lu_solve(mpmath.matrix(DG), G)
         except ZeroDivisionError:
             return None
-        dx = Jx.T * y
-        x = [xi - dxi for xi, dxi in zip(x, dx)]
-        if any(abs(v) > 1e6 for v in x):
+        z = [a - b for a, b in zip(z, dz)]
+    G, _ = prob.kkt(z, "mp")
+    return z if mpmath.norm(mpmath.matrix(G)) < tol * 10**6 else None
+
+
+def _project(prob_F, prob_J, x, steps=80):
+    """Gauss-Newton (minimum-norm steps, float) onto ``F = 0``; ``None`` if it does not converge."""
+    for _ in range(steps):
+        F = np.asarray(prob_F(*x), float)
+        if not np.all(np.isfinite(F)):
             return None
-    return x if mpmath.norm(mpmath.matrix(F(*x))) < tol else None
+        J = np.asarray(prob_J(*x), float)
+        dx = np.linalg.lstsq(J, F, rcond=None)[0]
+        x = x - dx
+        if not np.all(np.isfinite(x)) or np.abs(x).max() > 1e6:
+            return None
+        if np.linalg.norm(dx) < 1e-12 * (1 + np.linalg.norm(x)):
+            return x
+    return None
+
+
+def _independent(J, tol=1e-8):
+    """Indices of a maximal set of linearly independent rows of ``J`` (float), greedily."""
+    rows, basis = [], []
+    for i, row in enumerate(np.asarray(J, float)):
+        v = row.copy()
+        for b in basis:
+            v = v - (v @ b) * b
+        norm = np.linalg.norm(v)
+        if norm > tol * max(1.0, np.linalg.norm(row)):
+            basis.append(v / norm)
+            rows.append(i)
+    return rows
 
 
 def optimize_composition(spec, parts: int | None = None, order: int = 4, stages: int | None = None, *,
@@ -138,8 +197,8 @@ def optimize_composition(spec, parts: int | None = None, order: int = 4, stages:
     parts : int -- number of pieces (``"strang"``)
     order : int -- required order ``p``
     stages : int -- number of base steps of a ``"strang"`` / base-word template
-    dps : int -- digits of the numerical search (mpmath), default 30
-    starts : int -- seeded random starting points of the search
+    dps : int -- digits of the final Newton polish (mpmath), default 30
+    starts : int -- seeded random starting points of the (float) search
     seed : int
     max_denominator : int -- the free unknowns of the exact form are rationals with at most this denominator
     name : str, optional -- name of the returned composition
@@ -151,7 +210,7 @@ def optimize_composition(spec, parts: int | None = None, order: int = 4, stages:
 
     Raises
     ------
-    NoSolutionError -- no real solution was found; InvalidOrderError -- order too high.
+    NoSolutionError -- no real solution was found; InvalidOrderError -- order too high or too many unknowns.
 
     Examples
     --------
@@ -165,6 +224,8 @@ def optimize_composition(spec, parts: int | None = None, order: int = 4, stages:
     n = len(T.unknowns)
     if n > MAX_UNKNOWNS:
         raise InvalidOrderError(f"template {T.name!r} has {n} unknowns; the search accepts at most {MAX_UNKNOWNS}")
+    if isinstance(dps, bool) or not isinstance(dps, int) or not 15 <= dps <= 200:
+        raise InvalidOrderError(f"dps must be an integer in 15..200, got {dps!r}")
     conds = order_conditions(T, order)
     eqs = conds.polynomials
     degree = order + 1
@@ -174,72 +235,54 @@ def optimize_composition(spec, parts: int | None = None, order: int = 4, stages:
         defects = symbolic_defects(T, degree)
     objective = sympy.expand(sum(e**2 for e in defects.values()))
     x = list(T.unknowns)
+    every = _Problem(objective, eqs, x)
+    rng = np.random.RandomState(seed)
+    selected, prob, found = None, None, []
+    for _ in range(starts):
+        p = _project(every.float["F"], every.float["J"], rng.uniform(-1, 1, n))
+        if p is None:
+            continue
+        if selected is None:
+            selected = [eqs[i] for i in _independent(every.float["J"](*p))]
+            prob = _Problem(objective, selected, x)
+        J = np.asarray(prob.float["J"](*p), float)
+        g = np.asarray(prob.float["g"](*p), float)
+        lam = -np.linalg.lstsq(J.T, g, rcond=None)[0]
+        z = _newton_float(prob, np.concatenate([p, lam]))
+        if z is None or np.linalg.norm(np.asarray(every.float["F"](*z[:n]), float)) > 1e-8:
+            continue
+        if not any(np.abs(z[:n] - y[:n]).max() < 1e-7 for y in found):
+            found.append(z)
+    if not found:
+        raise NoSolutionError(
+            f"no real solution of the order-{order} conditions of template {T.name!r} was found from {starts} "
+            "starting points; add stages or lower the order"
+        )
+    found.sort(key=lambda z: float(every.float["f"](*z[:n])))
     with mpmath.workdps(dps + 10):
         tol = mpmath.mpf(10) ** (-(dps + 5))
-        F_all = _lambdify(eqs, x)
-        J_all = _lambdify([[sympy.diff(e, v) for v in x] for e in eqs], x)
-        rng = np.random.RandomState(seed)
-        found = []
-        selected = None
-        for _ in range(starts):
-            x0 = [mpmath.mpf(float(v)) for v in rng.uniform(-1, 1, n)]
-            p = _project(F_all if selected is None else F_sel, J_all if selected is None else J_sel, x0, tol=tol)
-            if p is None:
-                continue
-            if selected is None:
-                rows = _independent(mpmath.matrix(J_all(*p)), mpmath.mpf(10) ** (-dps // 2))
-                selected = [eqs[i] for i in rows]
-                lams = [sympy.Symbol(f"_lambda{i}") for i in range(len(selected))]
-                F_sel = _lambdify(selected, x)
-                J_sel = _lambdify([[sympy.diff(e, v) for v in x] for e in selected], x)
-                L = objective + sum(l * e for l, e in zip(lams, selected))
-                z = x + lams
-                G = _lambdify([sympy.diff(L, v) for v in z], z)
-                DG = _lambdify([[sympy.diff(L, a, b) for b in z] for a in z], z)
-                grad = _lambdify([sympy.diff(objective, v) for v in x], x)
-            Jp = mpmath.matrix(J_sel(*p))
-            try:
-                lam = -_solve_linear(Jp * Jp.T, Jp * mpmath.matrix(grad(*p)))
-            except ZeroDivisionError:
-                continue
-            zk = list(p) + list(lam)
-            ok = False
-            for _ in range(80):
-                Gz = mpmath.matrix(G(*zk))
-                if mpmath.norm(Gz) < tol * 10**3:
-                    ok = True
-                    break
-                try:
-                    dz = _solve_linear(mpmath.matrix(DG(*zk)), Gz)
-                except ZeroDivisionError:
-                    break
-                zk = [a - b for a, b in zip(zk, dz)]
-                if any(abs(v) > 1e6 for v in zk):
-                    break
-            if not ok:
-                continue
-            xs = zk[:n]
-            if mpmath.norm(mpmath.matrix(F_all(*xs))) > tol * 10**3:
-                continue
-            if not any(max(abs(a - b) for a, b in zip(xs, y)) < mpmath.mpf(10) ** (-dps // 2) for y, _ in found):
-                found.append((xs, objective.subs(dict(zip(x, [sympy.Float(str(v), dps + 5) for v in xs])))))
-        if not found:
-            raise NoSolutionError(
-                f"no real solution of the order-{order} conditions of template {T.name!r} was found from {starts} "
-                "starting points; add stages or lower the order"
-            )
-        best, fbest = min(found, key=lambda item: item[1])
+        best = None
+        for z in found[:3]:
+            zp = _newton_mp(prob, z, tol)
+            if zp is not None:
+                value = prob.mp["f"](*zp[:n])
+                if best is None or value < best[1]:
+                    best = (zp[:n], value)
+        if best is None:
+            raise NoSolutionError(f"the Newton polish of the order-{order} solutions of template {T.name!r} did not converge")
+        best, fbest = best
         optimum = tuple((v, mpmath.nstr(b, dps)) for v, b in zip(x, best))
-        lem_opt = float(sympy.sqrt(fbest))
-        final_order = degree - 1
-        label = name or f"designed:{T.name}:p{final_order}"
-        citation = f"optimize_composition({T.name!r}, order={order}): smallest error constant found ({len(found)} critical points)"
-        exact = _exact_form(T, eqs, selected, x, best, final_order, lem_opt, max_denominator, label, citation)
-        if exact is not None:
-            comp, values, lem = exact
-            return DesignedComposition(comp.pieces, comp.coefficients, label, final_order, citation,
-                                       T.name, values, optimum, lem, lem_opt, True, 0.0)
-        return _rational_form(T, conds, x, best, final_order, dps, label, citation, optimum, lem_opt)
+        lem_opt = float(mpmath.sqrt(fbest))
+    final_order = degree - 1
+    label = name or f"designed:{T.name}:p{final_order}"
+    citation = (f"optimize_composition({T.name!r}, order={order}): smallest error constant among "
+                f"{len(found)} critical points found")
+    exact = _exact_form(T, selected, x, best, final_order, max_denominator, label, citation)
+    if exact is not None:
+        comp, values, lem = exact
+        return DesignedComposition(comp.pieces, comp.coefficients, label, final_order, citation,
+                                   T.name, values, optimum, lem, lem_opt, True, 0.0)
+    return _rational_form(T, conds, x, best, final_order, dps, label, citation, optimum, lem_opt)
 
 
 def _is_real_radical(v) -> bool:
@@ -251,7 +294,41 @@ def _is_real_radical(v) -> bool:
     return all(a.exp.is_Rational for a in v.atoms(sympy.Pow))
 
 
-def _exact_form(T, eqs, selected, x, best, order, lem_opt, max_denominator, label, citation):
+def _shape_solutions(system, rest, max_degree=4):
+    """Real solutions of a zero-dimensional polynomial ``system`` in shape position, exactly, with their degree.
+
+    A lex Groebner basis ``[x_1 - r_1(x_k), ..., x_{k-1} - r_{k-1}(x_k), q(x_k)]`` gives every solution
+    from the real roots of the univariate ``q`` (``deg q <= max_degree``, roots in radicals).
+    Returns ``(deg q, [{unknown: value}, ...])`` or ``None`` if the basis is not of that shape.
+    """
+    if not rest:
+        return 0, [{}]
+    G = sympy.groebner(system, *rest, order="lex")
+    polys = list(G.polys)
+    last = rest[-1]
+    if len(polys) != len(rest) or polys[-1].free_symbols - {last}:
+        return None
+    q = sympy.Poly(polys[-1].as_expr(), last)
+    if not 1 <= q.degree() <= max_degree:
+        return None
+    linear = {}
+    for var, P in zip(rest[:-1], polys[:-1]):
+        P = sympy.Poly(P.as_expr(), var)
+        if P.degree() != 1 or P.LC().free_symbols or P.as_expr().free_symbols - {var, last}:
+            return None
+        linear[var] = sympy.expand(-P.nth(0) / P.LC())
+    roots = sympy.roots(q, filter="R")
+    if sum(roots.values()) == 0:
+        return q.degree(), []
+    sols = []
+    for r in roots:
+        sol = {last: sympy.radsimp(r)}
+        sol.update({var: sympy.radsimp(sympy.expand(expr.subs(last, r))) for var, expr in linear.items()})
+        sols.append(sol)
+    return q.degree(), sols
+
+
+def _exact_form(T, selected, x, best, order, max_denominator, label, citation):
     """The simplest verified exact composition near ``best`` (module docstring, step 4), or ``None``."""
     n, r = len(x), len(selected)
     candidates = []
@@ -259,19 +336,19 @@ def _exact_form(T, eqs, selected, x, best, order, lem_opt, max_denominator, labe
         subs = {x[i]: sympy.Rational(Fraction(str(mpmath.nstr(best[i], 40))).limit_denominator(max_denominator)) for i in free}
         rest = [x[i] for i in range(n) if i not in free]
         system = [sympy.expand(e.subs(subs)) for e in selected]
-        try:
-            sols = sympy.solve(system, rest, dict=True) if rest else [{}]
-        except (NotImplementedError, ValueError):
+        found = _shape_solutions(system, rest)
+        if found is None:
             continue
+        degree, sols = found
         for sol in sols:
             values = dict(subs)
-            values.update({k: sympy.radsimp(v) for k, v in sol.items()})
+            values.update(sol)
             if len(values) != n or not all(_is_real_radical(values[v]) for v in x):
                 continue
             if any(abs(sympy.N(values[x[i]], 30) - sympy.Float(str(best[i]), 30)) > 1e-4 for i in range(n)):
                 continue
-            candidates.append((sum(sympy.count_ops(v) for v in values.values()), len(candidates), values))
-    for _, _, values in sorted(candidates, key=lambda c: c[:2]):
+            candidates.append((degree, sum(sympy.count_ops(v) for v in values.values()), len(candidates), values))
+    for *_, values in sorted(candidates, key=lambda c: c[:3]):
         try:
             comp = T.instantiate(values, label, order, citation)
         except NambuBCHError:
@@ -299,7 +376,15 @@ def _rational_form(T, conds, x, best, order, dps, label, citation, optimum, lem_
     field = _Exact(comp)
     bound = max((abs(float(field.K.to_sympy(v))) for q in range(1, order + 1)
                  for v in field.defects(T.parts, q).values()), default=0.0)
-    lem = error_analysis(comp, T.parts)
-    return DesignedComposition(comp.pieces, comp.coefficients, label, order, citation + f"; {dps}-digit rationals",
-                               T.name, tuple((v, values[v]) for v in x), optimum, lem.value if lem.order == order else lem_opt,
-                               False, bound)
+    designed = DesignedComposition(
+        comp.pieces, comp.coefficients, label, order, citation + f"; {dps}-digit rationals, order conditions to {bound:.1e}",
+        template=T.name, values=tuple((v, values[v]) for v in x), optimum=optimum, lem_optimum=lem_opt,
+        exact=False, error_bound=bound,
+    )
+    analysis = error_analysis(designed, T.parts)  # defects below error_bound count as zero
+    if analysis.order != order:
+        raise NoSolutionError(
+            f"the {dps}-digit rationals of the order-{order} solution of template {T.name!r} do not reach order {order} "
+            f"within their error bound {bound:.1e}; raise dps"
+        )
+    return dataclasses.replace(designed, lem=analysis.value)
