@@ -327,7 +327,8 @@ class OrderConditions:
         return len(self.equations)
 
     def to_latex(self) -> str:
-        rows = [rf"{sympy.latex(e)} &= 0 \quad ({''.join(map(str, w))})" for w, e in self.equations]
+        """The distinct conditions (:attr:`polynomials`), one per line."""
+        rows = [rf"{sympy.latex(e)} &= 0" for e in self.polynomials]
         return r"\begin{aligned}" + r" \\ ".join(rows) + r"\end{aligned}"
 
     def _repr_latex_(self):
