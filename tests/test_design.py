@@ -276,6 +276,36 @@ def test_designed_composition_has_order_four_numerically(designed, system, param
     assert all(a > b for a, b in zip(errs, errs[1:]))
 
 
+def test_rational_fallback_states_its_bound(designed):
+    R = optimize_composition("strang", parts=3, order=4, stages=5, exact=False)
+    assert not R.exact and 0 < R.error_bound < 1e-25
+    assert all(c.is_Rational for c in R.coefficients)
+    E = error_analysis(R, 3)
+    assert E.order == 4 and E.tolerance == R.error_bound             # defects below the bound count as zero
+    assert abs(E.value - designed.lem_optimum) < 1e-12               # the 30-digit optimum itself
+    assert R.optimum == designed.optimum
+    # the exact symbolic route sees the rationals as they are: an h^2 term of the size of the bound
+    Z2 = nb.effective_field(nb.model("ho3").splitting, R, order=2)[2].to_sympy()
+    coeffs = [abs(c) for comp in Z2 for c in sympy.Poly(comp, *sympy.symbols("x1 x2 x3")).coeffs()]
+    m_, omega_ = sympy.symbols("m omega")
+    sizes = [float(c.subs({m_: 1, omega_: 1})) for c in coeffs]
+    assert 0 < max(sizes) < 1e3 * R.error_bound
+
+
+def test_optimize_finds_yoshidas_sixth_order_solution():
+    """7 Strang steps, order 6: Yoshida's three real solutions (Phys. Lett. A 150 (1990) 262, Table 1); the
+    smallest error constant is solution A (published LEM 16.17, CheckMethods 'Y 8-6')."""
+    D = optimize_composition("strang", parts=2, order=6, stages=7)
+    assert "among 3 critical points" in D.citation
+    yoshida = nb.composition("yoshida6:121")
+    w = [float(v) for _, v in D.optimum]
+    assert np.allclose(w[:3], [float(c) for c in (sympy.Rational(s) for s in ("0.784513610477560", "0.235573213359357",
+                                                                              "-1.17767998417887"))], atol=1e-13)
+    assert not D.exact and D.error_bound < 1e-26                     # no radical form: 30-digit rationals
+    assert round(error_constant(D, 2), 2) == 16.17
+    assert abs(error_constant(D, 2) - error_constant(yoshida, 2)) < 1e-10
+
+
 def test_optimize_bad_input():
     with pytest.raises(InvalidOrderError):
         optimize_composition("strang", parts=2, order=0, stages=3)
@@ -391,3 +421,10 @@ def test_cli_compare_bad_input(capsys, argv, needle):
     assert main(["compare", "--model", "ho", *argv] if "--model" not in argv else ["compare", *argv]) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and needle in err[0] and "Traceback" not in err[0]
+
+
+def test_catalog_names_match_the_alias_hook():
+    from nambu_bch.design.catalog import NAMES
+    from nambu_bch.integrators.composition import _CATALOG
+
+    assert tuple(NAMES) == tuple(_CATALOG)

@@ -132,7 +132,7 @@ def _build(kind: str, word, n_pieces):
     raise AssertionError(kind)
 
 
-NAMES = ("suzuki", "kahan-li", "yoshida6", "blanes-moan")
+NAMES = ("suzuki", "kahan-li", "yoshida6", "blanes-moan")  # also listed in integrators/composition.py (_CATALOG)
 
 
 def lookup(text: str, n_pieces=None):

@@ -51,6 +51,8 @@ from .conditions import _Exact, error_analysis, order_conditions, symbolic_defec
 
 #: Largest number of unknowns accepted by :func:`optimize_composition`.
 MAX_UNKNOWNS = 8
+#: Solutions with a coefficient larger than this in absolute value are not searched (useless in practice).
+MAX_COEFFICIENT = 50.0
 
 
 class NoSolutionError(NambuBCHError):
@@ -89,31 +91,62 @@ class DesignedComposition(Composition):
         }
 
 
-class _Problem:
-    """``f`` (objective) and ``F`` (conditions) with gradients and Hessians, as float and mpmath callables."""
+class _PolyEval:
+    """A polynomial with rational coefficients evaluated from its terms, in float64 or in mpmath."""
 
-    def __init__(self, objective, conditions, x):
+    def __init__(self, poly: sympy.Poly):
+        terms = poly.terms() or [((0,) * len(poly.gens), sympy.Integer(0))]
+        self.monoms = np.array([m for m, _ in terms], dtype=np.int64)
+        self.cf = np.array([float(c) for _, c in terms])
+        self.fractions = [(int(sympy.Rational(c).p), int(sympy.Rational(c).q)) for _, c in terms]
+        self.top = int(self.monoms.max()) if self.monoms.size else 0
+
+    def float(self, x):
+        return float(np.sum(self.cf * np.prod(np.power(np.asarray(x, float), self.monoms), axis=1)))
+
+    def mp(self, x):
+        powers = [[mpmath.mpf(1)] for _ in x]
+        for i, v in enumerate(x):
+            for _ in range(self.top):
+                powers[i].append(powers[i][-1] * v)
+        total = mpmath.mpf(0)
+        for (p, q), mon in zip(self.fractions, self.monoms):
+            if p:
+                term = mpmath.mpf(p) / q
+                for i, e in enumerate(mon):
+                    if e:
+                        term *= powers[i][e]
+                total += term
+        return total
+
+
+class _Problem:
+    """``f`` (objective) and ``F`` (conditions) with gradients and Hessians, evaluated from polynomial terms."""
+
+    def __init__(self, objective: sympy.Poly, conditions, x):
         self.x, self.n, self.m = list(x), len(x), len(conditions)
-        fp = sympy.Poly(objective, *x)
         Fp = [sympy.Poly(e, *x) for e in conditions]
-        grad = [fp.diff(v) for v in x]
-        hess = [[g.diff(v) for v in x] for g in grad]
+        grad = [objective.diff(v) for v in x]
         jac = [[P.diff(v) for v in x] for P in Fp]
-        chess = [[[d.diff(v) for v in x] for d in row] for row in jac]
-        exprs = {
-            "f": fp.as_expr(), "F": [P.as_expr() for P in Fp], "g": [g.as_expr() for g in grad],
-            "H": [[h.as_expr() for h in row] for row in hess], "J": [[d.as_expr() for d in row] for row in jac],
-            "C": [[[c.as_expr() for c in row] for row in block] for block in chess],
-        }
-        self.float = {k: sympy.lambdify(x, v, modules="numpy") for k, v in exprs.items()}
-        self.mp = {k: sympy.lambdify(x, v, modules="mpmath") for k, v in exprs.items()}
+        E = _PolyEval
+        self.f = E(objective)
+        self.F = [E(P) for P in Fp]
+        self.g = [E(g) for g in grad]
+        self.H = [[E(g.diff(v)) for v in x] for g in grad]
+        self.J = [[E(d) for d in row] for row in jac]
+        self.C = [[[E(d.diff(v)) for v in x] for d in row] for row in jac]
+
+    def values(self, name, x, lib):
+        def ev(obj):
+            return [ev(o) for o in obj] if isinstance(obj, list) else getattr(obj, lib)(x)
+
+        return ev(getattr(self, name))
 
     def kkt(self, z, lib):
         """``(G, DG)`` of the Lagrange system at ``z = (x, lambda)``; ``lib`` is ``"float"`` or ``"mp"``."""
-        fn = self.float if lib == "float" else self.mp
         n, m = self.n, self.m
         x, lam = list(z[:n]), list(z[n:])
-        F, g, H, J, C = (fn[k](*x) for k in ("F", "g", "H", "J", "C"))
+        F, g, H, J, C = (self.values(k, x, lib) for k in ("F", "g", "H", "J", "C"))
         G = [g[i] + sum(lam[k] * J[k][i] for k in range(m)) for i in range(n)] + list(F)
         DG = [[H[i][j] + sum(lam[k] * C[k][i][j] for k in range(m)) for j in range(n)] + [J[k][i] for k in range(m)]
               for i in range(n)]
@@ -133,7 +166,7 @@ def _newton_float(prob, z, steps=80):
         except np.linalg.LinAlgError:
             return None
         z = z - dz
-        if not np.all(np.isfinite(z)) or np.abs(z).max() > 1e6:
+        if not np.all(np.isfinite(z)) or np.abs(z[:prob.n]).max() > MAX_COEFFICIENT:
             return None
         if np.linalg.norm(dz) < 1e-12 * (1 + np.linalg.norm(z)):
             return z
@@ -165,11 +198,12 @@ def _project(prob_F, prob_J, x, steps=80):
         J = np.asarray(prob_J(*x), float)
         dx = np.linalg.lstsq(J, F, rcond=None)[0]
         x = x - dx
-        if not np.all(np.isfinite(x)) or np.abs(x).max() > 1e6:
+        if not np.all(np.isfinite(x)) or np.abs(x).max() > MAX_COEFFICIENT:
             return None
         if np.linalg.norm(dx) < 1e-12 * (1 + np.linalg.norm(x)):
-            return x
-    return None
+            break
+    F = np.asarray(prob_F(*x), float)
+    return x if np.all(np.isfinite(F)) and np.linalg.norm(F) < 1e-9 else None
 
 
 def _independent(J, tol=1e-8):
@@ -188,7 +222,7 @@ def _independent(J, tol=1e-8):
 
 def optimize_composition(spec, parts: int | None = None, order: int = 4, stages: int | None = None, *,
                          dps: int = 30, starts: int = 40, seed: int = 0, max_denominator: int = 1000,
-                         name: str | None = None) -> DesignedComposition:
+                         name: str | None = None, exact: bool = True) -> DesignedComposition:
     """The composition of a template with order ``>= order`` and the smallest error constant found.
 
     Parameters
@@ -202,6 +236,8 @@ def optimize_composition(spec, parts: int | None = None, order: int = 4, stages:
     seed : int
     max_denominator : int -- the free unknowns of the exact form are rationals with at most this denominator
     name : str, optional -- name of the returned composition
+    exact : bool -- look for an exact (real-radical) form first (default); ``False`` returns the
+        ``dps``-digit rationals with their ``error_bound`` directly
 
     Returns
     -------
@@ -233,23 +269,24 @@ def optimize_composition(spec, parts: int | None = None, order: int = 4, stages:
     while all(sympy.expand(e) == 0 for e in defects.values()):
         degree += 1
         defects = symbolic_defects(T, degree)
-    objective = sympy.expand(sum(e**2 for e in defects.values()))
     x = list(T.unknowns)
+    objective = sum((sympy.Poly(e, *x) ** 2 for e in defects.values()), sympy.Poly(0, *x))
     every = _Problem(objective, eqs, x)
     rng = np.random.RandomState(seed)
     selected, prob, found = None, None, []
     for _ in range(starts):
-        p = _project(every.float["F"], every.float["J"], rng.uniform(-1, 1, n))
+        p = _project(lambda *v: every.values("F", v, "float"), lambda *v: every.values("J", v, "float"),
+                     rng.uniform(-1, 1, n))
         if p is None:
             continue
         if selected is None:
-            selected = [eqs[i] for i in _independent(every.float["J"](*p))]
+            selected = [eqs[i] for i in _independent(every.values("J", list(p), "float"))]
             prob = _Problem(objective, selected, x)
-        J = np.asarray(prob.float["J"](*p), float)
-        g = np.asarray(prob.float["g"](*p), float)
+        J = np.asarray(prob.values("J", list(p), "float"), float)
+        g = np.asarray(prob.values("g", list(p), "float"), float)
         lam = -np.linalg.lstsq(J.T, g, rcond=None)[0]
         z = _newton_float(prob, np.concatenate([p, lam]))
-        if z is None or np.linalg.norm(np.asarray(every.float["F"](*z[:n]), float)) > 1e-8:
+        if z is None or np.linalg.norm(np.asarray(every.values("F", list(z[:n]), "float"), float)) > 1e-8:
             continue
         if not any(np.abs(z[:n] - y[:n]).max() < 1e-7 for y in found):
             found.append(z)
@@ -258,14 +295,14 @@ def optimize_composition(spec, parts: int | None = None, order: int = 4, stages:
             f"no real solution of the order-{order} conditions of template {T.name!r} was found from {starts} "
             "starting points; add stages or lower the order"
         )
-    found.sort(key=lambda z: float(every.float["f"](*z[:n])))
+    found.sort(key=lambda z: every.f.float(z[:n]))
     with mpmath.workdps(dps + 10):
         tol = mpmath.mpf(10) ** (-(dps + 5))
         best = None
         for z in found[:3]:
             zp = _newton_mp(prob, z, tol)
             if zp is not None:
-                value = prob.mp["f"](*zp[:n])
+                value = prob.f.mp(zp[:n])
                 if best is None or value < best[1]:
                     best = (zp[:n], value)
         if best is None:
@@ -277,9 +314,9 @@ def optimize_composition(spec, parts: int | None = None, order: int = 4, stages:
     label = name or f"designed:{T.name}:p{final_order}"
     citation = (f"optimize_composition({T.name!r}, order={order}): smallest error constant among "
                 f"{len(found)} critical points found")
-    exact = _exact_form(T, selected, x, best, final_order, max_denominator, label, citation)
-    if exact is not None:
-        comp, values, lem = exact
+    found_exact = _exact_form(T, selected, x, best, final_order, max_denominator, label, citation) if exact else None
+    if found_exact is not None:
+        comp, values, lem = found_exact
         return DesignedComposition(comp.pieces, comp.coefficients, label, final_order, citation,
                                    T.name, values, optimum, lem, lem_opt, True, 0.0)
     return _rational_form(T, conds, x, best, final_order, dps, label, citation, optimum, lem_opt)

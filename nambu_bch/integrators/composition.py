@@ -48,6 +48,8 @@ from sympy.polys.domains import QQ
 
 from ..errors import InconsistentCoefficientsError, InvalidCompositionError, UnknownPieceError
 
+#: Names resolved by :mod:`nambu_bch.design.catalog` (literature methods, ``name`` or ``name:WORD``).
+_CATALOG = ("suzuki", "kahan-li", "yoshida6", "blanes-moan")
 _ALIASES = {"tvt": "121", "pv": "121", "position-verlet": "121", "vtv": "212", "vv": "212", "velocity-verlet": "212"}
 
 
@@ -261,11 +263,10 @@ def _build(spec, n_pieces):
         return _triple_jump(composition("121"))
     if low.startswith(("yoshida:", "triple-jump:")):
         return _triple_jump(composition(text.split(":", 1)[1], n_pieces))
-    from ..design.catalog import lookup  # literature methods with citations (issue 15)
+    if low.partition(":")[0] in _CATALOG:
+        from ..design.catalog import lookup  # literature methods with citations (issue 15)
 
-    found = lookup(text, n_pieces)
-    if found is not None:
-        return found
+        return lookup(text, n_pieces)
     if ":" in text:
         pairs = []
         for item in text.split(","):
