@@ -900,6 +900,10 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--dpi", metavar="DPI", help="resolution of the images (default 100)")
     p.add_argument("--fig-format", choices=("png", "pdf", "svg"), default="png", help="image format (default png)")
     _output_options(p, "text", choices=("text", "json"))
+
+    from .cli_compare import add_compare_parser  # issue 15: work-precision comparison
+
+    add_compare_parser(sub)
     return parser
 
 

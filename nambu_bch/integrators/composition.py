@@ -56,6 +56,8 @@ from sympy.polys.domains import QQ
 
 from ..errors import InconsistentCoefficientsError, InvalidCompositionError, UnknownPieceError
 
+#: Names resolved by :mod:`nambu_bch.design.catalog` (literature methods, ``name`` or ``name:WORD``).
+_CATALOG = ("suzuki", "kahan-li", "yoshida6", "blanes-moan")
 _ALIASES = {"tvt": "121", "pv": "121", "position-verlet": "121", "vtv": "212", "vv": "212", "velocity-verlet": "212"}
 _JUMPS = ("forest-ruth", "yoshida", "triple-jump", "suzuki")
 #: Most factors a composition may have (bounded work downstream: BCH, kernels).
@@ -420,6 +422,10 @@ def _build(spec, n_pieces):
                 )
         inner = composition(base, n_pieces)
         return _five_jump(inner) if head == "suzuki" else _triple_jump(inner)
+    if low.partition(":")[0] in _CATALOG:
+        from ..design.catalog import lookup  # literature methods with citations (issue 15)
+
+        return lookup(text, n_pieces)
     if ":" in text:
         pairs = []
         for item in text.split(","):
@@ -431,7 +437,8 @@ def _build(spec, n_pieces):
     if not text.isdigit() or "0" in text:
         raise InvalidCompositionError(
             f"unknown composition {text!r}; use a word of piece digits 1-9 such as '12321', "
-            f"an alias ({', '.join(sorted(_ALIASES))}, lie-trotter, strang, forest-ruth, yoshida, yoshida:WORD, suzuki, suzuki:WORD) "
+            f"an alias ({', '.join(sorted(_ALIASES))}, lie-trotter, strang, forest-ruth, yoshida, yoshida:WORD, "
+            "triple-jump:WORD, suzuki[:WORD], kahan-li[:WORD], yoshida6[:WORD], blanes-moan) "
             "or an explicit list 'piece:coefficient,...'"
         )
     if len(text) % 2 == 1 and text == text[::-1] and len(text) > 1:

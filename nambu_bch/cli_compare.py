@@ -1,0 +1,84 @@
+"""``nambu-bch compare``: work-precision comparison of integrators on a system (issue 15).
+
+Registered by one line in :func:`nambu_bch.cli.build_parser`; the work is
+:func:`nambu_bch.design.compare`.
+"""
+
+from __future__ import annotations
+
+from .errors import NambuBCHError
+
+HELP = "compare integrators: order, cost, error constant, the system's leading error, measured error vs cost"
+EXAMPLES = (
+    "examples:\n"
+    "  nambu-bch compare --model ho3 --integrator 12321 --integrator triple-jump:12321 --integrator suzuki:12321\n"
+    "  nambu-bch compare --model rigid-body --param I1=1 --param I2=2 --param I3=3 --integrator 12321 \\\n"
+    "      --integrator 21312 --t-end 5 --step-counts 20,40,80,160 --figure wp.png --format json\n"
+    "  nambu-bch compare --integrator strang --integrator kahan-li      # defaults: --model ho3, T = 10\n"
+    "\n"
+    "integrators: digit words, aliases (strang, lie-trotter, forest-ruth, yoshida:WORD, suzuki[:WORD],\n"
+    "kahan-li[:WORD], yoshida6[:WORD], blanes-moan) or 'piece:coeff,...'; cost = sub-flow evaluations per\n"
+    "step after merging equal neighbours (also across steps); the slope of log(error) vs log(evaluations)\n"
+    "is -order. The reference solution is the 6th-order Kahan-Li composition at h_min/8."
+)
+MAX_INTEGRATORS = 12
+
+
+def add_compare_parser(sub) -> None:
+    """Register the ``compare`` subcommand on the ``argparse`` sub-parsers ``sub`` of :func:`nambu_bch.cli.build_parser`."""
+    from . import cli
+
+    p = sub.add_parser("compare", help=HELP, description=HELP, epilog=EXAMPLES, formatter_class=cli._Formatter)
+    p.set_defaults(func=cmd_compare)
+    cli._system_options(p)
+    p.add_argument("--integrator", dest="integrators", metavar="WORD", action="append",
+                   help="an integrator to compare; repeat (default: the Strang word, its triple jump and Suzuki 5-jump)")
+    p.add_argument("--t-end", metavar="T", default="10", help="final time T of the runs (default 10)")
+    p.add_argument("--step-counts", metavar="N,N,...", default="20,40,80,160,320,640",
+                   help="numbers of steps N (h = T/N), at least two (default 20,40,80,160,320,640)")
+    p.add_argument("--x0", metavar="X", help="initial state, comma separated (default 1,...,1)")
+    p.add_argument("--figure", metavar="FILE", help="write the log-log work-precision plot (.png, .pdf, .svg) atomically")
+    cli._output_options(p, "text", choices=("text", "json"))
+
+
+def _step_counts(text):
+    from .cli import positive_int
+    from .design.compare import MAX_STEPS
+
+    items = [t for t in text.replace(",", " ").split()]
+    if len(items) < 2 or len(items) > 20:
+        raise NambuBCHError(f"--step-counts {text!r} must list 2 to 20 step counts, e.g. 20,40,80,160")
+    counts = [positive_int(t, "--step-counts", MAX_STEPS // 8) for t in items]
+    if len(set(counts)) < 2:
+        raise NambuBCHError(f"--step-counts {text!r} must hold at least two different step counts")
+    return counts
+
+
+def cmd_compare(args):
+    from . import cli
+    from .design import compare
+
+    system, values = cli.system_from_args(args)
+    params, x0 = cli.numeric_inputs(args, system, values)
+    words = args.integrators
+    if not words:
+        strang = cli.default_word(system)
+        words = [strang, f"triple-jump:{strang}", f"suzuki:{strang}"] if len(strang) > 1 else [strang]
+    if len(words) > MAX_INTEGRATORS:
+        raise NambuBCHError(f"--integrator given {len(words)} times; compare accepts at most {MAX_INTEGRATORS}")
+    for w in words:
+        if not w.strip() or len(w) > 200:
+            raise NambuBCHError(f"--integrator {w[:40]!r} must be a non-empty string of at most 200 characters")
+    if args.figure is not None and not args.figure.lower().endswith((".png", ".pdf", ".svg")):
+        raise NambuBCHError(f"--figure {args.figure[:80]!r}: give a file name ending in .png, .pdf or .svg")
+    t_end = cli.positive_float(args.t_end, "--t-end")
+    if t_end > 1e5:
+        raise NambuBCHError(f"--t-end {args.t_end!r} must be at most 1e5")
+    counts = _step_counts(args.step_counts)
+    result = compare(system, words, t_end=t_end, steps=counts, x0=x0, params=params)
+    if args.figure:
+        try:
+            result.figure(args.figure)
+        except OSError as exc:
+            raise NambuBCHError(f"--figure {args.figure}: cannot write the file ({exc.strerror or exc})") from None
+    cli.emit(args, text=result.table, data=result.to_dict)

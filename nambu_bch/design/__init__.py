@@ -1,0 +1,47 @@
+"""Choosing and designing the integrator: error constants, order conditions, optimal compositions, comparisons.
+
+* :func:`error_constant`, :func:`error_analysis`, :func:`composition_order` -- the local error
+  measure LEM and the order of a composition, exactly (:mod:`.conditions`, :mod:`.words`);
+* :func:`template`, :func:`order_conditions` -- polynomial order conditions of templates;
+* :func:`optimize_composition` -- the template solution with the smallest error constant (:mod:`.optimize`);
+* :func:`leading_error` -- the system's own leading error term and its size (:mod:`.system_error`);
+* :func:`compare` -- work-precision comparison on a system (:mod:`.compare`);
+* :mod:`.catalog` -- literature methods (Suzuki, Kahan-Li, Yoshida 6, Blanes-Moan) by name.
+"""
+
+from .catalog import CatalogComposition, methods
+from .compare import Comparison, compare, cost
+from .conditions import (
+    ErrorConstant,
+    OrderConditions,
+    Template,
+    composition_order,
+    error_analysis,
+    error_constant,
+    order_conditions,
+    template,
+)
+from .optimize import DesignedComposition, NoSolutionError, optimize_composition
+from .system_error import LeadingError, field_size, leading_error
+
+__all__ = [
+    "CatalogComposition",
+    "Comparison",
+    "DesignedComposition",
+    "ErrorConstant",
+    "LeadingError",
+    "NoSolutionError",
+    "OrderConditions",
+    "Template",
+    "compare",
+    "composition_order",
+    "cost",
+    "error_analysis",
+    "error_constant",
+    "field_size",
+    "leading_error",
+    "methods",
+    "optimize_composition",
+    "order_conditions",
+    "template",
+]

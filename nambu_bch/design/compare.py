@@ -1,0 +1,229 @@
+"""Work-precision comparison of integrators on one system: order, cost, error constants, measured error.
+
+Per word:
+
+* ``order`` and ``error_constant`` -- formal, from the exact Lyndon defects
+  (:func:`~nambu_bch.design.error_analysis`; ``None`` if the word does not use every piece);
+* ``cost`` -- sub-flow evaluations per step after merging equal neighbours, including
+  across steps (first-same-as-last: a word that starts and ends with the same piece pays
+  that piece once per step, plus once for the whole run);
+* ``leading_power``, ``leading_size`` -- the system's own leading error term
+  ``h^j Z_j`` of ``X_eff - X_{H,G}`` and ``max ||Z_j||`` on a box
+  (:func:`~nambu_bch.design.leading_error`);
+* the measured global error ``||x_N - x_ref(T)||_2`` at ``T = N h`` for several ``N``,
+  against the evaluations ``N cost (+1)``, and the least-squares slope of
+  ``log(error)`` against ``log(evaluations)`` over the points above round-off: ``-order``.
+
+The reference ``x_ref(T)`` is the sixth-order Kahan-Li composition of the system's Strang
+step (:mod:`nambu_bch.design.catalog`) with a step ``h_min / 8``; its error is checked
+against the same run at ``h_min / 4`` and reported (``reference_error``).
+
+References
+----------
+Hairer, Lubich, Wanner, *Geometric Numerical Integration*, Sect. V.3.2 (work-precision
+comparisons of composition methods, Fig. 3.3); Blanes & Casas, *A Concise Introduction to
+Geometric Numerical Integration*, Sect. 3.7.
+"""
+
+from __future__ import annotations
+
+import io
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..atomic import write_atomic
+from ..errors import InvalidRunError, NambuBCHError
+from ..integrators.composition import composition as make_composition
+from ..numeric import iterate
+from ..numeric.iterate import as_system
+from .conditions import error_analysis
+from .system_error import leading_error
+
+#: Errors below this are round-off and are not used in the slope fits.
+FLOOR = 1e-11
+#: Largest number of steps of one run.
+MAX_STEPS = 10**7
+
+
+def cost(comp) -> tuple:
+    """``(per_step, extra)``: sub-flow evaluations per step after merging equal neighbours, and the FSAL extra.
+
+    >>> cost(make_composition("12321")), cost(make_composition("123"))
+    ((4, 1), (3, 0))
+    """
+    runs = [k for i, k in enumerate(comp.pieces) if i == 0 or comp.pieces[i - 1] != k]
+    if len(runs) > 1 and runs[0] == runs[-1]:
+        return len(runs) - 1, 1
+    return len(runs), 0
+
+
+def slope(x, y) -> float:
+    """Least-squares slope of ``log y`` against ``log x`` (``nan`` with fewer than two points)."""
+    x, y = np.asarray(x, float), np.asarray(y, float)
+    if len(x) < 2:
+        return float("nan")
+    return float(np.polyfit(np.log(x), np.log(y), 1)[0])
+
+
+@dataclass
+class Comparison:
+    """The result of :func:`compare`: ``rows`` (one dict per word) and ``curves`` (word -> list of points)."""
+
+    system: str
+    t_end: float
+    x0: tuple
+    params: dict
+    rows: list
+    curves: dict
+    reference: str
+    reference_error: float
+    meta: dict = field(default_factory=dict)
+
+    def to_dict(self) -> dict:
+        return {"system": self.system, "t_end": self.t_end, "x0": list(self.x0), "params": self.params,
+                "reference": self.reference, "reference_error": self.reference_error,
+                "integrators": self.rows, "curves": self.curves}
+
+    def to_json(self) -> str:
+        """Strict JSON (non-finite numbers as strings, :func:`nambu_bch.render.to_json`)."""
+        from ..render import to_json
+
+        return to_json(self.to_dict())
+
+    def table(self) -> str:
+        """A plain-text table, one line per word."""
+        head = f"{'integrator':<24} {'order':>5} {'cost':>5} {'LEM':>10} {'h^j':>4} {'|Z_j|max':>10} {'slope':>7} {'best error':>11}"
+        lines = [f"{self.system}, T = {self.t_end:g}, x0 = {list(self.x0)}; reference {self.reference} (error ~{self.reference_error:.1e})", head]
+        for r in self.rows:
+            lem = "-" if r["error_constant"] is None else f"{r['error_constant']:.4g}"
+            order = "-" if r["order"] is None else str(r["order"])
+            lines.append(f"{r['integrator']:<24} {order:>5} {r['cost']:>5} {lem:>10} {r['leading_power']:>4} "
+                         f"{r['leading_size']:>10.3g} {r['slope']:>7.2f} {r['best_error']:>11.2e}")
+        return "\n".join(lines)
+
+    def __str__(self):
+        return self.table()
+
+    def figure(self, path=None, dpi: int = 100):
+        """The log-log work-precision plot (error vs sub-flow evaluations); written atomically to ``path`` if given."""
+        import matplotlib
+
+        matplotlib.use("Agg")
+        import matplotlib.pyplot as plt
+
+        fig, ax = plt.subplots(figsize=(6.4, 4.4))
+        for r in self.rows:
+            pts = self.curves[r["integrator"]]
+            ax.loglog([p["evaluations"] for p in pts], [max(p["error"], 1e-17) for p in pts], "o-",
+                      label=f"{r['integrator']} (p={r['order']}, slope {r['slope']:.2f})")
+        ax.set_xlabel("sub-flow evaluations")
+        ax.set_ylabel(f"global error at T = {self.t_end:g}")
+        ax.set_title(f"work-precision, {self.system}")
+        ax.grid(True, which="both", alpha=0.3)
+        ax.legend(fontsize=8)
+        fig.tight_layout()
+        if path is not None:
+            buffer = io.BytesIO()
+            fmt = str(path).rsplit(".", 1)[-1].lower() if "." in str(path) else "png"
+            if fmt not in ("png", "pdf", "svg"):
+                plt.close(fig)
+                raise InvalidRunError(f"figure {path!r}: the file name must end in .png, .pdf or .svg")
+            fig.savefig(buffer, format=fmt, dpi=dpi)
+            plt.close(fig)
+            write_atomic(path, buffer.getvalue())
+            return path
+        return fig
+
+
+def _steps_list(steps):
+    try:
+        out = sorted({int(s) for s in steps})
+    except (TypeError, ValueError):
+        raise InvalidRunError(f"steps must be a list of positive integers, got {steps!r}") from None
+    if len(out) < 2 or out[0] < 1 or out[-1] > MAX_STEPS:
+        raise InvalidRunError(f"steps must hold at least two distinct integers in 1..{MAX_STEPS}, got {steps!r}")
+    return out
+
+
+def _final(system, comp, h, n, x0, params):
+    x = iterate(system, comp, h, n, x0, params=params, every=n, progress=False)
+    return np.asarray(x[-1], float)
+
+
+def compare(system, words, t_end: float = 10.0, steps=(20, 40, 80, 160, 320, 640), x0=None, params=None,
+            box=None, samples: int = 500) -> Comparison:
+    """Compare integrators on ``system``: order, cost, error constants, measured error vs cost (module docstring).
+
+    Parameters
+    ----------
+    system : System or model name
+    words : sequence of words, aliases or Compositions
+    t_end : float -- final time ``T``
+    steps : sequence of step counts ``N`` (``h = T/N``)
+    x0 : initial state (default all ones)
+    params : parameter values (default 1)
+    box, samples : region and sample size of the leading-error size (default ``[-1, 1]^N``, 500 points)
+
+    Examples
+    --------
+    >>> C = compare("ho", ["121", "forest-ruth"], t_end=2.0, steps=(10, 20, 40))
+    >>> [r["order"] for r in C.rows], [round(r["slope"]) for r in C.rows]
+    ([2, 4], [-2, -4])
+    """
+    system = as_system(system)
+    n = len(system.splitting)
+    if not words:
+        raise InvalidRunError("compare needs at least one integrator")
+    try:
+        t_end = float(t_end)
+    except (TypeError, ValueError):
+        raise InvalidRunError(f"t_end must be a positive number, got {t_end!r}") from None
+    if not 0 < t_end < 1e6:
+        raise InvalidRunError(f"t_end must be a positive number below 1e6, got {t_end!r}")
+    steps = _steps_list(steps)
+    x0 = tuple(float(v) for v in (x0 if x0 is not None else [1.0] * system.N))
+    params = dict(params or {})
+    strang = "".join(str(k) for k in range(1, n + 1))
+    strang = strang + strang[-2::-1] if n > 1 else "1"
+    ref_name = f"kahan-li:{strang}" if n > 1 else strang
+    ref = make_composition(ref_name, n)
+    h_min = t_end / steps[-1]
+    fine = max(8 * steps[-1], 64)
+    if fine > MAX_STEPS:
+        raise InvalidRunError(f"the reference run would need {fine} steps; use fewer steps (at most {MAX_STEPS // 8})")
+    x_ref = _final(system, ref, t_end / fine, fine, x0, params)
+    x_half = _final(system, ref, t_end / (fine // 2), fine // 2, x0, params)
+    ref_err = float(np.linalg.norm(x_ref - x_half)) / 63.0  # order 6: error(h) ~ (error(2h) - error(h)) / (2^6 - 1)
+    rows, curves = [], {}
+    for word in words:
+        comp = make_composition(word, n).check(system.splitting)
+        label = word if isinstance(word, str) else comp.name
+        try:
+            analysis = error_analysis(comp, n)
+            order, lem = analysis.order, analysis.value
+        except NambuBCHError:
+            order, lem = None, None
+        lead = leading_error(system, comp, box=box, samples=samples, params=params, hamiltonian=False)
+        per_step, extra = cost(comp)
+        pts = []
+        for N in steps:
+            h = t_end / N
+            try:
+                err = float(np.linalg.norm(_final(system, comp, h, N, x0, params) - x_ref))
+            except NambuBCHError as exc:
+                err = float("nan")
+                pts.append({"steps": N, "h": h, "evaluations": N * per_step + extra, "error": err, "note": str(exc)})
+                continue
+            pts.append({"steps": N, "h": h, "evaluations": N * per_step + extra, "error": err})
+        good = [p for p in pts if np.isfinite(p["error"]) and p["error"] > max(FLOOR, 100 * ref_err)]
+        rows.append({
+            "integrator": label, "name": comp.name, "order": order, "error_constant": lem,
+            "cost": per_step, "fsal_extra": extra, "leading_power": lead.power, "leading_size": lead.size,
+            "slope": slope([p["evaluations"] for p in good], [p["error"] for p in good]),
+            "slope_points": len(good),
+            "best_error": min((p["error"] for p in pts if np.isfinite(p["error"])), default=float("nan")),
+            "citation": comp.citation,
+        })
+        curves[label] = pts
+    return Comparison(system.name, t_end, x0, params, rows, curves, ref_name, ref_err)

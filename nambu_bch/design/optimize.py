@@ -1,0 +1,427 @@
+"""Design: solve a template's order conditions and keep the solution with the smallest error constant.
+
+Algorithm
+---------
+1. The order conditions ``F(x) = 0`` of the template (:func:`order_conditions`, exact
+   polynomials) and the objective ``f(x) = LEM(x)^2``, the sum of squares of the degree
+   ``p + 1`` log defects (``p`` the requested order, raised past degrees whose defects
+   vanish identically, e.g. the even ones of symmetric templates).
+2. A maximal independent subset of ``F`` (numerical rank of the Jacobian at a solution).
+3. The critical points of ``f`` on ``{F = 0}``: from ``starts`` seeded random points, each
+   projected onto ``{F = 0}`` by Gauss-Newton, Newton's method on the Lagrange system
+   ``grad f + J^T lambda = 0, F = 0`` in float64; distinct converged real points are
+   ranked by ``f`` and the three best are polished by Newton in mpmath (``dps`` digits,
+   default 30); the smallest ``f`` wins.  With as many independent conditions as unknowns
+   this is the plain solve, polished by Newton.
+4. An exact form: the ``n - r`` unknowns left free by the conditions are fixed to nearby
+   rationals (each choice of free unknowns is tried), the remaining conditions are solved
+   exactly through a lex Groebner basis in shape position (a univariate polynomial of degree
+   <= 4, solved in radicals, the lowest degree preferred); a solution counts only if it is
+   real and written in real radicals,
+   and it is then *verified exactly* (every log defect of length ``<= p`` is zero in the
+   algebraic field of the coefficients).  The exact composition nearest in error constant
+   to the numerical optimum is returned.
+5. If no such exact form exists, the coefficients are the ``dps``-digit optimum as
+   rationals (the degree-1 conditions re-solved exactly, so the scheme is consistent), the
+   result is marked ``exact=False`` and carries ``error_bound``: the largest absolute
+   Lyndon defect of length ``<= p``, computed exactly.  Symbolic routes then analyse these
+   rationals as they are: their ``X_eff`` has terms of size ``error_bound`` below ``h^p``.
+
+References
+----------
+Hairer, Lubich, Wanner, *Geometric Numerical Integration*, Sect. V.3 (composition
+methods, optimal coefficients); McLachlan, SIAM J. Sci. Comput. 16 (1995) 151;
+Auzinger, Hofstaetter, Ketcheson, Koch, BIT 57 (2017) 55 (LEM, Newton polishing).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from dataclasses import dataclass
+from fractions import Fraction
+from itertools import combinations
+
+import mpmath
+import numpy as np
+import sympy
+
+from ..errors import InvalidOrderError, NambuBCHError
+from ..integrators.composition import Composition
+from .conditions import _Exact, error_analysis, order_conditions, symbolic_defects, template
+
+#: Largest number of unknowns accepted by :func:`optimize_composition`.
+MAX_UNKNOWNS = 8
+#: Solutions with a coefficient larger than this in absolute value are not searched (useless in practice).
+MAX_COEFFICIENT = 50.0
+
+
+class NoSolutionError(NambuBCHError):
+    """A template whose order conditions have no real solution (found by the search)."""
+
+
+@dataclass(frozen=True)
+class DesignedComposition(Composition):
+    """A :class:`Composition` found by :func:`optimize_composition`, usable wherever a word is.
+
+    Extra attributes
+    ----------------
+    template : str            -- the template's name
+    values : tuple            -- ``(unknown, exact value)`` pairs
+    optimum : tuple           -- ``(unknown, dps-digit value)`` of the true constrained optimum
+    lem : float               -- the error constant of *this* composition (exact, as float)
+    lem_optimum : float       -- the error constant at the numerical optimum
+    exact : bool              -- True: order conditions hold exactly; False: see ``error_bound``
+    error_bound : float       -- largest absolute Lyndon defect of length <= order (0 when exact)
+    """
+
+    template: str = ""
+    values: tuple = ()
+    optimum: tuple = ()
+    lem: float = float("nan")
+    lem_optimum: float = float("nan")
+    exact: bool = True
+    error_bound: float = 0.0
+
+    def summary(self) -> dict:
+        return {
+            "name": self.name, "template": self.template, "order": self.order, "exact": self.exact,
+            "error_bound": self.error_bound, "error_constant": self.lem, "error_constant_optimum": self.lem_optimum,
+            "values": {str(k): str(v) for k, v in self.values},
+            "optimum": {str(k): str(v) for k, v in self.optimum},
+        }
+
+
+class _PolyEval:
+    """A polynomial with rational coefficients evaluated from its terms, in float64 or in mpmath."""
+
+    def __init__(self, poly: sympy.Poly):
+        terms = poly.terms() or [((0,) * len(poly.gens), sympy.Integer(0))]
+        self.monoms = np.array([m for m, _ in terms], dtype=np.int64)
+        self.cf = np.array([float(c) for _, c in terms])
+        self.fractions = [(int(sympy.Rational(c).p), int(sympy.Rational(c).q)) for _, c in terms]
+        self.top = int(self.monoms.max()) if self.monoms.size else 0
+
+    def float(self, x):
+        return float(np.sum(self.cf * np.prod(np.power(np.asarray(x, float), self.monoms), axis=1)))
+
+    def mp(self, x):
+        powers = [[mpmath.mpf(1)] for _ in x]
+        for i, v in enumerate(x):
+            for _ in range(self.top):
+                powers[i].append(powers[i][-1] * v)
+        total = mpmath.mpf(0)
+        for (p, q), mon in zip(self.fractions, self.monoms):
+            if p:
+                term = mpmath.mpf(p) / q
+                for i, e in enumerate(mon):
+                    if e:
+                        term *= powers[i][e]
+                total += term
+        return total
+
+
+class _Problem:
+    """``f`` (objective) and ``F`` (conditions) with gradients and Hessians, evaluated from polynomial terms."""
+
+    def __init__(self, objective: sympy.Poly, conditions, x):
+        self.x, self.n, self.m = list(x), len(x), len(conditions)
+        Fp = [sympy.Poly(e, *x) for e in conditions]
+        grad = [objective.diff(v) for v in x]
+        jac = [[P.diff(v) for v in x] for P in Fp]
+        E = _PolyEval
+        self.f = E(objective)
+        self.F = [E(P) for P in Fp]
+        self.g = [E(g) for g in grad]
+        self.H = [[E(g.diff(v)) for v in x] for g in grad]
+        self.J = [[E(d) for d in row] for row in jac]
+        self.C = [[[E(d.diff(v)) for v in x] for d in row] for row in jac]
+
+    def values(self, name, x, lib):
+        def ev(obj):
+            return [ev(o) for o in obj] if isinstance(obj, list) else getattr(obj, lib)(x)
+
+        return ev(getattr(self, name))
+
+    def kkt(self, z, lib):
+        """``(G, DG)`` of the Lagrange system at ``z = (x, lambda)``; ``lib`` is ``"float"`` or ``"mp"``."""
+        n, m = self.n, self.m
+        x, lam = list(z[:n]), list(z[n:])
+        F, g, H, J, C = (self.values(k, x, lib) for k in ("F", "g", "H", "J", "C"))
+        G = [g[i] + sum(lam[k] * J[k][i] for k in range(m)) for i in range(n)] + list(F)
+        DG = [[H[i][j] + sum(lam[k] * C[k][i][j] for k in range(m)) for j in range(n)] + [J[k][i] for k in range(m)]
+              for i in range(n)]
+        DG += [[J[k][j] for j in range(n)] + [0] * m for k in range(m)]
+        return G, DG
+
+
+def _newton_float(prob, z, steps=80):
+    """Newton on the Lagrange system in float64, stopped when the step is at round-off level."""
+    for _ in range(steps):
+        G, DG = prob.kkt(z, "float")
+        G = np.asarray(G, float)
+        if not np.all(np.isfinite(G)):
+            return None
+        try:
+            dz = np.linalg.solve(np.asarray(DG, float), G)
+        except np.linalg.LinAlgError:
+            return None
+        z = z - dz
+        if not np.all(np.isfinite(z)) or np.abs(z[:prob.n]).max() > MAX_COEFFICIENT:
+            return None
+        if np.linalg.norm(dz) < 1e-12 * (1 + np.linalg.norm(z)):
+            return z
+    return None
+
+
+def _newton_mp(prob, z, tol, steps=30):
+    z = [mpmath.mpf(float(v)) for v in z]
+    for _ in range(steps):
+        G, DG = prob.kkt(z, "mp")
+        G = mpmath.matrix(G)
+        if mpmath.norm(G) < tol:
+            return z
+        try:
+            dz = mpmath.lu_solve(mpmath.matrix(DG), G)
+        except ZeroDivisionError:
+            return None
+        z = [a - b for a, b in zip(z, dz)]
+    G, _ = prob.kkt(z, "mp")
+    return z if mpmath.norm(mpmath.matrix(G)) < tol * 10**6 else None
+
+
+def _project(prob_F, prob_J, x, steps=80):
+    """Gauss-Newton (minimum-norm steps, float) onto ``F = 0``; ``None`` if it does not converge."""
+    for _ in range(steps):
+        F = np.asarray(prob_F(*x), float)
+        if not np.all(np.isfinite(F)):
+            return None
+        J = np.asarray(prob_J(*x), float)
+        dx = np.linalg.lstsq(J, F, rcond=None)[0]
+        x = x - dx
+        if not np.all(np.isfinite(x)) or np.abs(x).max() > MAX_COEFFICIENT:
+            return None
+        if np.linalg.norm(dx) < 1e-12 * (1 + np.linalg.norm(x)):
+            break
+    F = np.asarray(prob_F(*x), float)
+    return x if np.all(np.isfinite(F)) and np.linalg.norm(F) < 1e-9 else None
+
+
+def _independent(J, tol=1e-8):
+    """Indices of a maximal set of linearly independent rows of ``J`` (float), greedily."""
+    rows, basis = [], []
+    for i, row in enumerate(np.asarray(J, float)):
+        v = row.copy()
+        for b in basis:
+            v = v - (v @ b) * b
+        norm = np.linalg.norm(v)
+        if norm > tol * max(1.0, np.linalg.norm(row)):
+            basis.append(v / norm)
+            rows.append(i)
+    return rows
+
+
+def optimize_composition(spec, parts: int | None = None, order: int = 4, stages: int | None = None, *,
+                         dps: int = 30, starts: int = 40, seed: int = 0, max_denominator: int = 1000,
+                         name: str | None = None, exact: bool = True) -> DesignedComposition:
+    """The composition of a template with order ``>= order`` and the smallest error constant found.
+
+    Parameters
+    ----------
+    spec : ``"strang"``, a palindromic base word, ``"word:WORD"`` or a :class:`Template`
+    parts : int -- number of pieces (``"strang"``)
+    order : int -- required order ``p``
+    stages : int -- number of base steps of a ``"strang"`` / base-word template
+    dps : int -- digits of the final Newton polish (mpmath), default 30
+    starts : int -- seeded random starting points of the (float) search
+    seed : int
+    max_denominator : int -- the free unknowns of the exact form are rationals with at most this denominator
+    name : str, optional -- name of the returned composition
+    exact : bool -- look for an exact (real-radical) form first (default); ``False`` returns the
+        ``dps``-digit rationals with their ``error_bound`` directly
+
+    Returns
+    -------
+    DesignedComposition -- a :class:`Composition` (coefficients exact: rationals and real radicals,
+    or, with ``exact=False``, ``dps``-digit rationals with ``error_bound``).
+
+    Raises
+    ------
+    NoSolutionError -- no real solution was found; InvalidOrderError -- order too high or too many unknowns.
+
+    Examples
+    --------
+    >>> C = optimize_composition("strang", parts=2, order=4, stages=3)     # the triple jump: unique
+    >>> C.exact, C.order, round(C.lem, 4)
+    (True, 4, 3.7163)
+    """
+    T = template(spec, parts, stages)
+    if isinstance(order, bool) or not isinstance(order, int) or order < 1:
+        raise InvalidOrderError(f"order must be a positive integer, got {order!r}")
+    n = len(T.unknowns)
+    if n > MAX_UNKNOWNS:
+        raise InvalidOrderError(f"template {T.name!r} has {n} unknowns; the search accepts at most {MAX_UNKNOWNS}")
+    if isinstance(dps, bool) or not isinstance(dps, int) or not 15 <= dps <= 200:
+        raise InvalidOrderError(f"dps must be an integer in 15..200, got {dps!r}")
+    conds = order_conditions(T, order)
+    eqs = conds.polynomials
+    degree = order + 1
+    defects = symbolic_defects(T, degree)
+    while all(sympy.expand(e) == 0 for e in defects.values()):
+        degree += 1
+        defects = symbolic_defects(T, degree)
+    x = list(T.unknowns)
+    objective = sum((sympy.Poly(e, *x) ** 2 for e in defects.values()), sympy.Poly(0, *x))
+    every = _Problem(objective, eqs, x)
+    rng = np.random.RandomState(seed)
+    selected, prob, found = None, None, []
+    for _ in range(starts):
+        p = _project(lambda *v: every.values("F", v, "float"), lambda *v: every.values("J", v, "float"),
+                     rng.uniform(-1, 1, n))
+        if p is None:
+            continue
+        if selected is None:
+            selected = [eqs[i] for i in _independent(every.values("J", list(p), "float"))]
+            prob = _Problem(objective, selected, x)
+        J = np.asarray(prob.values("J", list(p), "float"), float)
+        g = np.asarray(prob.values("g", list(p), "float"), float)
+        lam = -np.linalg.lstsq(J.T, g, rcond=None)[0]
+        z = _newton_float(prob, np.concatenate([p, lam]))
+        if z is None or np.linalg.norm(np.asarray(every.values("F", list(z[:n]), "float"), float)) > 1e-8:
+            continue
+        if not any(np.abs(z[:n] - y[:n]).max() < 1e-7 for y in found):
+            found.append(z)
+    if not found:
+        raise NoSolutionError(
+            f"no real solution of the order-{order} conditions of template {T.name!r} was found from {starts} "
+            "starting points; add stages or lower the order"
+        )
+    found.sort(key=lambda z: every.f.float(z[:n]))
+    with mpmath.workdps(dps + 10):
+        tol = mpmath.mpf(10) ** (-(dps + 5))
+        best = None
+        for z in found[:3]:
+            zp = _newton_mp(prob, z, tol)
+            if zp is not None:
+                value = prob.f.mp(zp[:n])
+                if best is None or value < best[1]:
+                    best = (zp[:n], value)
+        if best is None:
+            raise NoSolutionError(f"the Newton polish of the order-{order} solutions of template {T.name!r} did not converge")
+        best, fbest = best
+        optimum = tuple((v, mpmath.nstr(b, dps)) for v, b in zip(x, best))
+        lem_opt = float(mpmath.sqrt(fbest))
+    final_order = degree - 1
+    label = name or f"designed:{T.name}:p{final_order}"
+    citation = (f"optimize_composition({T.name!r}, order={order}): smallest error constant among "
+                f"{len(found)} critical points found")
+    found_exact = _exact_form(T, selected, x, best, final_order, max_denominator, label, citation) if exact else None
+    if found_exact is not None:
+        comp, values, lem = found_exact
+        return DesignedComposition(comp.pieces, comp.coefficients, label, final_order, citation,
+                                   T.name, values, optimum, lem, lem_opt, True, 0.0)
+    return _rational_form(T, conds, x, best, final_order, dps, label, citation, optimum, lem_opt)
+
+
+def _is_real_radical(v) -> bool:
+    v = sympy.nsimplify(v) if v.is_Float else v
+    if v.has(sympy.I) or v.has(sympy.RootOf) or v.has(sympy.Float):
+        return False
+    if not v.is_real:
+        return False
+    return all(a.exp.is_Rational for a in v.atoms(sympy.Pow))
+
+
+def _shape_solutions(system, rest, max_degree=4):
+    """Real solutions of a zero-dimensional polynomial ``system`` in shape position, exactly, with their degree.
+
+    A lex Groebner basis ``[x_1 - r_1(x_k), ..., x_{k-1} - r_{k-1}(x_k), q(x_k)]`` gives every solution
+    from the real roots of the univariate ``q`` (``deg q <= max_degree``, roots in radicals).
+    Returns ``(deg q, [{unknown: value}, ...])`` or ``None`` if the basis is not of that shape.
+    """
+    if not rest:
+        return 0, [{}]
+    G = sympy.groebner(system, *rest, order="lex")
+    polys = list(G.polys)
+    last = rest[-1]
+    if len(polys) != len(rest) or polys[-1].free_symbols - {last}:
+        return None
+    q = sympy.Poly(polys[-1].as_expr(), last)
+    if not 1 <= q.degree() <= max_degree:
+        return None
+    linear = {}
+    for var, P in zip(rest[:-1], polys[:-1]):
+        P = sympy.Poly(P.as_expr(), var)
+        if P.degree() != 1 or P.LC().free_symbols or P.as_expr().free_symbols - {var, last}:
+            return None
+        linear[var] = sympy.expand(-P.nth(0) / P.LC())
+    roots = sympy.roots(q, filter="R")
+    if sum(roots.values()) == 0:
+        return q.degree(), []
+    sols = []
+    for r in roots:
+        sol = {last: sympy.radsimp(r)}
+        sol.update({var: sympy.radsimp(sympy.expand(expr.subs(last, r))) for var, expr in linear.items()})
+        sols.append(sol)
+    return q.degree(), sols
+
+
+def _exact_form(T, selected, x, best, order, max_denominator, label, citation):
+    """The simplest verified exact composition near ``best`` (module docstring, step 4), or ``None``."""
+    n, r = len(x), len(selected)
+    candidates = []
+    for free in combinations(range(n), n - r):
+        subs = {x[i]: sympy.Rational(Fraction(str(mpmath.nstr(best[i], 40))).limit_denominator(max_denominator)) for i in free}
+        rest = [x[i] for i in range(n) if i not in free]
+        system = [sympy.expand(e.subs(subs)) for e in selected]
+        found = _shape_solutions(system, rest)
+        if found is None:
+            continue
+        degree, sols = found
+        for sol in sols:
+            values = dict(subs)
+            values.update(sol)
+            if len(values) != n or not all(_is_real_radical(values[v]) for v in x):
+                continue
+            if any(abs(sympy.N(values[x[i]], 30) - sympy.Float(str(best[i]), 30)) > 1e-4 for i in range(n)):
+                continue
+            candidates.append((degree, sum(sympy.count_ops(v) for v in values.values()), len(candidates), values))
+    for *_, values in sorted(candidates, key=lambda c: c[:3]):
+        try:
+            comp = T.instantiate(values, label, order, citation)
+        except NambuBCHError:
+            continue
+        field = _Exact(comp)
+        if all(v == field.K.zero for q in range(1, order + 1) for v in field.defects(T.parts, q).values()):
+            analysis = error_analysis(comp, T.parts)
+            if analysis.order == order:
+                return comp, tuple((v, values[v]) for v in x), analysis.value
+    return None
+
+
+def _rational_form(T, conds, x, best, order, dps, label, citation, optimum, lem_opt):
+    values = {v: sympy.Rational(Fraction(mpmath.nstr(b, dps))) for v, b in zip(x, best)}
+    linear = [e for w, e in conds.equations if len(w) == 1]
+    if linear:
+        basis = sympy.Matrix([[sympy.diff(e, v) for v in x] for e in linear])
+        pivots = basis.rref()[1]
+        solve_for = [x[i] for i in pivots]
+        fixed = {v: values[v] for v in x if v not in solve_for}
+        sol = sympy.solve([e.subs(fixed) for e in linear], solve_for, dict=True)
+        if sol:
+            values.update(sol[0])
+    comp = T.instantiate(values, label, order, citation)
+    field = _Exact(comp)
+    bound = max((abs(float(field.K.to_sympy(v))) for q in range(1, order + 1)
+                 for v in field.defects(T.parts, q).values()), default=0.0)
+    designed = DesignedComposition(
+        comp.pieces, comp.coefficients, label, order, citation + f"; {dps}-digit rationals, order conditions to {bound:.1e}",
+        template=T.name, values=tuple((v, values[v]) for v in x), optimum=optimum, lem_optimum=lem_opt,
+        exact=False, error_bound=bound,
+    )
+    analysis = error_analysis(designed, T.parts)  # defects below error_bound count as zero
+    if analysis.order != order:
+        raise NoSolutionError(
+            f"the {dps}-digit rationals of the order-{order} solution of template {T.name!r} do not reach order {order} "
+            f"within their error bound {bound:.1e}; raise dps"
+        )
+    return dataclasses.replace(designed, lem=analysis.value)
