@@ -34,7 +34,7 @@ import numpy as np
 
 from ..atomic import write_atomic
 from ..errors import InvalidRunError, NambuBCHError
-from ..integrators.composition import composition as make_composition
+from ..integrators.composition import composition as make_composition, composition_for
 from ..numeric import iterate
 from ..numeric.iterate import as_system
 from .conditions import error_analysis
@@ -197,7 +197,7 @@ def compare(system, words, t_end: float = 10.0, steps=(20, 40, 80, 160, 320, 640
     ref_err = float(np.linalg.norm(x_ref - x_half)) / 63.0  # order 6: error(h) ~ (error(2h) - error(h)) / (2^6 - 1)
     rows, curves = [], {}
     for word in words:
-        comp = make_composition(word, n).check(system.splitting)
+        comp = composition_for(word, system.splitting)
         label = word if isinstance(word, str) else comp.name
         try:
             analysis = error_analysis(comp, n)

@@ -41,11 +41,14 @@ from .words import MAX_WORK, log_coefficients, lyndon_defects, work
 MAX_DEGREE = 12
 
 
-def _parts(comp: Composition, parts) -> int:
-    if parts is None:
-        parts = comp.n_pieces
-    if isinstance(parts, bool) or not isinstance(parts, int) or parts < 1:
+def _check_parts(parts):
+    if parts is not None and (isinstance(parts, bool) or not isinstance(parts, int) or parts < 1):
         raise InvalidCompositionError(f"parts must be a positive integer (the number of pieces X_1..X_n), got {parts!r}")
+    return parts
+
+
+def _parts(comp: Composition, parts) -> int:
+    parts = comp.n_pieces if _check_parts(parts) is None else parts
     used = set(comp.pieces)
     if used != set(range(1, parts + 1)):
         raise InvalidCompositionError(
@@ -115,7 +118,7 @@ class ErrorConstant:
 
 def error_analysis(spec, parts: int | None = None) -> ErrorConstant:
     """Order and error constant of ``spec`` for ``parts`` pieces, exactly (see :func:`error_constant`)."""
-    comp = make_composition(spec, parts)
+    comp = make_composition(spec, _check_parts(parts))
     parts = _parts(comp, parts)
     field = _Exact(comp)
     bound = float(getattr(comp, "error_bound", 0.0) or 0.0)

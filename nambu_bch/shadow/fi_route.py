@@ -722,7 +722,7 @@ def count_brackets(system, word, order: int) -> int:
 
 
 def _bracket_composition(system, word, order):
-    comp = make_composition(word, len(system.splitting)).check(system.splitting)
+    comp = composition_for(word, system.splitting)
     if isinstance(order, bool) or not isinstance(order, int) or not 1 <= order <= MAX_FI_ORDER:
         raise InvalidOrderError(f"order must be an integer between 1 and {MAX_FI_ORDER} for the FI brackets, got {order!r}")
     return comp
