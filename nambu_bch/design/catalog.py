@@ -42,7 +42,7 @@ from ..errors import InvalidCompositionError
 from ..integrators.composition import Composition
 from ..integrators.composition import composition as make_composition
 
-_SUZUKI = "Suzuki, Phys. Lett. A 146 (1990) 319, Eq. (3.11)"
+_SUZUKI = "Suzuki, Phys. Lett. A 146 (1990) 319"  # built by integrators.composition (the five-jump)
 _KAHAN_LI = "Kahan & Li, Math. Comp. 66 (1997) 1089; Hairer, Lubich, Wanner, GNI, Sect. V.3.2, Eq. (3.11)"
 _YOSHIDA6 = "Yoshida, Phys. Lett. A 150 (1990) 262, Table 1, solution A"
 _BLANES_MOAN = "Blanes & Moan, J. Comput. Appl. Math. 142 (2002) 313, Table 2 (S6)"
@@ -121,10 +121,6 @@ def _build(kind: str, word, n_pieces):
         return _with_bound(Composition(tuple(pieces), tuple(coeffs), "blanes-moan", 4, _BLANES_MOAN), 2)
     base = _base(word, n_pieces, kind)
     label = f"{kind}:{base.name}"
-    if kind == "suzuki":
-        g = 1 / (4 - sympy.root(4, 3))
-        g = sympy.radsimp(g)
-        return _stages(base, [g, g, sympy.expand(1 - 4 * g), g, g], label, 4, _SUZUKI)
     if kind == "kahan-li":
         return _with_bound(_stages(base, _palindrome(KAHAN_LI), label, 6, _KAHAN_LI), base.n_pieces)
     if kind == "yoshida6":
@@ -132,7 +128,7 @@ def _build(kind: str, word, n_pieces):
     raise AssertionError(kind)
 
 
-NAMES = ("suzuki", "kahan-li", "yoshida6", "blanes-moan")  # also listed in integrators/composition.py (_CATALOG)
+NAMES = ("kahan-li", "yoshida6", "blanes-moan")  # also listed in integrators/composition.py (_CATALOG); suzuki lives there
 
 
 def lookup(text: str, n_pieces=None):

@@ -57,7 +57,7 @@ from sympy.polys.domains import QQ
 from ..errors import InconsistentCoefficientsError, InvalidCompositionError, UnknownPieceError
 
 #: Names resolved by :mod:`nambu_bch.design.catalog` (literature methods, ``name`` or ``name:WORD``).
-_CATALOG = ("suzuki", "kahan-li", "yoshida6", "blanes-moan")
+_CATALOG = ("kahan-li", "yoshida6", "blanes-moan")
 _ALIASES = {"tvt": "121", "pv": "121", "position-verlet": "121", "vtv": "212", "vv": "212", "velocity-verlet": "212"}
 _JUMPS = ("forest-ruth", "yoshida", "triple-jump", "suzuki")
 #: Most factors a composition may have (bounded work downstream: BCH, kernels).

@@ -325,6 +325,11 @@ class _KernelPrinter(_PowMixin, PythonCodePrinter):
     def __init__(self, prefix="_"):
         funcs = {f: f"{prefix}{f}" for f in _FUNCTIONS}
         super().__init__({"user_functions": funcs, "fully_qualified_modules": False})
+        self._prefix = prefix
+
+    def _hprint_Pow(self, expr, rational=False, sqrt="math.sqrt"):
+        # sqrt(x) and 1/sqrt(x) (exact radicals in designed coefficients) call the module's own sqrt
+        return super()._hprint_Pow(expr, rational=rational, sqrt=f"{self._prefix}sqrt")
 
 
 class _CPrinter(_PowMixin, C99CodePrinter):
