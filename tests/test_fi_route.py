@@ -380,11 +380,11 @@ def test_cli_bad_input_is_one_line(capsys, argv, fragment):
 
 
 def test_doc_table_rows_are_computed():
-    """Recompute rows of the table (docs/fi_route_table.py) and find them verbatim in docs/fi_route.md."""
+    """Recompute rows of the table (tools/fi_route_table.py) and find them verbatim in docs/fi_route.md."""
     import importlib.util
     from pathlib import Path
 
-    path = Path(__file__).resolve().parents[1] / "docs" / "fi_route_table.py"
+    path = Path(__file__).resolve().parents[1] / "tools" / "fi_route_table.py"
     spec = importlib.util.spec_from_file_location("fi_route_table", path)
     script = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(script)

@@ -1,7 +1,7 @@
 """Compute the FI-vs-direct comparison tables of docs/fi_route.md (issue 13) and write them between the markers.
 
-Run:  PYTHONPATH=. python docs/fi_route_table.py          (rewrites docs/fi_route.md in place, atomically)
-      PYTHONPATH=. python docs/fi_route_table.py --print  (prints the tables only)
+Run:  PYTHONPATH=. python tools/fi_route_table.py          (rewrites docs/fi_route.md in place, atomically)
+      PYTHONPATH=. python tools/fi_route_table.py --print  (prints the tables only)
 
 For each system (ho3, rigid body, Lotka-Volterra) and each of the six words of Eq. (words), at
 h^4 and h^6:
@@ -31,7 +31,7 @@ from nambu_bch.shadow import direct_route, fi_route
 from nambu_bch.shadow.fi_nested import RawOps
 
 fi = importlib.import_module("nambu_bch.shadow.fi_route")
-DOC = Path(__file__).with_name("fi_route.md")
+DOC = Path(__file__).resolve().parents[1] / "docs" / "fi_route.md"
 BEGIN, END = "<!-- fi_route_table.py: begin -->", "<!-- fi_route_table.py: end -->"
 
 
