@@ -229,18 +229,23 @@ def _pvalue(v0, x, tid, words, lengths, left, right, content, prefix, g, memo_ro
     return result
 
 
+_LANES = 8  # words evaluated together by one program sweep (8 x int32: one AVX2 vector)
+
+
 @numba.njit(cache=True)
 def _solve(z, primes, words, lengths, left, right, order, class_start, g):
     """Eq. (1) in place, all primes at once: ``z_w -= <P_v, w> z_v`` over ``v < w`` of ``w``'s content class.
 
     Rows run in (degree, content, lex) order.  Per class one straight-line program
-    (:func:`_class_program`) gives every ``<P_v, w>`` for a word ``w`` in one sweep; the
-    matrix is never stored, a class whose word coefficients all vanish is skipped, and
-    ``<P_v, w>`` is read only when ``z_v != 0``.  Returns the number of program nodes run."""
+    (:func:`_class_program`) gives every ``<P_v, w>`` in one sweep, for :data:`_LANES` words
+    ``w`` side by side (int32: ``|<P_u, x>| <= 2^(|u|-1)`` and each product of two children is
+    at most ``2^(|u|-2)``, exact for ``|u| <= 31``); the matrix is never stored, a class whose
+    word coefficients all vanish is skipped, and ``<P_v, w>`` is used only when ``z_v != 0``.
+    Returns the number of program nodes run (times lanes)."""
     k = primes.shape[0]
     m = order.shape[0]
     live = np.zeros(m, dtype=np.bool_)
-    x = np.zeros(64, dtype=np.int64)
+    x = np.zeros((_LANES, 64), dtype=np.int64)
     work = 0
     r0 = 0
     while r0 < m:
@@ -255,29 +260,34 @@ def _solve(z, primes, words, lengths, left, right, order, class_start, g):
         d = lengths[order[r0]]
         if any_nonzero and d > 1 and r1 - r0 > 1:
             kids, roots = _class_program(order[r0:r1], words, lengths, left, right, g, d)
-            X = np.zeros(g * d + kids.shape[0], dtype=np.int64)
-            for r in range(r0, r1):
-                w = order[r]
-                stop = -1
-                for q in range(r0, r):
-                    if live[q] and roots[q - r0] > stop:
+            X = np.zeros((g * d + kids.shape[0], _LANES), dtype=np.int32)
+            for b0 in range(r0, r1, _LANES):
+                b1 = min(b0 + _LANES, r1)
+                stop = -1  # every member before the group's last word that is (or may still become) non-zero
+                for q in range(r0, b1 - 1):
+                    if (live[q] or q >= b0) and roots[q - r0] > stop:
                         stop = roots[q - r0]
                 if stop >= 0:
-                    for i in range(d):
-                        x[i] = words[w, i]
+                    for r in range(b0, b1):
+                        for i in range(d):
+                            x[r - b0, i] = words[order[r], i]
                     _run_program(kids, x, g, d, stop, X)
-                    work += stop + 1
-                    for q in range(r0, r):
-                        if live[q]:
-                            c = X[roots[q - r0]]
-                            if c != 0:
-                                v = order[q]
-                                for i in range(k):
-                                    p = primes[i]
-                                    z[w, i] = (z[w, i] - (c % p) * z[v, i]) % p
-                for i in range(k):
-                    if z[w, i] != 0:
-                        live[r] = True
+                    work += (stop + 1) * _LANES
+                for r in range(b0, b1):
+                    w = order[r]
+                    lane = r - b0
+                    if stop >= 0:
+                        for q in range(r0, r):
+                            if live[q]:
+                                c = X[roots[q - r0], lane]
+                                if c != 0:
+                                    v = order[q]
+                                    for i in range(k):
+                                        p = primes[i]
+                                        z[w, i] = (z[w, i] - (c % p) * z[v, i]) % p
+                    for i in range(k):
+                        if z[w, i] != 0:
+                            live[r] = True
         else:
             for r in range(r0, r1):
                 for i in range(k):
@@ -530,11 +540,13 @@ def _class_program(members, words, lengths, left, right, g, d):
 
 @numba.njit(cache=True)
 def _run_program(kids, x, g, d, stop, X):
-    """Evaluate the program of :func:`_class_program` on the word ``x`` up to node ``stop``."""
+    """Evaluate the program of :func:`_class_program` on the words ``x[lane]`` up to node ``stop``."""
     for a in range(g):
         for l in range(d):
-            X[a * d + l] = 1 if x[l] == a else 0
+            for lane in range(_LANES):
+                X[a * d + l, lane] = 1 if x[lane, l] == a else 0
     base = g * d
     for i in range(stop + 1 - base):
-        c = kids[i]
-        X[base + i] = X[c[0]] * X[c[1]] - X[c[2]] * X[c[3]]
+        c0, c1, c2, c3 = kids[i, 0], kids[i, 1], kids[i, 2], kids[i, 3]
+        for lane in range(_LANES):
+            X[base + i, lane] = X[c0, lane] * X[c1, lane] - X[c2, lane] * X[c3, lane]
