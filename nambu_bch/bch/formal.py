@@ -134,7 +134,7 @@ def _fits(g: int, n: int) -> bool:
         return False
     if g <= 1:
         return True
-    if g**n >= 2**56:
+    if g**n >= 2**56 or n > 31:  # word codes in int64; int32 program values (modular._solve)
         return False
     return estimate_size(g, n)["pairs"] <= MAX_PAIRS
 

@@ -33,7 +33,7 @@ exactly: a word in the support of ``P_v`` has the content of ``v``, is ``>= v`` 
 is its reversal (``P_v`` reversed is ``(-1)^(|v|-1) P_v``).  The non-zero entries are
 kept as integer rows (``|<P_v, w>| <= 2^(|v|-1)``), once per alphabet size and degree.
 
-Exact arithmetic.  Everything runs modulo primes ``p < 2^31`` (products fit int64):
+Exact arithmetic.  Everything runs modulo primes ``p < 2^28`` (sums of 64 products fit int64):
 the rational numbers ``c_t^r / r!``, ``1/k`` are elements of ``Z/p``.  The numerators
 ``D_d z_w`` (``D_d = d! lcm(1..n) q^d``, ``q`` the common denominator of the ``c_t``,
 which the dense engine shows to be integral) are rebuilt by the Chinese remainder
@@ -60,8 +60,9 @@ import numba
 import numpy as np
 import sympy
 
-#: Primes below 2^31: products of two residues fit a signed int64.
-PRIMES = tuple(int(p) for p in sympy.primerange(2**31 - 4000, 2**31))[::-1]
+#: Primes below 2^28: a product of two residues is below 2^56, so up to 128 products (and every inner sum
+#: of the kernels, at most 64 terms for degrees <= 64) add up in int64 with one reduction at the end.
+PRIMES = tuple(int(p) for p in sympy.primerange(2**28 - 6000, 2**28))[::-1]
 #: Most primes the engine uses before leaving a series to the dense Python-int engine.
 MAX_PRIMES = 24
 
@@ -246,6 +247,7 @@ def _solve(z, primes, words, lengths, left, right, order, class_start, g):
     m = order.shape[0]
     live = np.zeros(m, dtype=np.bool_)
     x = np.zeros((_LANES, 64), dtype=np.int64)
+    acc = np.zeros(k, dtype=np.int64)
     work = 0
     r0 = 0
     while r0 < m:
@@ -258,6 +260,7 @@ def _solve(z, primes, words, lengths, left, right, order, class_start, g):
                 if z[order[r], i] != 0:
                     any_nonzero = True
         d = lengths[order[r0]]
+        block = 1 << max(0, 35 - d)
         if any_nonzero and d > 1 and r1 - r0 > 1:
             kids, roots = _class_program(order[r0:r1], words, lengths, left, right, g, d)
             X = np.zeros((g * d + kids.shape[0], _LANES), dtype=np.int32)
@@ -277,14 +280,24 @@ def _solve(z, primes, words, lengths, left, right, order, class_start, g):
                     w = order[r]
                     lane = r - b0
                     if stop >= 0:
+                        # sum c z_v in int64, reduced every ``block`` terms: |c| <= 2^(d-1), z_v < 2^28, so
+                        # block * 2^(d+27) <= 2^62 (no integer division in the inner loop)
+                        acc[:] = 0
+                        terms = 0
                         for q in range(r0, r):
                             if live[q]:
-                                c = X[roots[q - r0], lane]
+                                c = np.int64(X[roots[q - r0], lane])
                                 if c != 0:
                                     v = order[q]
                                     for i in range(k):
-                                        p = primes[i]
-                                        z[w, i] = (z[w, i] - (c % p) * z[v, i]) % p
+                                        acc[i] += c * z[v, i]
+                                    terms += 1
+                                    if terms == block:
+                                        for i in range(k):
+                                            acc[i] %= primes[i]
+                                        terms = 0
+                        for i in range(k):
+                            z[w, i] = (z[w, i] - acc[i] % primes[i]) % primes[i]
                     for i in range(k):
                         if z[w, i] != 0:
                             live[r] = True
@@ -336,9 +349,9 @@ def _word_coefficients(letters, cpow, logk, primes, g, n, count):
                 if letters[t - 1] == a:
                     for r in range(1, min(run[m], m - j) + 1):
                         for i in range(k):
-                            f = F[m - r, j, t - 1, i]
-                            if f != 0:
-                                acc[i] = (acc[i] + f * cpow[i, t - 1, r]) % primes[i]
+                            acc[i] += F[m - r, j, t - 1, i] * cpow[i, t - 1, r]
+                    for i in range(k):
+                        acc[i] %= primes[i]
                 for i in range(k):
                     F[m, j, t, i] = acc[i]
         for i in range(k):
@@ -348,17 +361,15 @@ def _word_coefficients(letters, cpow, logk, primes, g, n, count):
                 acc[i] = 0
             for j in range(kk - 1, m):
                 for i in range(k):
-                    aj = A[j, kk - 1, i]
-                    if aj != 0:
-                        acc[i] = (acc[i] + aj * F[m, j, s, i]) % primes[i]
+                    acc[i] += A[j, kk - 1, i] * F[m, j, s, i]
             for i in range(k):
-                A[m, kk, i] = acc[i]
+                A[m, kk, i] = acc[i] % primes[i]
         if not extend:
             for i in range(k):
                 total = 0
                 for kk in range(1, m + 1):
-                    total = (total + logk[i, kk] * A[m, kk, i]) % primes[i]
-                out[idx, i] = total
+                    total += logk[i, kk] * A[m, kk, i]
+                out[idx, i] = total % primes[i]
             idx += 1
             period = m
         if length < n:  # Duval: extend periodically, one letter (one row) at a time
