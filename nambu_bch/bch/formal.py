@@ -7,19 +7,29 @@ degree ``d``.  With the step, ``Phi_h = exp(h X_eff)`` and
 ``X_eff = sum_d h^(d-1) L_d``, so ``L_{j+1}`` is the coefficient ``Z_j``
 (Eqs. eL1, eL2).
 
-Algorithm (exact, no floats).  The product is expanded in the free associative
-algebra truncated at ``max_degree``, homogeneous part ``d`` stored as a dense
-vector over the ``g^d`` words (``g`` generators).  Clearing the common
-denominator ``q`` of the ``c_i`` and storing ``d! * (part d)`` keeps every
-product integral (``d!/(a! b!)`` is a binomial coefficient), and
+Engines (exact, no floats).  Rational compositions run the sparse engine of
+:mod:`nambu_bch.bch.modular`: coefficients of ``log Phi`` on Lyndon words only
+(a walk of the prefix tree), a unitriangular solve per content class whose
+entries ``<P_v, w>`` come from a compiled straight-line program, all modulo
+primes, numerators rebuilt by the Chinese remainder theorem from a rigorous
+bound (Casas & Murua 2009; Hofstätter's ``bch``).  Its size guard counts the
+same-content Lyndon pairs of the solve.
+
+The dense engine serves algebraic coefficients (triple jump, ``2**(1/3)``, run
+with elements of ``QQ(2**(1/3))``) and numerators too large for the primes.
+The product is expanded in the free associative algebra truncated at
+``max_degree``, homogeneous part ``d`` stored as a dense vector over the
+``g^d`` words (``g`` generators).  Clearing the common denominator ``q`` of the
+``c_i`` and storing ``d! * (part d)`` keeps every product integral
+(``d!/(a! b!)`` is a binomial coefficient), and
 ``log(1 + Q) = sum_k (-1)^(k+1) Q^k / k`` adds one factor ``lcm(1..n)``.  Each
 ``L_d`` is then written in the Lyndon basis ``P_w`` by a triangular solve
 (``P_w = w + larger words``, :mod:`nambu_bch.bch.lyndon`); the residual after
 the solve must vanish, which checks that the logarithm is a Lie element.  For
 small degrees the inverse of that unitriangular system is tabulated once
-(int64, overflow-checked) and the solve is one matrix-vector product.
-Algebraic coefficients (triple jump, ``2**(1/3)``) run the same code with
-elements of ``QQ(2**(1/3))``.
+(int64, overflow-checked) and the solve is one matrix-vector product.  Both
+engines give the same numerators over the same denominators
+``D_d = d! lcm(1..n) q^d``.
 
 References
 ----------

@@ -26,20 +26,21 @@ which visits every prefix of a Lyndon word (a pre-necklace) once, extending one
 letter at a time: each prefix's row is computed from its parent's rows (a depth-first
 walk of the prefix tree).  ``<log Phi, w> = sum_k (-1)^(k+1)/k <(Phi-1)^k, w>``.
 
-Lyndon matrix.  ``<P_v, w>`` for Lyndon ``v < w`` of equal content (letter counts) is
-evaluated by the recursion ``<[P_u, P_u'], x> = <P_u, x'><P_u', x''> - <P_u', y'><P_u, y''>``
-(``x = x'x''`` split after ``|u|`` letters, ``x = y'y''`` after ``|u'|``), pruned
-exactly: a word in the support of ``P_v`` has the content of ``v``, is ``>= v`` and so
-is its reversal (``P_v`` reversed is ``(-1)^(|v|-1) P_v``).  The non-zero entries are
-kept as integer rows (``|<P_v, w>| <= 2^(|v|-1)``), once per alphabet size and degree.
+Lyndon matrix.  ``<P_v, w>`` for Lyndon ``v < w`` of equal content (letter counts) follows
+``<[P_u, P_u'], x> = <P_u, x'><P_u', x''> - <P_u', y'><P_u, y''>`` (``x = x'x''`` split after
+``|u|`` letters, ``x = y'y''`` after ``|u'|``).  Per content class the nodes ``(u, offset)``
+reachable from the members form a straight-line program (children first, members in
+order), evaluated on eight words ``w`` at once in int32 (``|<P_u, x>| <= 2^(|u|-1)``) up to
+the last member needed.  The matrix is never stored, an entry is read only when
+``z_v != 0``, and a class whose word coefficients all vanish (the even degrees of a
+symmetric composition) is skipped.
 
-Exact arithmetic.  Everything runs modulo primes ``p < 2^28`` (sums of 64 products fit int64):
-the rational numbers ``c_t^r / r!``, ``1/k`` are elements of ``Z/p``.  The numerators
-``D_d z_w`` (``D_d = d! lcm(1..n) q^d``, ``q`` the common denominator of the ``c_t``,
-which the dense engine shows to be integral) are rebuilt by the Chinese remainder
-theorem from enough primes: the number is chosen from a rigorous magnitude bound, the
-same recursions run in float64 on absolute values (``|c_t|``, ``1/k``, ``|<P_v, w>|``),
-inflated for rounding.  When that bound is infinite or needs too many primes the caller
+Exact arithmetic.  Everything runs modulo primes ``p < 2^28`` (sums of 64 products fit
+int64, one reduction per sum): the rational numbers ``c_t^r / r!``, ``1/k`` are elements
+of ``Z/p``.  The numerators ``D_d z_w`` (``D_d = d! lcm(1..n) q^d``, ``q`` the common
+denominator of the ``c_t``; integral, as the dense engine shows) are rebuilt by the
+Chinese remainder theorem from enough primes for the rigorous bound of
+:func:`numerator_bound`.  When that needs more than :data:`MAX_PRIMES` primes the caller
 uses the dense engine (Python integers).
 
 References
