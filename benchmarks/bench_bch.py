@@ -1,9 +1,11 @@
 """Benchmarks of the BCH engine: each line prints ours vs a baseline measured in the same run.
 
-Run:  /work/venv/bin/python benchmarks/bench_bch.py [--quick]
+Run:  python benchmarks/bench_bch.py [--quick]
 
-1. Formal BCH of Phi^{12321} (5 factors, 3 generators, Eq. eL2): degree 7 and 9, against a naive
-   log in the free associative algebra with dicts of Fractions (degree 7; degree 9 naive is minutes).
+1. Formal BCH of Phi^{12321} (5 factors, 3 generators, Eq. eL2): degrees 7, 9, 11 cold (a fresh
+   interpreter per call, CPU time of the call alone) and warm (repeat in one process), and against a
+   naive log in the free associative algebra with dicts of Fractions at degree 7 (degree 9 naive is
+   minutes), both cold and both warm.  Against the C program: benchmarks/bch_c_reference.py.
 2. Concrete X_eff of the six paper words of ho3 to h^6: ours (effective_field_bch) against the same
    formal series evaluated with plain sympy expressions (diff + expand, the same memoisation shared
    across the six words, the same pruning).
@@ -35,9 +37,9 @@ def timed(fn, *args, repeat=1, **kwargs):
     for _ in range(repeat):
         clear_cache()
         sympy.core.cache.clear_cache()
-        t = time.perf_counter()
+        t = time.process_time()
         result = fn(*args, **kwargs)
-        best = min(best, time.perf_counter() - t)
+        best = min(best, time.process_time() - t)
     return best, result
 
 
@@ -66,28 +68,48 @@ def naive_log(comp, n):
     return {w: c for w, c in L.items() if c}
 
 
-def cold(degree):
-    """Seconds for formal_bch("12321", degree) in a fresh interpreter (static Lyndon tables included)."""
-    code = (
-        "import time; from nambu_bch.bch import formal_bch; t = time.perf_counter(); "
-        f"formal_bch('12321', {degree}); print(time.perf_counter() - t)"
-    )
+def _child(kind, spec, degree):
+    """Run in a fresh interpreter: CPU seconds of one call (ours or the naive log) and its size."""
+    comp = composition(spec)
+    t = time.process_time()
+    result = formal_bch(comp, degree) if kind == "ours" else naive_log(comp, degree)
+    print(time.process_time() - t, len(result))
+
+
+def cold(kind, spec, degree):
+    """CPU seconds of the call alone in a fresh interpreter (package imported, nothing computed yet)."""
     root = Path(__file__).resolve().parents[1]
-    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=root, check=True)
-    return float(out.stdout.strip())
+    out = subprocess.run([sys.executable, str(Path(__file__).resolve()), "--child", kind, spec, str(degree)],
+                         capture_output=True, text=True, cwd=root, check=True)
+    seconds, size = out.stdout.split()
+    return float(seconds), int(size)
+
+
+def warm(fn, *args, repeat=3):
+    """Best CPU seconds of ``repeat`` calls in this process after one untimed call (all caches kept)."""
+    fn(*args)
+    best = float("inf")
+    for _ in range(repeat):
+        t = time.process_time()
+        fn(*args)
+        best = min(best, time.process_time() - t)
+    return best
 
 
 def bench_formal(quick):
     comp = composition("12321")
-    t7, B7 = timed(formal_bch, comp, 7, repeat=3)
-    tn, _ = timed(naive_log, comp, 6 if quick else 7)
-    tn_ours, _ = timed(formal_bch, comp, 6 if quick else 7, repeat=3)
-    t9, B9 = timed(formal_bch, comp, 9, repeat=3)
-    print(f"[formal] 12321 degree 7: {t7:.3f} s ({len(B7)} Lyndon terms); degree 9: {t9:.3f} s ({len(B9)} terms)"
-          f"; in a fresh interpreter: degree 7 {cold(7):.3f} s, degree 9 {cold(9):.3f} s")
     label = 6 if quick else 7
-    print(f"[formal] naive free-associative log to degree {label} (dicts of Fractions, no Lie basis): {tn:.3f} s; "
-          f"ours {tn_ours:.4f} s; ratio naive/ours = {tn / tn_ours:.1f}x")
+    for d in (7, 9, 11):
+        t_cold, size = cold("ours", "12321", d)
+        print(f"[formal] 12321 degree {d}: {size} Lyndon terms; cold {t_cold:.4f} s (fresh interpreter, call alone), "
+              f"warm {warm(formal_bch, comp, d):.4f} s")
+    tn_cold, _ = cold("naive", "12321", label)
+    to_cold, _ = cold("ours", "12321", label)
+    tn_warm, to_warm = warm(naive_log, comp, label, repeat=1), warm(formal_bch, comp, label)
+    print(f"[formal] naive free-associative log to degree {label} (dicts of Fractions, no Lie basis) vs ours: "
+          f"both cold {tn_cold:.3f} s / {to_cold:.4f} s = {tn_cold / to_cold:.1f}x; "
+          f"both warm {tn_warm:.3f} s / {to_warm:.4f} s = {tn_warm / to_warm:.1f}x")
+    print("[formal] against Hofstätter's C program: benchmarks/bch_c_reference.py /path/to/BCH (both cold)")
 
 
 # -- 2. concrete X_eff: ours vs plain sympy -----------------------------------------------------------------------
@@ -167,6 +189,9 @@ def bench_rigid_body(quick):
 
 
 if __name__ == "__main__":
+    if sys.argv[1:2] == ["--child"]:
+        _child(sys.argv[2], sys.argv[3], int(sys.argv[4]))
+        sys.exit(0)
     quick = "--quick" in sys.argv
     bench_formal(quick)
     bench_concrete(quick)

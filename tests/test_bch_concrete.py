@@ -172,3 +172,23 @@ def test_integral_orders_accepted(route):
 def test_unknown_piece():
     with pytest.raises(UnknownPieceError, match="3"):
         effective_field_bch(model("ho").splitting, "123", 2)
+
+
+# -- route by cost -----------------------------------------------------------------------------------------
+
+@pytest.mark.parametrize("name,word,order", [("ho3", "yoshida:12321", 4), ("ho", "yoshida:121", 4), ("ho3", "12321", 4)])
+def test_route_by_cost_gives_the_same_field_as_both_routes(monkeypatch, name, word, order):
+    """Issue 14: algebraic coefficients take backward error analysis, rational ones the BCH route; the field is
+    the same exact X_eff either way (compared with both routes)."""
+    from nambu_bch.bch import concrete
+
+    S = model(name).splitting
+    both = effective_field(S, word, order), effective_field_bch(S, word, order)
+    algebraic = word.startswith("yoshida")
+
+    def refuse(*args, **kwargs):
+        raise AssertionError("wrong route")
+
+    monkeypatch.setattr(concrete, "effective_field_bch" if algebraic else "effective_field", refuse)
+    X = concrete.effective_field_by_cost(S, word, order)
+    assert all(X[j] == both[0][j] == both[1][j] for j in range(order + 1))

@@ -22,6 +22,7 @@ from nambu_bch.bch import (
 from nambu_bch.bch import formal as formal_module
 from nambu_bch.bch.lyndon import is_lyndon, lyndon_expansion, standard_factorization, word_index
 from nambu_bch.errors import UnknownPieceError
+from nambu_bch.integrators import composition
 
 
 @pytest.mark.parametrize("g,d", [(1, 1), (1, 3), (2, 1), (2, 6), (3, 5), (4, 4), (3, 9)])
@@ -95,14 +96,19 @@ def test_latex_names_must_cover_the_generators():
 
 @pytest.mark.parametrize("spec,degree", [("12321", 7), ("1:1/3,2:1/2,1:2/3,3:1,2:1/2", 6), ("1:999/7,2:1,1:-992/7", 6)])
 def test_fast_paths_equal_general_paths(monkeypatch, spec, degree):
-    """int64 associative log and tabulated triangular inverse == Python-int log and residual solve."""
+    """Dense engine: int64 associative log and tabulated triangular inverse == Python-int log and residual
+    solve; and both == the sparse multi-modular engine that formal_bch uses for rational coefficients."""
+    comp = composition(spec)
+    gens = tuple(sorted(set(comp.pieces)))
     formal_module.clear_cache()
-    fast = formal_bch(spec, degree).all_terms()
+    sparse = formal_bch(spec, degree).all_terms()
+    fast = formal_module._formal_dense(comp, gens, degree).all_terms()
     monkeypatch.setattr(formal_module, "_INT64_LIMIT", 0.0)
     monkeypatch.setattr(formal_module, "_INVERSE_LIMIT", 0)
     formal_module._lyndon_inverse.cache_clear()
     formal_module.clear_cache()
-    general = formal_bch(spec, degree).all_terms()
+    general = formal_module._formal_dense(comp, gens, degree).all_terms()
+    assert sparse == fast
     formal_module._lyndon_inverse.cache_clear()
     formal_module.clear_cache()
     assert fast == general

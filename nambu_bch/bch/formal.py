@@ -7,19 +7,29 @@ degree ``d``.  With the step, ``Phi_h = exp(h X_eff)`` and
 ``X_eff = sum_d h^(d-1) L_d``, so ``L_{j+1}`` is the coefficient ``Z_j``
 (Eqs. eL1, eL2).
 
-Algorithm (exact, no floats).  The product is expanded in the free associative
-algebra truncated at ``max_degree``, homogeneous part ``d`` stored as a dense
-vector over the ``g^d`` words (``g`` generators).  Clearing the common
-denominator ``q`` of the ``c_i`` and storing ``d! * (part d)`` keeps every
-product integral (``d!/(a! b!)`` is a binomial coefficient), and
+Engines (exact, no floats).  Rational compositions run the sparse engine of
+:mod:`nambu_bch.bch.modular`: coefficients of ``log Phi`` on Lyndon words only
+(a walk of the prefix tree), a unitriangular solve per content class whose
+entries ``<P_v, w>`` come from a compiled straight-line program, all modulo
+primes, numerators rebuilt by the Chinese remainder theorem from a rigorous
+bound (Casas & Murua 2009; Hofstätter's ``bch``).  Its size guard counts the
+same-content Lyndon pairs of the solve.
+
+The dense engine serves algebraic coefficients (triple jump, ``2**(1/3)``, run
+with elements of ``QQ(2**(1/3))``) and numerators too large for the primes.
+The product is expanded in the free associative algebra truncated at
+``max_degree``, homogeneous part ``d`` stored as a dense vector over the
+``g^d`` words (``g`` generators).  Clearing the common denominator ``q`` of the
+``c_i`` and storing ``d! * (part d)`` keeps every product integral
+(``d!/(a! b!)`` is a binomial coefficient), and
 ``log(1 + Q) = sum_k (-1)^(k+1) Q^k / k`` adds one factor ``lcm(1..n)``.  Each
 ``L_d`` is then written in the Lyndon basis ``P_w`` by a triangular solve
 (``P_w = w + larger words``, :mod:`nambu_bch.bch.lyndon`); the residual after
 the solve must vanish, which checks that the logarithm is a Lie element.  For
 small degrees the inverse of that unitriangular system is tabulated once
-(int64, overflow-checked) and the solve is one matrix-vector product.
-Algebraic coefficients (triple jump, ``2**(1/3)``) run the same code with
-elements of ``QQ(2**(1/3))``.
+(int64, overflow-checked) and the solve is one matrix-vector product.  Both
+engines give the same numerators over the same denominators
+``D_d = d! lcm(1..n) q^d``.
 
 References
 ----------
@@ -34,7 +44,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 from functools import lru_cache
-from math import comb, factorial, lcm
+from math import comb, factorial, gcd, lcm
 
 import numpy as np
 import sympy
@@ -44,6 +54,7 @@ from sympy.polys.domains import QQ
 from ..errors import InvalidCompositionError, InvalidOrderError
 from ..integrators.composition import Composition
 from ..integrators.composition import composition as make_composition
+from ..compiled import numba_available
 from ..printing import Printable, bracket_sum
 from .lyndon import (
     lyndon_expansion,
@@ -54,21 +65,56 @@ from .lyndon import (
     word_index,
 )
 
-#: Largest number of words ``g^max_degree`` of the top degree that the engine accepts.
+#: Largest number of words ``g^max_degree`` of the top degree that the dense engine accepts.
 MAX_WORDS = 600_000
-#: Largest total size ``sum_d dim L_d 2^(d-1)`` of the Lyndon-basis expansions the projection walks.
+#: Largest total size ``sum_d dim L_d 2^(d-1)`` of the Lyndon-basis expansions the dense projection walks.
 MAX_EXPANSION = 15_000_000
+#: Largest number of same-content Lyndon pairs ``(v, w)`` the sparse (modular) engine's solve may visit.
+MAX_PAIRS = 2_500_000_000
 _HARD_DEGREE = 64  # beyond this not even the estimate is computed
 
 
+@lru_cache(maxsize=4096)
+def _class_pairs(g: int, d: int) -> int:
+    """``sum_c m_c (m_c - 1) / 2`` over the letter contents ``c`` of degree ``d``, ``m_c`` Lyndon words of content ``c``.
+
+    ``m_c = (1/d) sum_{e | gcd(c)} mu(e) (d/e)! / prod (c_i/e)!`` (necklaces of fixed content,
+    Reutenauer Cor. 4.14 refined by multidegree)."""
+    total = 0
+    for c in _contents(g, d):
+        gc = 0
+        for ci in c:
+            gc = gcd(gc, ci)
+        m = 0
+        for e in sympy.divisors(gc):
+            mult = factorial(d // e)
+            for ci in c:
+                mult //= factorial(ci // e)
+            m += int(sympy.mobius(e)) * mult
+        m //= d
+        total += m * (m - 1) // 2
+    return total
+
+
+def _contents(g: int, d: int):
+    if g == 1:
+        yield (d,)
+        return
+    for first in range(d + 1):
+        for rest in _contents(g - 1, d - first):
+            yield (first,) + rest
+
+
 def estimate_size(n_generators: int, max_degree: int) -> dict:
-    """Sizes of the BCH computation: Lyndon basis elements (Witt), associative words, expansion entries.
+    """Sizes of the BCH computation: Lyndon basis elements (Witt), words, expansion entries, solve pairs.
 
-    ``expansion`` bounds the work of the Lyndon projection: ``P_w`` of a word of
-    length ``d`` has at most ``2^(d-1)`` terms.
+    ``lyndon`` (Witt's formula) sizes the sparse engine's tables; ``pairs`` (same-content Lyndon
+    pairs, the unitriangular solve of :mod:`nambu_bch.bch.modular`) bounds its work;
+    ``words``/``top_words``/``expansion`` size the dense engine (associative words, and
+    ``P_w`` of a word of length ``d`` has at most ``2^(d-1)`` terms).
 
-    >>> estimate_size(3, 7)["lyndon"], estimate_size(3, 9)["expansion"]
-    (508, 687417)
+    >>> estimate_size(3, 7)["lyndon"], estimate_size(3, 9)["expansion"], estimate_size(2, 4)["pairs"]
+    (508, 687417, 0)
     """
     g = n_generators
     return {
@@ -76,11 +122,12 @@ def estimate_size(n_generators: int, max_degree: int) -> dict:
         "words": sum(g**d for d in range(1, max_degree + 1)),
         "top_words": g**max_degree,
         "expansion": sum(witt_dimension(g, d) * 2 ** (d - 1) for d in range(1, max_degree + 1)),
+        "pairs": sum(_class_pairs(g, d) for d in range(1, max_degree + 1)),
     }
 
 
 @lru_cache(maxsize=1024)
-def _fits(g: int, n: int) -> bool:
+def _fits_dense(g: int, n: int) -> bool:
     if n > _HARD_DEGREE:
         return False
     if g <= 1:
@@ -90,12 +137,26 @@ def _fits(g: int, n: int) -> bool:
     return estimate_size(g, n)["expansion"] <= MAX_EXPANSION
 
 
-def check_degree(max_degree, n_generators: int) -> int:
+@lru_cache(maxsize=1024)
+def _fits(g: int, n: int) -> bool:
+    """The sparse engine finishes: at most :data:`MAX_PAIRS` solve pairs, word codes fit int64."""
+    if n > _HARD_DEGREE:
+        return False
+    if g <= 1:
+        return True
+    if g**n >= 2**56 or n > 31:  # word codes in int64; int32 program values (modular._solve)
+        return False
+    return estimate_size(g, n)["pairs"] <= MAX_PAIRS
+
+
+def check_degree(max_degree, n_generators: int, dense: bool = False) -> int:
     """``max_degree`` as an int ``>= 1`` whose computation fits the size limits, else :class:`InvalidOrderError`.
 
-    The size is estimated up front (Witt's formula for the number of Lyndon words,
-    ``g^n`` associative words) so that an order too high to finish is refused
-    instead of hanging.
+    The size is estimated up front from the algorithm that will run: for the sparse
+    engine (rational coefficients) the number of Lyndon words (Witt's formula) and of
+    same-content Lyndon pairs of the solve; for the dense engine (``dense=True``,
+    algebraic coefficients) the ``g^n`` associative words and the Lyndon expansions.  An
+    order too high to finish is refused instead of hanging.
     """
     if isinstance(max_degree, sympy.Integer):
         max_degree = int(max_degree)
@@ -105,17 +166,24 @@ def check_degree(max_degree, n_generators: int) -> int:
     g = n_generators
     if max_degree < 1:
         raise InvalidOrderError(f"BCH degree must be a positive integer (1 = X_1 + X_2 + ...), got {max_degree}")
-    if not _fits(g, max_degree):
+    fits = _fits_dense if dense else _fits
+    if not fits(g, max_degree):
         if max_degree <= _HARD_DEGREE:
             size = estimate_size(g, max_degree)
-            detail = (
-                f"{size['lyndon']} Lyndon basis elements (Witt's formula), {size['top_words']} words of top "
-                f"degree and {size['expansion']} expansion terms"
-            )
+            if dense:
+                detail = (
+                    f"{size['lyndon']} Lyndon basis elements (Witt's formula), {size['top_words']} words of top "
+                    f"degree and {size['expansion']} expansion terms (algebraic coefficients use the dense engine)"
+                )
+            else:
+                detail = (
+                    f"{size['lyndon']} Lyndon basis elements (Witt's formula) and {size['pairs']} same-content "
+                    f"Lyndon pairs in the triangular solve (at most {MAX_PAIRS})"
+                )
         else:
-            detail = f"more than {MAX_WORDS} words of top degree"
+            detail = f"more than {_HARD_DEGREE} degrees"
         best = 1
-        while _fits(g, best + 1):
+        while fits(g, best + 1):
             best += 1
         raise InvalidOrderError(
             f"BCH to degree {max_degree} in {g} generators needs {detail}, too many to finish in reasonable time; "
@@ -516,7 +584,27 @@ def formal_bch(comp, max_degree: int, n_pieces: int | None = None) -> FormalBCH:
         raise InvalidCompositionError(f"formal_bch needs a composition with at least one factor, got {comp!r}")
     generators = tuple(sorted(set(comp.pieces)))
     g = len(generators)
-    n = check_degree(max_degree, g)
+    scalars = _Scalars(tuple(comp.coefficients))
+    sparse = scalars.K is None and numba_available()
+    n = check_degree(max_degree, g, dense=not sparse)
+    if sparse:
+        from .modular import lyndon_numerators  # compiled (numba); without it the dense engine below
+
+        big = lcm(*range(1, n + 1))
+        dens = [factorial(d) * big * scalars.q**d for d in range(n + 1)]
+        letters = [generators.index(k) for k in comp.pieces]
+        numerators = lyndon_numerators(letters, scalars.values, scalars.q, g, n, dens)
+        if numerators is not None:
+            trees = _duval_trees(g, n, generators)
+            elements = {d: (dens[d], tuple((c, trees[i]) for i, c in items)) for d, items in numerators.items()}
+            return FormalBCH(comp, generators, n, elements, None)
+        check_degree(n, g, dense=True)  # coefficients too large for the primes: Python ints, dense engine
+    return _formal_dense(comp, generators, n)
+
+
+def _formal_dense(comp, generators: tuple, n: int) -> FormalBCH:
+    """The dense engine: associative log over all ``g^d`` words, then the Lyndon projection (module docstring)."""
+    g = len(generators)
     # the associative log depends on the word only up to renaming letters (the six paper words are one
     # scheme): compute it once per pattern, letters numbered by first appearance, then permute the digits
     first = list(dict.fromkeys(comp.pieces))
@@ -532,3 +620,17 @@ def formal_bch(comp, max_degree: int, n_pieces: int | None = None) -> FormalBCH:
             trees = _lyndon_trees(g, d, generators)
             elements[d] = (dens[d], tuple((c, trees[k]) for k, c in coords))
     return FormalBCH(comp, generators, n, elements, scalars.K)
+
+
+@lru_cache(maxsize=32)
+def _duval_trees(g: int, n: int, generators: tuple) -> tuple:
+    """Standard bracketings of all Lyndon words of length ``<= n``, in the Duval order of
+    :func:`~nambu_bch.bch.modular.lyndon_table` (children are shorter: built by length)."""
+    from .modular import lyndon_table
+
+    words, lengths, left, right = lyndon_table(g, n)
+    first, left, right = words[:, 0].tolist(), left.tolist(), right.tolist()
+    trees = [None] * len(first)
+    for i in np.argsort(lengths, kind="stable").tolist():
+        trees[i] = generators[first[i]] if right[i] < 0 else (trees[left[i]], trees[right[i]])
+    return tuple(trees)

@@ -60,6 +60,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..compiled import numba_available  # noqa: F401  (re-exported: nambu_bch.numeric.numba_available)
 from ..errors import InvalidRunError, NumericalRangeError
 from ..integrators.composition import composition as make_composition
 from ..integrators.step import parameter_values
@@ -153,19 +154,6 @@ def _usable_dir(root: Path) -> Path:
     if path is None:  # pragma: no cover - a fresh mkdtemp directory is always ours
         raise InvalidRunError(f"no safe kernel cache directory: {reason}; {reason2}; {reason3}")
     return path
-
-
-def numba_available() -> bool:
-    """numba installed and not disabled by ``NAMBU_BCH_DISABLE_NUMBA=1`` (read at every call; numba is
-    located, not imported: importing it costs ~0.3 s, paid only when a kernel is compiled)."""
-    if os.environ.get("NAMBU_BCH_DISABLE_NUMBA", "").strip().lower() in ("1", "true", "yes", "on"):
-        return False
-    if "numba" in sys.modules:
-        return True
-    try:
-        return importlib.util.find_spec("numba") is not None
-    except (ImportError, ValueError):
-        return False
 
 
 def resolve_backend(backend: str = "auto") -> str:

@@ -65,7 +65,7 @@ import sympy
 
 from ..algebra import liouville_field
 from ..bch.backward import check_order
-from ..bch.concrete import effective_field_bch
+from ..bch.concrete import effective_field_by_cost
 from ..errors import InvalidOrderError, NambuBCHError, ResourceLimitError
 from ..integrators.composition import composition_for
 from .linear import rank, solve_affine
@@ -188,7 +188,7 @@ class _Solver:
         self.order = order
         self.degree = degree
         splitting = system.splitting
-        self.effective = effective_field_bch(splitting, comp, order)
+        self.effective = effective_field_by_cost(splitting, comp, order)  # backward route for algebraic coefficients
         alg0 = self.effective[0].algebra
         self.alg = alg = alg0.with_constants(ALPHA)
         self.n = alg.n

@@ -1,0 +1,193 @@
+"""The sparse multi-modular BCH engine (nambu_bch.bch.modular) against the dense engine and the literature."""
+
+from math import factorial, lcm
+
+import numpy as np
+import pytest
+import sympy
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from nambu_bch.bch import formal_bch, lyndon_words, standard_bracketing, witt_dimension
+from nambu_bch.bch import formal as formal_module
+from nambu_bch.bch import modular
+from nambu_bch.bch.lyndon import standard_factorization
+from nambu_bch.errors import InvalidOrderError
+from nambu_bch.integrators import Composition, composition
+
+R = sympy.Rational
+
+
+def _dense(spec, degree):
+    comp = composition(spec)
+    return formal_module._formal_dense(comp, tuple(sorted(set(comp.pieces))), degree)
+
+
+def _same(A, B):
+    return all(A.scaled_terms(d) == B.scaled_terms(d) for d in range(1, A.max_degree + 1))
+
+
+# -- tables ------------------------------------------------------------------------------------------------
+
+@pytest.mark.parametrize("g,n", [(2, 9), (3, 6), (4, 4)])
+def test_lyndon_table_is_duval_order_with_standard_factorisations(g, n):
+    """Reutenauer Sect. 5.1: words (lexicographic within a length) and ``w = u v``, ``v`` the longest Lyndon suffix."""
+    words, lengths, left, right = modular.lyndon_table(g, n)
+    for d in range(1, n + 1):
+        ours = [tuple(int(a) for a in words[i, :d]) for i in range(len(lengths)) if lengths[i] == d]
+        assert ours == lyndon_words(g, d)
+        assert len(ours) == witt_dimension(g, d)
+    for i in range(len(lengths)):
+        if lengths[i] > 1:
+            w = tuple(int(a) for a in words[i, : lengths[i]])
+            u, v = standard_factorization(w)
+            assert tuple(int(a) for a in words[left[i], : lengths[left[i]]]) == u
+            assert tuple(int(a) for a in words[right[i], : lengths[right[i]]]) == v
+
+
+def test_garner_recovers_signed_integers():
+    """Mixed-radix CRT (Knuth 4.3.2) in the symmetric range, beyond int64."""
+    primes = list(modular.PRIMES[:4])
+    values = [0, 1, -1, 10**30, -(10**30) + 7, 2**100 - 3]
+    residues = np.array([[v % p for p in primes] for v in values], dtype=np.int64)
+    assert modular._garner(residues, primes).tolist() == values
+
+
+# -- the engines agree exactly -----------------------------------------------------------------------------
+
+@pytest.mark.parametrize(
+    "spec,degree",
+    [("12", 12), ("121", 11), ("12321", 9), ("123", 8), ("21", 8), ("3:1/2,1:1,3:1/2", 8), ("1234321", 6),
+     ("1:1/3,2:1/2,1:2/3,3:1,2:1/2", 7), ("1:999/7,2:1,1:-992/7", 8)],
+)
+def test_sparse_engine_equals_dense_engine(spec, degree):
+    """Same numerators, same denominators, same Lyndon trees in the same order (the dense engine:
+    associative log over all g^d words + residual solve with the full P_w expansions)."""
+    A, B = formal_bch(spec, degree), _dense(spec, degree)
+    assert _same(A, B)
+    assert len(A) == len(B) > 0
+
+
+def test_algebraic_coefficients_use_the_dense_engine():
+    """Triple jump (2^(1/3)): not rational, so the series comes from the dense engine with field elements."""
+    B = formal_bch("yoshida:121", 5)
+    assert B.domain != sympy.QQ and B.degrees == (1, 5)
+
+
+@st.composite
+def compositions(draw, max_generators=3, max_factors=6):
+    g = draw(st.integers(1, max_generators))
+    pieces = draw(st.lists(st.integers(1, g), min_size=1, max_size=max_factors))
+    coeffs = [R(draw(st.integers(-9, 9)), draw(st.integers(1, 7))) for _ in pieces]
+    for k in set(pieces):  # consistency: every piece's coefficients sum to one
+        last = max(i for i, p in enumerate(pieces) if p == k)
+        coeffs[last] = 1 - sum(c for i, (p, c) in enumerate(zip(pieces, coeffs)) if p == k and i != last)
+    return Composition(tuple(pieces), tuple(coeffs), "random")
+
+
+@settings(max_examples=30, deadline=None)
+@given(compositions())
+def test_property_sparse_equals_dense(comp):
+    """Random consistent rational compositions (zeros, negatives, repeated letters): identical series."""
+    n = 7 if len(set(comp.pieces)) < 3 else 6
+    A = formal_bch(comp, n)
+    B = formal_module._formal_dense(comp, tuple(sorted(set(comp.pieces))), n)
+    assert _same(A, B)
+
+
+@pytest.mark.parametrize("spec,degree", [("12", 10), ("12321", 9), ("1:1/3,2:1/2,1:2/3,3:1,2:1/2", 7)])
+def test_numerator_bound_holds(spec, degree):
+    """The a-priori bound (dual PBW basis, Reutenauer Thm. 5.3) dominates every actual numerator."""
+    comp = composition(spec)
+    B = formal_bch(comp, degree)
+    scalars = formal_module._Scalars(tuple(comp.coefficients))
+    total = sympy.Rational(sum(abs(v) for v in scalars.values), scalars.q)
+    from fractions import Fraction
+
+    total = Fraction(int(total.p), int(total.q))
+    for d in B.degrees:
+        den, items = B.scaled_terms(d)
+        bound = modular.numerator_bound(d, total, den)
+        assert max(abs(int(n)) for n, _ in items) <= bound
+
+
+def test_huge_coefficients_many_primes_or_python_ints():
+    """Coefficients 10^30: 17 primes, still identical to the dense engine; 10^80: the bound needs more than
+    MAX_PRIMES primes, the dense Python-int engine runs.  Degree 2 is (a - b)/2 [X, Y] (HLW Sect. III.4)."""
+    for e in (30, 80):
+        a, b = sympy.Integer(10) ** e, 1 - sympy.Integer(10) ** e
+        dens = [factorial(d) * lcm(*range(1, 6)) for d in range(6)]
+        stats = {}
+        out = modular.lyndon_numerators([0, 1, 0], [int(a), 1, int(b)], 1, 2, 5, dens, stats)
+        assert (out is None) == (e == 80)
+        assert (stats["primes"] >= 17) if e == 30 else stats == {}
+        spec = f"1:{a},2:1,1:{b}"
+        B = formal_bch(spec, 5)
+        assert B.terms(2) == [((a - b) / 2, (1, 2))]
+        assert _same(B, _dense(spec, 5))
+
+
+# -- literature values at high degree -------------------------------------------------------------------
+
+def test_hofstaetter_counts_at_degree_18():
+    """log(e^A e^B) through degree 18 in the Lyndon basis: 31042 basis elements, 21573 non-zero coefficients
+    (Hofstätter, bch user manual, arXiv:2102.06570, Sect. 5, table 'Lyndon basis')."""
+    B = formal_bch("12", 18)
+    assert sum(witt_dimension(2, d) for d in range(1, 19)) == 31042
+    assert len(B) == 21573
+
+
+@pytest.mark.parametrize("m", [13, 14, 16])
+def test_bernoulli_coefficients_of_ad_powers(m):
+    """log(e^X e^Y) = X + ad_X/(1 - e^(-ad_X)) Y + O(Y^2) and = Y + ad_Y/(e^(ad_Y) - 1) X + O(X^2)
+    (Hairer-Lubich-Wanner, Sect. III.4.2): the Lyndon words 0^m 1 ([A,[A,...,[A,B]]] = ad_A^m B) and
+    0 1^m ([[[A,B],B],...,B] = (-1)^m ad_B^m A) carry B_m/m! with B_1 = +1/2 and (-1)^m B_m/m!
+    with B_1 = -1/2."""
+    B = formal_bch("12", m + 1)
+    terms = dict((t, c) for c, t in B.terms(m + 1))
+    left = standard_bracketing((0,) * m + (1,), (1, 2))
+    right = standard_bracketing((0,) + (1,) * m, (1, 2))
+    bern = sympy.bernoulli(m)  # B_m, the same in both conventions for m >= 2
+    assert terms.get(left, 0) == bern / sympy.factorial(m)
+    assert terms.get(right, 0) == (-1) ** m * bern / sympy.factorial(m)
+    assert (bern != 0) == (m % 2 == 0)
+
+
+# -- size guard ----------------------------------------------------------------------------------------
+
+def test_degrees_accepted_and_refused_by_the_sparse_estimate():
+    """Issue 14: no cap below degree 20 (2 generators) and 14 (3 generators); refusals name the estimate."""
+    assert formal_module.check_degree(20, 2) == 20 and formal_module.check_degree(14, 3) == 14
+    with pytest.raises(InvalidOrderError, match="Witt's formula.*same-content Lyndon pairs"):
+        formal_module.check_degree(23, 2)
+    with pytest.raises(InvalidOrderError, match="largest accepted degree for 3 generators is 14"):
+        formal_module.check_degree(15, 3)
+    with pytest.raises(InvalidOrderError, match="dense engine"):
+        formal_module.check_degree(16, 2, dense=True)
+    with pytest.raises(InvalidOrderError, match="degree 15 in 3 generators"):
+        formal_bch("12321", 15)
+
+
+def test_pair_estimate_matches_the_tables():
+    """``estimate_size(...)["pairs"]`` counts same-content Lyndon pairs: checked by grouping the words."""
+    for g, n in [(2, 10), (3, 6)]:
+        words, lengths, _, _ = modular.lyndon_table(g, n)
+        groups: dict = {}
+        for i in range(len(lengths)):
+            w = tuple(int(a) for a in words[i, : lengths[i]])
+            key = (len(w),) + tuple(w.count(a) for a in range(g))
+            groups[key] = groups.get(key, 0) + 1
+        assert formal_module.estimate_size(g, n)["pairs"] == sum(m * (m - 1) // 2 for m in groups.values())
+
+
+def test_without_numba_the_dense_engine_gives_the_same_series(monkeypatch):
+    """NAMBU_BCH_DISABLE_NUMBA=1 (or numba missing): formal_bch falls back to the pure-Python dense engine,
+    coefficient for coefficient the same series (Eq. BCH2 for 12321, and a non-symmetric word)."""
+    from nambu_bch.bch.formal import formal_bch
+
+    for word, degree in (("12321", 7), ("123", 6)):
+        fast = formal_bch(word, degree)
+        monkeypatch.setenv("NAMBU_BCH_DISABLE_NUMBA", "1")
+        dense = formal_bch(word, degree)
+        monkeypatch.delenv("NAMBU_BCH_DISABLE_NUMBA")
+        assert all(fast.terms(d) == dense.terms(d) for d in range(1, degree + 1))
