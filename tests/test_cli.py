@@ -18,7 +18,7 @@ import sys
 from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
-import pytest
+
 import sympy
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st

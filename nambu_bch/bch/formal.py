@@ -542,7 +542,7 @@ class FormalBCH(Printable):
         parts = []
         for d in range(1, self.max_degree + 1):
             for c, tree in self._terms.get(d, ()):
-                factor = "" if d == 1 else (f"h*" if d == 2 else f"h**{d - 1}*")
+                factor = "" if d == 1 else ("h*" if d == 2 else f"h**{d - 1}*")
                 parts.append(("" if c == 1 else f"({c})*") + factor + bracket(tree))
         tail = f" + O(h^{self.composition.remainder_power(self.max_degree - 1)})"
         return "X_eff = " + (" + ".join(parts) or "0") + tail

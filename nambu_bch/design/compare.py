@@ -188,7 +188,6 @@ def compare(system, words, t_end: float = 10.0, steps=(20, 40, 80, 160, 320, 640
     strang = strang + strang[-2::-1] if n > 1 else "1"
     ref_name = f"kahan-li:{strang}" if n > 1 else strang
     ref = make_composition(ref_name, n)
-    h_min = t_end / steps[-1]
     fine = max(8 * steps[-1], 64)
     if fine > MAX_STEPS:
         raise InvalidRunError(f"the reference run would need {fine} steps; use fewer steps (at most {MAX_STEPS // 8})")

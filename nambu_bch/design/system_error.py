@@ -29,7 +29,7 @@ import sympy
 
 from ..bch import effective_field
 from ..errors import InvalidOrderError, InvalidRunError
-from ..integrators.composition import composition as make_composition, composition_for
+from ..integrators.composition import composition_for
 from ..integrators.step import parameter_values
 from ..numeric.iterate import as_system
 from .conditions import error_analysis
@@ -131,7 +131,6 @@ def leading_error(system, word, box=None, samples: int = 2000, params=None, seed
     True
     """
     system = as_system(system)
-    n = len(system.splitting)
     comp = composition_for(word, system.splitting)
     parts = len(set(comp.pieces))
     p = error_analysis(comp, max(comp.pieces)).order if parts == max(comp.pieces) else 1

@@ -46,7 +46,6 @@ parameter value.
 from __future__ import annotations
 
 import hashlib
-import importlib.util
 import json
 import os
 import re

@@ -10,7 +10,7 @@ from __future__ import annotations
 import sympy
 
 from ..bch.backward import check_order
-from ..errors import InvalidOrderError, NambuBCHError
+from ..errors import NambuBCHError
 from ..integrators.composition import composition_for
 from .direct_route import ALPHA, direct_route
 from .family import ShadowFamily
@@ -139,7 +139,7 @@ def shadow_hamiltonians(system, word, order: int = 2, route: str = "direct", deg
         fam = ShadowFamily(system, comp, order, route, True)
         if order < power:
             fam.shadows = tuple(sympy.expand(Hk) for Hk in system.hamiltonians)
-            notes.append(f"h^1: the correction vanishes (symmetric word)")
+            notes.append("h^1: the correction vanishes (symmetric word)")
         else:
             R = fi_route(system, comp, order, degree)
             fam.details = R

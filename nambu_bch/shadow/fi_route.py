@@ -637,7 +637,6 @@ def _higher_orders(result, order, degree) -> None:
     system, comp, ctx = result.system, result.composition, result._ctx
     alg, atoms = ctx["algebra"], ctx["atoms"]
     hams = system.hamiltonians
-    slots = len(hams)
     if not result.exists:
         return
     corrections = {(a, result.power): _alpha_parts(alg, c) for a, c in enumerate(result.corrections)}
