@@ -636,7 +636,6 @@ def _higher_orders(result, order, degree) -> None:
     """Solve ``h^{power+1} .. h^order`` by the recursive hulls (fi_nested), the lower family fed into the cross terms."""
     system, comp, ctx = result.system, result.composition, result._ctx
     alg, atoms = ctx["algebra"], ctx["atoms"]
-    hams = system.hamiltonians
     if not result.exists:
         return
     corrections = {(a, result.power): _alpha_parts(alg, c) for a, c in enumerate(result.corrections)}
