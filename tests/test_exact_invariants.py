@@ -187,3 +187,12 @@ def test_property_invariant_along_exact_rational_orbits(word, state, params):
     for _ in range(3):
         point = dict(zip((x1, x2, x3), (e.xreplace(point) for e in phi)))
         assert (Hc.xreplace(point), Gc.xreplace(point)) == start
+
+
+def test_invariant_search_too_large_is_refused_up_front():
+    """Bounded work (issue 10, item 8): the rigid body's 12321 at ansatz degree 4 (about 142 000 image terms,
+    200 s) is refused from the size estimate in one line; degree 2 (the default) still runs."""
+    from nambu_bch.errors import ResourceLimitError
+
+    with pytest.raises(ResourceLimitError, match="lower the degree"):
+        conserved_quantities(model("rigid-body"), "12321", degree=4)
