@@ -31,8 +31,11 @@ def _corrections(shadow, base, coordinates):
     out = []
     for key, part in groups.items():
         power = 0 if key == 1 else sympy.degree(key, H_STEP)
-        poly = sympy.Poly(part, *coordinates)
-        terms = [sympy.factor(c) * sympy.Mul(*(x**e for x, e in zip(coordinates, m))) for m, c in poly.terms()]
+        if part.is_polynomial(*coordinates):
+            poly = sympy.Poly(part, *coordinates)
+            terms = [sympy.factor(c) * sympy.Mul(*(x**e for x, e in zip(coordinates, m))) for m, c in poly.terms()]
+        else:  # cos, exp, rational: the terms as they are (shadow/generic.py)
+            terms = list(sympy.Add.make_args(part))
         out.append((power, sympy.Add(*terms, evaluate=False)))
     return sorted(out, key=lambda item: item[0])
 
