@@ -223,7 +223,7 @@ class System:
         """The default splitting of this system (see :mod:`nambu_bch.systems.splitting`)."""
         from .splitting import canonical_split, full_split, single_split, triplet_split
 
-        if self.bracket == "canonical" and self.N > 2 or self.bracket == "canonical" and self.split == "fine":
+        if self.bracket == "canonical":
             return canonical_split(self, fine=self.split == "fine")
         if self.bracket == "triplets":
             return triplet_split(self, single=self.split == "single")
