@@ -173,7 +173,7 @@ def canonical_split(system, fine: bool = False) -> Splitting:
         in_q, in_p = term.has(*q), term.has(*p)
         if in_q and in_p:
             raise NotSeparableError(
-                f"H = {system.H} is not of the form T(p) + V(q): the term {term} mixes positions "
+                f"H = {system.H} is not separable into T(p) + V(q): the term {term} mixes positions "
                 f"({', '.join(map(str, q))}) and momenta ({', '.join(map(str, p))}); accepted: a sum of terms each "
                 "depending only on the momenta or only on the positions (their flows are exact shears)")
         if in_p:
