@@ -97,6 +97,13 @@ def test_non_separable_canonical_refused_in_one_line():
     assert "\n" not in str(info.value)
 
 
+def test_piece_without_exact_flow_refused_in_one_line():
+    S = System("x1 x2 x3", ["x1**2 + x2 + x3", "x2**2*x3**2 + x1"], split="single")
+    with pytest.raises(NoExactFlowError, match=r"piece 1 .* neither free of nor linear .*accepted: shears") as info:
+        nb.iterate(S, "12321", h=0.1, steps=10, x0=(1.0, 1.0, 1.0))
+    assert "\n" not in str(info.value)
+
+
 def test_triplet_bracket_is_the_sum_of_jacobians():
     """Nambu (1973), Sect. III: {f, g, k} = sum over triplets of the 3x3 Jacobians."""
     xs = sympy.symbols("x1:7")

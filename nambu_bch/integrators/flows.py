@@ -75,7 +75,8 @@ def _exact_flow(piece, coordinates) -> ExactFlow:
         if any(A[r, c].has(*xs) for c in range(len(moving) + 1)):
             raise NoExactFlowError(
                 f"piece {piece.number} ({piece.label()}) has velocity {comps[i]} for {coordinates[i]}, which is neither "
-                "free of nor linear in the coordinates it moves; its flow has no closed form here"
+                "free of nor linear in the coordinates it moves; its flow has no closed form here (accepted: shears, "
+                "affine-linear pieces; try another split)"
             )
     nilpotent = (A**(len(moving) + 1)).is_zero_matrix
     if nilpotent:
