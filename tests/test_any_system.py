@@ -97,6 +97,12 @@ def test_non_separable_canonical_refused_in_one_line():
     assert "\n" not in str(info.value)
 
 
+@pytest.mark.parametrize("name", ["ho3-pair", "henon-heiles"])
+def test_fi_route_refused_for_canonical_and_triplets(name):
+    with pytest.raises(NambuBCHError, match="the FI route needs the Nambu bracket"):
+        nb.shadow_hamiltonians(nb.model(name), "121" if name == "henon-heiles" else "12321", route="fi")
+
+
 def test_piece_without_exact_flow_refused_in_one_line():
     S = System("x1 x2 x3", ["x1**2 + x2 + x3", "x2**2*x3**2 + x1"], split="single")
     with pytest.raises(NoExactFlowError, match=r"piece 1 .* neither free of nor linear .*accepted: shears") as info:
