@@ -179,7 +179,7 @@ def system_from_args(args):
     """``(system, values)``: the built-in model, TOML file or flag-defined system, and parameter values."""
     from .model_file import load_system
     from .parsing import parse_expression
-    from .systems import System, model
+    from .systems import System, infer_bracket, model
 
     names, values = parse_params(getattr(args, "param", None))
     user_flags = [f for f, v in (("--H", args.H), ("--G", args.G), ("--coords", args.coords)) if v is not None]
@@ -211,16 +211,15 @@ def system_from_args(args):
                 raise NambuBCHError(f"--coords {args.coords!r}: {c!r} is not a symbol name; write e.g. --coords 'x1 x2 x3'")
             if c in ("h", "alpha"):
                 raise NambuBCHError(f"--coords {args.coords!r}: {c!r} is reserved (the step h, the family parameter alpha)")
-        expected = 1 if len(coords) == 2 else len(coords) - 1
-        if len(coords) >= 2 and len(hams) != expected:
-            raise NambuBCHError(
-                f"--coords {' '.join(coords)!r}: a system on {len(coords)} coordinates needs {expected} Hamiltonian(s) "
-                f"(--H and {expected - 1} --G), got {len(hams)}"
-            )
+        if len(coords) >= 2:
+            try:
+                infer_bracket(len(coords), len(hams), args.bracket)
+            except NambuBCHError as exc:
+                raise NambuBCHError(f"--coords {' '.join(coords)!r} with --H and {len(hams) - 1} --G: {exc}") from None
         symbols = [sympy.Symbol(s) for s in (*coords, *names)]
         flags = ["--H"] + ["--G"] * (len(hams) - 1)
         parsed = [parse_expression(text, symbols, what=flag) for text, flag in zip(hams, flags)]
-        system = System(coords, parsed, names, name=name, split=args.split or "full")
+        system = System(coords, parsed, names, name=name, split=args.split, bracket=args.bracket)
         return system, values
     if args.system:
         file_values: dict = {}
@@ -228,17 +227,25 @@ def system_from_args(args):
         extra = [n for n in names if n not in {p.name for p in system.parameters}]
         if extra:
             raise NambuBCHError(f"--param {extra[0]}: the system of {args.system} has parameters {_list(system.parameters)}")
-        if args.split and args.split != system.split:
-            system = _with(system, split=args.split)
+        system = _with_flags(system, args)
         args.file_values = file_values  # numeric defaults for check / plot; not substituted symbolically
         return system, values
     system = model(args.model or DEFAULT_MODEL)
     extra = [n for n in names if n not in {p.name for p in system.parameters}]
     if extra:
         raise NambuBCHError(f"--param {extra[0]}: model {system.name} has parameters {_list(system.parameters)}")
+    return _with_flags(system, args), values
+
+
+def _with_flags(system, args):
+    """``system`` with the --bracket and --split flags applied (a new System when they change it)."""
+    changes = {}
+    if args.bracket and args.bracket != system.bracket:
+        changes["bracket"] = args.bracket
+        changes["split"] = args.split  # the new bracket's default split unless given
     if args.split and args.split != system.split:
-        system = _with(system, split=args.split)
-    return system, values
+        changes["split"] = args.split
+    return _with(system, **changes) if changes else system
 
 
 def _list(symbols):
@@ -251,6 +258,7 @@ def _with(system, **changes):
     fields = dict(
         coordinates=system.coordinates, hamiltonians=system.hamiltonians, parameters=system.parameters,
         name=system.name, split=system.split, description=system.description, citation=system.citation,
+        bracket=system.bracket,
     )
     fields.update(changes)
     return System(**fields)
@@ -360,7 +368,7 @@ def _base(system, word, **extra):
 # subcommands
 # --------------------------------------------------------------------------------------------
 def cmd_models(args):
-    chosen = any(v is not None for v in (args.model, args.system, args.H, args.G, args.coords, args.param, args.split, args.name))
+    chosen = any(v is not None for v in (args.model, args.system, args.H, args.G, args.coords, args.param, args.split, args.bracket, args.name))
 
     @_once
     def systems():
@@ -391,7 +399,7 @@ def cmd_models(args):
     def text():
         lines = []
         for s in systems():
-            lines.append(f"{s.name}  (N = {s.N}, split = {s.split}, default integrator {default_word(s)})")
+            lines.append(f"{s.name}  (N = {s.N}, bracket = {s.bracket}, split = {s.split}, default integrator {default_word(s)})")
             if s.description:
                 lines.append(f"  {s.description}")
             lines.append(f"  coordinates: {_list(s.coordinates)};  parameters: {_list(s.parameters)}")
@@ -573,7 +581,7 @@ def cmd_exact(args):
 
 
 def _system_chosen(args) -> bool:
-    return any((args.model, args.system, args.H, args.G, args.coords, args.param, args.split, args.integrator))
+    return any((args.model, args.system, args.H, args.G, args.coords, args.param, args.split, args.bracket, args.integrator))
 
 
 def fi_representations(system, comp):
@@ -739,14 +747,19 @@ def cmd_plot(args):
 # --------------------------------------------------------------------------------------------
 def _system_options(parser):
     group = parser.add_argument_group("system (one of --model, --system, --H)")
-    group.add_argument("--model", metavar="NAME", help=f"built-in model: ho, ho3, rigid-body, lotka-volterra, ho3-composite (default {DEFAULT_MODEL})")
+    group.add_argument("--model", metavar="NAME", help=f"built-in model (see nambu-bch models): ho, ho3, rigid-body, lotka-volterra, ho3-composite, pendulum, "
+                       f"henon-heiles, fpu-beta, toda, exp-well, rational, rigid-body-lp, ho3-pair (default {DEFAULT_MODEL})")
     group.add_argument("--system", metavar="FILE", help="a TOML file defining the system (keys: coordinates, H, G, parameters, split)")
     group.add_argument("--H", metavar="EXPR", help="first Hamiltonian of a user system, e.g. 'x2^2/2 + x1^2/2'")
     group.add_argument("--G", metavar="EXPR", action="append", help="second Hamiltonian (N = 3); repeat for N >= 4")
     group.add_argument("--coords", metavar="NAMES", help="coordinates of a user system, e.g. 'x1 x2 x3' (default x1..xN)")
     group.add_argument("--param", metavar="NAME[=VALUE]", action="append",
                        help="declare a parameter (user system) and/or set its value, e.g. --param m=1; repeatable")
-    group.add_argument("--split", choices=("full", "single"), help="split every Hamiltonian (full) or only H (single)")
+    group.add_argument("--split", choices=("full", "single", "fine"),
+                       help="split every Hamiltonian (full) or only H (single); canonical: T|V (full) or independent parts (fine)")
+    group.add_argument("--bracket", choices=("canonical", "nambu", "triplets", "lie-poisson"),
+                       help="the bracket (default inferred: 1 Hamiltonian on N = 2d canonical, N - 1 Nambu, 2 on N = 3n "
+                            "triplets); lie-poisson: 1 Hamiltonian on N = 3 with the Casimir |x|^2/2")
     group.add_argument("--name", metavar="NAME", help="name of a user system in the output (default custom)")
 
 

@@ -12,7 +12,8 @@ Format (every expression is parsed by the safe parser, never evaluated)::
     # [parameters]                                    # with numeric values used by
     # m = 1                                           # 'check' and 'plot'
     # omega = "1/2"
-    split = "full"                                    # or "single" (split only H)
+    split = "full"                                    # or "single" (split only H); canonical: "fine"
+    bracket = "nambu"                                 # optional: inferred from N and the count of Hamiltonians
     description = "..."                               # optional
     citation = "..."                                  # optional
 
@@ -39,7 +40,7 @@ except ModuleNotFoundError:  # pragma: no cover - Python 3.10 with tomli install
 
 #: Largest accepted model file, in bytes.
 MAX_FILE_SIZE = 64 * 1024
-KEYS = ("name", "coordinates", "H", "G", "hamiltonians", "parameters", "split", "description", "citation")
+KEYS = ("name", "coordinates", "H", "G", "hamiltonians", "parameters", "split", "bracket", "description", "citation")
 
 
 def parse_value(text, what: str):
@@ -120,7 +121,7 @@ def load_system(path, values: dict | None = None):
                 values[key] = parse_value(value, f"--system {shown}: parameter {key}")
     else:
         names = text_list("parameters", params)
-    for key in ("name", "split", "description", "citation"):
+    for key in ("name", "split", "description", "citation", "bracket"):
         if key in data and not isinstance(data[key], str):
             raise InvalidSystemError(f"--system {shown}: {key} must be a string, got {data[key]!r}")
     if "name" in data:
@@ -131,7 +132,7 @@ def load_system(path, values: dict | None = None):
     symbols = _symbols(coordinates, names, shown)
     parsed = [parse_expression(H, symbols, what=f"--system {shown}: {label}") for H, label in zip(hams, _labels(len(hams)))]
     system = System(
-        coordinates, parsed, names, name=name, split=data.get("split", "full"),
+        coordinates, parsed, names, name=name, split=data.get("split"), bracket=data.get("bracket"),
         description=data.get("description", ""), citation=data.get("citation", ""),
     )
     return system

@@ -99,6 +99,7 @@ def system_dict(system) -> dict:
         "parameters": [str(p) for p in system.parameters],
         "H": expression(hams[0]),
         "G": expression(hams[1]) if len(hams) > 1 else None,
+        "bracket": getattr(system, "bracket", None),
     }
     if len(hams) > 2:
         data["hamiltonians"] = [expression(H) for H in hams]

@@ -27,7 +27,8 @@ from nambu_bch.systems import is_separable, separate
 x1, x2, x3, x4, y = sympy.symbols("x1 x2 x3 x4 y")
 m, omega, I1, I2, I3 = sympy.symbols("m omega I1 I2 I3")
 FULL_SPLIT_MODELS = ["ho", "ho3", "rigid-body"]
-ALL_MODELS = ["ho", "ho3", "rigid-body", "lotka-volterra", "ho3-composite"]
+ALL_MODELS = ["ho", "ho3", "rigid-body", "lotka-volterra", "ho3-composite", "pendulum", "henon-heiles", "fpu-beta", "toda",
+              "exp-well", "rational", "rigid-body-lp", "ho3-pair"]
 
 
 def simplified(field):
@@ -374,7 +375,9 @@ class TestBadInput:
             ("x1 x2 x3", ["x1"], "needs 2 Hamiltonian\\(s\\), got 1"),
             ("x1 x2 x3", ["x1", "x2", "x3"], "needs 2 Hamiltonian\\(s\\), got 3"),
             ("x1 x2", ["x1", "x2"], "needs 1 Hamiltonian\\(s\\), got 2"),
-            ("x1 x2 x3 x4", ["x1", "x2"], "needs 3 Hamiltonian\\(s\\), got 2"),
+            ("x1 x2 x3 x4", ["x1", "x2"], "needs 1 or 3 Hamiltonian\\(s\\), got 2 \\(two Hamiltonians on N > 3 need N = 3n"),
+            ("x1 x2 x3 x4 x5", ["x1"], "needs 4 Hamiltonian\\(s\\), got 1 \\(one Hamiltonian needs an even N = 2d"),
+            ("x1 x2 x3 x4 x5 x6", ["x1", "x2", "x3"], "needs 1, 2 or 5 Hamiltonian\\(s\\), got 3"),
         ],
     )
     def test_wrong_number_of_hamiltonians(self, coords, hams, expected):
@@ -391,8 +394,8 @@ class TestBadInput:
             System(coords, hams, params)
 
     def test_unknown_model(self):
-        with pytest.raises(UnknownModelError, match=r"unknown model 'pendulum'.*ho3"):
-            model("pendulum")
+        with pytest.raises(UnknownModelError, match=r"unknown model 'pendulumm'.*ho3"):
+            model("pendulumm")
         assert issubclass(UnknownModelError, NambuBCHError)
 
     @pytest.mark.parametrize(
@@ -403,7 +406,7 @@ class TestBadInput:
             (dict(coordinates="x1 x2", hamiltonians=["x1*x2"], parameters="x1"), "distinct"),
             (dict(coordinates="x1 2x", hamiltonians=["x1"]), "'2x' is not a valid symbol name"),
             (dict(coordinates="x1 x2", hamiltonians=["m"], parameters="m"), "does not depend on any coordinate"),
-            (dict(coordinates="x1 x2", hamiltonians=["x1 + x2"], split="both"), "split must be 'full' or 'single'"),
+            (dict(coordinates="x1 x2", hamiltonians=["x1 + x2"], split="both"), "split 'both' does not apply to a canonical system; accepted are full, fine"),
             (dict(coordinates="x1 x2", hamiltonians=[object()]), "not a sympy expression"),
         ],
     )

@@ -117,6 +117,8 @@ def liouville_field(algebra: PolynomialAlgebra, *hamiltonians) -> VectorField:
     if len(hamiltonians) == 1 and algebra.n % 2 == 0 and algebra.n > 2:
         H = hamiltonians[0]
         return VectorField(algebra, [poisson_bracket(algebra, x, H) for x in algebra.gens[: algebra.n]])
+    if len(hamiltonians) == 2 and algebra.n % 3 == 0 and algebra.n > 3:
+        return triplet_field(algebra, *hamiltonians)
     if len(hamiltonians) != algebra.n - 1:
         raise NambuBCHError(
             f"a Liouville field on {algebra.n} coordinates needs {algebra.n - 1} Hamiltonians, got {len(hamiltonians)}"
@@ -126,4 +128,31 @@ def liouville_field(algebra: PolynomialAlgebra, *hamiltonians) -> VectorField:
     for i in range(algebra.n):
         unit = [algebra.ring.one if j == i else algebra.zero for j in range(algebra.n)]
         components.append(_determinant(algebra, [unit, *grads]))
+    return VectorField(algebra, components)
+
+
+def triplet_field(algebra: PolynomialAlgebra, H, G) -> VectorField:
+    """``X_{H,G}`` for Nambu's canonical triplets: ``{f, H, G} = sum_t d(f, H, G)/d(x_3t+1, x_3t+2, x_3t+3)``.
+
+    The bracket on ``N = 3n`` coordinates is the sum of the 3x3 Jacobians over the
+    consecutive triplets ``(x1, x2, x3), (x4, x5, x6), ...``; for ``n >= 2`` it does
+    not satisfy the fundamental identity (Nambu 1973, Sect. III; Horikoshi, Sect. 6).
+
+    Examples
+    --------
+    >>> import sympy
+    >>> x = sympy.symbols("x1:7")
+    >>> A = PolynomialAlgebra(x)
+    >>> triplet_field(A, x[1] + x[4], x[2] + x[5]).to_sympy()
+    (1, 0, 0, 1, 0, 0)
+    """
+    n = algebra.n
+    if n % 3:
+        raise NambuBCHError(f"canonical triplets need N = 3n coordinates, got N = {n}")
+    gH, gG = _gradient(algebra, H), _gradient(algebra, G)
+    components = []
+    for i in range(n):
+        t = 3 * (i // 3)
+        local = [algebra.ring.one if j == i else algebra.zero for j in range(t, t + 3)]
+        components.append(_determinant(algebra, [local, gH[t:t + 3], gG[t:t + 3]]))
     return VectorField(algebra, components)

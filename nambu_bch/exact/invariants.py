@@ -141,6 +141,12 @@ def _exp_images(setup: _Setup, monos):
     therefore an exact identity (the search is sound); an invariant that needs an identity between
     different exponentials would be missed."""
     coords = setup.coords
+    if any(e.has(sympy.sin, sympy.cos, sympy.tan) for e in setup.phi_exprs):
+        # rotations (Lie-Poisson rigid body): the powers of cos/sin expressions blow up and the
+        # exponential-generator bookkeeping below does not apply; refuse up front (bounded work)
+        raise NoExactResultError(
+            f"the composed map on {setup.system.name} has trigonometric sub-flows (rotations); "
+            "polynomial invariants are not searched for it")
     columns = []
     for mu in monos:
         image = sympy.Integer(1)

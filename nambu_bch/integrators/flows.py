@@ -9,7 +9,8 @@ on ``x_M`` and on constants of the motion.  Two cases are solved exactly:
 * **affine-linear** -- ``dx_M/dt = A x_M + b`` with ``A, b`` free of ``x_M``:
   ``(x_M(t), 1) = exp(t [[A, b], [0, 0]]) (x_M, 1)``.  Diagonal ``A`` gives the
   exponentials of the Lotka-Volterra pieces, nilpotent ``A`` the polynomial
-  flows of the ``(q^2, p^2, qp)`` oscillator.
+  flows of the ``(q^2, p^2, qp)`` oscillator, imaginary eigenvalues the rotations
+  of the Lie-Poisson rigid body (written with real ``cos``, ``sin``).
 
 Anything else raises :class:`~nambu_bch.errors.NoExactFlowError` naming the piece.
 """
@@ -34,7 +35,7 @@ class ExactFlow:
     Attributes
     ----------
     expressions : tuple of sympy expressions, one per coordinate
-    kind : ``"shear"``, ``"nilpotent"`` or ``"linear"``
+    kind : ``"shear"``, ``"nilpotent"``, ``"linear"`` or ``"rotation"`` (real ``cos``/``sin`` of the fixed coordinates)
     polynomial : bool -- the flow is polynomial in the coordinates and ``t``
     """
 
@@ -74,7 +75,8 @@ def _exact_flow(piece, coordinates) -> ExactFlow:
         if any(A[r, c].has(*xs) for c in range(len(moving) + 1)):
             raise NoExactFlowError(
                 f"piece {piece.number} ({piece.label()}) has velocity {comps[i]} for {coordinates[i]}, which is neither "
-                "free of nor linear in the coordinates it moves; its flow has no closed form here"
+                "free of nor linear in the coordinates it moves; its flow has no closed form here (accepted: shears, "
+                "affine-linear pieces; try another split)"
             )
     nilpotent = (A**(len(moving) + 1)).is_zero_matrix
     if nilpotent:
@@ -90,7 +92,29 @@ def _exact_flow(piece, coordinates) -> ExactFlow:
             raise NoExactFlowError(f"piece {piece.number} ({piece.label()}): exp(t A) has no closed form ({exc})") from None
     state = sympy.Matrix([*xs, 1])
     new = E * state
+    kind = "nilpotent" if nilpotent else "linear"
     for r, i in enumerate(moving):
-        out[i] = sympy.expand(sympy.simplify(new[r]))
+        value = sympy.expand(sympy.simplify(new[r]))
+        if value.has(sympy.I):
+            value = _real_form(value, piece)
+            kind = "rotation"
+        out[i] = value
     polynomial = all(e.is_polynomial(*coordinates, TIME) for e in out)
-    return ExactFlow(tuple(out), "nilpotent" if nilpotent else "linear", polynomial)
+    return ExactFlow(tuple(out), kind, polynomial)
+
+
+def _real_form(value, piece):
+    """``exp(+-i w t)`` combinations of a real flow as ``cos(w t)``, ``sin(w t)`` (rotations, e.g. rigid-body pieces).
+
+    A real matrix ``A`` with imaginary eigenvalues ``+-i w`` gives ``exp(t A)`` in
+    complex exponentials; rewriting them by Euler's formula and expanding cancels
+    every ``i`` (the flow is real), which is checked: the numeric kernels then see
+    only real ``cos`` and ``sin`` (McLachlan 1993, the rigid-body rotations).
+    """
+    real = sympy.expand(value.rewrite(sympy.cos))
+    if real.has(sympy.I):
+        real = sympy.expand(sympy.simplify(real))
+    if real.has(sympy.I):
+        raise NoExactFlowError(
+            f"piece {piece.number} ({piece.label()}): its exact flow {value} could not be written without complex numbers")
+    return real

@@ -105,6 +105,10 @@ def shadow_hamiltonians(system, word, order: int = 2, route: str = "direct", deg
     if route not in ROUTES:
         raise NambuBCHError(f"route must be one of {', '.join(ROUTES)}, got {route!r}")
     order = check_order(order)
+    if route == "fi" and getattr(system, "bracket", "nambu") in ("canonical", "triplets") and system.N > 2:
+        raise NambuBCHError(
+            f"the FI route needs the Nambu bracket (N - 1 Hamiltonians, the fundamental identity); {system.name} has the "
+            f"{system.bracket} bracket on N = {system.N}: use route='direct'")
     comp = composition_for(word, system.splitting)
     notes = []
     if route == "direct":

@@ -428,6 +428,8 @@ def direct_route(system, word, order: int = 2, degree=None, max_unknowns=None, p
             raise InvalidOrderError(f"degree must be a positive integer (the ansatz degree) or None, got {degree!r}")
         _check_ansatz_size(len(system.hamiltonians), system.N, degree)
     comp = composition_for(word, system.splitting)
+    if not all(system.algebra.is_polynomial(system.algebra.convert(Hk)) for Hk in system.hamiltonians):
+        return _non_polynomial(system, comp, order)
     if max_unknowns is not None and (isinstance(max_unknowns, bool) or not isinstance(max_unknowns, int) or max_unknowns < 1):
         raise InvalidOrderError(f"max_unknowns must be a positive integer or None, got {max_unknowns!r}")
     solver = _Solver(system, comp, order, degree, max_unknowns)
@@ -441,3 +443,33 @@ def direct_route(system, word, order: int = 2, degree=None, max_unknowns=None, p
         if sol.status in ("obstructed", "refused"):
             break
     return DirectResult(system, comp, order, orders, solver.hams, solver.alg, solver.effective, corrections)
+
+
+def _non_polynomial(system, comp, order) -> DirectResult:
+    """Non-polynomial Hamiltonians: the BCH series on the pieces' Hamiltonians (substitution into the generic answer).
+
+    A polynomial ansatz cannot hold ``cos q`` or ``exp q``; when the pieces are Hamiltonian
+    for one Poisson bracket (canonical ``T|V`` splits, ``split="single"`` Nambu systems),
+    :func:`~nambu_bch.shadow.generic.bch_shadow` gives ``H_S`` for any smooth functions,
+    re-checked against backward error analysis before it is used.  The solution is
+    unique up to constants (connected phase space, canonical) or up to the Casimir
+    gauge (``G_S = G`` is the member returned).
+    """
+    from .generic import bch_shadow, poisson_structure
+
+    if poisson_structure(system) is None:
+        bad = next(Hk for Hk in system.hamiltonians if not system.algebra.is_polynomial(system.algebra.convert(Hk)))
+        raise NambuBCHError(
+            f"the direct route needs polynomial Hamiltonians unless every piece is Hamiltonian for one Poisson bracket "
+            f"(canonical T(p) + V(q), or split='single'); got {bad} with the {system.splitting.kind} split")
+    R = bch_shadow(system, comp, order, verify=True)
+    slots = len(system.hamiltonians)
+    corrections, orders = {}, []
+    for j in range(1, order + 1):
+        c = R.series.get(j, sympy.Integer(0))
+        if c == 0:
+            orders.append(OrderSolution(j, "vanishes", corrections=(sympy.Integer(0),) * slots))
+            continue
+        corrections[(0, j)] = c
+        orders.append(OrderSolution(j, "solved", corrections=(c,) + (sympy.Integer(0),) * (slots - 1)))
+    return DirectResult(system, comp, order, orders, tuple(system.hamiltonians), system.algebra, R.effective, corrections)

@@ -201,6 +201,7 @@ class ShadowFamily(Printable):
             "coordinates": [str(x) for x in sys_.coordinates],
             "H": str(sys_.H),
             "G": None if sys_.G is None else str(sys_.G),
+            "bracket": getattr(sys_, "bracket", None),
             "exists": self.exists,
             "H_S": None if self.H_S is None else str(self.H_S),
             "G_S": None if self.G_S is None else str(self.G_S),

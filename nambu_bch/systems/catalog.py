@@ -53,12 +53,94 @@ def _ho3_composite():
     )
 
 
+_HLW = "Hairer, Lubich, Wanner, Geometric Numerical Integration (2nd ed.)"
+
+
+def _pendulum():
+    return System(
+        "x1 x2", ["x2**2/2 - cos(x1)"], (), name="pendulum",
+        description="mathematical pendulum, canonical (x1, x2) = (q, p); pieces 1 = T, 2 = V (121 = position Verlet)",
+        citation=f"{_HLW}, Sect. I.1.4",
+    )
+
+
+def _henon_heiles():
+    return System(
+        "q1 q2 p1 p2", ["p1**2/2 + p2**2/2 + q1**2/2 + q2**2/2 + q1**2*q2 - q2**3/3"], (), name="henon-heiles",
+        description="Henon-Heiles, canonical d = 2 (q1, q2, p1, p2); pieces 1 = T, 2 = V",
+        citation=f"Henon, Heiles (1964); {_HLW}, Sect. I.3",
+    )
+
+
+def _fpu_beta():
+    q = ["0", "q1", "q2", "q3", "0"]
+    springs = [f"({q[i + 1]} - {q[i]})" for i in range(4)]
+    V = " + ".join(f"{s}**2/2 + beta*{s}**4/4" for s in springs)
+    return System(
+        "q1 q2 q3 p1 p2 p3", [f"p1**2/2 + p2**2/2 + p3**2/2 + {V}"], "beta", name="fpu-beta",
+        description="FPU-beta chain, 3 moving particles, fixed ends, canonical d = 3; pieces 1 = T, 2 = V",
+        citation="Fermi, Pasta, Ulam (1955); Gallavotti (ed.), The Fermi-Pasta-Ulam Problem (2008)",
+    )
+
+
+def _toda():
+    return System(
+        "q1 q2 q3 p1 p2 p3", ["p1**2/2 + p2**2/2 + p3**2/2 + exp(q1 - q2) + exp(q2 - q3) + exp(q3 - q1)"], (), name="toda",
+        description="periodic Toda lattice, 3 particles, canonical d = 3, exponential potential; pieces 1 = T, 2 = V",
+        citation="Toda (1967); Henon (1974); Flaschka (1974)",
+    )
+
+
+def _exp_well():
+    return System(
+        "x1 x2", ["x2**2/2 + exp(x1) - x1"], (), name="exp-well",
+        description="1-DOF Toda-type exponential well V = e^q - q, canonical (q, p); pieces 1 = T, 2 = V",
+        citation="Toda (1967), the two-particle reduction",
+    )
+
+
+def _rational():
+    return System(
+        "x1 x2", ["x2**2/2 - 1/(1 + x1**2)"], (), name="rational",
+        description="rational (Lorentzian) well V = -1/(1 + q^2), canonical (q, p); pieces 1 = T, 2 = V",
+        citation=f"{_HLW}, Sect. IX.3 (any smooth separable H)",
+    )
+
+
+def _rigid_body_lp():
+    return System(
+        "x1 x2 x3", ["x1**2/(2*I1) + x2**2/(2*I2) + x3**2/(2*I3)"], "I1 I2 I3", name="rigid-body-lp",
+        bracket="lie-poisson",
+        description="free rigid body as a Lie-Poisson system (G = |x|^2/2 the Casimir); only H is split, "
+                    "piece i = X_{x_i^2/(2 I_i), G} is a rotation about axis i",
+        citation="McLachlan (1993) Phys. Rev. Lett. 71, 3043; Touma, Wisdom (1994); Modin (2010)",
+    )
+
+
+def _ho3_pair():
+    return System(
+        "x1 x2 x3 x4 x5 x6", ["x2**2/2 + x3/2 + x5**2/2 + x6/2 + kappa*x1*x4", "x3 - x1**2 + x6 - x4**2"], "kappa",
+        name="ho3-pair",
+        description="two (q, p, q^2) oscillators on Nambu's canonical triplets, coupled by kappa q1 q2; "
+                    "pieces are shears (each term of H paired with each term of G, merged)",
+        citation=f"Nambu (1973), Sect. III; {_PAPER}, Sect. 6",
+    )
+
+
 _MODELS = {
     "ho": _ho,
     "ho3": _ho3,
     "rigid-body": _rigid_body,
     "lotka-volterra": _lotka_volterra,
     "ho3-composite": _ho3_composite,
+    "pendulum": _pendulum,
+    "henon-heiles": _henon_heiles,
+    "fpu-beta": _fpu_beta,
+    "toda": _toda,
+    "exp-well": _exp_well,
+    "rational": _rational,
+    "rigid-body-lp": _rigid_body_lp,
+    "ho3-pair": _ho3_pair,
 }
 _CACHE: dict = {}
 
@@ -68,7 +150,9 @@ def model_names() -> tuple:
 
 
 def model(name: str) -> System:
-    """A built-in system by name: ``ho``, ``ho3``, ``rigid-body``, ``lotka-volterra``, ``ho3-composite``.
+    """A built-in system by name (:func:`model_names`): the paper's ``ho``, ``ho3``, ``rigid-body``,
+    ``lotka-volterra``, ``ho3-composite``; canonical ``pendulum``, ``henon-heiles``, ``fpu-beta``,
+    ``toda``, ``exp-well``, ``rational``; Lie-Poisson ``rigid-body-lp``; canonical triplets ``ho3-pair``.
 
     Examples
     --------

@@ -62,6 +62,73 @@ def as_system(system, what: str = "system") -> "System":
         return model(system)
     raise InvalidSystemError(f"{what} must be a System or a built-in model name such as 'ho3', got {type(system).__name__}")
 
+#: The kinds of bracket a system may carry (see :func:`infer_bracket`).
+BRACKETS = ("canonical", "nambu", "triplets", "lie-poisson")
+
+#: Splits accepted per bracket kind; the first is the default.
+SPLITS = {
+    "canonical": ("full", "fine"),
+    "nambu": ("full", "single"),
+    "triplets": ("full", "single"),
+    "lie-poisson": ("single", "full"),
+}
+
+_ACCEPTED = ("accepted: 1 Hamiltonian on N = 2d coordinates (canonical, q = the first d, p = the last d), "
+             "N - 1 Hamiltonians on N (Nambu), 2 Hamiltonians on N = 3n (Nambu's canonical triplets), "
+             "or bracket='lie-poisson' with 1 Hamiltonian on N = 3")
+
+
+def infer_bracket(n_coords: int, n_hams: int, bracket=None) -> str:
+    """The bracket of a system from the number of coordinates and of Hamiltonians.
+
+    * one Hamiltonian on ``N = 2d``: ``"canonical"`` (``q`` = the first ``d``
+      coordinates, ``p`` = the last ``d``; Eq. Poisson);
+    * ``N - 1`` Hamiltonians on ``N >= 3``: ``"nambu"`` (the Jacobian, Eq. NB);
+    * two Hamiltonians on ``N = 3n``, ``n >= 2``: ``"triplets"`` (the sum of the
+      3x3 Jacobians over consecutive triplets; Nambu 1973, Sect. III);
+    * ``bracket="lie-poisson"``: one Hamiltonian on ``N = 3`` with the so(3)
+      Lie-Poisson bracket ``{f, g} = {f, g, |x|^2/2}`` (the rigid body).
+
+    An explicit ``bracket`` must agree with the counts (it overrides only the
+    ambiguous cases ``N = 2``, where canonical = Nambu, and ``N = 3`` with two
+    Hamiltonians, where triplets = Nambu).
+
+    Raises
+    ------
+    InvalidSystemError
+        naming the counts and what is accepted.
+
+    Examples
+    --------
+    >>> infer_bracket(4, 1), infer_bracket(3, 2), infer_bracket(6, 2), infer_bracket(3, 1, "lie-poisson")
+    ('canonical', 'nambu', 'triplets', 'lie-poisson')
+    """
+    N, k = n_coords, n_hams
+    if bracket is not None and bracket not in BRACKETS:
+        raise InvalidSystemError(f"bracket {bracket!r} is not known; accepted are {', '.join(BRACKETS)} (or None to infer)")
+    if bracket == "lie-poisson":
+        if (N, k) != (3, 1):
+            raise InvalidSystemError(
+                f"bracket='lie-poisson' takes 1 Hamiltonian on N = 3 coordinates (the rigid body), got {k} on N = {N}")
+        return bracket
+    counts = sorted({c for c, ok in ((1, N % 2 == 0), (N - 1, N >= 3), (2, N % 3 == 0 and N > 3)) if ok})
+    if k not in counts:
+        listed = (
+            ", ".join(map(str, counts[:-1])) + " or " + str(counts[-1]) if len(counts) > 1 else str(counts[0]))
+        why = (" (one Hamiltonian needs an even N = 2d, the canonical bracket)" if k == 1 else
+               " (two Hamiltonians on N > 3 need N = 3n, Nambu's canonical triplets)" if k == 2 else "")
+        raise InvalidSystemError(
+            f"a system on {N} coordinates needs {listed} Hamiltonian(s), got {k}{why}; {_ACCEPTED}")
+    inferred = "canonical" if k == 1 and N % 2 == 0 else "nambu" if k == N - 1 else "triplets"
+    if bracket is None or bracket == inferred:
+        return inferred
+    same = {("canonical", "nambu"): N == 2, ("nambu", "canonical"): N == 2, ("nambu", "triplets"): N == 3,
+            ("triplets", "nambu"): N == 3}
+    if same.get((inferred, bracket)):
+        return bracket
+    raise InvalidSystemError(
+        f"bracket={bracket!r} does not fit {k} Hamiltonian(s) on N = {N} coordinates (that is {inferred!r}); {_ACCEPTED}")
+
 
 def _as_symbols(names, what):
     if isinstance(names, str):
@@ -95,10 +162,12 @@ def _symbol_name(name, what):
 
 @dataclass(frozen=True, eq=False)
 class System:
-    """Coordinates ``x_1..x_N`` driven by ``N - 1`` Hamiltonians (one for N = 2).
+    """Coordinates ``x_1..x_N`` driven by Hamiltonians through a bracket inferred from their numbers.
 
     The equations of motion are ``df/dt = {f, H_1, ..., H_{N-1}}`` (Eq. NambuEq;
-    Eq. HamiltonEq for N = 2), i.e. ``dx/dt = X_{H_1..H_{N-1}}``.
+    Eq. HamiltonEq for N = 2), i.e. ``dx/dt = X_{H_1..H_{N-1}}``; one Hamiltonian on
+    ``N = 2d`` coordinates is canonical (``df/dt = {f, H}``, q first, p last), two on
+    ``N = 3n`` are Nambu's canonical triplets (:func:`infer_bracket`).
 
     Parameters
     ----------
@@ -108,6 +177,11 @@ class System:
     name : str, optional
     split : ``"full"`` to split every Hamiltonian per coordinate (Eqs. X1-X3),
         or ``"single"`` to split only the first one (the paper's footnote).
+        Canonical systems: ``"full"`` = pieces T(p), V(q) (so ``121`` is position
+        Verlet), ``"fine"`` = T and V further split into independent parts.
+        Default: the first accepted split of the bracket (``"single"`` for Lie-Poisson).
+    bracket : ``None`` (inferred, :func:`infer_bracket`), ``"canonical"``, ``"nambu"``,
+        ``"triplets"`` or ``"lie-poisson"``.
     description, citation : str, optional
 
     Examples
@@ -121,10 +195,11 @@ class System:
     hamiltonians: tuple
     parameters: tuple = ()
     name: str = "custom"
-    split: str = "full"
+    split: str | None = None
     description: str = ""
     citation: str = ""
     piece_labels: tuple = field(default=(), compare=False)
+    bracket: str | None = None
 
     def __post_init__(self):
         coords = _as_symbols(self.coordinates, "coordinate")
@@ -158,11 +233,13 @@ class System:
         if len(hams) > MAX_COORDINATES:
             raise InvalidSystemError(f"{len(hams)} Hamiltonians are refused: at most {MAX_COORDINATES - 1} are accepted")
         hams = tuple(self._parse(H) for H in hams)
-        expected = 1 if len(coords) == 2 else len(coords) - 1
-        if len(hams) != expected:
-            raise InvalidSystemError(
-                f"a system on {len(coords)} coordinates needs {expected} Hamiltonian(s), got {len(hams)}"
-            )
+        casimir = sympy.Add(*(x**2 for x in coords)) / 2
+        if self.bracket == "lie-poisson" and len(hams) == 2 and sympy.expand(hams[1] - casimir) == 0:
+            hams = hams[:1]  # a copy of a Lie-Poisson system (the Casimir is already there)
+        bracket = infer_bracket(len(coords), len(hams), self.bracket)
+        if bracket == "lie-poisson":
+            hams = (hams[0], casimir)
+        object.__setattr__(self, "bracket", bracket)
         allowed = set(coords) | set(params)
         for k, H in enumerate(hams):
             stray = H.free_symbols - allowed
@@ -174,8 +251,12 @@ class System:
             if not H.free_symbols & set(coords):
                 raise InvalidSystemError(f"Hamiltonian {self._ham_name(k, len(hams))} = {H} does not depend on any coordinate")
         object.__setattr__(self, "hamiltonians", hams)
-        if not isinstance(self.split, str) or self.split not in ("full", "single"):
-            raise InvalidSystemError(f"split must be 'full' or 'single', got {self.split!r}")
+        accepted = SPLITS[bracket]
+        split = accepted[0] if self.split is None else self.split
+        if not isinstance(split, str) or split not in accepted:
+            raise InvalidSystemError(
+                f"split {split!r} does not apply to a {bracket} system; accepted are {', '.join(accepted)}")
+        object.__setattr__(self, "split", split)
 
     def _parse(self, H):
         if isinstance(H, str):
@@ -222,9 +303,18 @@ class System:
     @cached_property
     def splitting(self):
         """The default splitting of this system (see :mod:`nambu_bch.systems.splitting`)."""
-        from .splitting import full_split, single_split
+        from .splitting import canonical_split, full_split, single_split, triplet_split
 
+        if self.bracket == "canonical":
+            return canonical_split(self, fine=self.split == "fine")
+        if self.bracket == "triplets":
+            return triplet_split(self, single=self.split == "single")
         return full_split(self) if self.split == "full" else single_split(self)
+
+    @property
+    def dof(self):
+        """Degrees of freedom ``d`` of a canonical system (``N = 2d``), else ``None``."""
+        return self.N // 2 if self.bracket == "canonical" else None
 
     def equations_of_motion(self) -> tuple:
         """``dx_i/dt`` as sympy expressions (e.g. Eq. NambuOHeqs for ``ho3``)."""

@@ -1,0 +1,364 @@
+"""Shadow Hamiltonians of Poisson splittings by the BCH series on Hamiltonians, for any smooth functions.
+
+When every piece of a splitting is a Hamiltonian field of *one* Poisson bracket,
+``X_k = X_{H_k}`` with ``X_F f = P(f, F)``, the map ``F -> X_F`` turns brackets of
+functions into commutators of fields: ``[X_A, X_B] = X_{P(B, A)}`` (Eq. CL1; the
+Jacobi identity of ``P``).  The formal BCH series of a composition (Eqs. BCH1,
+BCH2, any degree), evaluated on the functions ``H_k`` with ``[A, B] -> P(B, A)``,
+is then a shadow Hamiltonian:
+
+    H_S = sum_j h^j sum_w c_w P_w(H_1, ..., H_n),    X_{H_S} = X_eff  (order by order).
+
+No ansatz and no linear solve are needed, so ``H_k`` may be any functions
+(``cos q``, ``exp(q1 - q2)``, ``1/(1 + q^2)``, or undefined ``T(p)``, ``V(q)``: the
+*generic answer* of the paper's Sect. 4 procedure, a polynomial in the derivatives
+of ``T`` and ``V``).  The brackets that qualify:
+
+* canonical systems (``N = 2d``, one Hamiltonian, pieces ``T(p)``, ``V(q)``):
+  ``P`` = the canonical Poisson bracket (Eq. Poisson);
+* Nambu systems split in the first Hamiltonian only (``split="single"``, the
+  Lie-Poisson rigid body, Lotka-Volterra): ``P(f, g) = {f, g, H_2, ..., H_{N-1}}``
+  is a Poisson bracket (a Nambu bracket with ``N - 2`` fixed slots; Takhtajan 1994,
+  Sect. 2), so the pieces ``X_{H_k, G}`` are Hamiltonian for it and ``G_S = G``.
+
+Every result is re-checked: ``X_{H_S}`` against ``X_eff`` from backward error
+analysis (:func:`~nambu_bch.bch.backward.effective_field`, no Lie algebra) through
+``h^order``, before it is returned.
+
+References
+----------
+Horikoshi, Sect. 4 (general procedure), Eqs. (CL1), (BCH1), (BCH2), (SHPV1);
+Hairer, Lubich, Wanner, *Geometric Numerical Integration*, 2nd ed., Sect. IX.4
+(modified equations of splitting methods from the BCH formula) and Sect. III.4.2
+(the symmetric BCH formula); Yoshida, Celest. Mech. 56 (1993) 27, Sect. 3.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import sympy
+
+from ..algebra import liouville_field, nambu_bracket, poisson_bracket
+from ..bch.backward import check_order, effective_field
+from ..bch.evaluation import BracketEvaluator
+from ..bch.formal import formal_bch
+from ..errors import NambuBCHError, NoExactResultError
+from ..integrators.composition import composition as make_composition
+
+H_STEP = sympy.Symbol("h")
+
+
+def poisson_structure(system):
+    """``(piece Hamiltonians, fixed Hamiltonians)`` when every piece is ``X_{H_k, fixed...}``, else ``None``.
+
+    Examples
+    --------
+    >>> from nambu_bch import model
+    >>> poisson_structure(model("pendulum"))
+    ((x2**2/2, -cos(x1)), ())
+    >>> poisson_structure(model("ho3")) is None      # the full split: pieces are sums of X_{A,C}
+    True
+    """
+    splitting = system.splitting
+    if system.bracket == "canonical":
+        hams = []
+        for piece in splitting.pieces:
+            if len(piece.terms) != 1 or len(piece.terms[0]) != 1:
+                return None
+            hams.append(piece.terms[0][0])
+        return tuple(hams), ()
+    if system.bracket in ("nambu", "lie-poisson") and splitting.kind == "single":
+        rest = tuple(system.hamiltonians[1:])
+        hams = []
+        for piece in splitting.pieces:
+            if len(piece.terms) != 1 or tuple(piece.terms[0][1:]) != rest:
+                return None
+            hams.append(piece.terms[0][0])
+        return tuple(hams), rest
+    return None
+
+
+def _bracket(system, fixed):
+    alg = system.algebra
+
+    if not fixed:
+        def P(f, g):
+            return poisson_bracket(alg, f, g) if alg.n > 2 else nambu_bracket(alg, f, g)
+    else:
+        def P(f, g):
+            return nambu_bracket(alg, f, g, *fixed)
+    return P
+
+
+@dataclass
+class PoissonShadow:
+    """``H_S`` of a Poisson splitting through ``h^order`` (``fixed`` = the unsplit Hamiltonians, kept).
+
+    Attributes
+    ----------
+    system, composition, order
+    series : dict ``j -> expr`` -- the coefficient of ``h^j`` (``series[0] = H``)
+    fixed : tuple -- ``(G,)`` for a single-split Nambu system, ``()`` for canonical
+    verified_orders : int -- ``X_{H_S}`` equals the backward-error ``X_eff`` through this power
+    """
+
+    system: object
+    composition: object
+    order: int
+    series: dict
+    fixed: tuple = ()
+    verified_orders: int = -1
+    brackets: int = 0
+    effective: object = None
+    notes: list = field(default_factory=list)
+
+    @property
+    def H_S(self):
+        return sympy.Add(*(H_STEP**j * c for j, c in sorted(self.series.items())))
+
+    @property
+    def shadows(self) -> tuple:
+        return (self.H_S, *self.fixed)
+
+
+def bch_shadow(system, word, order: int = 2, verify: bool = True) -> PoissonShadow:
+    """``H_S`` of ``word`` on a Poisson splitting from the BCH series on the pieces' Hamiltonians.
+
+    Parameters
+    ----------
+    system : System whose pieces are Hamiltonian for one Poisson bracket (:func:`poisson_structure`)
+    word : composition spec
+    order : int -- highest power of ``h``
+    verify : bool -- re-check ``X_{H_S, fixed} = X_eff + O(h^{order+1})`` against backward error analysis
+
+    Returns
+    -------
+    PoissonShadow
+
+    Raises
+    ------
+    NambuBCHError
+        when the pieces are not Hamiltonian for one bracket (use the direct route).
+
+    Examples
+    --------
+    >>> from nambu_bch import model
+    >>> R = bch_shadow(model("pendulum"), "121", order=2)       # position Verlet
+    >>> R.series[2]
+    -x2**2*cos(x1)/24 + sin(x1)**2/12
+    """
+    order = check_order(order)
+    structure = poisson_structure(system)
+    if structure is None:
+        raise NambuBCHError(
+            f"{system.name}: the pieces of the {system.splitting.kind} splitting are not Hamiltonian fields of one Poisson "
+            "bracket (accepted: canonical T|V splits, or Nambu systems with split='single'); use the direct route")
+    hams, fixed = structure
+    comp = make_composition(word, len(system.splitting)).check(system.splitting)
+    alg = system.algebra
+    frac = _FractionBackend.make(system, (*hams, *fixed))
+    if frac is not None:  # rational Hamiltonians: exact sparse fractions, no expand/cancel of sympy trees
+        P, to_sympy = frac.bracket, frac.to_sympy
+        leaves = {k + 1: frac.convert(Hk) for k, Hk in enumerate(hams)}
+        zero_test = lambda v: not v  # noqa: E731
+    else:
+        P, to_sympy = _bracket(system, fixed), alg.to_sympy
+        leaves = {k + 1: alg.convert(Hk) for k, Hk in enumerate(hams)}
+        zero_test = lambda v: alg.is_zero(v) if alg.is_polynomial(v) else is_zero(v)  # noqa: E731
+    # [X_A, X_B] = X_{P(B, A)} (Eq. CL1 with X_F f = P(f, F))
+    evaluator = BracketEvaluator(leaves, bracket=lambda A, B: P(B, A), is_zero=zero_test)
+    series = formal_bch(comp, order + 1)
+    out = {}
+    for j in range(order + 1):
+        total = sympy.Integer(0)
+        for c, tree in series.terms(j + 1):
+            value = evaluator.value(tree)
+            if value is not None:
+                total += sympy.sympify(c) * to_sympy(value)
+        out[j] = _tidy(total)
+    result = PoissonShadow(system, comp, order, out, tuple(fixed), brackets=evaluator.brackets_computed)
+    if verify:
+        check_against_backward(result)
+    return result
+
+
+class _FractionBackend:
+    """Rational functions of the coordinates (and parameters) as sparse fractions over QQ.
+
+    Brackets of rational Hamiltonians (``-1/(1 + q^2)``) in sympy trees need ``cancel``
+    after every step; in sympy's ``FracField`` they are exact and fast.
+    """
+
+    def __init__(self, system, field, gens):
+        self.system = system
+        self.field = field
+        self.gens = gens[: system.N]
+        fixed = poisson_structure(system)[1]
+        self.fixed_grads = [[f.diff(x) for x in self.gens] for f in (self.convert(F) for F in fixed)]
+
+    @classmethod
+    def make(cls, system, exprs):
+        symbols = (*system.coordinates, *system.parameters)
+        if all(sympy.sympify(e).is_polynomial(*system.coordinates) for e in exprs):
+            return None  # the polynomial ring is faster still
+        if not all(sympy.sympify(e).is_rational_function(*symbols) for e in exprs):
+            return None
+        from sympy.polys.domains import QQ
+        from sympy.polys.fields import field
+
+        K, *gens = field(list(symbols), QQ)
+        return cls(system, K, gens)
+
+    def convert(self, expr):
+        return self.field.from_expr(sympy.sympify(expr))
+
+    def to_sympy(self, value):
+        return value.as_expr()
+
+    def bracket(self, f, g):
+        xs = self.gens
+        if not self.fixed_grads:
+            d = len(xs) // 2
+            if len(xs) == 2:
+                d = 1
+            return sum((f.diff(xs[k]) * g.diff(xs[k + d]) - f.diff(xs[k + d]) * g.diff(xs[k]) for k in range(d)),
+                       self.field.zero)
+        rows = [[f.diff(x) for x in xs], [g.diff(x) for x in xs], *self.fixed_grads]
+        return _det(rows, self.field.zero)
+
+    def equal(self, a, b) -> bool:
+        return self.convert(a) == self.convert(b)
+
+
+def _det(rows, zero):
+    from itertools import permutations
+
+    from ..algebra.brackets import permutation_sign
+
+    total = zero
+    for perm in permutations(range(len(rows))):
+        term = None
+        for r, c in enumerate(perm):
+            entry = rows[r][c]
+            if not entry:
+                term = None
+                break
+            term = entry if term is None else term * entry
+        if term is not None:
+            total = total + term if permutation_sign(perm) > 0 else total - term
+    return total
+
+
+def _tidy(expr):
+    """A readable exact form: polynomials expanded, rational functions factored, exponentials combined."""
+    expr = sympy.expand(expr)
+    symbols = sorted(expr.free_symbols, key=str)
+    if expr.is_polynomial(*symbols):
+        return expr
+    if expr.is_rational_function(*symbols):
+        return sympy.factor(sympy.cancel(expr))
+    if expr.has(sympy.exp):
+        return sympy.expand(sympy.powsimp(expr, combine="exp"))
+    return expr
+
+
+def is_zero(expr) -> bool:
+    """Exact zero test for the expressions met here (polynomial, rational, exp, trigonometric, undefined functions).
+
+    Rational functions are cancelled; exponentials and trigonometric functions are
+    rewritten as exponentials and combined, which decides every identity between
+    polynomials in ``exp(a x)``, ``cos``, ``sin``; ``simplify`` only as the last resort.
+
+    >>> x = sympy.Symbol("x")
+    >>> is_zero(sympy.sin(x)**2 + sympy.cos(x)**2 - 1), is_zero(1/(1 + x) - 1/(x + 1)**2 * (x + 1))
+    (True, True)
+    """
+    expr = sympy.sympify(expr)
+    symbols = sorted(expr.free_symbols, key=str)
+    if expr.is_rational_function(*symbols):
+        return sympy.cancel(sympy.together(expr)) == 0
+    e = sympy.expand(expr)
+    if e == 0:
+        return True
+    if e.has(sympy.exp, sympy.sin, sympy.cos, sympy.tan, sympy.sinh, sympy.cosh, sympy.tanh):
+        r = sympy.expand(sympy.powsimp(sympy.expand(e.rewrite(sympy.exp)), combine="exp"))
+        if r == 0:
+            return True
+        r = sympy.cancel(sympy.together(r))
+        if r == 0:
+            return True
+    return sympy.simplify(e) == 0
+
+
+def check_against_backward(result: PoissonShadow) -> None:
+    """Raise :class:`NoExactResultError` unless ``X_{H_S, fixed}`` equals the backward-error ``X_eff`` through ``h^order``."""
+    system, order = result.system, result.order
+    X = effective_field(system.splitting, result.composition, order)
+    result.effective = X
+    alg = system.algebra
+    for j in range(order + 1):
+        Hj = result.series[j]
+        if result.fixed or alg.is_polynomial(alg.convert(Hj)):
+            comps = liouville_field(alg, Hj, *result.fixed).to_sympy()
+        else:  # canonical, X_F = (dF/dp, -dF/dq): differentiate without expanding rational functions
+            d = alg.n // 2
+            comps = [sympy.diff(Hj, x) for x in alg.coordinates[d:]] + [-sympy.diff(Hj, x) for x in alg.coordinates[:d]]
+        expected = X[j].to_sympy()
+        frac = _FractionBackend.make(system, (*comps, *expected))
+        for i, (a, b) in enumerate(zip(comps, expected)):
+            same = frac.equal(a, b) if frac is not None else is_zero(a - b)
+            if not same:
+                raise NoExactResultError(
+                    f"{system.name}, {result.composition.name}: X_(H_S) differs from the backward-error X_eff at h^{j} "
+                    f"in d{system.coordinates[i]}/dt; not returned")
+    result.verified_orders = order
+
+
+# ----------------------------------------------------------------------------------------------
+# the generic answer: undefined T(p), V(q)
+# ----------------------------------------------------------------------------------------------
+T_FUN, V_FUN = sympy.Function("T"), sympy.Function("V")
+Q, P_ = sympy.symbols("x1 x2")
+
+
+def generic_system():
+    """``H = T(p) + V(q)`` on ``(x1, x2) = (q, p)`` with undefined functions ``T``, ``V``.
+
+    >>> generic_system().H
+    T(x2) + V(x1)
+    """
+    from ..systems import System
+
+    return System("x1 x2", [T_FUN(P_) + V_FUN(Q)], (), name="generic-TV",
+                  description="H = T(p) + V(q), T and V undefined", citation="Horikoshi, Sect. 4")
+
+
+def generic_shadow(word="121", order: int = 2) -> PoissonShadow:
+    """The generic shadow Hamiltonian of ``word`` for ``H = T(p) + V(q)``: a polynomial in derivatives of T, V.
+
+    For position Verlet (``121``: half steps of T, piece 1) the h^2 term is
+    ``T''(p) V'(q)^2 / 12 - V''(q) T'(p)^2 / 24``: the symmetric BCH formula
+    ``log(e^{A/2} e^B e^{A/2}) = A + B - [A,[A,B]]/24 - [B,[A,B]]/12 + ...``
+    (HLW Sect. III.4.2) with ``[X_A, X_B] = X_{{B,A}}``; for the harmonic oscillator it is Eq. (SHPV1).
+
+    Examples
+    --------
+    >>> R = generic_shadow("121", 2)
+    >>> R.series[2]
+    -Derivative(T(x2), x2)**2*Derivative(V(x1), (x1, 2))/24 + Derivative(T(x2), (x2, 2))*Derivative(V(x1), x1)**2/12
+    """
+    return bch_shadow(generic_system(), word, order, verify=True)
+
+
+def substitute(expr, T=None, V=None):
+    """``expr`` (in undefined ``T(x2)``, ``V(x1)`` and their derivatives) with concrete ``T(p)``, ``V(q)``.
+
+    >>> substitute(generic_shadow("121", 2).series[2], T=P_**2/2, V=-sympy.cos(Q))
+    -x2**2*cos(x1)/24 + sin(x1)**2/12
+    """
+    if T is not None:
+        expr = expr.replace(T_FUN, sympy.Lambda(P_, T))
+    if V is not None:
+        expr = expr.replace(V_FUN, sympy.Lambda(Q, V))
+    return sympy.expand(expr.doit())
