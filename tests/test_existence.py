@@ -240,3 +240,13 @@ def test_cli_shadow_prints_the_outcome(capsys):
     assert main(["shadow", "--integrator", "123", "--order", "1", "--no-existence", "--format", "json"]) == 0
     d = json.loads(capsys.readouterr().out)
     assert d["exists"] is None and d["evidence"]["outcome"] == "undecided"
+
+
+def test_criterion_needs_orbits_that_are_curves():
+    """Nambu triplets (two Hamiltonians on N = 6): level sets are 4-dimensional, the orbit-average criterion
+    does not apply, so a failed polynomial ansatz stays undecided at once (bounded work, no orbit numerics)."""
+    S = model("ho3-pair")
+    R = direct_route(S, "123", 1)
+    assert not R.exists
+    d = decide(R, measure=False)
+    assert d.outcome == "undecided" and d.exists is None and "curves" in d.reason

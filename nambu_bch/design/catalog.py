@@ -23,7 +23,7 @@ size of ``error_bound`` below ``h^order``.
 
 References
 ----------
-Suzuki, Phys. Lett. A 146 (1990) 319, Eq. (3.11) (5-jump, "fractal" decomposition);
+Suzuki, Phys. Lett. A 146 (1990) 319 (5-jump, "fractal" decomposition; built in integrators.composition);
 Kahan & Li, Math. Comp. 66 (1997) 1089, and Hairer, Lubich, Wanner, *Geometric Numerical
 Integration*, Sect. V.3.2, Eq. (3.11) (p6 s9 coefficients); Yoshida, Phys. Lett. A 150
 (1990) 262, Table 1, solution A; Blanes & Moan, J. Comput. Appl. Math. 142 (2002) 313,

@@ -442,6 +442,13 @@ def direct_route(system, word, order: int = 2, degree=None, max_unknowns=None, p
         orders.append(sol)
         if sol.status in ("obstructed", "refused"):
             break
+    if orders[-1].status == "refused":
+        from .generic import poisson_structure
+
+        if poisson_structure(system) is not None:
+            # the ansatz is too large, but the pieces are Hamiltonian for one Poisson bracket: the BCH
+            # series on their Hamiltonians is the shadow Hamiltonian (verified against backward error analysis)
+            return _non_polynomial(system, comp, order)
     return DirectResult(system, comp, order, orders, solver.hams, solver.alg, solver.effective, corrections)
 
 

@@ -370,6 +370,13 @@ def decide(result, params=None, points=None, orbits: int = DEFAULT_ORBITS, measu
     gs, j = integrands(result)
     names = _names(system)
     n = len(system.coordinates)
+    if len(system.hamiltonians) != n - 1:
+        # the criterion needs orbits that are curves (N - 1 first integrals); canonical d >= 2 and triplet
+        # systems have invariant tori of higher dimension, whose averages are not orbit averages
+        return Existence("undecided", None, j, params=params, names=names,
+                         reason=(f"the orbit-average criterion needs N - 1 = {n - 1} Hamiltonians (orbits that are "
+                                 f"curves); {system.name} has {len(system.hamiltonians)} on N = {n}, so no decision "
+                                 "is made beyond the polynomial ansatz"))
     if points is None:
         pts = sample_points(n, orbits)
     else:
