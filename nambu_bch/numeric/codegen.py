@@ -47,7 +47,7 @@ from sympy.printing.c import C99CodePrinter
 from sympy.printing.pycode import PythonCodePrinter
 
 from ..errors import InvalidSystemError
-from ..integrators.composition import composition as make_composition
+from ..integrators.composition import composition_for
 from ..integrators.flows import TIME, exact_flow
 
 #: The step symbol of the constants (same name as in the rest of the package).
@@ -137,7 +137,7 @@ def step_program(system, word) -> StepProgram:
     >>> prog.constants[:3]
     ((k0, h/(2*m)), (k1, -h*m*omega**2/2), (k2, 2*h/m))
     """
-    comp = make_composition(word, len(system.splitting)).check(system.splitting)
+    comp = composition_for(word, system.splitting)
     return _step_program(system, comp)
 
 

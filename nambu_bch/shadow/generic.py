@@ -44,7 +44,7 @@ from ..bch.backward import check_order, effective_field
 from ..bch.evaluation import BracketEvaluator
 from ..bch.formal import formal_bch
 from ..errors import NambuBCHError, NoExactResultError
-from ..integrators.composition import composition as make_composition
+from ..integrators.composition import composition_for
 
 H_STEP = sympy.Symbol("h")
 
@@ -155,7 +155,7 @@ def bch_shadow(system, word, order: int = 2, verify: bool = True) -> PoissonShad
             f"{system.name}: the pieces of the {system.splitting.kind} splitting are not Hamiltonian fields of one Poisson "
             "bracket (accepted: canonical T|V splits, or Nambu systems with split='single'); use the direct route")
     hams, fixed = structure
-    comp = make_composition(word, len(system.splitting)).check(system.splitting)
+    comp = composition_for(word, system.splitting)
     alg = system.algebra
     frac = _FractionBackend.make(system, (*hams, *fixed))
     if frac is not None:  # rational Hamiltonians: exact sparse fractions, no expand/cancel of sympy trees
