@@ -244,7 +244,7 @@ PAPER_FI = {
 
 
 def test_fi_forms_match_the_paper():
-    from nambu_bch.render import fi_form
+    from nambu_bch.shadow.fundamental_identity import formal_form as fi_form
 
     for label, text in PAPER_FI.items():
         got = " ".join(("+" if sign > 0 else "-") + ",".join(slots) for sign, slots in fi_form(label))

@@ -14,7 +14,7 @@ import hashlib
 import os
 from pathlib import Path
 
-_PACKAGE = Path(__file__).resolve().parent
+_PACKAGE = Path(__file__).resolve().parent.parent  # the nambu_bch package
 
 
 def _key(request) -> str:
@@ -39,7 +39,7 @@ def cached_text(request, compute) -> str:
         pass
     text = compute()
     try:
-        from .atomic import write_atomic
+        from ..atomic import write_atomic
 
         path.parent.mkdir(parents=True, exist_ok=True)
         write_atomic(path, text)
