@@ -33,13 +33,13 @@ from dataclasses import dataclass, field
 import numpy as np
 import sympy
 
+from ..checks import is_int
 from ..errors import InvalidOrderError, InvalidRunError, NambuBCHError, NumericalRangeError
 from ..integrators.composition import composition as make_composition
 from ..integrators.step import parameter_values
 from .iterate import as_system, iterate, sample_times
+from ..symbols import ALPHA, STEP
 
-H_STEP = sympy.Symbol("h")
-ALPHA = sympy.Symbol("alpha")
 
 #: The quantities :func:`quantities` can provide, in display order.
 QUANTITY_NAMES = ("H", "G", "H_c", "G_c", "H_S", "G_S", "H_S_exact", "G_S_exact")
@@ -69,7 +69,7 @@ def quantities(system, word, h, params=None, order=2, alpha=0.5, which=QUANTITY_
     system = as_system(system)
     values = parameter_values(system, params)
     # exact binary values (60 digits), so mpmath evaluations see the same h as the run
-    subs = {**{p: sympy.Float(v, 60) for p, v in values.items()}, H_STEP: sympy.Float(float(h), 60),
+    subs = {**{p: sympy.Float(v, 60) for p, v in values.items()}, STEP: sympy.Float(float(h), 60),
             ALPHA: sympy.Float(float(alpha), 60)}
     out = {}
 
@@ -370,7 +370,7 @@ def check(system, word, h, steps, x0, params=None, *, order=2, alpha=0.5, every=
     comp = make_composition(word, len(system.splitting))
     name = word if isinstance(word, str) else str(comp)
     alpha = _finite_real(alpha, "alpha")
-    if isinstance(order, bool) or not isinstance(order, (int, np.integer)) or order < 0:
+    if not is_int(order, 0, numpy=True):
         raise InvalidOrderError(f"order must be a non-negative integer, got {order!r}")
     if np.ndim(x0) != 1:
         raise InvalidRunError(f"check takes one initial state of shape ({system.N},), got shape {np.shape(x0)}")

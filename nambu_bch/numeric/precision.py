@@ -28,6 +28,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..checks import is_int
 from ..errors import InvalidRunError
 from .codegen import mpmath_source
 
@@ -37,7 +38,7 @@ MAX_DPS = 10_000
 
 def check_dps(dps) -> int:
     """``dps`` as an int in ``[15, MAX_DPS]``."""
-    if isinstance(dps, bool) or not isinstance(dps, (int, np.integer)) or not 15 <= dps <= MAX_DPS:
+    if not is_int(dps, 15, MAX_DPS, numpy=True):
         raise InvalidRunError(f"dps must be an integer number of decimal digits between 15 and {MAX_DPS}, got {dps!r}")
     return int(dps)
 

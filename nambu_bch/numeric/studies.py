@@ -192,13 +192,15 @@ def truncation_study(system="ho3", word="32123", orders=(2, 4, 6, 8), h=0.1, ste
     """
     import sympy
 
+    from ..symbols import ALPHA, STEP
+
     system = as_system(system)
     x0 = np.ones(system.N) if x0 is None else np.asarray(x0, dtype=np.float64)
     samples = iterate(system, word, h, steps, x0, params, every, backend=backend)
     t = sample_times(h, steps, every)
     values = parameter_values(system, params)
-    subs = {**{p: sympy.Float(v, 60) for p, v in values.items()}, sympy.Symbol("h"): sympy.Float(float(h), 60),
-            sympy.Symbol("alpha"): sympy.Float(float(alpha), 60)}
+    subs = {**{p: sympy.Float(v, 60) for p, v in values.items()}, STEP: sympy.Float(float(h), 60),
+            ALPHA: sympy.Float(float(alpha), 60)}
     derive, errs, drifts, sources = [], {}, {}, []
     for k in orders:
         start = time.perf_counter()
