@@ -37,7 +37,8 @@ from ..checks import is_int
 from ..errors import InvalidOrderError, InvalidRunError, NambuBCHError, NumericalRangeError
 from ..integrators.composition import composition as make_composition
 from ..integrators.step import parameter_values
-from .iterate import as_system, iterate, sample_times
+from .iterate import as_system, iterate
+from .samples import sample_times
 from ..symbols import ALPHA, STEP
 
 
@@ -92,11 +93,11 @@ def quantities(system, word, h, params=None, order=2, alpha=0.5, which=QUANTITY_
             put("G_c", cq.G_c)
     if {"H_S", "G_S"} & set(which):
         fam = _try(lambda: _shadow(system, word, order))
-        if fam is not None and getattr(fam, "exists", True):
-            free = [s for s in getattr(fam, "free_parameters", ()) or ()]
+        if fam is not None and fam.exists:
+            free = list(fam.free_parameters)
             extra = {sympy.Symbol(str(s)) if not isinstance(s, sympy.Symbol) else s: sympy.Float(float(alpha), 60) for s in free}
             put("H_S", None if fam.H_S is None else sympy.sympify(fam.H_S).xreplace(extra))
-            put("G_S", None if getattr(fam, "G_S", None) is None else sympy.sympify(fam.G_S).xreplace(extra))
+            put("G_S", None if fam.G_S is None else sympy.sympify(fam.G_S).xreplace(extra))
     if {"H_S_exact", "G_S_exact"} & set(which):
         es = _try(lambda: _exact().exact_shadow_hamiltonians(system, word))
         if es is not None:
@@ -118,10 +119,15 @@ def _shadow(system, word, order):
 
 
 def _try(fn):
-    """The result, or None when the package says the result does not exist (or is not built yet)."""
+    """The result, or None when the package says the result does not exist (a :class:`NambuBCHError`).
+
+    ``NotImplementedError`` is sympy's answer for an equation its solvers cannot handle
+    (an exact solution of a sub-flow the package does not know): the quantity is then
+    left out, as a non-existent one.  Anything else is a bug and propagates.
+    """
     try:
         return fn()
-    except (NambuBCHError, ImportError, AttributeError, NotImplementedError):
+    except (NambuBCHError, NotImplementedError):
         return None
 
 

@@ -288,7 +288,6 @@ class Kernel:
         self.from_cache = self._load_cached()
         if not self.from_cache:
             self._generate()
-        self._constants = {}
         self._jitted = {}
         self.compile_seconds = {}
 

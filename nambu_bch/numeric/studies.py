@@ -33,7 +33,8 @@ import numpy as np
 from ..errors import NambuBCHError, NumericalRangeError, UnstableStepError
 from ..integrators.step import parameter_values
 from .diagnostics import QUANTITY_NAMES, drift_rate, errors_along, quantities
-from .iterate import as_system, iterate, sample_times
+from .iterate import as_system, iterate
+from .samples import sample_times
 from .kernels import kernel, resolve_backend
 
 
@@ -209,11 +210,11 @@ def truncation_study(system="ho3", word="32123", orders=(2, 4, 6, 8), h=0.1, ste
             from ..shadow import shadow_hamiltonians
 
             fam = shadow_hamiltonians(system, word, order=k)
-            if getattr(fam, "exists", True):
-                free = {sympy.Symbol(str(s)): sympy.Float(float(alpha), 60) for s in getattr(fam, "free_parameters", ()) or ()}
-                exprs = {"H_S": fam.H_S, "G_S": getattr(fam, "G_S", None)}
+            if fam.exists:
+                free = {sympy.Symbol(str(s)): sympy.Float(float(alpha), 60) for s in fam.free_parameters}
+                exprs = {"H_S": fam.H_S, "G_S": fam.G_S}
                 exprs = {n: sympy.sympify(e).xreplace(free) for n, e in exprs.items() if e is not None}
-        except (ImportError, NambuBCHError):
+        except NambuBCHError:
             exprs = None
         if exprs is None:  # BCH route unavailable (or no shadow Hamiltonian): the exact family's series
             from ..exact import exact_shadow_hamiltonians
