@@ -1,6 +1,6 @@
 """Rendering of results as text, LaTeX or JSON, and atomic output files.
 
-JSON convention (DESIGN.md, "Public surface"): every symbolic expression is a
+JSON convention (docs/json.md, "Conventions"): every symbolic expression is a
 string that ``sympy.sympify`` reads back with the system's symbol names, e.g.
 ``sympify(data["H_S"], locals={"x1": Symbol("x1"), ..., "h": Symbol("h")})``
 (``str`` of a sympy expression; no floats appear in symbolic output); numbers

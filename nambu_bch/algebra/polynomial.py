@@ -104,9 +104,6 @@ class PolynomialAlgebra:
             return value.as_expr()
         return sympy.sympify(value)
 
-    def to_general(self, value) -> sympy.Expr:
-        return self.to_sympy(value)
-
     @cached_property
     def zero(self):
         return self.ring.zero

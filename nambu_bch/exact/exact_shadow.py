@@ -115,13 +115,6 @@ class ExactShadow(Printable):
         G = truncate_h(factor_power_series(1 - ALPHA, order, x) * self.G_c, order)
         return (sympy.collect(H, STEP), sympy.collect(G, STEP))
 
-    def field_series(self, order: int) -> tuple:
-        """The components of ``X_eff = F(omega h) X_{H_c,G_c}`` through ``h^order`` (sympy)."""
-        system = self.conserved.system
-        Xc = liouville_field(system.algebra, *self.conserved.hamiltonians_c).to_sympy()
-        Fs = F_series(self.frequency * STEP, order)
-        return tuple(truncate_h(Fs * c, order) for c in Xc)
-
     def remainder_power(self, order: int) -> int:
         """The power ``p`` of the remainder ``O(h^p)`` after ``series(order)``: ``order + 2`` when the
         ``h^(order+1)`` coefficients vanish (checked exactly; an even series such as ho3's), else ``order + 1``."""

@@ -192,7 +192,7 @@ class ShadowFamily(Printable):
         return out
 
     def to_dict(self) -> dict:
-        """JSON-ready dict (DESIGN.md): expressions as strings ``sympy.sympify`` reads back."""
+        """JSON-ready dict (docs/json.md): expressions as strings ``sympy.sympify`` reads back."""
         sys_ = self.system
         out = {
             "model": sys_.name,
