@@ -86,7 +86,7 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 class _progress_off:
-    """``--no-progress``: ``NAMBU_BCH_PROGRESS=0`` for the run (read by :mod:`nambu_bch.numeric.progress`), then restored."""
+    """``--no-progress``: ``NAMBU_BCH_PROGRESS=0`` for the run (read by :mod:`nambu_bch.progress`), then restored."""
 
     def __enter__(self):
         self.saved = os.environ.get("NAMBU_BCH_PROGRESS")

@@ -27,11 +27,11 @@ import sys
 import numpy as np
 
 from ..errors import InvalidRunError, InvalidSystemError
+from ..progress import Progress, progress_wanted
 from ..systems import System, model
 from .guards import check_count, check_inputs, check_range, check_result, check_stability
 from .kernels import kernel, resolve_backend
 from .precision import check_dps, run_mpmath
-from .progress import Progress, progress_wanted
 from .samples import n_samples, sample_steps, sample_times
 
 #: Largest sample array accepted (bytes); beyond it, sample less often (larger ``every``).
