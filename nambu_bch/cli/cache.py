@@ -34,6 +34,9 @@ def cached_text(request, compute) -> str:
     """``compute()`` (a str), read from the cache when the same ``request`` was answered by the same source."""
     try:
         path = _directory() / (_key(request) + ".txt")
+    except OSError:  # the package's files cannot be read for the key: no cache
+        return compute()
+    try:
         return path.read_text(encoding="utf-8")
     except (OSError, UnicodeDecodeError):
         pass
@@ -43,6 +46,6 @@ def cached_text(request, compute) -> str:
 
         path.parent.mkdir(parents=True, exist_ok=True)
         write_atomic(path, text)
-    except (OSError, NameError):
+    except OSError:
         pass
     return text
