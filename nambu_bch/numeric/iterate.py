@@ -32,7 +32,7 @@ from ..systems import System, model
 from .guards import check_count, check_inputs, check_range, check_result, check_stability
 from .kernels import kernel, resolve_backend
 from .precision import check_dps, run_mpmath
-from .samples import n_samples, sample_steps, sample_times
+from .samples import n_samples, sample_steps
 
 #: Largest sample array accepted (bytes); beyond it, sample less often (larger ``every``).
 MAX_SAMPLE_BYTES = 16 * 2**30
