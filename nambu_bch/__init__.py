@@ -41,6 +41,13 @@ def __dir__():
     return sorted(set(globals()) | set(_WHERE))
 
 
+def clear_caches() -> None:
+    """Empty every in-memory cache of the package (:func:`nambu_bch.caches.clear_caches`)."""
+    from .caches import clear_caches as clear
+
+    clear()
+
+
 __version__ = "0.1.0"
 
-__all__ = sorted([*_WHERE, "NambuBCHError", "errors"])
+__all__ = sorted([*_WHERE, "NambuBCHError", "clear_caches", "errors"])

@@ -25,18 +25,11 @@ from __future__ import annotations
 
 import os
 import stat
+import tomllib
 
 from .errors import InvalidSystemError
 from .parsing import parse_expression
 from .systems.system import USER_NAME, check_name
-
-try:  # Python >= 3.11
-    import tomllib
-except ModuleNotFoundError:  # pragma: no cover - Python 3.10 with tomli installed
-    try:
-        import tomli as tomllib
-    except ModuleNotFoundError:
-        tomllib = None
 
 #: Largest accepted model file, in bytes.
 MAX_FILE_SIZE = 64 * 1024
@@ -75,8 +68,6 @@ def load_system(path, values: dict | None = None):
     from .systems import System
 
     shown = os.fspath(path)
-    if tomllib is None:  # pragma: no cover
-        raise InvalidSystemError("--system needs Python >= 3.11 (tomllib) or the 'tomli' package")
     raw = _read_regular_file(shown)
     try:
         data = tomllib.loads(raw.decode("utf-8"))

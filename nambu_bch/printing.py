@@ -33,12 +33,13 @@ import re
 
 import sympy
 
+from .symbols import STEP
+
 __all__ = [
     "Printable", "HSeries", "bracket_sum", "WIDTH", "h_coefficients", "series_tokens", "series_text", "sum_tokens", "signed",
     "aligned", "latex_text", "display", "standalone", "flatten",
 ]
 
-H_STEP = sympy.Symbol("h")
 
 #: Estimated width of one display line, in characters of printed math (``article``, 10 pt, no overfull boxes).
 WIDTH = 58
@@ -76,7 +77,7 @@ def _by_monomial(expr, coordinates):
     return sympy.factor(expr)
 
 
-def h_coefficients(expr, base, coordinates, step=H_STEP):
+def h_coefficients(expr, base, coordinates, step=STEP):
     """``[(k, c_k)]`` with ``expr - base = sum_k c_k step^k``, lowest power first; ``None`` if not polynomial in ``step``.
 
     Each ``c_k`` is laid out by monomials of the coordinates with factored coefficients
@@ -149,7 +150,7 @@ def sum_tokens(expr, first=True) -> list:
     return [tok for i, t in enumerate(terms) for tok in _term_tokens(t, first and i == 0)]
 
 
-def series_tokens(base_latex, expr, base, coordinates, remainder=None, step=H_STEP) -> list:
+def series_tokens(base_latex, expr, base, coordinates, remainder=None, step=STEP) -> list:
     r"""Tokens of ``base + h^k (c_k) + ... + O(h^remainder)``; ``\Bigl( \Bigr)`` may span line breaks.
 
     Falls back to ``base + (expr - base)`` term by term when the difference is not
@@ -181,7 +182,7 @@ def series_tokens(base_latex, expr, base, coordinates, remainder=None, step=H_ST
     return tokens
 
 
-def series_text(base_text, expr, base, coordinates, remainder=None, step=H_STEP) -> str:
+def series_text(base_text, expr, base, coordinates, remainder=None, step=STEP) -> str:
     """Plain-text twin of :func:`series_tokens`: ``H + h**2*(...) - h**4*x1**2/12 + O(h^4)``.
 
     >>> x, h = sympy.symbols("x h")
@@ -238,7 +239,7 @@ class HSeries(Printable):
         return f"HSeries({self.lhs!r}, {self.expr})"
 
 
-def bracket_sum(lhs, items, names=None, remainder=None, step=H_STEP) -> str:
+def bracket_sum(lhs, items, names=None, remainder=None, step=STEP) -> str:
     r"""``lhs &= c_1 h^{k_1} [X,[X,X]] + ...`` as an ``aligned`` block, one token per bracket term.
 
     ``items`` are ``(coefficient, tree, power_of_h)``; trees are printed by

@@ -1,6 +1,6 @@
 """Rendering of results as text, LaTeX or JSON, and atomic output files.
 
-JSON convention (DESIGN.md, "Public surface"): every symbolic expression is a
+JSON convention (docs/json.md, "Conventions"): every symbolic expression is a
 string that ``sympy.sympify`` reads back with the system's symbol names, e.g.
 ``sympify(data["H_S"], locals={"x1": Symbol("x1"), ..., "h": Symbol("h")})``
 (``str`` of a sympy expression; no floats appear in symbolic output); numbers
@@ -156,65 +156,41 @@ def write_output(text: str, path) -> None:
 
 
 # --------------------------------------------------------------------------------------------
-# the eight fundamental-identity forms, generically (Eqs. 1AX-2BY)
+# the eight fundamental-identity forms, printed from shadow.fundamental_identity.formal_form (Eqs. 1AX-2BY)
 # --------------------------------------------------------------------------------------------
-def _fi_commutator(left, right, way, sign):
-    """``sign * [X_left, X_right]`` as ``[(sign, slots)]`` with slots as bracket strings (Eqs. CL2a, CL2b)."""
-    base, other, s = (right, left, 1) if way == "a" else (left, right, -1)
-    out = []
-    for j in range(len(base)):
-        slots = list(base)
-        slots[j] = "{" + ",".join([base[j], *other]) + "}"
-        out.append((sign * s, tuple(slots)))
-    return out
+def _fi_terms(label: str, bracket_open: str, bracket_close: str) -> list:
+    """Signed terms ``"+ X_{..}"`` of the right-hand side of Eq. (label), braces of the slots written as given."""
+    from .shadow.fundamental_identity import formal_form
 
+    def slot(text):
+        return text.replace("{", bracket_open).replace("}", bracket_close)
 
-def fi_form(label: str) -> list:
-    """``[(sign, (slot1, slot2)), ...]`` of ``[X_{A,B}, [X_{C,D}, X_{E,F}]]`` in representation ``label``.
-
-    ``label[0]``: ``1`` uses the fundamental identity on the first term of Eq. (CL2) (Eq. CL2a),
-    ``2`` on the second (Eq. CL2b); ``label[1]`` (``A``/``B``) and ``label[2]`` (``X``/``Y``) make
-    the same choice for Eqs. (CL3) and (CL4).  Slots are strings in the paper's bracket notation.
-
-    >>> [(s, ",".join(t)) for s, t in fi_form("1AX")]     # Eq. (1AX)
-    [(1, '{{E,C,D},A,B},F'), (1, '{E,C,D},{F,A,B}'), (1, '{E,A,B},{F,C,D}'), (1, 'E,{{F,C,D},A,B}')]
-    """
-    if len(label) != 3 or label[0] not in "12" or label[1] not in "AB" or label[2] not in "XY":
-        raise ValueError(f"FI label must be one of 1AX..2BY, got {label!r}")
-    inner = "a" if label[0] == "1" else "b"
-    outer = ("a" if label[1] == "A" else "b", "a" if label[2] == "X" else "b")
-    out = []
-    for (sign, slots), way in zip(_fi_commutator(("C", "D"), ("E", "F"), inner, 1), outer):
-        out.extend(_fi_commutator(("A", "B"), slots, way, sign))
-    return out
+    return [("+ " if s > 0 else "- ") + "X_{" + ",".join(slot(t) for t in slots) + "}" for s, slots in formal_form(label)]
 
 
 def fi_form_text(label: str) -> str:
-    terms = fi_form(label)
-    body = " ".join(("+ " if s > 0 else "- ") + "X_{" + ",".join(slots) + "}" for s, slots in terms)
-    return "[X_{A,B},[X_{C,D},X_{E,F}]] = " + body.lstrip("+ ")
+    """``[X_{A,B},[X_{C,D},X_{E,F}]] = ...`` in representation ``label``, plain text (Eqs. 1AX-2BY).
+
+    >>> fi_form_text("1AX")
+    '[X_{A,B},[X_{C,D},X_{E,F}]] = X_{{{E,C,D},A,B},F} + X_{{E,C,D},{F,A,B}} + X_{{E,A,B},{F,C,D}} + X_{E,{{F,C,D},A,B}}'
+    """
+    return "[X_{A,B},[X_{C,D},X_{E,F}]] = " + " ".join(_fi_terms(label, "{", "}")).lstrip("+ ")
 
 
 def fi_form_tokens(label: str) -> list:
     """The right-hand side of :func:`fi_form_latex` as signed LaTeX terms (for line breaking)."""
-
-    def lx(text):
-        return text.replace("{", r"\{").replace("}", r"\}")
-
-    tokens = [("+ " if s > 0 else "- ") + "X_{" + ",".join(lx(t) for t in slots) + "}" for s, slots in fi_form(label)]
+    tokens = _fi_terms(label, r"\{", r"\}")
     tokens[0] = tokens[0][2:] if tokens[0].startswith("+ ") else tokens[0]
     return tokens
 
 
-FI_LABELS = ("1AX", "1AY", "1BX", "1BY", "2AX", "2AY", "2BX", "2BY")
-
-
-def fi_forms_latex(labels=FI_LABELS) -> str:
+def fi_forms_latex(labels=None) -> str:
     r"""The eight forms of ``[X_{A,B},[X_{C,D},X_{E,F}]]`` (Eqs. 1AX-2BY) as one ``aligned`` block, aligned at ``=``."""
     from .printing import aligned
+    from .shadow.fundamental_identity import FI_LABELS
 
     lhs = "[X_{A,B},[X_{C,D},X_{E,F}]]"
-    return aligned([(lhs, rf"\overset{{\rm {lab}}}{{=}}", fi_form_tokens(lab)) for lab in labels])
+    return aligned([(lhs, rf"\overset{{\rm {lab}}}{{=}}", fi_form_tokens(lab)) for lab in labels or FI_LABELS])
 
 
 def fi_representations_latex(title: str, coefficient, commutator, forms) -> str:
@@ -236,9 +212,5 @@ def fi_representations_latex(title: str, coefficient, commutator, forms) -> str:
 
 
 def fi_form_latex(label: str) -> str:
-    def lx(text):
-        return text.replace("{", r"\{").replace("}", r"\}")
-
-    terms = fi_form(label)
-    body = " ".join(("+ " if s > 0 else "- ") + "X_{" + ",".join(lx(t) for t in slots) + "}" for s, slots in terms)
-    return r"[X_{A,B},[X_{C,D},X_{E,F}]] \overset{\rm " + label + "}{=} " + body.lstrip("+ ")
+    r"""``[X_{A,B},[X_{C,D},X_{E,F}]] \overset{\rm label}{=} ...`` in LaTeX (Eqs. 1AX-2BY)."""
+    return r"[X_{A,B},[X_{C,D},X_{E,F}]] \overset{\rm " + label + "}{=} " + " ".join(fi_form_tokens(label))

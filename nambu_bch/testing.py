@@ -32,6 +32,7 @@ from __future__ import annotations
 import pytest
 import sympy
 
+from .symbols import STEP
 from .systems import model
 
 __all__ = [
@@ -41,8 +42,6 @@ __all__ = [
     "liouville_components",
 ]
 
-H = sympy.Symbol("h")
-ALPHA = sympy.Symbol("alpha")
 
 
 # --------------------------------------------------------------------------------------------
@@ -98,11 +97,11 @@ def _zero_or_simplified(expr):
 def _truncate(expr, order):
     """Coefficients of ``h^0 .. h^order`` of ``expr`` (a polynomial in ``h`` or a series)."""
     expr = sympy.expand(expr)
-    if expr.is_polynomial(H):
-        poly = sympy.Poly(expr, H)
-        return [_zero_or_simplified(poly.coeff_monomial(H**k)) for k in range(order + 1)]
-    series = sympy.series(expr, H, 0, order + 1).removeO()
-    return [_zero_or_simplified(sympy.expand(series).coeff(H, k)) for k in range(order + 1)]
+    if expr.is_polynomial(STEP):
+        poly = sympy.Poly(expr, STEP)
+        return [_zero_or_simplified(poly.coeff_monomial(STEP**k)) for k in range(order + 1)]
+    series = sympy.series(expr, STEP, 0, order + 1).removeO()
+    return [_zero_or_simplified(sympy.expand(series).coeff(STEP, k)) for k in range(order + 1)]
 
 
 def _residual_report(coordinates, residuals, header):
@@ -194,15 +193,15 @@ def _shadow_residuals(system, hams, X_eff, order):
     """
     from .algebra import VectorField, liouville_field
 
-    allowed = set(system.coordinates) | set(system.parameters) | {H}
+    allowed = set(system.coordinates) | set(system.parameters) | {STEP}
     extra = sorted(set().union(*(sympy.sympify(Hk).free_symbols for Hk in hams)) - allowed, key=str)
-    algebra = system.algebra.with_constants(H, *extra)
+    algebra = system.algebra.with_constants(STEP, *extra)
     converted = [algebra.convert(Hk) for Hk in hams]
     if all(algebra.is_polynomial(c) for c in converted):
         X_S = liouville_field(algebra, *converted)
         rhs = VectorField(algebra, X_eff.to_sympy())
         if all(algebra.is_polynomial(c) for c in (*X_S.components, *rhs.components)):
-            index = algebra.n + algebra.constants.index(H)
+            index = algebra.n + algebra.constants.index(STEP)
             diffs = [a - b for a, b in zip(X_S.components, rhs.components)]
             out = []
             for k in range(order + 1):
@@ -217,7 +216,7 @@ def _shadow_residuals(system, hams, X_eff, order):
     return [[c[k] for c in columns] for k in range(order + 1)]
 
 
-def assert_invariant(system, word, I, h=H):
+def assert_invariant(system, word, I, h=STEP):
     """Assert that ``I`` is an exact invariant of the composed map: ``I(Phi_h(x)) - I(x) = 0``.
 
     ``Phi_h`` is :func:`~nambu_bch.integrators.composed_map` (exact in ``h``,

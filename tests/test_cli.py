@@ -1,16 +1,19 @@
 """The ``nambu-bch`` command line.
 
-Every subcommand and flag runs at least once as a subprocess
-(``python -m nambu_bch``), checking exit codes and that JSON output reads back
-with ``sympy.sympify`` using the model's symbol names.  Subprocesses run two at
-a time (the machine has two cores).  Most bad-input cases run in-process
-through ``main(argv)``: one line on stderr, exit code 2, no traceback; a few
-run as subprocesses too, including an injection attempt that must not create
-a file.
+Every subcommand and flag runs at least once, checking exit codes and that JSON
+output reads back with ``sympy.sympify`` using the model's symbol names.  The
+runs go through ``main(argv)`` in process (stdout and stderr captured): a
+subprocess adds nothing to them but the interpreter start and the imports.  One
+subprocess per subcommand (``python -m nambu_bch``, two at a time: the machine
+has two cores) and the console script keep the entry points honest.  Bad input:
+one line on stderr, exit code 2, no traceback, including an injection attempt
+that must not create a file.
 """
 
 from __future__ import annotations
 
+import contextlib
+import io
 import json
 import os
 import subprocess
@@ -33,15 +36,50 @@ x1, x2, x3, m, omega, h, alpha = sympy.symbols("x1 x2 x3 m omega h alpha")
 # --------------------------------------------------------------------------------------------
 # helpers
 # --------------------------------------------------------------------------------------------
-def cli(*args, cwd=REPO, executable=None):
+def subprocess_cli(*args, cwd=REPO, executable=None):
+    """``python -m nambu_bch ARGS`` (or the console script ``executable``) as a subprocess."""
     command = [executable] if executable else [sys.executable, "-m", "nambu_bch"]
     return subprocess.run([*command, *map(str, args)], cwd=cwd, env=ENV, capture_output=True, text=True, timeout=600)
 
 
+def cli(*args):
+    """``main(ARGS)`` in process, as a ``CompletedProcess`` (exit status, captured stdout and stderr)."""
+    out, err = io.StringIO(), io.StringIO()
+    argv = [str(a) for a in args]
+    with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
+        code = main(argv)
+    return subprocess.CompletedProcess(argv, code, out.getvalue(), err.getvalue())
+
+
 def cli_many(*argvs):
-    """Run several CLI invocations, two at a time."""
+    """Several CLI invocations in process, one after the other."""
+    return [cli(*argv) for argv in argvs]
+
+
+# one run of every subcommand through the interpreter's entry point (python -m nambu_bch)
+SMOKE = (
+    ("models", "--model", "ho"),
+    ("bch", "--model", "ho", "--integrator", "TVT", "--format", "text"),
+    ("fi", "--format", "text"),
+    ("shadow", "--model", "ho", "--integrator", "TVT", "--format", "json"),
+    ("conserved", "--model", "ho", "--integrator", "TVT", "--format", "text"),
+    ("exact", "--model", "ho", "--integrator", "TVT", "--format", "text"),
+    ("check", "--model", "ho", "--steps", "10", "--format", "json"),
+    ("plot", "--help"),
+    ("compare", "--model", "ho", "--integrator", "TVT", "--integrator", "VTV", "--step-counts", "10,20", "--t-end", "1"),
+)
+
+
+def test_every_subcommand_runs_as_a_subprocess():
+    """``python -m nambu_bch SUBCOMMAND ...``: exit 0, output on stdout, no traceback; the symbolic output is byte for
+    byte the in-process one (numeric reports carry timings, help text the terminal width)."""
     with ThreadPoolExecutor(max_workers=2) as pool:
-        return list(pool.map(lambda argv: cli(*argv), argvs))
+        runs = list(pool.map(lambda argv: subprocess_cli(*argv), SMOKE))
+    for argv, done in zip(SMOKE, runs):
+        assert done.returncode == 0 and "Traceback" not in done.stderr, (argv, done.stderr[-2000:])
+        assert done.stdout.strip(), argv
+        if argv[0] in ("models", "bch", "fi", "shadow", "conserved", "exact"):
+            assert done.stdout == cli(*argv).stdout, argv
 
 
 def ok(done):
@@ -96,7 +134,7 @@ def test_help_version_and_console_script(tmp_path):
     bad(runs[2], "subcommand")
     script = Path(sys.executable).with_name("nambu-bch")
     if script.exists():  # the console script of pyproject's [project.scripts]
-        assert "shadow" in ok(cli("--help", executable=str(script), cwd=tmp_path))
+        assert "shadow" in ok(subprocess_cli("--help", executable=str(script), cwd=tmp_path))
 
 
 def test_help_of_every_subcommand_has_an_example(capsys):
@@ -244,7 +282,7 @@ PAPER_FI = {
 
 
 def test_fi_forms_match_the_paper():
-    from nambu_bch.render import fi_form
+    from nambu_bch.shadow.fundamental_identity import formal_form as fi_form
 
     for label, text in PAPER_FI.items():
         got = " ".join(("+" if sign > 0 else "-") + ",".join(slots) for sign, slots in fi_form(label))
@@ -308,11 +346,13 @@ def test_plot(tmp_path):
 # --------------------------------------------------------------------------------------------
 def test_bad_input_as_subprocess(tmp_path):
     target = tmp_path / "pwned"
-    runs = cli_many(
+    argvs = (
         ("conserved", "--H", f"__import__('os').system('touch {target}')", "--coords", "x1 x2"),
         ("models", "--system", tmp_path / "missing.toml"),
         ("bch", "--frobnicate"),
     )
+    with ThreadPoolExecutor(max_workers=2) as pool:
+        runs = list(pool.map(lambda argv: subprocess_cli(*argv), argvs))
     bad(runs[0], "--H", "not accepted")
     assert not target.exists() and not Path("/tmp/pwned").exists()
     bad(runs[1], "--system", "missing.toml")

@@ -9,9 +9,6 @@ checked a second, independent way (hand computation or the formal BCH engine).
 from __future__ import annotations
 
 import json
-import os
-import subprocess
-import sys
 from fractions import Fraction
 from math import factorial
 from pathlib import Path
@@ -40,8 +37,6 @@ from nambu_bch.design.compare import slope
 from nambu_bch.design.words import log_coefficients, lyndon_defect_words, lyndon_defects, word_coefficient
 from nambu_bch.errors import InvalidCompositionError, InvalidOrderError, InvalidRunError, NambuBCHError
 
-REPO = Path(__file__).resolve().parents[1]
-ENV = {**os.environ, "PYTHONPATH": str(REPO)}
 F1 = Fraction(1)
 F0 = Fraction(0)
 
@@ -397,13 +392,10 @@ def test_compare_bad_input():
 def test_cli_compare(tmp_path):
     fig = tmp_path / "wp.png"
     out = tmp_path / "wp.json"
-    r = subprocess.run(
-        [sys.executable, "-m", "nambu_bch", "compare", "--model", "ho", "--integrator", "121", "--integrator",
-         "forest-ruth", "--t-end", "2", "--step-counts", "10,20,40", "--format", "json", "--output", str(out),
-         "--figure", str(fig)],
-        capture_output=True, text=True, env=ENV, timeout=600,
-    )
-    assert r.returncode == 0, r.stderr
+    # in process (tests/test_cli.py runs compare once as a subprocess)
+    code = main(["compare", "--model", "ho", "--integrator", "121", "--integrator", "forest-ruth", "--t-end", "2",
+                 "--step-counts", "10,20,40", "--format", "json", "--output", str(out), "--figure", str(fig)])
+    assert code == 0
     data = json.loads(out.read_text())
     assert [row["order"] for row in data["integrators"]] == [2, 4]
     assert fig.read_bytes()[:4] == b"\x89PNG"

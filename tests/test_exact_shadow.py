@@ -127,10 +127,9 @@ def test_order_four_shadow_equation():
 
 
 def _bch_family(word, order):
-    shadow = pytest.importorskip("nambu_bch.shadow")
-    if not hasattr(shadow, "shadow_hamiltonians"):
-        pytest.skip("nambu_bch.shadow.shadow_hamiltonians has not landed")
-    fam = shadow.shadow_hamiltonians(model("ho3"), word, order=order)
+    from nambu_bch.shadow import shadow_hamiltonians
+
+    fam = shadow_hamiltonians(model("ho3"), word, order=order)
     assert fam.exists
     return fam
 

@@ -378,12 +378,12 @@ def test_expansion_estimate_two_ways():
 # item 10: Ctrl-C and a closed stdout
 # =============================================================================================
 def test_keyboard_interrupt_in_main_is_one_line(monkeypatch, capsys):
-    import nambu_bch.cli as cli
+    import nambu_bch.cli.models as models
 
     def interrupted(args):
         raise KeyboardInterrupt
 
-    monkeypatch.setattr(cli, "cmd_models", interrupted)
+    monkeypatch.setattr(models, "run", interrupted)
     assert main(["models"]) == 130
     err = capsys.readouterr().err
     assert err.strip() == "nambu-bch models: interrupted"

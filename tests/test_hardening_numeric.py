@@ -179,9 +179,29 @@ def test_check_non_finite_is_refused_without_warnings(kwargs, phrase):
             check("ho3", "32123", 0.1, 100, args["x0"], alpha=kwargs.get("alpha", 0.5))
 
 
-def _cli(*argv, env=None):
-    return subprocess.run([sys.executable, "-m", "nambu_bch", *argv], capture_output=True, text=True, timeout=300,
-                          env={**os.environ, **(env or {})})
+#: Warnings a fresh interpreter does not print by default (``python -W default`` shows them).
+_SILENT_BY_DEFAULT = (DeprecationWarning, PendingDeprecationWarning, ImportWarning, ResourceWarning)
+
+
+def _cli(*argv):
+    """``nambu-bch ARGV`` through ``main(argv)`` in process, as a ``CompletedProcess``.
+
+    Warnings are recorded and written to the captured stderr as the interpreter would print
+    them (those it shows by default), so "no numpy warning on stderr" is tested as before.
+    """
+    import contextlib
+    import io
+
+    from nambu_bch.cli import main
+
+    out, err = io.StringIO(), io.StringIO()
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
+            code = main(list(argv))
+    shown = "".join(f"{w.filename}:{w.lineno}: {w.category.__name__}: {w.message}\n"
+                    for w in caught if not issubclass(w.category, _SILENT_BY_DEFAULT))
+    return subprocess.CompletedProcess(list(argv), code, out.getvalue(), err.getvalue() + shown)
 
 
 @pytest.mark.parametrize("argv", [

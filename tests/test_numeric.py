@@ -25,7 +25,7 @@ from nambu_bch.integrators import step_function
 from nambu_bch.numeric import iterate, kernel, n_samples, sample_steps, sample_times, step_program
 from nambu_bch.numeric.codegen import c_source, python_source
 from nambu_bch.numeric.kernels import numba_available, resolve_backend
-from nambu_bch.numeric.progress import Progress
+from nambu_bch.progress import Progress
 
 numba_only = pytest.mark.skipif(not numba_available(), reason="numba not installed or disabled")
 

@@ -136,7 +136,7 @@ def test_user_text_cannot_reach_latex_unescaped():
 # -- progress (item 3) ----------------------------------------------------------------------------------------------
 def test_progress_bar_captured_off_a_tty():
     """A tqdm bar drawn into a StringIO when enabled; nothing when automatic (a StringIO is not a terminal)."""
-    from nambu_bch.numeric.progress import Progress, stages
+    from nambu_bch.progress import Progress, stages
 
     stream = io.StringIO()
     with Progress(2000, "iterate ho3 32123", enabled=True, stream=stream, delay=0, interval=0) as p:

@@ -23,6 +23,7 @@ from sympy.polys.polyerrors import CoercionFailed, GeneratorsError, PolynomialEr
 from sympy.polys.rings import PolyElement, ring
 
 from ..errors import InvalidSystemError
+from .zero import is_zero
 
 _CONVERSION_ERRORS = (CoercionFailed, GeneratorsError, PolynomialError, ValueError, TypeError)
 
@@ -103,9 +104,6 @@ class PolynomialAlgebra:
             return value.as_expr()
         return sympy.sympify(value)
 
-    def to_general(self, value) -> sympy.Expr:
-        return self.to_sympy(value)
-
     @cached_property
     def zero(self):
         return self.ring.zero
@@ -118,13 +116,10 @@ class PolynomialAlgebra:
         return sympy.diff(value, self.coordinates[index])
 
     def is_zero(self, value) -> bool:
-        """Exact zero test: structural for polynomials, ``simplify`` for the rest."""
+        """Exact zero test: structural for polynomials, :func:`nambu_bch.algebra.zero.is_zero` for the rest."""
         if isinstance(value, PolyElement):
             return not value
-        value = sympy.sympify(value)
-        if value == 0:
-            return True
-        return sympy.expand(value) == 0 or sympy.simplify(value) == 0
+        return is_zero(value)
 
     def common(self, *values):
         """The values in one representation: all ring elements if possible, else all sympy."""

@@ -14,6 +14,7 @@ from __future__ import annotations
 import sympy
 
 from ..errors import NambuBCHError
+from .zero import is_zero
 
 
 def jacobian(map_components, coordinates) -> sympy.Matrix:
@@ -23,11 +24,6 @@ def jacobian(map_components, coordinates) -> sympy.Matrix:
             f"a map of {len(coordinates)} coordinates needs {len(coordinates)} components, got {len(map_components)}"
         )
     return sympy.Matrix(map_components).jacobian(sympy.Matrix(coordinates))
-
-
-def _is_zero(expr) -> bool:
-    expr = sympy.expand(expr)
-    return expr == 0 or sympy.simplify(expr) == 0
 
 
 def _ring_condition(map_components, coordinates):
@@ -73,7 +69,7 @@ def satisfies_nambu_condition(map_components, coordinates) -> bool:
     result = _ring_condition(map_components, coordinates)
     if result is not None:
         return result
-    return _is_zero(jacobian(map_components, coordinates).det(method="berkowitz") - 1)
+    return is_zero(jacobian(map_components, coordinates).det(method="berkowitz") - 1)
 
 
 def is_symplectic(map_components, coordinates) -> bool:
@@ -86,4 +82,4 @@ def is_symplectic(map_components, coordinates) -> bool:
     eps = sympy.zeros(n)
     for i in range(k):
         eps[i, i + k], eps[i + k, i] = 1, -1
-    return all(_is_zero(e) for e in (J * eps * J.T - eps))
+    return all(is_zero(e) for e in (J * eps * J.T - eps))

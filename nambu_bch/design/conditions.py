@@ -32,6 +32,7 @@ from sympy.polys.constructor import construct_domain
 from sympy.polys.domains import QQ
 from sympy.polys.rings import ring
 
+from ..checks import is_int
 from ..errors import InvalidCompositionError, InvalidOrderError
 from ..integrators.composition import Composition
 from ..integrators.composition import composition as make_composition
@@ -42,7 +43,7 @@ MAX_DEGREE = 12
 
 
 def _check_parts(parts):
-    if parts is not None and (isinstance(parts, bool) or not isinstance(parts, int) or parts < 1):
+    if parts is not None and not is_int(parts, 1):
         raise InvalidCompositionError(f"parts must be a positive integer (the number of pieces X_1..X_n), got {parts!r}")
     return parts
 
@@ -268,10 +269,10 @@ def template(spec, parts: int | None = None, stages: int | None = None) -> Templ
         if set(pieces) != set(range(1, n + 1)):
             raise InvalidCompositionError(f"template {spec!r} must use every piece 1..{n}")
         return Template(f"{kind}:{word}", n, pieces, coeffs, unknowns, "word")
-    if isinstance(stages, bool) or not isinstance(stages, int) or stages < 1:
+    if not is_int(stages, 1):
         raise InvalidCompositionError(f"template {spec!r} needs stages = a positive integer (number of base steps), got {stages!r}")
     if text == "strang":
-        if isinstance(parts, bool) or not isinstance(parts, int) or parts < 2:
+        if not is_int(parts, 2):
             raise InvalidCompositionError(f"template 'strang' needs parts >= 2 (the number of pieces), got {parts!r}")
         word = "".join(str(k) for k in range(1, parts + 1))
         word = word + word[-2::-1]
@@ -371,7 +372,7 @@ def order_conditions(spec, order: int, parts: int | None = None, stages: int | N
     [2*gamma1 + gamma2 - 1, 2*gamma1**3 + gamma2**3]
     """
     T = template(spec, parts, stages)
-    if isinstance(order, bool) or not isinstance(order, int) or order < 1:
+    if not is_int(order, 1):
         raise InvalidOrderError(f"order must be a positive integer, got {order!r}")
     if order >= MAX_DEGREE:
         raise InvalidOrderError(f"order conditions are generated up to order {MAX_DEGREE - 1}, got {order}")

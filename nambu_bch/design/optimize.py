@@ -45,6 +45,7 @@ import mpmath
 import numpy as np
 import sympy
 
+from ..checks import is_int
 from ..errors import InvalidOrderError, NambuBCHError
 from ..integrators.composition import Composition
 from .conditions import _Exact, error_analysis, order_conditions, symbolic_defects, template
@@ -255,12 +256,12 @@ def optimize_composition(spec, parts: int | None = None, order: int = 4, stages:
     (True, 4, 3.7163)
     """
     T = template(spec, parts, stages)
-    if isinstance(order, bool) or not isinstance(order, int) or order < 1:
+    if not is_int(order, 1):
         raise InvalidOrderError(f"order must be a positive integer, got {order!r}")
     n = len(T.unknowns)
     if n > MAX_UNKNOWNS:
         raise InvalidOrderError(f"template {T.name!r} has {n} unknowns; the search accepts at most {MAX_UNKNOWNS}")
-    if isinstance(dps, bool) or not isinstance(dps, int) or not 15 <= dps <= 200:
+    if not is_int(dps, 15, 200):
         raise InvalidOrderError(f"dps must be an integer in 15..200, got {dps!r}")
     conds = order_conditions(T, order)
     eqs = conds.polynomials

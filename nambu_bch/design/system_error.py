@@ -28,15 +28,16 @@ import numpy as np
 import sympy
 
 from ..bch import effective_field
+from ..checks import is_int
 from ..errors import InvalidOrderError, InvalidRunError
 from ..integrators.composition import composition_for
 from ..integrators.step import parameter_values
 from ..numeric.iterate import as_system
 from .conditions import error_analysis
+from ..symbols import STEP
 
 #: Highest power of ``h`` searched for the leading term.
 MAX_POWER = 8
-STEP = sympy.Symbol("h")
 
 
 @dataclass(frozen=True)
@@ -98,7 +99,7 @@ def _box(system, box):
 def field_size(components, system, box=None, samples: int = 2000, params=None, seed: int = 0) -> float:
     """``max ||F(x)||_2`` of a polynomial field over a seeded uniform sample of ``box`` (default ``[-1, 1]^N``)."""
     box = _box(system, box)
-    if isinstance(samples, bool) or not isinstance(samples, int) or not 1 <= samples <= 10**7:
+    if not is_int(samples, 1, 10**7):
         raise InvalidRunError(f"samples must be an integer in 1..10^7, got {samples!r}")
     values = parameter_values(system, params)
     exprs = [sympy.sympify(c).subs(values) for c in components]

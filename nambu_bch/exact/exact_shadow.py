@@ -34,21 +34,21 @@ from functools import lru_cache
 import sympy
 
 from ..algebra import liouville_field
+from ..algebra.zero import is_zero
 from ..bch import effective_field
 from ..errors import NoExactResultError
 from .factor import F, F_series
-from .invariants import ConservedQuantities, conserved_quantities, has_radicals
+from .invariants import ConservedQuantities, conserved_quantities
 from .linear_core import linear_core
 from ..printing import Printable, aligned, series_text, series_tokens
+from ..symbols import ALPHA, STEP
 
-H_STEP = sympy.Symbol("h")
-ALPHA = sympy.Symbol("alpha")
 OMEGA = sympy.Symbol("omega")
 #: Order in h through which X_eff = F(omega h) X_{H_c,G_c} is verified before an ExactShadow is returned.
 CHECK_ORDER = 8
 
 
-def truncate_h(expr, order: int, h=H_STEP):
+def truncate_h(expr, order: int, h=STEP):
     """``expr`` (a polynomial in ``h``) without the powers of ``h`` above ``order``."""
     expr = sympy.expand(expr)
     return sympy.Add(*[t for t in sympy.Add.make_args(expr) if sympy.degree(t, h) <= order])
@@ -62,7 +62,7 @@ def factor_power_series(exponent, order: int, x=None):
     >>> factor_power_series(ALPHA, 2)
     alpha*h**2*omega**2/6 + 1
     """
-    x = OMEGA * H_STEP if x is None else x
+    x = OMEGA * STEP if x is None else x
     u = F_series(x, order) - 1
     total, term = sympy.Integer(1), sympy.Integer(1)
     for k in range(1, order // 2 + 1):
@@ -108,25 +108,18 @@ class ExactShadow(Printable):
 
         Eqs. (ESH12321), (ESG12321) are ``series(2)`` for ``ho3`` and ``12321``.
         """
-        x = self.frequency * H_STEP
+        x = self.frequency * STEP
         if self.G_S is None:
             return (truncate_h(factor_power_series(1, order, x) * self.H_c, order), None)
         H = truncate_h(factor_power_series(ALPHA, order, x) * self.H_c, order)
         G = truncate_h(factor_power_series(1 - ALPHA, order, x) * self.G_c, order)
-        return (sympy.collect(H, H_STEP), sympy.collect(G, H_STEP))
-
-    def field_series(self, order: int) -> tuple:
-        """The components of ``X_eff = F(omega h) X_{H_c,G_c}`` through ``h^order`` (sympy)."""
-        system = self.conserved.system
-        Xc = liouville_field(system.algebra, *self.conserved.hamiltonians_c).to_sympy()
-        Fs = F_series(self.frequency * H_STEP, order)
-        return tuple(truncate_h(Fs * c, order) for c in Xc)
+        return (sympy.collect(H, STEP), sympy.collect(G, STEP))
 
     def remainder_power(self, order: int) -> int:
         """The power ``p`` of the remainder ``O(h^p)`` after ``series(order)``: ``order + 2`` when the
         ``h^(order+1)`` coefficients vanish (checked exactly; an even series such as ho3's), else ``order + 1``."""
         nxt = self.series(order + 1)
-        zero = all(S is None or sympy.expand(S).coeff(H_STEP, order + 1) == 0 for S in nxt)
+        zero = all(S is None or sympy.expand(S).coeff(STEP, order + 1) == 0 for S in nxt)
         return order + 2 if zero else order + 1
 
     def _rows(self):
@@ -137,7 +130,7 @@ class ExactShadow(Printable):
         return [("H", "H", self.H_S, self.H_c, hams[0], r"\alpha"), ("G", "G", self.G_S, self.G_c, hams[1], r"1-\alpha")]
 
     def _factor_latex(self, exponent):
-        arg = r"\omega h" if self.frequency == OMEGA else rf"\left({sympy.latex(self.frequency * H_STEP)}\right)"
+        arg = r"\omega h" if self.frequency == OMEGA else rf"\left({sympy.latex(self.frequency * STEP)}\right)"
         return f"F({arg})" + ("" if exponent is None else f"^{{{exponent}}}")
 
     def to_latex(self, order=None) -> str:
@@ -160,7 +153,7 @@ class ExactShadow(Printable):
     def to_text(self, order=None) -> str:
         """Plain-text twin of :meth:`to_latex`."""
         coords = self.conserved.system.coordinates
-        arg = "omega*h" if self.frequency == OMEGA else f"{self.frequency * H_STEP}"
+        arg = "omega*h" if self.frequency == OMEGA else f"{self.frequency * STEP}"
         lines = [f"{tx}_S^e = F({arg})" + ("" if e is None else f"**({e.replace(chr(92), '')})") + f" * {tx}_c"
                  for _, tx, _, _, _, e in self._rows()]
         lines += [f"{tx}_c = " + series_text(tx, Ic, H, coords) for _, tx, _, Ic, H, _ in self._rows()]
@@ -179,7 +172,7 @@ class ExactShadow(Printable):
                "free_parameters": [] if self.G_S is None else ["alpha"]}
         if order is not None:
             names = [f"{tx}_S" for _, tx, *_ in self._rows()]
-            out["series"] = {name: {str(k): str(S.coeff(H_STEP, k)) for k in range(order + 1) if S.coeff(H_STEP, k) != 0}
+            out["series"] = {name: {str(k): str(S.coeff(STEP, k)) for k in range(order + 1) if S.coeff(STEP, k) != 0}
                              for name, S in zip(names, (sympy.expand(S) for S in self.series(order) if S is not None))}
             out["remainder_power"] = self.remainder_power(order)
         return out
@@ -231,15 +224,15 @@ def _exact_shadow(system, word, cq):
         )
     X = effective_field(system.splitting, word, CHECK_ORDER)
     Xc = [_taylor_in_h(c, CHECK_ORDER) for c in liouville_field(system.algebra, *cq.hamiltonians_c).to_sympy()]
-    Fs = F_series(omega * H_STEP, CHECK_ORDER)
+    Fs = F_series(omega * STEP, CHECK_ORDER)
     for j, Z in enumerate(X.coefficients):
         for zc, xc in zip(Z.to_sympy(), Xc):
-            if not _is_zero(sympy.expand(Fs * xc).coeff(H_STEP, j) - zc):
+            if not is_zero(sympy.expand(Fs * xc).coeff(STEP, j) - zc):
                 raise NoExactResultError(
                     f"no exact factor form for {what}: X_eff differs from F(omega h) X_(H_c,G_c) at order h^{j} "
                     "(exact shadow Hamiltonians exist here only for linear oscillators such as ho and ho3)"
                 )
-    Fx = F(omega * H_STEP)
+    Fx = F(omega * STEP)
     if system.N == 2:
         return ExactShadow(Fx * cq.H_c, None, Fx, cq, frequency=omega)
     return ExactShadow(Fx**ALPHA * cq.H_c, Fx ** (1 - ALPHA) * cq.G_c, Fx, cq, frequency=omega)
@@ -249,19 +242,9 @@ def _taylor_in_h(expr, order):
     """``expr`` through ``h^order``: itself if polynomial in ``h``, else its Taylor polynomial at ``h = 0``
     (conserved quantities of triple-jump compositions are rational in ``h``)."""
     expr = sympy.expand(expr)
-    if all(not sympy.fraction(sympy.together(t))[1].has(H_STEP) for t in sympy.Add.make_args(expr)):
+    if all(not sympy.fraction(sympy.together(t))[1].has(STEP) for t in sympy.Add.make_args(expr)):
         return truncate_h(expr, order)
-    return sympy.expand(sympy.series(expr, H_STEP, 0, order + 1).removeO())
-
-
-def _is_zero(expr) -> bool:
-    """Exact zero test; radicals (triple-jump coefficients) need rationalising before ``expand`` sees 0."""
-    expr = sympy.expand(expr)
-    if expr == 0:
-        return True
-    if not has_radicals(expr):
-        return False
-    return sympy.expand(sympy.radsimp(sympy.together(expr))) == 0
+    return sympy.expand(sympy.series(expr, STEP, 0, order + 1).removeO())
 
 
 def frequency(system):

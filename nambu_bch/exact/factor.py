@@ -34,6 +34,7 @@ import mpmath
 import numpy as np
 import sympy
 
+from ..checks import is_int
 from ..errors import NambuBCHError, NumericalRangeError, UnstableStepError
 
 #: Below this |x| the series is used (its 13 terms reach 2^-60 relative accuracy).
@@ -72,7 +73,7 @@ def F_series(x, order: int):
     >>> F_series(x, 8).coeff(x, 8) == sympy.factorial(4)**2 / sympy.factorial(9)
     True
     """
-    if isinstance(order, bool) or not isinstance(order, int) or order < 0:
+    if not is_int(order, 0):
         from ..errors import InvalidOrderError
 
         raise InvalidOrderError(f"order of F_series must be a non-negative integer, got {order!r}")

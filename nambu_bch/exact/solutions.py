@@ -44,8 +44,8 @@ from ..integrators.step import parameter_values
 from .exact_shadow import OMEGA, exact_shadow_hamiltonians, frequency
 from .invariants import conserved_quantities
 from .linear_core import linear_core
+from ..symbols import STEP
 
-H_STEP = sympy.Symbol("h")
 TIME = sympy.Symbol("t")
 KINDS = ("o", "c", "s")
 
@@ -183,7 +183,7 @@ class ModifiedSolution:
             x = complex(sympy.sympify(self.step_frequency).subs(values)) * h
             if abs(x.imag) > 0 or abs(x.real) >= 2:
                 raise UnstableStepError(f"the modified solution {self.kind!r} needs |omega h| < 2, got omega h = {x.real!r}")
-        args = (self.time, *self.initial_symbols, *values, H_STEP)
+        args = (self.time, *self.initial_symbols, *values, STEP)
         fn = _lambdify(args, self.expressions)
         pvals = tuple(values.values())
         n = len(self.initial_symbols)

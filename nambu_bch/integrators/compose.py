@@ -10,13 +10,13 @@ from __future__ import annotations
 
 import sympy
 
+from ..symbols import STEP
 from .composition import composition_for
 from .flows import TIME, exact_flow
 
-H = sympy.Symbol("h")
 
 
-def composed_map(splitting, comp, h=H) -> tuple:
+def composed_map(splitting, comp, h=STEP) -> tuple:
     """``Phi_h(x)`` as sympy expressions in the coordinates, parameters and ``h``.
 
     Examples

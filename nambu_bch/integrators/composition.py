@@ -54,6 +54,7 @@ from functools import lru_cache
 import sympy
 from sympy.polys.domains import QQ
 
+from ..checks import is_int
 from ..errors import InconsistentCoefficientsError, InvalidCompositionError, UnknownPieceError
 
 #: Names resolved by :mod:`nambu_bch.design.catalog` (literature methods, ``name`` or ``name:WORD``).
@@ -99,7 +100,7 @@ class Composition:
                 f"composition {_shown(self.name)} has {len(self.pieces)} factors; at most {MAX_FACTORS} are accepted"
             )
         for k in self.pieces:
-            if isinstance(k, bool) or not isinstance(k, int) or not 1 <= k <= MAX_FACTORS:
+            if not is_int(k, 1, MAX_FACTORS):
                 raise UnknownPieceError(
                     f"piece numbers are integers 1..{MAX_FACTORS}, got {k!r} in composition {_shown(self.name)}"
                 )
@@ -353,7 +354,7 @@ def composition(spec, n_pieces: int | None = None) -> Composition:
     (1, False)
     """
     if n_pieces is not None:
-        if isinstance(n_pieces, bool) or not isinstance(n_pieces, int) or not 1 <= n_pieces <= MAX_FACTORS:
+        if not is_int(n_pieces, 1, MAX_FACTORS):
             raise InvalidCompositionError(f"n_pieces must be a positive integer (the number of pieces), got {n_pieces!r}")
     if isinstance(spec, str):
         if len(spec) > MAX_TEXT:

@@ -5,13 +5,14 @@ mpmath fallbacks, optional Kahan summation); ``check`` measures every error the 
 predicts; ``paper_figures`` redraws Figs. 1-4; the studies answer speed-versus-accuracy questions.
 """
 
+from ..progress import Progress
 from .codegen import StepProgram, step_program
 from .diagnostics import (CheckResult, DriftFit, OrderFit, RunningStats, check, drift_rate, fit_order, observed_order,
                           quantities)
 from .figures import FigureSet, paper_figures
-from .iterate import iterate, iterate_chunks, n_samples, sample_steps, sample_times
+from .iterate import iterate, iterate_chunks
 from .kernels import Kernel, cache_dir, kernel, numba_available
-from .progress import Progress
+from .samples import n_samples, sample_steps, sample_times
 from .studies import HScan, PrecisionStudy, TruncationStudy, h_scan, precision_study, truncation_study
 
 __all__ = [

@@ -34,7 +34,8 @@ import sympy
 from ..errors import InvalidRunError, NambuBCHError
 from ..integrators.step import parameter_values
 from .diagnostics import _exact, _try, numpy_function, quantities
-from .iterate import as_system, iterate_chunks, n_samples
+from .iterate import as_system, iterate_chunks
+from .samples import n_samples
 
 #: File names written by :func:`paper_figures`.
 FIGURE_NAMES = ("fig1", "fig2", "fig3", "fig4")

@@ -27,11 +27,12 @@ import sys
 import numpy as np
 
 from ..errors import InvalidRunError, InvalidSystemError
+from ..progress import Progress, progress_wanted
 from ..systems import System, model
 from .guards import check_count, check_inputs, check_range, check_result, check_stability
 from .kernels import kernel, resolve_backend
 from .precision import check_dps, run_mpmath
-from .progress import Progress, progress_wanted
+from .samples import n_samples, sample_steps
 
 #: Largest sample array accepted (bytes); beyond it, sample less often (larger ``every``).
 MAX_SAMPLE_BYTES = 16 * 2**30
@@ -46,32 +47,6 @@ def as_system(system) -> System:
     if isinstance(system, str):
         return model(system)
     raise InvalidSystemError(f"system must be a nambu_bch System or a built-in model name, got {system!r}")
-
-
-def n_samples(steps: int, every: int) -> int:
-    """Number of samples of a run: ``ceil(steps / every) + 1``.
-
-    >>> n_samples(10, 5), n_samples(10, 3), n_samples(0, 4)
-    (3, 5, 1)
-    """
-    return -(-int(steps) // int(every)) + 1
-
-
-def sample_steps(steps: int, every: int = 1) -> np.ndarray:
-    """The step number of every sample: ``0, every, 2 every, ...``, ending at ``steps``.
-
-    >>> sample_steps(10, 3).tolist()
-    [0, 3, 6, 9, 10]
-    """
-    grid = np.arange(0, int(steps) + 1, int(every), dtype=np.int64)
-    if grid[-1] != steps:
-        grid = np.append(grid, np.int64(steps))
-    return grid
-
-
-def sample_times(h, steps: int, every: int = 1) -> np.ndarray:
-    """Times ``t = n h`` of the samples (float64)."""
-    return float(h) * sample_steps(steps, every).astype(np.float64)
 
 
 def iterate(system, word, h, steps, x0, params=None, every=1, *, kahan=False, dps=None,

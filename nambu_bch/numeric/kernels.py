@@ -61,7 +61,7 @@ import numpy as np
 
 from ..compiled import numba_available  # noqa: F401  (re-exported: nambu_bch.numeric.numba_available)
 from ..errors import InvalidRunError, NumericalRangeError
-from ..integrators.composition import composition as make_composition
+from ..integrators.composition import composition_for
 from ..integrators.step import parameter_values
 from .codegen import TEMPLATE_VERSION, python_source, source_hash, step_program
 
@@ -275,7 +275,6 @@ class Kernel:
         self.from_cache = self._load_cached()
         if not self.from_cache:
             self._generate()
-        self._constants = {}
         self._jitted = {}
         self.compile_seconds = {}
 
@@ -482,13 +481,13 @@ def kernel(system, word) -> Kernel:
     directory = str(cache_dir())
     if isinstance(word, str):  # resolving a word can be slow (triple jumps: exact algebraic coefficients)
         return _kernel_for_word(system, word, directory)
-    comp = make_composition(word, len(system.splitting)).check(system.splitting)
+    comp = composition_for(word, system)
     return _kernel(system, comp, directory)
 
 
 @lru_cache(maxsize=64)
 def _kernel_for_word(system, word, directory):
-    comp = make_composition(word, len(system.splitting)).check(system.splitting)
+    comp = composition_for(word, system)
     return _kernel(system, comp, directory)
 
 

@@ -26,10 +26,14 @@ Horikoshi, Sect. 5.5 (long runs of Phi^{32123}).
 
 from __future__ import annotations
 
+import weakref
+
 import numpy as np
 
+from ..checks import is_int
 from ..errors import InvalidRunError
 from .codegen import mpmath_source
+from .samples import n_samples
 
 #: Largest accepted ``dps``.
 MAX_DPS = 10_000
@@ -37,7 +41,7 @@ MAX_DPS = 10_000
 
 def check_dps(dps) -> int:
     """``dps`` as an int in ``[15, MAX_DPS]``."""
-    if isinstance(dps, bool) or not isinstance(dps, (int, np.integer)) or not 15 <= dps <= MAX_DPS:
+    if not is_int(dps, 15, MAX_DPS, numpy=True):
         raise InvalidRunError(f"dps must be an integer number of decimal digits between 15 and {MAX_DPS}, got {dps!r}")
     return int(dps)
 
@@ -72,22 +76,30 @@ def _namespace():
     return ns
 
 
-def _runner(kernel):
-    fn = getattr(kernel, "_mpmath_run", None)
-    if fn is None:
+#: kernel -> {"run": the mpmath step loop, "constants": the mpmath constant function}, built once per kernel
+#: and dropped with it (the kernel object itself is never written to).
+_MPMATH: "weakref.WeakKeyDictionary" = weakref.WeakKeyDictionary()
+
+
+def _compiled(kernel) -> dict:
+    entry = _MPMATH.get(kernel)
+    if entry is None:
         ns = _namespace()
         exec(compile(mpmath_source(kernel.program), f"<nambu_bch mpmath {kernel.program.word}>", "exec"), ns)
-        fn = kernel._mpmath_run = ns["run"]
-    return fn
+        entry = _MPMATH[kernel] = {"run": ns["run"], "constants": kernel.program.constant_function("mpmath")}
+    return entry
+
+
+def clear_cache() -> None:
+    """Forget the compiled mpmath loops (they are rebuilt on the next run)."""
+    _MPMATH.clear()
 
 
 def mp_constants(kernel, h, params=None):
     """The constants ``K`` as mpf at the current mpmath precision (missing parameters default to 1)."""
     raw = {str(k): v for k, v in (params or {}).items()}
     args = [to_mpf(raw.get(p.name, 1)) for p in kernel.program.parameters]
-    f = kernel._constants.get("mpmath")
-    if f is None:
-        f = kernel._constants["mpmath"] = kernel.program.constant_function("mpmath")
+    f = _compiled(kernel)["constants"]
     return [to_mpf(k) for k in f(to_mpf(h), *args)]
 
 
@@ -106,9 +118,7 @@ def run_mpmath(kernel, x0, h, steps, every, params=None, dps=50, progress=None):
     """
     import mpmath
 
-    from .iterate import n_samples
-
-    run = _runner(kernel)
+    run = _compiled(kernel)["run"]
     arr = np.asarray(x0, dtype=object)
     single = arr.ndim == 1
     cols = arr.reshape(arr.shape[0], -1)

@@ -33,7 +33,8 @@ import numpy as np
 from ..errors import NambuBCHError, NumericalRangeError, UnstableStepError
 from ..integrators.step import parameter_values
 from .diagnostics import QUANTITY_NAMES, drift_rate, errors_along, quantities
-from .iterate import as_system, iterate, sample_times
+from .iterate import as_system, iterate
+from .samples import sample_times
 from .kernels import kernel, resolve_backend
 
 
@@ -192,13 +193,15 @@ def truncation_study(system="ho3", word="32123", orders=(2, 4, 6, 8), h=0.1, ste
     """
     import sympy
 
+    from ..symbols import ALPHA, STEP
+
     system = as_system(system)
     x0 = np.ones(system.N) if x0 is None else np.asarray(x0, dtype=np.float64)
     samples = iterate(system, word, h, steps, x0, params, every, backend=backend)
     t = sample_times(h, steps, every)
     values = parameter_values(system, params)
-    subs = {**{p: sympy.Float(v, 60) for p, v in values.items()}, sympy.Symbol("h"): sympy.Float(float(h), 60),
-            sympy.Symbol("alpha"): sympy.Float(float(alpha), 60)}
+    subs = {**{p: sympy.Float(v, 60) for p, v in values.items()}, STEP: sympy.Float(float(h), 60),
+            ALPHA: sympy.Float(float(alpha), 60)}
     derive, errs, drifts, sources = [], {}, {}, []
     for k in orders:
         start = time.perf_counter()
@@ -207,11 +210,11 @@ def truncation_study(system="ho3", word="32123", orders=(2, 4, 6, 8), h=0.1, ste
             from ..shadow import shadow_hamiltonians
 
             fam = shadow_hamiltonians(system, word, order=k)
-            if getattr(fam, "exists", True):
-                free = {sympy.Symbol(str(s)): sympy.Float(float(alpha), 60) for s in getattr(fam, "free_parameters", ()) or ()}
-                exprs = {"H_S": fam.H_S, "G_S": getattr(fam, "G_S", None)}
+            if fam.exists:
+                free = {sympy.Symbol(str(s)): sympy.Float(float(alpha), 60) for s in fam.free_parameters}
+                exprs = {"H_S": fam.H_S, "G_S": fam.G_S}
                 exprs = {n: sympy.sympify(e).xreplace(free) for n, e in exprs.items() if e is not None}
-        except (ImportError, NambuBCHError):
+        except NambuBCHError:
             exprs = None
         if exprs is None:  # BCH route unavailable (or no shadow Hamiltonian): the exact family's series
             from ..exact import exact_shadow_hamiltonians

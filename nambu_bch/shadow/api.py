@@ -12,7 +12,8 @@ import sympy
 from ..bch.backward import check_order
 from ..errors import NambuBCHError
 from ..integrators.composition import composition_for
-from .direct_route import ALPHA, direct_route
+from ..symbols import ALPHA
+from .direct_route import direct_route
 from .family import ShadowFamily
 from .fi_route import fi_route
 

@@ -50,6 +50,7 @@ from dataclasses import dataclass
 import numpy as np
 import sympy
 
+from ..checks import is_int
 from ..errors import NambuBCHError
 
 # Dormand--Prince 5(4) (HNW I, Table II.5.2), FSAL
@@ -278,7 +279,7 @@ def orbit_average(F: OrbitFunctions, x0, rtol: float = 1e-10, max_steps: int = M
     """
     if not (1e-13 <= rtol <= 1e-4):
         raise NambuBCHError(f"rtol must lie in [1e-13, 1e-4], got {rtol!r}")
-    if isinstance(max_steps, bool) or not isinstance(max_steps, int) or not (10 <= max_steps <= 1_000_000):
+    if not is_int(max_steps, 10, 1_000_000):
         raise NambuBCHError(f"max_steps must be an integer in [10, 10^6], got {max_steps!r}")
     x0 = np.asarray(x0, dtype=float)
     if x0.shape != (F.n,) or not np.all(np.isfinite(x0)):

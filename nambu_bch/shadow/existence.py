@@ -72,9 +72,10 @@ import sympy
 from sympy.polys.matrices import DomainMatrix
 from sympy.polys.matrices.sdm import SDM
 
+from ..checks import is_int
 from ..errors import NambuBCHError
 from .averaging import orbit_average, orbit_functions, sample_points, section_integral
-from .direct_route import ALPHA, H_STEP
+from ..symbols import ALPHA, STEP
 
 MAX_EXACT_UNKNOWNS = 400  # the exact decomposition g = X(p) + c(H, G) is refused above this size
 DEFAULT_ORBITS = 6
@@ -304,7 +305,7 @@ def measure_drift(system, word, conserved, x0, params: dict, h: float, periods: 
     w = int(round(period / h))
     rates = []
     for C in conserved:
-        f = sympy.lambdify([system.coordinates], C.subs(subs).subs(H_STEP, sympy.nsimplify(h)), modules="numpy")
+        f = sympy.lambdify([system.coordinates], C.subs(subs).subs(STEP, sympy.nsimplify(h)), modules="numpy")
         vals = np.asarray(f(xs.T), dtype=float) * np.ones(xs.shape[0])
         first, last = vals[:w].mean(), vals[-w:].mean()
         rates.append(float((last - first) / (t[-w:].mean() - t[:w].mean())))
@@ -364,7 +365,7 @@ def decide(result, params=None, points=None, orbits: int = DEFAULT_ORBITS, measu
     ('none', 'exact', [omega**2*(G*m*omega**2 - 2*H)/4, (G*m*omega**2 - 2*H)/(2*m)])
     """
     system = result.system
-    if isinstance(orbits, bool) or not isinstance(orbits, int) or not 1 <= orbits <= 64:
+    if not is_int(orbits, 1, 64):
         raise NambuBCHError(f"orbits must be an integer in 1..64, got {orbits!r}")
     params = _check_params(system, params)
     gs, j = integrands(result)
@@ -413,7 +414,7 @@ def decide(result, params=None, points=None, orbits: int = DEFAULT_ORBITS, measu
             dec.reason = f"exact averages {exact} but no sampled periodic orbit where they are non-zero"
             return dec
         dec.outcome, dec.exists = "none", False
-        dec.drift = {nm: H_STEP**j * c for nm, c in zip(names, exact)}
+        dec.drift = {nm: STEP**j * c for nm, c in zip(names, exact)}
         dec.reason = (f"at h^{j} the orbit averages are exactly " +
                       ", ".join(f"<R.grad {nm}> = {c}" for nm, c in zip(names, exact)) +
                       " on every periodic orbit (g = X(p) + c(H, G)), non-zero on the certificate orbit")
@@ -442,7 +443,7 @@ def decide(result, params=None, points=None, orbits: int = DEFAULT_ORBITS, measu
             o = max(sig, key=lambda o: max(abs(a) / (e + 1e-300) for a, e in zip(o.averages, o.errors)))
             dec.certificate_orbit = o
             dec.outcome, dec.exists = "none", False
-            dec.drift = {nm: H_STEP**j * sympy.Float(a, 12) for nm, a in zip(names, o.averages)}
+            dec.drift = {nm: STEP**j * sympy.Float(a, 12) for nm, a in zip(names, o.averages)}
             dec.reason = (f"at h^{j} the average " + ", ".join(f"<R.grad {nm}> = {a:.6g} (+- {e:.1e})"
                                                               for nm, a, e in zip(names, o.averages, o.errors)) +
                           f" on the periodic orbit through {[round(v, 6) for v in o.x0]} (numerical, error estimate from two tolerances)")

@@ -18,8 +18,8 @@ from dataclasses import dataclass, field
 import sympy
 
 from ..printing import Printable, aligned, h_coefficients, latex_text, series_text, series_tokens
+from ..symbols import STEP
 
-H_STEP = sympy.Symbol("h")
 
 
 @dataclass
@@ -134,7 +134,7 @@ class ShadowFamily(Printable):
         order, degree = self.failed_order, self.degree.get(self.failed_order)
         head = [r"\text{no polynomial shadow Hamiltonians of }" + latex_text(self.composition.name),
                 r"\text{on }" + latex_text(self.system.name),
-                r"\text{at order }" + sympy.latex(H_STEP**order)
+                r"\text{at order }" + sympy.latex(STEP**order)
                 + (rf"\text{{ with corrections of degree }} \le {degree}" if degree is not None else "") + ":"]
         rows = [("", "", head)]
         cert = self.certificate or {}
@@ -192,7 +192,7 @@ class ShadowFamily(Printable):
         return out
 
     def to_dict(self) -> dict:
-        """JSON-ready dict (DESIGN.md): expressions as strings ``sympy.sympify`` reads back."""
+        """JSON-ready dict (docs/json.md): expressions as strings ``sympy.sympify`` reads back."""
         sys_ = self.system
         out = {
             "model": sys_.name,

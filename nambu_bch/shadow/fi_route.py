@@ -54,9 +54,11 @@ from ..algebra import liouville_field
 from ..bch import expand_terms, formal_bch
 from ..bch.expansion import piece_evaluator, term_evaluator
 from ..bch.lyndon import is_bracket
+from ..checks import is_int
 from ..errors import InvalidOrderError, NambuBCHError
 from ..integrators.composition import composition_for
-from .direct_route import ALPHA, H_STEP, _monomials
+from ..symbols import ALPHA, STEP
+from .direct_route import _monomials
 from .fi_nested import Echelon, RawOps, nested_hull
 from .fundamental_identity import representations, single_representations
 from .linear import kernel_rref, normal_form, rank, solve_affine
@@ -251,10 +253,10 @@ class FIResult:
         """``(H_S, G_S)`` of the alpha-family through the highest power solved."""
         out = []
         for a, Hk in enumerate(self.system.hamiltonians):
-            total = Hk + H_STEP**self.power * self.corrections[a]
+            total = Hk + STEP**self.power * self.corrections[a]
             for o in self.orders:
                 if o.status == "solved":
-                    total += H_STEP**o.order * o.corrections[a]
+                    total += STEP**o.order * o.corrections[a]
             out.append(sympy.expand(total))
         return tuple(out)
 
@@ -475,7 +477,7 @@ def fi_route(system, word, order: int = 2, degree=None, terms=None) -> FIResult:
     splitting = system.splitting
     comp = composition_for(word, splitting)
     power = 2 if comp.symmetric else 1
-    if isinstance(order, bool) or not isinstance(order, int) or not power <= order <= MAX_FI_ORDER:
+    if not is_int(order, power, MAX_FI_ORDER):
         raise InvalidOrderError(
             f"the FI route solves h^{power}..h^{MAX_FI_ORDER} for {'symmetric' if comp.symmetric else 'non-symmetric'} "
             f"word {comp.name!r}; got order={order!r} -- use route='direct' for other orders"
@@ -507,7 +509,7 @@ def fi_route(system, word, order: int = 2, degree=None, terms=None) -> FIResult:
         degree = max((sum(v) for c in commutators for r in c.representations for key in r.formal.terms
                       for kind, v in key if kind == 0), default=1)
         degree = max(degree, 1)
-    elif isinstance(degree, bool) or not isinstance(degree, int) or degree < 1:
+    elif not is_int(degree, 1):
         raise InvalidOrderError(f"degree must be a positive integer (the ansatz degree) or None, got {degree!r}")
     monos = _monomials(alg.n, degree)
     # columns: weights (t, r), then corrections (a, monomial)
@@ -702,7 +704,7 @@ def fi_brackets(system, word, order: int, limit=None) -> list:
     (6, [1, 1, 2, 2, 1, 1])
     """
     comp = _bracket_composition(system, word, order)
-    if limit is not None and (isinstance(limit, bool) or not isinstance(limit, int) or limit < 1):
+    if limit is not None and not is_int(limit, 1):
         raise NambuBCHError(f"limit must be a positive integer or None, got {limit!r}")
     atoms, _ = _atoms(system)
     return _brackets(system, formal_bch(comp, order + 1), order, RawOps(system.algebra, atoms), {}, limit)
@@ -721,7 +723,7 @@ def count_brackets(system, word, order: int) -> int:
 
 def _bracket_composition(system, word, order):
     comp = composition_for(word, system.splitting)
-    if isinstance(order, bool) or not isinstance(order, int) or not 1 <= order <= MAX_FI_ORDER:
+    if not is_int(order, 1, MAX_FI_ORDER):
         raise InvalidOrderError(f"order must be an integer between 1 and {MAX_FI_ORDER} for the FI brackets, got {order!r}")
     return comp
 

@@ -56,6 +56,36 @@ def _bracket(algebra, *fs):
     return nambu_bracket(algebra, *fs)
 
 
+def _commutator(left, right, way: str, bracket) -> list:
+    """``[X_left, X_right]`` as ``[(sign, slots), ...]`` by the fundamental identity used ``way`` (Eqs. CL2a, CL2b).
+
+    ``bracket(f, g1, ..., g_{N-1})`` computes the Nambu bracket ``{f, g1, ...}``: the
+    algebra's bracket for :func:`commutator_terms`, the paper's notation ``"{E,C,D}"``
+    for :func:`formal_form` (one implementation of the identity for both).
+    """
+    if way == "a":
+        base, other, sign = right, left, 1
+    elif way == "b":
+        base, other, sign = left, right, -1
+    else:
+        raise ValueError(f"way must be 'a' (Eq. CL2a) or 'b' (Eq. CL2b), got {way!r}")
+    out = []
+    for j in range(len(base)):
+        slots = list(base)
+        slots[j] = bracket(base[j], *other)
+        out.append((sign, tuple(slots)))
+    return out
+
+
+def _double(a, b, c, label: str, bracket) -> list:
+    """``[X_a, [X_b, X_c]]`` as ``[(sign, slots), ...]`` in representation ``label`` (Eqs. 1AX-2BY)."""
+    inner, outer = _ways(label, len(a))
+    out = []
+    for (s1, slots), way in zip(_commutator(b, c, inner, bracket), outer):
+        out.extend((s1 * s2, t) for s2, t in _commutator(a, slots, way, bracket))
+    return out
+
+
 def commutator_terms(algebra, left, right, way: str, coefficient=1) -> list:
     """``coefficient * [X_left, X_right]`` as Liouville terms by the fundamental identity used ``way`` (``"a"``/``"b"``).
 
@@ -77,19 +107,9 @@ def commutator_terms(algebra, left, right, way: str, coefficient=1) -> list:
     >>> [str(t) for t in commutator_terms(alg, (x[1], x[2]), (x[0]**2, x[2]), "a")]
     ['X_{2*x1, x3}', 'X_{x1**2, 0}']
     """
-    left, right = tuple(left), tuple(right)
-    if way == "a":
-        base, other, sign = right, left, 1
-    elif way == "b":
-        base, other, sign = left, right, -1
-    else:
-        raise ValueError(f"way must be 'a' (Eq. CL2a) or 'b' (Eq. CL2b), got {way!r}")
-    out = []
-    for j in range(len(base)):
-        slots = list(base)
-        slots[j] = _bracket(algebra, base[j], *other)
-        out.append(LiouvilleTerm(tuple(slots), sign * sympy.sympify(coefficient)))
-    return out
+    c = sympy.sympify(coefficient)
+    pairs = _commutator(tuple(left), tuple(right), way, lambda *fs: _bracket(algebra, *fs))
+    return [LiouvilleTerm(slots, sign * c) for sign, slots in pairs]
 
 
 def labels(n_slots: int) -> tuple:
@@ -119,12 +139,9 @@ def double_commutator_terms(algebra, a, b, c, label: str, coefficient=1) -> list
     >>> [str(t) for t in double_commutator_terms(alg, AC, AC, BD, "1AX") if not t.vanishes(alg.coordinates)]   # Eq. (CL5)
     ['X_{m*omega**2*x3/2, -2*x2**2/m**2}']
     """
-    n_slots = len(a)
-    inner, outer = _ways(label, n_slots)
-    out = []
-    for term, way in zip(commutator_terms(algebra, b, c, inner, coefficient), outer):
-        out.extend(commutator_terms(algebra, a, term.slots, way, term.coefficient))
-    return out
+    c_ = sympy.sympify(coefficient)
+    pairs = _double(tuple(a), tuple(b), tuple(c), label, lambda *fs: _bracket(algebra, *fs))
+    return [LiouvilleTerm(slots, sign * c_) for sign, slots in pairs]
 
 
 def representations(algebra, a, b, c, coefficient=1) -> dict:
@@ -135,3 +152,52 @@ def representations(algebra, a, b, c, coefficient=1) -> dict:
 def single_representations(algebra, b, c, coefficient=1) -> dict:
     """``{"a": Eq. CL2a terms, "b": Eq. CL2b terms}`` of ``coefficient * [X_b, X_c]``."""
     return {way: commutator_terms(algebra, b, c, way, coefficient) for way in "ab"}
+
+
+def formal_form(label: str) -> list:
+    """``[(sign, (slot1, slot2)), ...]`` of ``[X_{A,B}, [X_{C,D}, X_{E,F}]]`` in representation ``label`` (Eqs. 1AX-2BY).
+
+    The same identity as :func:`double_commutator_terms`, with symbolic functions
+    ``A..F`` and slots written in the paper's bracket notation: ``label[0]``: ``1``
+    uses the fundamental identity on the first term of Eq. (CL2) (Eq. CL2a), ``2``
+    on the second (Eq. CL2b); ``label[1]`` (``A``/``B``) and ``label[2]``
+    (``X``/``Y``) make the same choice for Eqs. (CL3) and (CL4).
+
+    >>> [(s, ",".join(t)) for s, t in formal_form("1AX")]     # Eq. (1AX)
+    [(1, '{{E,C,D},A,B},F'), (1, '{E,C,D},{F,A,B}'), (1, '{E,A,B},{F,C,D}'), (1, 'E,{{F,C,D},A,B}')]
+    """
+    if label not in FI_LABELS:
+        raise ValueError(f"FI label must be one of 1AX..2BY, got {label!r}")
+    return _double(("A", "B"), ("C", "D"), ("E", "F"), label, lambda *fs: "{" + ",".join(fs) + "}")
+
+
+def bch_double_commutators(system, comp) -> list:
+    """``[(coefficient, (a, b, c), {label: [LiouvilleTerm, ...]})]`` for each non-zero ``h^2`` double commutator.
+
+    The degree-3 part of the formal BCH series of ``comp`` (Eq. BCH2) is expanded
+    into Liouville terms on the system's splitting with vanishing brackets pruned
+    (Eqs. BCH3, BCH4); each ``[[a, b], c]`` is rewritten ``-[c, [a, b]]``, and each
+    ``[X_a, [X_b, X_c]]`` is represented in the eight ways of Eqs. (1AX)-(2BY),
+    vanishing Liouville terms dropped (as in Eqs. CL5-CL8).
+
+    >>> from nambu_bch import model, composition
+    >>> [(c, lab) for c, _, forms in bch_double_commutators(model("ho3"), composition("12321"))
+    ...  for lab, terms in forms.items() if lab == "1AX"][:1]
+    [(-1/24, '1AX')]
+    """
+    from ..bch import expand_terms, formal_bch
+    from ..bch.lyndon import is_bracket
+
+    out = []
+    for c, tree in expand_terms(formal_bch(comp, 3).terms(3), system.splitting):
+        if is_bracket(tree[1]):
+            a, (b, d) = tree[0], tree[1]
+        else:  # [[a, b], d] = -[d, [a, b]]
+            (a, b), d, c = tree[0], tree[1], -c
+            a, b, d = d, a, b
+        reps = {}
+        for label in labels(len(a)):
+            terms = double_commutator_terms(system.algebra, a, b, d, label, c)
+            reps[label] = [t for t in terms if not t.vanishes(system.coordinates)]
+        out.append((c, (a, b, d), reps))
+    return out

@@ -178,10 +178,21 @@ def _atom_id(expr) -> int:
 
 
 def _context(algebra, atoms) -> _Context:
-    key = (id(algebra), atoms)
+    # keyed by content (the ring and coordinates fix the vanishing rule), not by id(): an id is
+    # reused after the algebra is freed, and a dict keyed by ids only grows
+    key = (algebra.ring, algebra.coordinates, atoms)
     if key not in _CONTEXTS:
+        if len(_CONTEXTS) > 256:
+            _CONTEXTS.clear()
         _CONTEXTS[key] = _Context(algebra, atoms)
     return _CONTEXTS[key]
+
+
+def clear_cache() -> None:
+    """Forget the canonical-key contexts and the key caches (atom ids are kept: live sums use them)."""
+    _CONTEXTS.clear()
+    canonical_key.cache_clear()
+    _dependent.cache_clear()
 
 
 def _to_domain(algebra, c):

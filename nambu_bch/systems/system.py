@@ -326,6 +326,46 @@ class System:
         names.update({n: sympy.Symbol(n) for n in RESERVED_SYMBOLS})
         return names
 
+    def substitute(self, values) -> "System":
+        """The system with parameter values substituted exactly: ``{name: exact value}`` (``--param m=1/2``).
+
+        The substituted parameters leave ``parameters``; the name records the values
+        (``ho3[m=1/2]``), shortened to ``ho3[m substituted]`` when that would not be a
+        safe name (:data:`SYSTEM_NAME`).  No values: the system itself.
+
+        >>> from nambu_bch import model
+        >>> S = model("ho3").substitute({"m": sympy.Rational(1, 2)})
+        >>> S.name, S.parameters, S.H
+        ('ho3[m=1/2]', (omega,), omega**2*x3/4 + x2**2)
+        """
+        if not values:
+            return self
+        subs = {p: values[p.name] for p in self.parameters if p.name in values}
+        rest = tuple(p for p in self.parameters if p.name not in values)
+        hams = tuple(sympy.sympify(H).subs(subs) for H in self.hamiltonians)
+        label = ",".join(f"{k}={v}" for k, v in values.items())
+        name = f"{self.name}[{label}]"
+        if not SYSTEM_NAME.match(name):  # a long or unusual value: keep the name short and safe
+            name = f"{self.name}[{','.join(values)} substituted]"
+        return self._replaced(hamiltonians=hams, parameters=rest, name=name)
+
+    def with_split(self, split: str) -> "System":
+        """The same system split another way (``"full"``, ``"single"``, ``"fine"``; :mod:`nambu_bch.systems.splitting`)."""
+        return self if split == self.split else self._replaced(split=split)
+
+    def with_bracket(self, bracket: str, split: str | None = None) -> "System":
+        """The same Hamiltonians under another bracket (``split=None``: that bracket's default split)."""
+        if bracket == self.bracket:
+            return self if split is None else self.with_split(split)
+        return self._replaced(bracket=bracket, split=split)
+
+    def _replaced(self, **changes) -> "System":
+        fields = dict(coordinates=self.coordinates, hamiltonians=self.hamiltonians, parameters=self.parameters,
+                      name=self.name, split=self.split, description=self.description, citation=self.citation,
+                      bracket=self.bracket)
+        fields.update(changes)
+        return System(**fields)
+
     def to_latex(self) -> str:
         labels = ["H", "G"] if len(self.hamiltonians) == 2 else [f"H_{{{k + 1}}}" for k in range(len(self.hamiltonians))]
         if len(self.hamiltonians) == 1:

@@ -1,12 +1,14 @@
 """``nambu-bch compare``: work-precision comparison of integrators on a system (issue 15).
 
-Registered by one line in :func:`nambu_bch.cli.build_parser`; the work is
-:func:`nambu_bch.design.compare`.
+The work is :func:`nambu_bch.design.compare`.
 """
 
 from __future__ import annotations
 
-from .errors import NambuBCHError
+from ..errors import NambuBCHError
+from ._options import (add_subcommand, numeric_inputs, output_options, positive_float, positive_int, system_from_args,
+                       system_options)
+from ._output import emit
 
 HELP = "compare integrators: order, cost, error constant, the system's leading error, measured error vs cost"
 EXAMPLES = (
@@ -24,13 +26,9 @@ EXAMPLES = (
 MAX_INTEGRATORS = 12
 
 
-def add_compare_parser(sub) -> None:
-    """Register the ``compare`` subcommand on the ``argparse`` sub-parsers ``sub`` of :func:`nambu_bch.cli.build_parser`."""
-    from . import cli
-
-    p = sub.add_parser("compare", help=HELP, description=HELP, epilog=EXAMPLES, formatter_class=cli._Formatter)
-    p.set_defaults(func=cmd_compare)
-    cli._system_options(p)
+def register(sub) -> None:
+    p = add_subcommand(sub, "compare", HELP, EXAMPLES, run)
+    system_options(p)
     p.add_argument("--integrator", dest="integrators", metavar="WORD", action="append",
                    help="an integrator to compare; repeat (default: the Strang word, its triple jump and Suzuki 5-jump)")
     p.add_argument("--t-end", metavar="T", default="10", help="final time T of the runs (default 10)")
@@ -38,12 +36,11 @@ def add_compare_parser(sub) -> None:
                    help="numbers of steps N (h = T/N), at least two (default 20,40,80,160,320,640)")
     p.add_argument("--x0", metavar="X", help="initial state, comma separated (default 1,...,1)")
     p.add_argument("--figure", metavar="FILE", help="write the log-log work-precision plot (.png, .pdf, .svg) atomically")
-    cli._output_options(p, "text", choices=("text", "json"))
+    output_options(p, "text", choices=("text", "json"))
 
 
 def _step_counts(text):
-    from .cli import positive_int
-    from .design.compare import MAX_STEPS
+    from ..design.compare import MAX_STEPS
 
     items = [t for t in text.replace(",", " ").split()]
     if len(items) < 2 or len(items) > 20:
@@ -54,15 +51,15 @@ def _step_counts(text):
     return counts
 
 
-def cmd_compare(args):
-    from . import cli
-    from .design import compare
+def run(args):
+    from ..design import compare
+    from ..integrators.composition import strang_word
 
-    system, values = cli.system_from_args(args)
-    params, x0 = cli.numeric_inputs(args, system, values)
+    system, values = system_from_args(args)
+    params, x0 = numeric_inputs(args, system, values)
     words = args.integrators
     if not words:
-        strang = cli.default_word(system)
+        strang = strang_word(len(system.splitting))
         words = [strang, f"triple-jump:{strang}", f"suzuki:{strang}"] if len(strang) > 1 else [strang]
     if len(words) > MAX_INTEGRATORS:
         raise NambuBCHError(f"--integrator given {len(words)} times; compare accepts at most {MAX_INTEGRATORS}")
@@ -71,7 +68,7 @@ def cmd_compare(args):
             raise NambuBCHError(f"--integrator {w[:40]!r} must be a non-empty string of at most 200 characters")
     if args.figure is not None and not args.figure.lower().endswith((".png", ".pdf", ".svg")):
         raise NambuBCHError(f"--figure {args.figure[:80]!r}: give a file name ending in .png, .pdf or .svg")
-    t_end = cli.positive_float(args.t_end, "--t-end")
+    t_end = positive_float(args.t_end, "--t-end")
     if t_end > 1e5:
         raise NambuBCHError(f"--t-end {args.t_end!r} must be at most 1e5")
     counts = _step_counts(args.step_counts)
@@ -81,4 +78,4 @@ def cmd_compare(args):
             result.figure(args.figure)
         except OSError as exc:
             raise NambuBCHError(f"--figure {args.figure}: cannot write the file ({exc.strerror or exc})") from None
-    cli.emit(args, text=result.table, data=result.to_dict)
+    emit(args, text=result.table, data=result.to_dict)

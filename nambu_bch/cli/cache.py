@@ -14,7 +14,7 @@ import hashlib
 import os
 from pathlib import Path
 
-_PACKAGE = Path(__file__).resolve().parent
+_PACKAGE = Path(__file__).resolve().parent.parent  # the nambu_bch package
 
 
 def _key(request) -> str:
@@ -34,15 +34,18 @@ def cached_text(request, compute) -> str:
     """``compute()`` (a str), read from the cache when the same ``request`` was answered by the same source."""
     try:
         path = _directory() / (_key(request) + ".txt")
+    except OSError:  # the package's files cannot be read for the key: no cache
+        return compute()
+    try:
         return path.read_text(encoding="utf-8")
     except (OSError, UnicodeDecodeError):
         pass
     text = compute()
     try:
-        from .atomic import write_atomic
+        from ..atomic import write_atomic
 
         path.parent.mkdir(parents=True, exist_ok=True)
         write_atomic(path, text)
-    except (OSError, NameError):
+    except OSError:
         pass
     return text

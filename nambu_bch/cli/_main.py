@@ -1,0 +1,176 @@
+"""The ``nambu-bch`` command line (also ``python -m nambu_bch``): a thin layer over the library.
+
+Synopsis::
+
+    nambu-bch models   [--model NAME] [--format text|latex|json]
+    nambu-bch bch      [SYSTEM] [--integrator WORD] [--order K] [--field] [--terms]
+    nambu-bch fi       [SYSTEM] [--integrator WORD] [--order K] [--limit N]
+    nambu-bch shadow   [SYSTEM] [--integrator WORD] [--order K] [--route direct|fi] [--degree D]
+    nambu-bch conserved [SYSTEM] [--integrator WORD]
+    nambu-bch exact    [SYSTEM] [--integrator WORD]
+    nambu-bch check    [SYSTEM] [--integrator WORD] [--h H] [--steps N] [--x0 X] [--every K] [--order K] [--alpha A]
+    nambu-bch plot     [SYSTEM] [--integrator WORD] [--outdir DIR] [--h H] [--steps N] [--short-steps N]
+                       [--x0 X] [--every K] [--dpi DPI] [--fig-format png|pdf|svg]
+    nambu-bch compare  [SYSTEM] [--integrator WORD ...] [--t-end T] [--step-counts N,N,...] [--figure FILE]
+
+    SYSTEM is one of   --model NAME                         (built-in; default ho3)
+                       --system FILE.toml                   (see nambu_bch.model_file)
+                       --H EXPR [--G EXPR ...] [--coords "x1 x2 x3"] [--param NAME ...] [--split full|single]
+    --param NAME=VALUE sets a parameter's value: numeric subcommands use it (default 1 for
+                       every parameter), symbolic ones substitute it exactly before the analysis.
+    --format latex|text|json (default latex for symbolic results, text for models/check/plot),
+    --output FILE      (a regular file is written atomically: temporary file in the same directory +
+                       os.replace, keeping its mode; a symlink is followed; a device or FIFO such as
+                       /dev/stdout is written through as a stream; see nambu_bch.atomic).
+    --standalone       (LaTeX: a complete document; default: align* environments for a document body),
+    --no-progress      (no progress bars on stderr for long runs; docs/latex.md).
+
+With no options ``nambu-bch shadow`` prints the alpha-family of shadow
+Hamiltonians of Phi^{12321} for the paper's N = 3 oscillator at order 2
+(Horikoshi, Eqs. SH12321c, SG12321c) as LaTeX.
+
+Bad input (an unknown model, a malformed word or expression, a word that
+leaves out a piece of the splitting, a missing file, an invalid flag, a request
+too large to finish) prints one line on stderr naming the input and what is
+accepted, and exits with status 2; user expressions are parsed by
+:func:`nambu_bch.parsing.parse_expression`, never evaluated, and names are
+checked against a LaTeX- and source-safe pattern.  Ctrl-C prints one line and
+exits 130 (also during the imports); a reader that closes stdout early ends the
+run quietly with status 141.  See ``docs/hardening.md``.  Any other exception
+is a bug and propagates with its traceback (exit status 1).
+
+The package: :mod:`._main` (this entry point, error handling and exit codes),
+:mod:`._options` (option groups, flag conversion, the system and integrator from
+the flags), :mod:`._output` (formats and writing), one module per subcommand
+(``models``, ``bch``, ``fi``, ``shadow``, ``conserved``, ``exact``, ``check``,
+``plot``, ``compare``, each with ``register(sub)`` and ``run(args)``) and
+:mod:`.cache` (the ``models`` output cache).  Nothing is imported from sympy
+before a subcommand runs: ``--help`` and argument errors answer at once.
+"""
+
+from __future__ import annotations
+
+import argparse
+import importlib
+import os
+import sys
+
+from ..errors import NambuBCHError
+from ._options import MAX_MESSAGE, PROG, UsageError, _Formatter, _Parser, normalise
+
+#: The subcommands in the order of ``--help``: each module ``nambu_bch.cli.<name>`` has ``register(sub)``, ``run(args)``.
+SUBCOMMANDS = ("models", "bch", "fi", "shadow", "conserved", "exact", "check", "plot", "compare")
+
+
+def build_parser() -> argparse.ArgumentParser:
+    """The ``argparse`` parser of ``nambu-bch`` with every subcommand registered."""
+    parser = _Parser(
+        prog=PROG, formatter_class=_Formatter,
+        description="Shadow Hamiltonians of splitting integrators in Nambu mechanics (Horikoshi).",
+        epilog="the system: --model NAME (default ho3) | --system FILE.toml | --H EXPR [--G EXPR] [--coords ...] [--param NAME]\n"
+               "parameter values: --param NAME=VALUE (exact, e.g. m=1/2): check/plot use them (default 1),\n"
+               "  symbolic subcommands substitute them before the analysis\n"
+               "bad input: one line on stderr, exit status 2; expressions are parsed by a whitelist, never eval-ed\n\n"
+               "examples:\n  nambu-bch shadow            # the paper's alpha-family of Phi^{12321}, LaTeX\n"
+               "  nambu-bch shadow --integrator 32123 --format json\n"
+               "  nambu-bch models\n  nambu-bch SUBCOMMAND --help",
+    )
+    from .. import __version__
+
+    parser.add_argument("--version", action="version", version=f"%(prog)s {__version__}")
+    sub = parser.add_subparsers(dest="command", metavar="SUBCOMMAND", parser_class=_Parser)
+    sub.required = True
+    for name in SUBCOMMANDS:
+        importlib.import_module(f"{__package__}.{name}").register(sub)
+    return parser
+
+
+class _progress_off:
+    """``--no-progress``: ``NAMBU_BCH_PROGRESS=0`` for the run (read by :mod:`nambu_bch.progress`), then restored."""
+
+    def __enter__(self):
+        self.saved = os.environ.get("NAMBU_BCH_PROGRESS")
+        os.environ["NAMBU_BCH_PROGRESS"] = "0"
+
+    def __exit__(self, *exc):
+        if self.saved is None:
+            os.environ.pop("NAMBU_BCH_PROGRESS", None)
+        else:
+            os.environ["NAMBU_BCH_PROGRESS"] = self.saved
+        return False
+
+
+def _stdout_closed() -> None:
+    """After EPIPE: point stdout at /dev/null so that the interpreter's final flush stays quiet."""
+    try:
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, sys.stdout.fileno())
+        os.close(devnull)
+    except (OSError, ValueError, AttributeError):  # stdout without a file descriptor (captured in tests)
+        pass
+
+
+def _say(line: str) -> None:
+    """One line on stderr; a closed stderr is ignored."""
+    try:
+        print(line, file=sys.stderr)
+        sys.stderr.flush()
+    except (OSError, ValueError):
+        pass
+
+
+def main(argv=None) -> int:
+    """Run the CLI on ``argv`` (default ``sys.argv[1:]``); returns the exit status.
+
+    0 on success, 2 on bad input (one line on stderr), 130 on Ctrl-C (one line),
+    141 quietly when stdout is closed early (``nambu-bch shadow | head -c1``),
+    1 with one line when memory or the interpreter's recursion limit runs out.
+    Nothing a user types produces a traceback; any other exception is a bug and
+    propagates with its traceback.
+    """
+    from .. import _startup
+
+    _startup.cli_started()  # from here on Ctrl-C is a KeyboardInterrupt handled below
+    prog = PROG
+    try:
+        parser = build_parser()
+        args = parser.parse_args(argv)
+        prog = f"{PROG} {args.command}"
+        normalise(args)
+        if getattr(args, "no_progress", False):
+            with _progress_off():
+                args.func(args)
+        else:
+            args.func(args)
+    except SystemExit as exc:  # --help, --version
+        return exc.code if isinstance(exc.code, int) else 0
+    except UsageError as exc:
+        hint = exc.prog if exc.prog != PROG else PROG
+        message = " ".join(str(exc).split())
+        if len(message) > MAX_MESSAGE:
+            message = message[: MAX_MESSAGE - 3] + "..."
+        _say(f"{exc.prog}: error: {message}; see '{hint} --help'")
+        return 2
+    except NambuBCHError as exc:
+        message = " ".join(str(exc).split())
+        if len(message) > MAX_MESSAGE:  # a huge input echoed back: keep the line readable
+            message = message[: MAX_MESSAGE - 3] + "..."
+        _say(f"{prog}: error: {message}")
+        return 2
+    except KeyboardInterrupt:
+        _say(f"{prog}: interrupted")
+        return 130
+    except BrokenPipeError:
+        _stdout_closed()
+        return 141  # as a shell reports a process ended by SIGPIPE; nothing printed
+    except MemoryError:
+        _say(f"{prog}: error: out of memory; the request is too large for this machine (reduce --order, --degree or --steps)")
+        return 1
+    except RecursionError:
+        _say(f"{prog}: error: the input is nested too deeply to process (recursion limit)")
+        return 1
+    return 0
+
+
+if __name__ == "__main__":  # pragma: no cover
+    sys.exit(main())

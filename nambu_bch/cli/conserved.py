@@ -1,0 +1,37 @@
+"""``nambu-bch conserved``: exact conserved quantities H_c, G_c of an integrator (Table (table))."""
+
+from __future__ import annotations
+
+from ._options import (add_subcommand, integrator_from_args, integrator_options, output_options, progress_option,
+                       symbolic_system, system_options)
+from ._output import base_dict, emit
+
+HELP = "exact conserved quantities H_c, G_c of the integrator (Table (table))"
+EXAMPLES = "examples:\n  nambu-bch conserved --integrator 31213   # a row of Table (table)\n  nambu-bch conserved --format json"
+
+
+def register(sub) -> None:
+    p = add_subcommand(sub, "conserved", HELP, EXAMPLES, run)
+    progress_option(p)
+    system_options(p)
+    integrator_options(p)
+    p.add_argument("--degree", metavar="D", type=str,
+                   help="total degree of the polynomial ansatz for invariants (default: that of the Hamiltonians)")
+    output_options(p, "latex")
+
+
+def run(args):
+    from ..exact import conserved_quantities
+
+    system = symbolic_system(args)
+    word, comp = integrator_from_args(args, system)
+    result = conserved_quantities(system, comp, **({"degree": args.degree} if args.degree is not None else {}))
+
+    def data():
+        out = base_dict(system, word)
+        out.update(result.to_dict())
+        out["model"], out["integrator"] = system.name, word
+        return out
+
+    emit(args, latex=result.to_latex, text=result.to_text, data=data)
+

@@ -1,0 +1,53 @@
+"""``nambu-bch shadow``: the shadow-Hamiltonian family of a word at an order, or the obstruction (Eq. Xeff2)."""
+
+from __future__ import annotations
+
+from ._options import (add_subcommand, integrator_from_args, integrator_options, output_options, progress_option,
+                       symbolic_system, system_options)
+from ._output import base_dict, emit
+
+HELP = "the shadow-Hamiltonian family of a word at an order, or the obstruction"
+EXAMPLES = ("examples:\n  nambu-bch shadow                       # alpha-family of Phi^{12321}, ho3, order 2 (Eqs. SH12321c, SG12321c)\n"
+            "  nambu-bch shadow --integrator 32123 --format json\n"
+            "  nambu-bch shadow --model ho --integrator TVT --order 4\n"
+            "  nambu-bch shadow --H 'x2^2/(2*m) + m*x3/2' --G 'x3 - x1^2' --param m --route fi")
+
+
+def register(sub) -> None:
+    p = add_subcommand(sub, "shadow", HELP, EXAMPLES, run)
+    progress_option(p)
+    system_options(p)
+    integrator_options(p, order=True)
+    p.add_argument("--route", choices=("direct", "fi"), default="direct",
+                   help="direct: order-by-order linear solve; fi: fundamental-identity representations (default direct)")
+    p.add_argument("--degree", metavar="D", type=str, help="polynomial degree of the ansatz for H_S, G_S (default: the library's)")
+    p.add_argument("--no-existence", dest="existence", action="store_false",
+                   help="when no polynomial pair is found, do not decide existence by orbit averages (answer: undecided)")
+    output_options(p, "latex")
+
+
+def run(args):
+    from ..shadow import shadow_hamiltonians
+
+    system = symbolic_system(args)
+    word, comp = integrator_from_args(args, system)
+    order = args.order if args.order is not None else 2
+    kwargs = {"order": order, "route": args.route, "existence": args.existence}
+    if args.degree is not None:
+        kwargs["degree"] = args.degree
+    family = shadow_hamiltonians(system, comp, **kwargs)
+
+    def data():
+        out = base_dict(system, word, order=order, route=args.route)
+        out.update(family.to_dict())
+        out["model"], out["integrator"] = system.name, word
+        return out
+
+    def text():
+        out = f"{word} on {system.name}, order {order}, route {args.route}\n" + family.to_text()
+        if args.route == "fi" and hasattr(family.details, "to_text"):
+            out += "\n" + family.details.to_text()  # each commutator's representations and weights
+        return out
+
+    emit(args, latex=family.to_latex, text=text, data=data)
+
