@@ -73,8 +73,8 @@ SURFACE = {
         "fi_route", "representations", "shadow_hamiltonians",
     ),
     "nambu_bch.systems": (
-        "Piece", "Splitting", "System", "full_split", "is_separable", "model", "model_names", "separate",
-        "single_split",
+        "BRACKETS", "Piece", "Splitting", "System", "canonical_split", "full_split", "infer_bracket", "is_separable",
+        "model", "model_names", "separate", "single_split", "triplet_split",
     ),
 }
 

@@ -74,14 +74,25 @@ def run(args):
     def latex():
         import sympy
 
-        from ..printing import aligned, latex_text
+        from ..printing import WIDTH, aligned, latex_text, sum_tokens, width
+
+        def field_tokens(piece):
+            # "X_{A,C} + ... = (c_1) d/dx_1 + ...": one token per Liouville term and per component (lines break between)
+            labels = ["X_{" + ", ".join(sympy.latex(f) for f in term) + "}" for term in piece.terms]
+            if any(width(lab) > WIDTH // 2 for lab in labels):  # a long Hamiltonian in a subscript cannot break
+                labels = []
+            tokens = labels[:1] + ["+ " + lab for lab in labels[1:]]
+            parts = [rf"\left({sympy.latex(sympy.factor(c))}\right)\frac{{\partial}}{{\partial {sympy.latex(x)}}}"
+                     for x, c in zip(piece.field.algebra.coordinates, piece.field.to_sympy()) if c != 0]
+            head = ("= " if tokens else "") + (parts[0] if parts else "0")
+            return tokens + [head] + ["+ " + part for part in parts[1:]]
 
         blocks = []
         for s in systems():
             rows = [("", "", [latex_text(s.name) + ":"])]
             labels = ["H", "G"] if len(s.hamiltonians) == 2 else [f"H_{{{k + 1}}}" for k in range(len(s.hamiltonians))]
-            rows += [(lab, "=", [sympy.latex(H)]) for lab, H in zip(labels[: len(s.hamiltonians)] or ["H"], s.hamiltonians)]
-            rows += [(f"X_{{{p.number}}}", "=", [p.label(), "= " + p.field.to_latex()]) for p in s.splitting.pieces]
+            rows += [(lab, "=", sum_tokens(H)) for lab, H in zip(labels[: len(s.hamiltonians)] or ["H"], s.hamiltonians)]
+            rows += [(f"X_{{{p.number}}}", "=", field_tokens(p)) for p in s.splitting.pieces]
             blocks.append(aligned(rows))
         return blocks
 
