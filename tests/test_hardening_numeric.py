@@ -346,7 +346,9 @@ def test_planted_kernel_in_foreign_cache_is_not_run(fresh_cache, tmp_path, monke
     """Item 6: a cache owned by another user (here: we pretend to be another uid) is refused."""
     marker = tmp_path / "planted-ran"
     _plant(fresh_cache, model("ho"), "121", marker)
-    monkeypatch.setattr(K, "_euid", lambda: os.stat(fresh_cache).st_uid + 4242)
+    import nambu_bch.private_dirs as private_dirs
+
+    monkeypatch.setattr(private_dirs, "euid", lambda: os.stat(fresh_cache).st_uid + 4242)
     kern = K.kernel(model("ho"), "121")
     assert kern.directory != fresh_cache / "kernels" and "owned by uid" in K.CACHE_NOTES[str(fresh_cache)]
     assert not marker.exists()

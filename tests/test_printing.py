@@ -214,3 +214,29 @@ def test_models_listing_is_cached_and_identical(tmp_path):
     assert first.stdout == second.stdout and '"ho3"' in first.stdout
     fresh = _python(PROBE.format(argv=argv), tmp_path / "empty")
     assert fresh.stdout == first.stdout
+
+
+def test_models_cache_is_not_trusted_in_a_shared_directory(tmp_path, monkeypatch, capsys):
+    """A cache directory writable by others (or a planted file in it) is never read back: the listing is
+    computed, so another local user cannot choose what `nambu-bch models` prints (issue 10, item 6)."""
+    import os
+
+    from nambu_bch.cli import main
+    from nambu_bch.cli.cache import _key
+
+    root = tmp_path / "shared"
+    monkeypatch.setenv("NAMBU_BCH_CACHE", str(root))
+    assert main(["models", "--format", "text"]) == 0
+    honest = capsys.readouterr().out
+    planted = root / "cli" / (_key(("models", "text", False)) + ".txt")
+    files = list((root / "cli").glob("*.txt"))
+    assert len(files) == 1
+    files[0].write_text("planted\n")
+    os.chmod(root / "cli", 0o777)             # group/other-writable: untrusted
+    assert main(["models", "--format", "text"]) == 0
+    assert capsys.readouterr().out == honest
+    os.chmod(root / "cli", 0o700)
+    os.chmod(files[0], 0o666)                 # the file itself writable by others: untrusted
+    assert main(["models", "--format", "text"]) == 0
+    assert capsys.readouterr().out == honest
+    del planted

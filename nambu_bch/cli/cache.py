@@ -4,15 +4,17 @@ The output of ``models`` for the built-in catalogue depends only on the package'
 source; it is stored under ``$NAMBU_BCH_CACHE/cli`` (else ``~/.cache/nambu_bch/cli``)
 keyed by a SHA-256 of the request and of every ``.py`` file of the package, so any
 edit of the package invalidates it.  An unwritable or corrupt cache is ignored
-(the output is then computed, as without a cache).  Nothing but text the package
-itself produced is stored or read back.
+(the output is then computed, as without a cache), and so is one whose directory or
+file is not private (owned by this user, writable by nobody else: :mod:`nambu_bch.private_dirs`),
+so another local user cannot plant the text it prints.
 """
 
 from __future__ import annotations
 
 import hashlib
-import os
 from pathlib import Path
+
+from ..private_dirs import cache_root, untrusted
 
 _PACKAGE = Path(__file__).resolve().parent.parent  # the nambu_bch package
 
@@ -25,26 +27,36 @@ def _key(request) -> str:
     return digest.hexdigest()
 
 
-def _directory() -> Path:
-    root = os.environ.get("NAMBU_BCH_CACHE") or os.path.join(os.path.expanduser("~"), ".cache", "nambu_bch")
-    return Path(root) / "cli"
+def _directory():
+    """``$NAMBU_BCH_CACHE/cli`` when it and its parent are private (:mod:`nambu_bch.private_dirs`), else None."""
+    root = cache_root()
+    path = root / "cli"
+    try:
+        root.mkdir(mode=0o700, parents=True, exist_ok=True)
+        path.mkdir(mode=0o700, exist_ok=True)
+    except OSError:
+        return None
+    return path if untrusted(root) is None and untrusted(path) is None else None
 
 
 def cached_text(request, compute) -> str:
     """``compute()`` (a str), read from the cache when the same ``request`` was answered by the same source."""
-    try:
-        path = _directory() / (_key(request) + ".txt")
-    except OSError:  # the package's files cannot be read for the key: no cache
+    directory = _directory()
+    if directory is None:  # no private cache directory: compute, as without a cache
         return compute()
     try:
-        return path.read_text(encoding="utf-8")
-    except (OSError, UnicodeDecodeError):
-        pass
+        path = directory / (_key(request) + ".txt")
+    except OSError:  # the package's files cannot be read for the key: no cache
+        return compute()
+    if untrusted(path, kind="file") is None:
+        try:
+            return path.read_text(encoding="utf-8")
+        except (OSError, UnicodeDecodeError):
+            pass
     text = compute()
     try:
         from ..atomic import write_atomic
 
-        path.parent.mkdir(parents=True, exist_ok=True)
         write_atomic(path, text)
     except OSError:
         pass

@@ -61,6 +61,7 @@ import numpy as np
 
 from ..compiled import numba_available  # noqa: F401  (re-exported: nambu_bch.numeric.numba_available)
 from ..errors import InvalidRunError, NumericalRangeError
+from ..private_dirs import cache_root, euid, untrusted
 from ..integrators.composition import composition_for
 from ..integrators.step import parameter_values
 from .codegen import TEMPLATE_VERSION, python_source, source_hash, step_program
@@ -85,34 +86,12 @@ def cache_dir() -> Path:
     ``$TMPDIR/nambu_bch-<uid>`` if it passes the same checks, else a fresh ``mkdtemp`` directory
     (mode 0700).  The reason is kept in :data:`CACHE_NOTES`.
     """
-    root = os.environ.get("NAMBU_BCH_CACHE") or os.path.join(os.path.expanduser("~"), ".cache", "nambu_bch")
+    root = str(cache_root())
     known = _CACHE_DIRS.get(root)
-    if known is not None and _secure(known) is None:
+    if known is not None and untrusted(known) is None:
         return known
     _CACHE_DIRS[root] = path = _usable_dir(Path(root))
     return path
-
-
-def _euid():
-    """The effective user id (None where the platform has none)."""
-    return os.geteuid() if hasattr(os, "geteuid") else None
-
-
-def _secure(path: Path, check_owner=True):
-    """None if ``path`` is a directory we own that nobody else may write; else the reason (one phrase)."""
-    try:
-        st = os.lstat(path)
-    except OSError as exc:
-        return f"{path} is not accessible ({exc.strerror})"
-    if stat.S_ISLNK(st.st_mode):
-        return f"{path} is a symbolic link"
-    if not stat.S_ISDIR(st.st_mode):
-        return f"{path} is not a directory"
-    if check_owner and _euid() is not None and st.st_uid != _euid():
-        return f"{path} is owned by uid {st.st_uid}, not by this user ({_euid()})"
-    if st.st_mode & (stat.S_IWGRP | stat.S_IWOTH):
-        return f"{path} is writable by group or others (mode {stat.S_IMODE(st.st_mode):o})"
-    return None
 
 
 def _prepare(root: Path, fresh=False):
@@ -126,7 +105,7 @@ def _prepare(root: Path, fresh=False):
             level.mkdir(mode=0o700, parents=True, exist_ok=True)
         except OSError as exc:
             return None, f"cannot create {level} ({exc.strerror})"
-        reason = _secure(level, check_owner=not fresh)
+        reason = untrusted(level, check_owner=not fresh)
         if reason:
             return None, reason
     probe = levels[1] / f".probe-{os.getpid()}"
@@ -144,7 +123,7 @@ def _usable_dir(root: Path) -> Path:
     if path is not None:
         return path
     CACHE_NOTES[str(root)] = reason
-    uid = _euid() if _euid() is not None else "user"
+    uid = euid() if euid() is not None else "user"
     path, reason2 = _prepare(Path(tempfile.gettempdir()) / f"nambu_bch-{uid}")
     if path is not None:
         return path
