@@ -18,6 +18,12 @@ from nambu_bch.integrators import Composition, composition
 R = sympy.Rational
 
 
+@pytest.fixture(autouse=True)
+def sparse_at_every_degree(monkeypatch):
+    """formal_bch uses the sparse engine from SPARSE_FROM_DEGREE on; here it is exercised at every degree."""
+    monkeypatch.setattr(formal_module, "SPARSE_FROM_DEGREE", 1)
+
+
 def _dense(spec, degree):
     comp = composition(spec)
     return formal_module._formal_dense(comp, tuple(sorted(set(comp.pieces))), degree)

@@ -126,6 +126,11 @@ def estimate_size(n_generators: int, max_degree: int) -> dict:
     }
 
 
+#: From this degree on (or when the dense engine's arrays would be too large) rational series use the sparse
+#: modular engine; below it the dense engine is faster cold (bench_bch: 12321 degree 7, 0.03 s against 0.5 s).
+SPARSE_FROM_DEGREE = 10
+
+
 @lru_cache(maxsize=1024)
 def _fits_dense(g: int, n: int) -> bool:
     if n > _HARD_DEGREE:
@@ -587,6 +592,8 @@ def formal_bch(comp, max_degree: int, n_pieces: int | None = None) -> FormalBCH:
     scalars = _Scalars(tuple(comp.coefficients))
     sparse = scalars.K is None and numba_available()
     n = check_degree(max_degree, g, dense=not sparse)
+    # low degrees: the dense engine answers in milliseconds without loading numba (~0.4 s in a fresh process)
+    sparse = sparse and (n >= SPARSE_FROM_DEGREE or not _fits_dense(g, n))
     if sparse:
         from .modular import lyndon_numerators  # compiled (numba); without it the dense engine below
 
