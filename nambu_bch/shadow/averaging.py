@@ -177,6 +177,30 @@ class OrbitAverage:
         return out
 
 
+def _crossing(rhs, y, k, dt, f_lo, f_hi, value, f_tol, t_tol):
+    """``(tau, y(tau))`` with ``value(y(tau)) = 0`` for ``tau`` in ``[0, dt]``, where ``value`` goes from ``f_lo < 0``
+    to ``f_hi >= 0`` over the accepted step: regula falsi, Illinois variant, on the step size from ``y``."""
+    lo, hi, side = 0.0, dt, 0
+    tau, y_tau = dt, None
+    for _ in range(60):
+        tau = (lo * f_hi - hi * f_lo) / (f_hi - f_lo)
+        y_tau, _, _ = _rk_step(rhs, y, k, tau)
+        f_tau = value(y_tau)
+        if abs(f_tau) <= f_tol or hi - lo <= t_tol:
+            break
+        if f_tau < 0:
+            lo, f_lo = tau, f_tau
+            if side == -1:
+                f_hi /= 2
+            side = -1
+        else:
+            hi, f_hi = tau, f_tau
+            if side == 1:
+                f_lo /= 2
+            side = 1
+    return tau, y_tau
+
+
 def _one_orbit(F: OrbitFunctions, x0, rtol, max_steps, radius):
     n, m = F.n, F.m
     y = np.concatenate([np.asarray(x0, float), np.zeros(m)])
@@ -218,26 +242,8 @@ def _one_orbit(F: OrbitFunctions, x0, rtol, max_steps, radius):
         crossings += (sg != signs) & (sg != 0)
         signs = np.where(sg != 0, sg, signs)
         if accepted > 3 and s_prev < 0.0 <= s_new and d_new < 0.5 * diam:
-            # regula falsi (Illinois) on the step size from y: s(step(y, tau)) = 0
-            lo, hi, f_lo, f_hi = 0.0, dt, s_prev, s_new
-            tau, y_tau = dt, y_new
-            side = 0
-            for _ in range(60):
-                tau = (lo * f_hi - hi * f_lo) / (f_hi - f_lo)
-                y_tau, _, _ = _rk_step(F.rhs, y, k, tau)
-                f_tau = float(v @ (y_tau[:n] - x0))
-                if abs(f_tau) <= 1e-15 * max(1.0, diam) or hi - lo <= 1e-16 * max(1.0, t):
-                    break
-                if f_tau < 0:
-                    lo, f_lo = tau, f_tau
-                    if side == -1:
-                        f_hi /= 2
-                    side = -1
-                else:
-                    hi, f_hi = tau, f_tau
-                    if side == 1:
-                        f_lo /= 2
-                    side = 1
+            tau, y_tau = _crossing(F.rhs, y, k, dt, s_prev, s_new, lambda z: float(v @ (z[:n] - x0)),
+                                   1e-15 * max(1.0, diam), 1e-16 * max(1.0, t))
             if float(np.linalg.norm(y_tau[:n] - x0)) < 1e-4 * diam:
                 T = t + tau
                 return dict(period=T, averages=y_tau[n:] / T, scales=scale, H0=H0, dH=dH,
@@ -348,24 +354,8 @@ def section_integral(F: OrbitFunctions, x, index: int, rtol: float = 1e-11, max_
             dt *= max(0.2, 0.9 * e ** -0.2)
             continue
         if y[index] < 0.0 <= y_new[index]:
-            lo, hi, f_lo, f_hi, side = 0.0, dt, float(y[index]), float(y_new[index]), 0
-            y_tau = y_new
-            for _ in range(60):
-                tau = (lo * f_hi - hi * f_lo) / (f_hi - f_lo)
-                y_tau, _, _ = _rk_step(F.rhs, y, k, tau)
-                f_tau = float(y_tau[index])
-                if abs(f_tau) <= 1e-15 or hi - lo <= 1e-16:
-                    break
-                if f_tau < 0:
-                    lo, f_lo = tau, f_tau
-                    if side == -1:
-                        f_hi /= 2
-                    side = -1
-                else:
-                    hi, f_hi = tau, f_tau
-                    if side == 1:
-                        f_lo /= 2
-                    side = 1
+            _, y_tau = _crossing(F.rhs, y, k, dt, float(y[index]), float(y_new[index]), lambda z: float(z[index]),
+                                 1e-15, 1e-16)
             return y_tau[n:].copy()
         y, k = y_new, k_new
         dt *= min(5.0, max(0.2, 0.9 * max(e, 1e-10) ** -0.2))
