@@ -241,7 +241,8 @@ def _log_of_product(letters, scalars: _Scalars, g: int, n: int):
     big = lcm(*range(1, n + 1))
     dens = [factorial(d) * big * scalars.q**d for d in range(n + 1)]
     if scalars.K is None:
-        _, largest = _log_arrays(letters, [float(abs(c)) for c in scalars.values], np.float64, 0.0, 1.0, g, n, big, True)
+        with np.errstate(over="ignore", invalid="ignore"):  # an overflow here only means "too large for int64"
+            _, largest = _log_arrays(letters, [float(abs(c)) for c in scalars.values], np.float64, 0.0, 1.0, g, n, big, True)
         if largest < _INT64_LIMIT:
             L, _ = _log_arrays(letters, scalars.values, np.int64, 0, 1, g, n, big, False)
             return L, dens
