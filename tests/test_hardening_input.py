@@ -33,7 +33,6 @@ from nambu_bch.errors import (
     InvalidCompositionError,
     InvalidSystemError,
     NambuBCHError,
-    OutputError,
     ResourceLimitError,
     UnknownPieceError,
 )

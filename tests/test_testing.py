@@ -10,7 +10,6 @@ from pathlib import Path
 import pytest
 import sympy
 
-from nambu_bch import model
 from nambu_bch.testing import assert_fields_equal, assert_invariant, assert_shadow_pair, liouville_components
 
 REPO = Path(__file__).resolve().parents[1]
