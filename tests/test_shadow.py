@@ -512,3 +512,26 @@ def test_fi_route_agrees_with_direct_at_h1(name, word):
     assert F.exists == D.exists
     if F.exists:
         assert all(zero(a - b) for a, b in zip(F.shadows, D.shadows))
+
+
+def test_family_is_frozen_and_built_by_named_constructors():
+    """A ShadowFamily is immutable (issue 11, item 6) and is what its named constructor makes of the route's own
+    result: ``from_direct(direct_route(...))`` and ``from_fi(fi_route(...))`` equal ``shadow_hamiltonians``
+    (ho3, Phi^{12321}, Eqs. SH12321c, SG12321c); an undecided obstruction keeps its order (ho3, Phi^{123}, h^1)."""
+    import dataclasses
+
+    from nambu_bch.integrators.composition import composition_for
+    from nambu_bch.shadow import ShadowFamily
+
+    S = model("ho3")
+    comp = composition_for("12321", S.splitting)
+    F = shadow_hamiltonians(S, "12321")
+    with pytest.raises(dataclasses.FrozenInstanceError):
+        F.exists = False
+    D = ShadowFamily.from_direct(S, comp, 2, direct_route(S, comp, 2))
+    assert D.to_dict() == F.to_dict() and D.shadows == F.shadows and D.free_parameters == ["alpha"]
+    G = shadow_hamiltonians(S, "12321", route="fi")
+    assert ShadowFamily.from_fi(S, comp, 2, fi_route(S, comp, 2)).to_dict() == G.to_dict()
+    assert all(sympy.expand(a - b) == 0 for a, b in zip(F.shadows, G.shadows))
+    U = shadow_hamiltonians(S, "123", 1, existence=False)
+    assert U.exists is None and U.evidence["outcome"] == "undecided" and U.evidence["order"] == U.failed_order == 1

@@ -229,14 +229,14 @@ class _LaurentOps:
                 d = f.diff(x)
                 if d:
                     total = total + c * d
-        return self.engine._reduce(total)
+        return self.engine.reduce(total)
 
     @staticmethod
     def is_zero(f) -> bool:
         return not f
 
     def finish(self, comps) -> VectorField:
-        return VectorField(self.engine.algebra, [self.engine.to_algebra(self.engine._reduce(c)) for c in comps])
+        return VectorField(self.engine.algebra, [self.engine.to_algebra(self.engine.reduce(c)) for c in comps])
 
 
 class _SympyOps:

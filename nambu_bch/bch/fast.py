@@ -141,8 +141,8 @@ class FastFields:
         return self.ring.from_dict({k: v for k, v in out.items() if v})
 
     # -- operations ---------------------------------------------------------------
-    def _reduce(self, poly):
-        """Canonical Laurent form: no monomial holds both ``p`` and ``p_inv``."""
+    def reduce(self, poly):
+        """Canonical Laurent form of a ring element: no monomial holds both ``p`` and ``p_inv`` (``p p_inv = 1``)."""
         pairs = self._laurent
         if not pairs or not any(m[i] and m[j] for m in poly.keys() for i, j in pairs):
             return poly
@@ -169,7 +169,7 @@ class FastFields:
                     total = total + X.components[j] * dY[i][j]
                 if Y.components[j] and dX[i][j]:
                     total = total - Y.components[j] * dX[i][j]
-            comps.append(self._reduce(total))
+            comps.append(self.reduce(total))
         return _Field(comps, X.scale * Y.scale)
 
     def coefficients(self, numbers) -> list:

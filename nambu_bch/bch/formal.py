@@ -476,19 +476,6 @@ class FormalBCH(Printable):
                 self._sympy[d] = tuple((to_sympy(c), t) for c, t in items)
         return self._sympy
 
-    def domain_terms(self, degree: int, domain):
-        """``[(c, tree)]`` with ``c`` an element of the sympy ``domain`` (QQ or an algebraic field).
-
-        Avoids re-deriving algebraic numbers from sympy expressions (a minimal-polynomial
-        computation per coefficient) when the caller works in the same field.
-        """
-        raw = self._elements.get(degree, ())
-        if self._domain is not None and domain == self._domain:
-            return list(raw)
-        if self._domain is None:
-            return list(raw) if domain == QQ else [(domain.convert_from(c, QQ), t) for c, t in raw]
-        return [(domain.from_sympy(c), t) for c, t in self.terms(degree)]
-
     def terms(self, degree: int) -> list:
         """``[(coefficient, tree), ...]`` of the degree-``degree`` part, Lyndon words in lexicographic order.
 

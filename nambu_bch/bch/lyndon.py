@@ -71,13 +71,6 @@ def tree_leaves(tree) -> tuple:
     return (tree,)
 
 
-def map_leaves(tree, function):
-    """The same tree with every leaf replaced by ``function(leaf)``."""
-    if is_bracket(tree):
-        return (map_leaves(tree[0], function), map_leaves(tree[1], function))
-    return function(tree)
-
-
 @lru_cache(maxsize=4096)
 def witt_dimension(n_letters: int, degree: int) -> int:
     """Number of Lyndon words of length ``degree`` over ``n_letters`` letters (Witt's formula).

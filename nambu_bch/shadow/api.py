@@ -7,12 +7,9 @@ Horikoshi, Sects. 4.2 and 5.2; Eqs. (L2), (SH12321c), (SG12321c).
 
 from __future__ import annotations
 
-import sympy
-
 from ..bch.backward import check_order
 from ..errors import NambuBCHError
 from ..integrators.composition import composition_for
-from ..symbols import ALPHA
 from .direct_route import direct_route
 from .family import ShadowFamily
 from .fi_route import fi_route
@@ -31,39 +28,13 @@ def _system(system):
     return system
 
 
-def _operator(n_hams: int) -> str:
-    if n_hams == 1:
-        return "X_{dH}"
-    if n_hams == 2:
-        return "X_{dH,G} + X_{H,dG}"
-    return "sum_a X_{H_1..dH_a..H_" + str(n_hams) + "}"
-
-
-def _obstruction_text(sol, n_hams: int = 2) -> str:
-    terms = sorted(sol.certificate.items(), key=lambda kv: (str(kv[0][0]), sympy.default_sort_key(kv[0][1])))
-    shown = " + ".join(f"({c})*[{mono}]Y^{x}" for (x, mono), c in terms[:6])
-    more = f" + ... ({len(terms)} terms)" if len(terms) > 6 else ""
-    return (
-        f"at h^{sol.order} no polynomial corrections of degree <= {sol.degree} solve "
-        f"{_operator(n_hams)} = Z_{sol.order} - (cross terms): the functional l(Y) = {shown}{more} "
-        f"vanishes on every such field but l(RHS) = {sol.obstruction_value}"
-    )
-
-
-def _decide(fam, R, existence, params):
-    """Set ``exists`` / ``drift`` / ``evidence`` of a family whose polynomial ansatz failed (issue 17)."""
-    if not existence:
-        fam.exists = None
-        fam.evidence = {"outcome": "undecided", "order": fam.failed_order, "method": None,
-                        "reason": "no polynomial pair; existence in smooth functions not decided (existence=False)"}
-        return
+def _decision(result, existence: bool, params):
+    """The existence decision (orbit averages, issue 17) of a direct result without a polynomial pair; None if not asked."""
+    if not existence or result is None or result.exists:
+        return None
     from .existence import decide
 
-    dec = decide(R, params=params)
-    fam.existence = dec
-    fam.exists = dec.exists
-    fam.drift = dec.drift_dict()
-    fam.evidence = dec.evidence()
+    return decide(result, params=params)
 
 
 def shadow_hamiltonians(system, word, order: int = 2, route: str = "direct", degree=None, *,
@@ -93,6 +64,7 @@ def shadow_hamiltonians(system, word, order: int = 2, route: str = "direct", deg
 
     Examples
     --------
+    >>> import sympy
     >>> from nambu_bch import model
     >>> F = shadow_hamiltonians(model("ho3"), "12321")          # Eqs. (SH12321c), (SG12321c)
     >>> sympy.expand(F.H_S - model("ho3").H)
@@ -111,83 +83,12 @@ def shadow_hamiltonians(system, word, order: int = 2, route: str = "direct", deg
             f"the FI route needs the Nambu bracket (N - 1 Hamiltonians, the fundamental identity); {system.name} has the "
             f"{system.bracket} bracket on N = {system.N}: use route='direct'")
     comp = composition_for(word, system.splitting)
-    notes = []
     if route == "direct":
         R = direct_route(system, comp, order, degree, max_unknowns, progress=progress)
-        fam = ShadowFamily(system, comp, order, route, R.exists, details=R)
-        for o in R.orders:
-            if o.status == "vanishes":
-                why = " (odd order of a symmetric word)" if comp.symmetric and o.order % 2 else ""
-                notes.append(f"h^{o.order}: the correction vanishes{why}")
-            elif o.status == "solved":
-                fam.gauge[o.order] = o.gauge
-                fam.corrections[o.order] = o.corrections
-                fam.degree[o.order] = o.degree
-            else:
-                fam.degree[o.order] = o.degree
-        if R.exists:
-            fam.shadows = R.shadow()
-            fam.polynomial = True
-        else:
-            bad = R.orders[-1]
-            fam.failed_order = bad.order
-            fam.polynomial = False
-            if bad.status == "obstructed":
-                fam.certificate = bad.certificate
-                fam.obstruction = _obstruction_text(bad, len(system.hamiltonians))
-            else:
-                fam.obstruction = (f"at h^{bad.order} the polynomial ansatz of degree <= {bad.degree} has more than "
-                                   f"max_unknowns={max_unknowns} unknowns: the exact solve was refused up front")
-            _decide(fam, R, existence, params)
-    else:
-        power = 2 if comp.symmetric else 1
-        fam = ShadowFamily(system, comp, order, route, True)
-        if order < power:
-            fam.shadows = tuple(sympy.expand(Hk) for Hk in system.hamiltonians)
-            notes.append("h^1: the correction vanishes (symmetric word)")
-        else:
-            R = fi_route(system, comp, order, degree)
-            fam.details = R
-            fam.exists = R.exists
-            fam.degree[power] = R.degree
-            if R.certificate is not None:
-                fam.failed_order = power
-                fam.certificate = R.certificate
-                fam.obstruction = (f"at h^{power} no affine combination of the FI representations equals "
-                                   f"X_{{H,dG}} + X_{{dH,G}} with corrections of degree <= {R.degree}")
-            else:
-                fam.corrections[power] = R.corrections
-                fam.gauge[power] = R.kernel_corrections()
-                for o in R.orders:
-                    if o.status == "vanishes":
-                        why = " (odd order of a symmetric word)" if comp.symmetric and o.order % 2 else ""
-                        notes.append(f"h^{o.order}: the correction vanishes{why}")
-                        continue
-                    fam.degree[o.order] = o.degree
-                    if o.status == "solved":
-                        fam.corrections[o.order] = o.corrections
-                        fam.gauge[o.order] = list(o.kernel)
-                    else:
-                        fam.failed_order = o.order
-                        fam.certificate = o.certificate
-                        fam.obstruction = (f"at h^{o.order} no affine combination of the FI representations equals "
-                                           f"X_{{H,dG}} + X_{{dH,G}} + (cross terms) with corrections of degree <= {o.degree}")
-            if R.exists:
-                fam.shadows = R.shadow()
-                fam.polynomial = True
-            else:
-                # the FI ansatz failing is no certificate: the direct route and the orbit averages decide
-                fam.polynomial = False
-                if not existence:
-                    _decide(fam, None, existence, params)
-                else:
-                    D = direct_route(system, comp, order, None, max_unknowns)
-                    if D.exists:
-                        fam.exists, fam.polynomial, fam.shadows = True, True, D.shadow()
-                        notes.append("the FI ansatz failed; the shadows are the direct route's polynomial pair")
-                    else:
-                        _decide(fam, D, existence, params)
-    fam.notes = notes
-    if fam.exists and any(S.has(ALPHA) for S in fam.shadows):
-        fam.free_parameters = ["alpha"]
-    return fam
+        return ShadowFamily.from_direct(system, comp, order, R, _decision(R, existence, params), max_unknowns=max_unknowns)
+    if order < (2 if comp.symmetric else 1):
+        return ShadowFamily.unperturbed(system, comp, order)
+    R = fi_route(system, comp, order, degree)
+    # the FI ansatz failing is no certificate: the direct route and the orbit averages decide
+    D = direct_route(system, comp, order, None, max_unknowns) if existence and not R.exists else None
+    return ShadowFamily.from_fi(system, comp, order, R, _decision(D, existence, params), direct=D)

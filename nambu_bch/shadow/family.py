@@ -18,11 +18,68 @@ from dataclasses import dataclass, field
 import sympy
 
 from ..printing import Printable, aligned, h_coefficients, latex_text, series_text, series_tokens
-from ..symbols import STEP
+from ..symbols import ALPHA, STEP
 
 
+def existence_fields(decision, failed_order) -> dict:
+    """The fields ``exists, existence, drift, evidence`` of a family whose polynomial ansatz failed at ``h^failed_order``.
 
-@dataclass
+    Parameters
+    ----------
+    decision : :class:`~nambu_bch.shadow.existence.Existence` or None -- the decision by orbit
+        averages (:func:`~nambu_bch.shadow.existence.decide`); None: existence in smooth
+        functions was not decided (``existence=False``)
+    failed_order : int or None -- the first power of ``h`` the polynomial ansatz did not solve
+
+    Returns
+    -------
+    dict -- keyword arguments of :class:`ShadowFamily` (a pure function: nothing is computed or changed)
+
+    References
+    ----------
+    The three outcomes of issue 17 (pair / certified non-existence / undecided); Horikoshi, Eq. (L2).
+
+    >>> existence_fields(None, 3)["evidence"]["outcome"]
+    'undecided'
+    """
+    if decision is None:
+        return {"exists": None, "existence": None, "drift": None,
+                "evidence": {"outcome": "undecided", "order": failed_order, "method": None,
+                             "reason": "no polynomial pair; existence in smooth functions not decided (existence=False)"}}
+    return {"exists": decision.exists, "existence": decision, "drift": decision.drift_dict(), "evidence": decision.evidence()}
+
+
+def _vanishing_note(composition, order: int) -> str:
+    why = " (odd order of a symmetric word)" if composition.symmetric and order % 2 else ""
+    return f"h^{order}: the correction vanishes{why}"
+
+
+def _operator(n_hams: int) -> str:
+    if n_hams == 1:
+        return "X_{dH}"
+    if n_hams == 2:
+        return "X_{dH,G} + X_{H,dG}"
+    return "sum_a X_{H_1..dH_a..H_" + str(n_hams) + "}"
+
+
+def _obstruction_text(sol, n_hams: int = 2) -> str:
+    """One line: the direct route's left-null functional ``l`` at the failed order and ``l(RHS) != 0``."""
+    terms = sorted(sol.certificate.items(), key=lambda kv: (str(kv[0][0]), sympy.default_sort_key(kv[0][1])))
+    shown = " + ".join(f"({c})*[{mono}]Y^{x}" for (x, mono), c in terms[:6])
+    more = f" + ... ({len(terms)} terms)" if len(terms) > 6 else ""
+    return (
+        f"at h^{sol.order} no polynomial corrections of degree <= {sol.degree} solve "
+        f"{_operator(n_hams)} = Z_{sol.order} - (cross terms): the functional l(Y) = {shown}{more} "
+        f"vanishes on every such field but l(RHS) = {sol.obstruction_value}"
+    )
+
+
+def _free_parameters(exists, shadows) -> list:
+    """``["alpha"]`` when an existing family's shadows depend on ``alpha`` (Eq. Xeff3), else ``[]``."""
+    return ["alpha"] if exists and any(S.has(ALPHA) for S in shadows) else []
+
+
+@dataclass(frozen=True)
 class ShadowFamily(Printable):
     """Shadow Hamiltonians of a composition on a system, as a family.
 
@@ -44,6 +101,8 @@ class ShadowFamily(Printable):
     notes : list of str -- e.g. vanishing odd orders
     failed_order, certificate, obstruction -- set when ``exists`` is false
     details : the route's own result (``DirectResult`` or ``FIResult``)
+
+    A family is immutable; it is built by :meth:`from_direct`, :meth:`from_fi` or :meth:`unperturbed`.
     """
 
     system: object
@@ -65,6 +124,92 @@ class ShadowFamily(Printable):
     drift: dict | None = None
     evidence: dict | None = None
     existence: object = None
+
+    # -- named constructors ------------------------------------------------------------
+    @classmethod
+    def from_direct(cls, system, composition, order: int, result, decision=None, *, max_unknowns=None) -> "ShadowFamily":
+        """The family of a direct-route result (:func:`~nambu_bch.shadow.direct_route.direct_route`).
+
+        Parameters
+        ----------
+        system, composition, order -- as given to the route
+        result : DirectResult
+        decision : Existence or None -- the existence decision when the polynomial ansatz failed
+            (:func:`existence_fields`; None: undecided); ignored when a polynomial pair was found
+        max_unknowns : int or None -- the bound the route used (named in the obstruction of a refused order)
+        """
+        notes, gauge, corrections, degree = [], {}, {}, {}
+        for o in result.orders:
+            if o.status == "vanishes":
+                notes.append(_vanishing_note(composition, o.order))
+            elif o.status == "solved":
+                gauge[o.order] = o.gauge
+                corrections[o.order] = o.corrections
+                degree[o.order] = o.degree
+            else:
+                degree[o.order] = o.degree
+        common = dict(gauge=gauge, corrections=corrections, degree=degree, notes=notes, details=result)
+        if result.exists:
+            shadows = result.shadow()
+            return cls(system, composition, order, "direct", True, shadows=shadows, polynomial=True,
+                       free_parameters=_free_parameters(True, shadows), **common)
+        bad = result.orders[-1]
+        if bad.status == "obstructed":
+            certificate, obstruction = bad.certificate, _obstruction_text(bad, len(system.hamiltonians))
+        else:
+            certificate = None
+            obstruction = (f"at h^{bad.order} the polynomial ansatz of degree <= {bad.degree} has more than "
+                           f"max_unknowns={max_unknowns} unknowns: the exact solve was refused up front")
+        return cls(system, composition, order, "direct", failed_order=bad.order, polynomial=False, certificate=certificate,
+                   obstruction=obstruction, **existence_fields(decision, bad.order), **common)
+
+    @classmethod
+    def from_fi(cls, system, composition, order: int, result, decision=None, *, direct=None) -> "ShadowFamily":
+        """The family of an FI-route result (:func:`~nambu_bch.shadow.fi_route.fi_route`).
+
+        When the FI ansatz fails, the FI ansatz is no certificate: a polynomial pair of the
+        ``direct`` route (a DirectResult, if given) gives the shadows; otherwise ``decision``
+        (:func:`existence_fields`; None: undecided) gives the existence outcome.
+        """
+        power = result.power
+        notes, gauge, corrections, degree = [], {}, {}, {power: result.degree}
+        failed_order = certificate = obstruction = None
+        if result.certificate is not None:
+            failed_order, certificate = power, result.certificate
+            obstruction = (f"at h^{power} no affine combination of the FI representations equals "
+                           f"X_{{H,dG}} + X_{{dH,G}} with corrections of degree <= {result.degree}")
+        else:
+            corrections[power] = result.corrections
+            gauge[power] = result.kernel_corrections()
+            for o in result.orders:
+                if o.status == "vanishes":
+                    notes.append(_vanishing_note(composition, o.order))
+                    continue
+                degree[o.order] = o.degree
+                if o.status == "solved":
+                    corrections[o.order] = o.corrections
+                    gauge[o.order] = list(o.kernel)
+                else:
+                    failed_order, certificate = o.order, o.certificate
+                    obstruction = (f"at h^{o.order} no affine combination of the FI representations equals "
+                                   f"X_{{H,dG}} + X_{{dH,G}} + (cross terms) with corrections of degree <= {o.degree}")
+        if result.exists:
+            outcome = dict(exists=True, polynomial=True, shadows=result.shadow())
+        elif direct is not None and direct.exists:
+            outcome = dict(exists=True, polynomial=True, shadows=direct.shadow())
+            notes.append("the FI ansatz failed; the shadows are the direct route's polynomial pair")
+        else:
+            outcome = dict(polynomial=False, **existence_fields(decision, failed_order))
+        return cls(system, composition, order, "fi", gauge=gauge, corrections=corrections, degree=degree, notes=notes,
+                   failed_order=failed_order, certificate=certificate, obstruction=obstruction, details=result,
+                   free_parameters=_free_parameters(outcome["exists"], outcome.get("shadows", ())), **outcome)
+
+    @classmethod
+    def unperturbed(cls, system, composition, order: int, route: str = "fi") -> "ShadowFamily":
+        """A symmetric word below its first correction (``order < 2``): the shadows are the Hamiltonians."""
+        shadows = tuple(sympy.expand(Hk) for Hk in system.hamiltonians)
+        return cls(system, composition, order, route, True, shadows=shadows, free_parameters=_free_parameters(True, shadows),
+                   notes=["h^1: the correction vanishes (symmetric word)"])
 
     def _outcome_headline(self) -> str:
         """The existence outcome of a family without a polynomial pair (the three outcomes of issue 17)."""

@@ -1,4 +1,4 @@
-"""The built-in models, by the names the CLI and :func:`model` share (DESIGN.md)."""
+"""The built-in models, by the names the CLI and :func:`model` share (symbols: docs/conventions.md; list: docs/systems.md)."""
 
 from __future__ import annotations
 
@@ -29,7 +29,7 @@ def _rigid_body():
         "x1 x2 x3", ["x1**2/(2*I1) + x2**2/(2*I2) + x3**2/(2*I3)", "x1**2/2 + x2**2/2 + x3**2/2"],
         "I1 I2 I3", name="rigid-body",
         # With H (energy) before G (|L|^2/2), {f, H, G} gives dL/dt = omega x L: Euler's equations
-        # with t -> -t.  DESIGN.md fixes this order; reversing time maps h -> -h and changes no
+        # with t -> -t.  This order is part of the model's definition; reversing time maps h -> -h and changes no
         # existence result, so the model keeps it and says so.
         description="free rigid body (Euler equations with t -> -t for this order of H, G), full split; piece i moves x_i",
         citation="Nambu (1973); Modin (2010)",
