@@ -35,7 +35,7 @@ STAGES = [  # (stage, (file, function) pairs whose cumulative CPU time is attrib
     ("cross terms (lower orders fed in)", [("fi_route.py", "_cross_terms")]),
     ("formal target columns (X_{H,x^e}, X_{x^e,G})", [("fi_route.py", "_monomial_column")]),
     ("exact linear algebra (solve_affine, normal_form, kernel_rref)",
-     [("linear.py", "solve_affine"), ("linear.py", "normal_form"), ("linear.py", "kernel_rref")]),
+     [("elimination.py", "solve_affine"), ("elimination.py", "normal_form"), ("elimination.py", "kernel_rref")]),
     ("alpha-family in sympy (alpha parts, H_S, G_S)", [("fi_route.py", "_alpha_parts"), ("fi_route.py", "shadow")]),
 ]
 

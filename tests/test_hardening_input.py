@@ -415,12 +415,24 @@ def test_library_import_keeps_pythons_sigint_handler():
 
 
 def test_sigint_while_computing_is_one_line():
-    proc = subprocess.Popen([sys.executable, "-m", "nambu_bch", "shadow", "--model", "rigid-body", "--order", "8"],
-                            env=ENV, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    """SIGINT delivered while ``nambu-bch shadow --model rigid-body --order 8`` computes (the child says on stdout
+    when the computation starts, so the signal is sent then instead of after a fixed sleep)."""
+    code = textwrap.dedent("""
+        import sys
+        import nambu_bch.shadow as shadow
+        sys.argv[0] = "nambu-bch"                      # as the console script
+        real = shadow.shadow_hamiltonians
+        def marked(*args, **kwargs):                   # the subcommand looks it up at call time
+            print("computing", flush=True)
+            return real(*args, **kwargs)
+        shadow.shadow_hamiltonians = marked
+        from nambu_bch.cli import main
+        sys.exit(main(["shadow", "--model", "rigid-body", "--order", "8"]))
+    """)
+    proc = subprocess.Popen([sys.executable, "-c", code], env=ENV, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                            text=True)
     try:
-        import time
-
-        time.sleep(4)  # not a timing assertion: interrupted during the import or the computation, same contract
+        assert proc.stdout.readline() == "computing\n"
         proc.send_signal(signal.SIGINT)
         out, err = proc.communicate(timeout=600)
     finally:

@@ -6,7 +6,7 @@ out), with unknown coefficients ``c_mu`` in the field ``K = QQ(parameters, h)``.
 Substituting the exact composed map (:func:`~nambu_bch.integrators.composed_map`)
 makes ``I(Phi_h(x)) - I(x)`` a polynomial in ``x`` whose coefficients are
 linear in the ``c_mu``; setting them to zero is a linear system over ``K``,
-solved exactly by a Gauss-Jordan nullspace over ``K`` (``DomainMatrix``).  Its
+solved exactly by a Gauss-Jordan nullspace over ``K`` (:mod:`nambu_bch.algebra.elimination`).  Its
 rows span *all* invariants of degree ``<= d`` (modulo constants).  Maps with
 exponentials (Lotka-Volterra) are handled by treating the combined
 exponential of each term as one more generator, which finds ``G = x1 x2 x3``
@@ -43,9 +43,9 @@ from math import comb, prod
 
 import sympy
 from sympy.polys.domains import QQ
-from sympy.polys.matrices import DomainMatrix
 from sympy.polys.rings import ring
 
+from ..algebra.elimination import nullspace, rank, solve_affine
 from ..errors import InvalidOrderError, InvalidSystemError, NoExactResultError, ResourceLimitError
 from ..integrators import composed_map, composition_for
 from ..printing import Printable, aligned, series_text, series_tokens
@@ -190,29 +190,13 @@ def _invariant_basis(setup: _Setup, degree: int):
             rows.setdefault(m, len(rows))
     if not rows:  # the map is the identity: every monomial is invariant
         return [R({mu: setup.K.one}) for mu in monos]
-    mat = [[setup.K.zero] * len(monos) for _ in rows]
+    mat: dict = {}
     for col, diff in enumerate(columns):
         for key, c in diff.items():
-            mat[rows[key]][col] = c
-    return [R({mu: c for mu, c in zip(monos, vec) if c}) for vec in _nullspace(mat, len(monos), setup.K)]
-
-
-def _nullspace(mat, ncols, K):
-    """Rows spanning the nullspace, from a Gauss-Jordan rref over the field ``K``.
-
-    (``DomainMatrix.nullspace`` goes through the fraction-free ``rref_den``,
-    whose gcds in ``QQ(m, omega, h)`` are 100x slower here.)
-    """
-    rref, pivots = DomainMatrix(mat, (len(mat), ncols), K).rref(method="GJ")
-    rows = rref.to_list()
-    out = []
-    for free in (c for c in range(ncols) if c not in pivots):
-        vec = [K.zero] * ncols
-        vec[free] = K.one
-        for i, p in enumerate(pivots):
-            vec[p] = -rows[i][free]
-        out.append(vec)
-    return out
+            if c:
+                mat.setdefault(rows[key], {})[col] = c
+    kernel = nullspace(mat, len(rows), len(monos), setup.K)
+    return [R({monos[c]: v for c, v in sorted(vec.items()) if v}) for vec in kernel]
 
 
 def _vanishes_at_h0(K, c) -> bool:
@@ -245,12 +229,11 @@ def _normalise(setup: _Setup, basis, target):
         count += 1
         if count > _MAX_CANDIDATES:
             break
-        B = DomainMatrix([[b.get(mu, K.zero) for b in basis] for mu in S], (r, r), K)
-        if B.rank() < r:
+        columns = [{i: b.get(mu, K.zero) for i, mu in enumerate(S)} for b in basis]
+        sol = solve_affine(columns, [{i: T.get(mu, K.zero) for i, mu in enumerate(S)}], r, K, certificate=False)
+        if sol.kernel:  # the r x r minor on S is singular
             continue
-        rhs = DomainMatrix([[T.get(mu, K.zero)] for mu in S], (r, 1), K)
-        sol = B.lu_solve(rhs)
-        coeffs = [sol[i, 0].element for i in range(r)]
+        coeffs = [sol.particular[0].get(j, K.zero) for j in range(r)]
         I = R.zero
         for c, b in zip(coeffs, basis):
             I = I + b * c
@@ -459,8 +442,8 @@ def _rank(setup, polys) -> int:
     monos = sorted(set().union(*(set(p.keys()) for p in polys)))
     if not monos:
         return 0
-    mat = DomainMatrix([[p.get(m, setup.K.zero) for m in monos] for p in polys], (len(polys), len(monos)), setup.K)
-    return mat.rank()
+    index = {m: j for j, m in enumerate(monos)}
+    return rank([{index[m]: c for m, c in p.items()} for p in polys], len(monos), setup.K)
 
 
 def _primitive(p):

@@ -16,7 +16,7 @@ effective field ``X_eff = sum_j h^j Z_j`` (Eq. L2) gives at each order the
 for polynomial corrections of degree ``<= D`` (the ansatz degree, chosen from
 the degrees of the right-hand side and of the Hamiltonians, or given).  The
 unknowns are the monomial coefficients; (*) is solved exactly with
-``DomainMatrix`` over ``QQ(parameters)`` (:mod:`nambu_bch.shadow.linear`).
+``DomainMatrix`` over ``QQ(parameters)`` (:mod:`nambu_bch.algebra.elimination`).
 
 The complete solution space at order ``j`` is a particular solution plus the
 kernel of ``L`` -- the *gauge*: it contains ``(d psi/dG, -d psi/dH)`` for every
@@ -25,7 +25,7 @@ computed, not assumed, and compared with the ``psi`` directions.
 
 The alpha-family (the package's parametrisation, Eq. Xeff3 generalised).  Two
 canonical members are the normal forms of the solution modulo the kernel
-(:func:`~nambu_bch.shadow.linear.normal_form`):
+(:func:`~nambu_bch.algebra.elimination.normal_form`):
 
 * ``alpha = 0``: the corrections of ``H`` cleared first (constants first, then
   the monomials of ``H`` itself, lexicographic with ``x_N`` highest, then the
@@ -64,11 +64,11 @@ from itertools import product
 import sympy
 
 from ..algebra import liouville_field
+from ..algebra.elimination import rank, solve_affine
 from ..bch.backward import check_order
 from ..bch.concrete import effective_field_by_cost
 from ..errors import InvalidOrderError, NambuBCHError, ResourceLimitError
 from ..integrators.composition import composition_for
-from .linear import rank, solve_affine
 
 H_STEP = sympy.Symbol("h")
 ALPHA = sympy.Symbol("alpha")

@@ -69,9 +69,8 @@ from itertools import combinations, product
 
 import numpy as np
 import sympy
-from sympy.polys.matrices import DomainMatrix
-from sympy.polys.matrices.sdm import SDM
 
+from ..algebra.elimination import solve_affine
 from ..checks import is_int
 from ..errors import NambuBCHError
 from .averaging import orbit_average, orbit_functions, sample_points, section_integral
@@ -236,35 +235,16 @@ def exact_average(system, g, max_unknowns: int = MAX_EXACT_UNKNOWNS):
     cols = [vec(X.apply(alg.convert(sympy.Mul(*(x**k for x, k in zip(coords, e)))))) for e in pmonos]
     ccols = [vec(sympy.Mul(*(H**k for H, k in zip(hams, e)))) for e in cmonos]
     b = vec(g)
-    particular = _particular(cols + ccols, b, len(rows), alg.domain)
-    if particular is None:
+    solution = solve_affine(cols + ccols, [b], len(rows), alg.domain, certificate=False)
+    if not solution.consistent:
         return None
+    particular = solution.particular[0]
     c = sympy.Integer(0)
     for col, v in particular.items():
         if col >= len(cols):
             e = cmonos[col - len(cols)]
             c += alg.domain.to_sympy(v) * sympy.Mul(*(s**k for s, k in zip(names, e)))
     return sympy.factor(c)
-
-
-def _particular(columns, b, nrows, domain):
-    """A solution ``{column: value}`` of ``L x = b`` (free columns zero), or None; no certificate (cheaper than
-    :func:`~nambu_bch.shadow.linear.solve_affine`, whose left-null-vector search is not needed here)."""
-    ncols = len(columns)
-    rows: dict = {}
-    for j, col in enumerate(columns):
-        for i, v in col.items():
-            if v:
-                rows.setdefault(i, {})[j] = v
-    for i, v in b.items():
-        if v:
-            rows.setdefault(i, {})[ncols] = v
-    M = DomainMatrix.from_rep(SDM({i: r for i, r in rows.items() if r}, (nrows, ncols + 1), domain))
-    R, pivots = M.rref()
-    if ncols in pivots:
-        return None
-    R = R.rep.to_sdm()
-    return {p: R[r][ncols] for r, p in enumerate(pivots) if ncols in R.get(r, {})}
 
 
 # -- symmetry ---------------------------------------------------------------------------------

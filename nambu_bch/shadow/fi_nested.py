@@ -49,6 +49,7 @@ from dataclasses import dataclass, field
 import sympy
 
 from ..algebra.brackets import permutation_sign
+from ..algebra.elimination import Echelon  # noqa: F401  (used here; imported from here by tests)
 from ..bch.lyndon import is_bracket
 from ..errors import NambuBCHError
 from .fundamental_identity import _bracket
@@ -69,56 +70,6 @@ def _canonical(entries):
 def _content_order(key):
     """A sort key of a raw term by content (atoms by their expression, not by registration order)."""
     return tuple((kind, v) if kind == 0 else (kind, str(_ATOMS[v])) for kind, v in key)
-
-
-class Echelon:
-    """Incremental reduced row echelon form of sparse vectors ``{key: value}`` over a field.
-
-    >>> from sympy.polys.domains import QQ
-    >>> E = Echelon(QQ)
-    >>> E.insert({"x": QQ(1), "y": QQ(2)}), E.insert({"x": QQ(2), "y": QQ(4)}), E.insert({"y": QQ(1)})
-    (True, False, True)
-    >>> len(E.rows)
-    2
-    """
-
-    def __init__(self, domain):
-        self.domain = domain
-        self.rows: dict = {}  # pivot key -> row (pivot coefficient one, no other pivot keys)
-
-    def reduce(self, vec: dict) -> dict:
-        v = {k: c for k, c in vec.items() if c}
-        for p in [k for k in v if k in self.rows]:
-            c = v.get(p)
-            if not c:
-                continue
-            for k, r in self.rows[p].items():
-                s = v.get(k, self.domain.zero) - c * r
-                if s:
-                    v[k] = s
-                else:
-                    v.pop(k, None)
-        return v
-
-    def insert(self, vec: dict) -> bool:
-        """Add ``vec`` if independent of the rows so far; ``True`` if it was."""
-        v = self.reduce(vec)
-        if not v:
-            return False
-        p = min(v)
-        inv = self.domain.one / v[p]
-        v = {k: c * inv for k, c in v.items()}
-        for q, row in self.rows.items():
-            c = row.get(p)
-            if c:
-                for k, r in v.items():
-                    s = row.get(k, self.domain.zero) - c * r
-                    if s:
-                        row[k] = s
-                    else:
-                        row.pop(k, None)
-        self.rows[p] = v
-        return True
 
 
 class RawOps:

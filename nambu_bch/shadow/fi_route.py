@@ -16,7 +16,7 @@ valid representation; we ask for which weights the total equals
 as a formal sum of Liouville terms modulo multilinearity, antisymmetry and the
 vanishing rule (:class:`~nambu_bch.shadow.liouville_terms.LiouvilleSum`).  The
 unknowns are the weights and the monomial coefficients of ``dH, dG``; the
-condition is linear and is solved exactly (:mod:`nambu_bch.shadow.linear`).
+condition is linear and is solved exactly (:mod:`nambu_bch.algebra.elimination`).
 The result is the whole solution family (particular + kernel), its two
 canonical members and their alpha-family (same rule as the direct route, see
 :mod:`nambu_bch.shadow.direct_route`), and :meth:`FIResult.check_member` to
@@ -51,6 +51,7 @@ from itertools import product
 import sympy
 
 from ..algebra import liouville_field
+from ..algebra.elimination import Echelon, kernel_rref, normal_form, rank, solve_affine
 from ..bch import expand_terms, formal_bch
 from ..bch.expansion import piece_evaluator, term_evaluator
 from ..bch.lyndon import is_bracket
@@ -59,9 +60,8 @@ from ..errors import InvalidOrderError, NambuBCHError
 from ..integrators.composition import composition_for
 from ..symbols import ALPHA, STEP
 from .direct_route import _monomials
-from .fi_nested import Echelon, RawOps, nested_hull
+from .fi_nested import RawOps, nested_hull
 from .fundamental_identity import representations, single_representations
-from .linear import kernel_rref, normal_form, rank, solve_affine
 from .liouville_terms import LiouvilleSum
 
 #: Highest power of ``h`` the FI route solves (the hulls of degree-9 brackets are not bounded cheaply).

@@ -40,9 +40,9 @@ import sympy
 from sympy.polys.domains import QQ
 from sympy.polys.rings import ring
 
+from ..algebra.elimination import solve_affine
 from ..bch.formal import formal_bch
 from ..errors import InvalidOrderError
-from .linear import solve_affine
 
 _EPS = {(1, 2, 3): 1, (2, 3, 1): 1, (3, 1, 2): 1, (1, 3, 2): -1, (3, 2, 1): -1, (2, 1, 3): -1}
 

@@ -33,10 +33,12 @@ from functools import lru_cache
 
 import sympy
 from sympy.core.sorting import default_sort_key
+from sympy.polys.domains import QQ
 from sympy.polys.rings import PolyElement
 
 from ..algebra import VectorField, liouville_field
 from ..algebra.brackets import permutation_sign
+from ..algebra.elimination import rank
 from ..errors import NambuBCHError
 
 
@@ -112,21 +114,11 @@ class LiouvilleTerm:
 
 @lru_cache(maxsize=None)
 def _dependent(exponents: tuple) -> bool:
-    """Are the integer vectors linearly dependent (exact Gaussian elimination over QQ)?"""
-    rows = [[Fraction(v) for v in e] for e in exponents]
-    r = 0
-    ncols = len(rows[0]) if rows else 0
-    for c in range(ncols):
-        pivot = next((i for i in range(r, len(rows)) if rows[i][c] != 0), None)
-        if pivot is None:
-            continue
-        rows[r], rows[pivot] = rows[pivot], rows[r]
-        for i in range(r + 1, len(rows)):
-            if rows[i][c]:
-                f = rows[i][c] / rows[r][c]
-                rows[i] = [a - f * b for a, b in zip(rows[i], rows[r])]
-        r += 1
-    return r < len(rows)
+    """Are the integer vectors linearly dependent (exact rank over QQ)?"""
+    if not exponents:
+        return False
+    rows = [{c: QQ(v) for c, v in enumerate(e) if v} for e in exponents]
+    return rank(rows, len(exponents[0]), QQ) < len(rows)
 
 
 @lru_cache(maxsize=None)
