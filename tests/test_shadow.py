@@ -535,3 +535,10 @@ def test_family_is_frozen_and_built_by_named_constructors():
     assert all(sympy.expand(a - b) == 0 for a, b in zip(F.shadows, G.shadows))
     U = shadow_hamiltonians(S, "123", 1, existence=False)
     assert U.exists is None and U.evidence["outcome"] == "undecided" and U.evidence["order"] == U.failed_order == 1
+
+
+def test_symmetric_word_below_its_first_correction_is_a_polynomial_pair():
+    """FI route, 12321 on ho3 at order 1: the shadows are H, G themselves (Eq. BCH2 has no h^1 term), a polynomial
+    pair, reported as such (it was polynomial=None)."""
+    fam = shadow_hamiltonians(model("ho3"), "12321", order=1, route="fi")
+    assert fam.exists is True and fam.polynomial is True and fam.H_S == sympy.expand(model("ho3").H)

@@ -208,8 +208,9 @@ class ShadowFamily(Printable):
     def unperturbed(cls, system, composition, order: int, route: str = "fi") -> "ShadowFamily":
         """A symmetric word below its first correction (``order < 2``): the shadows are the Hamiltonians."""
         shadows = tuple(sympy.expand(Hk) for Hk in system.hamiltonians)
+        polynomial = all(system.algebra.is_polynomial(system.algebra.convert(Hk)) for Hk in system.hamiltonians)
         return cls(system, composition, order, route, True, shadows=shadows, free_parameters=_free_parameters(True, shadows),
-                   notes=["h^1: the correction vanishes (symmetric word)"])
+                   notes=["h^1: the correction vanishes (symmetric word)"], polynomial=polynomial)
 
     def _outcome_headline(self) -> str:
         """The existence outcome of a family without a polynomial pair (the three outcomes of issue 17)."""
