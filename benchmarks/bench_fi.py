@@ -23,6 +23,8 @@ import time
 
 import sympy
 
+from timing import cpu  # benchmarks/timing.py (the script's directory is on sys.path)
+
 from nambu_bch import PAPER_WORDS, model
 from nambu_bch.bch.formal import clear_cache as bch_clear_cache
 from nambu_bch.shadow import shadow_hamiltonians
@@ -39,15 +41,6 @@ STAGES = [  # (stage, (file, function) pairs whose cumulative CPU time is attrib
     ("alpha-family in sympy (alpha parts, H_S, G_S)", [("fi_route.py", "_alpha_parts"), ("fi_route.py", "shadow")]),
 ]
 
-
-def cpu(fn, repeat=3):
-    best, out = None, None
-    for _ in range(repeat):
-        t = time.process_time()
-        out = fn()
-        dt = time.process_time() - t
-        best = dt if best is None else min(best, dt)
-    return best, out
 
 
 def profile(word, order):

@@ -22,21 +22,14 @@ from itertools import product
 
 import sympy
 
+from timing import cpu  # benchmarks/timing.py (the script's directory is on sys.path)
+
 from nambu_bch import PAPER_WORDS, liouville_field, model
 from nambu_bch.bch import effective_field
 from nambu_bch.shadow import shadow_hamiltonians
 
 H = sympy.Symbol("h")
 
-
-def cpu(fn, repeat=3):
-    best = None
-    for _ in range(repeat):
-        t = time.process_time()
-        out = fn()
-        dt = time.process_time() - t
-        best = dt if best is None else min(best, dt)
-    return best, out
 
 
 def baseline(system, word, order, degrees):
