@@ -25,7 +25,7 @@ computed, not assumed, and compared with the ``psi`` directions.
 
 The alpha-family (the package's parametrisation, Eq. Xeff3 generalised).  Two
 canonical members are the normal forms of the solution modulo the kernel
-(:func:`~nambu_bch.algebra.elimination.normal_form`):
+(the one rule of :mod:`nambu_bch.algebra.ansatz`, shared with the FI route):
 
 * ``alpha = 0``: the corrections of ``H`` cleared first (constants first, then
   the monomials of ``H`` itself, lexicographic with ``x_N`` highest, then the
@@ -64,7 +64,8 @@ from itertools import product
 import sympy
 
 from ..algebra import liouville_field
-from ..algebra.elimination import rank, solve_affine
+from ..algebra.ansatz import Ansatz, Rows
+from ..algebra.elimination import rank
 from ..bch.backward import check_order
 from ..bch.concrete import effective_field_by_cost
 from ..errors import InvalidOrderError, NambuBCHError, ResourceLimitError
@@ -153,19 +154,13 @@ MAX_UNKNOWNS = 4000
 
 def _check_ansatz_size(slots, n, degree):
     """Refuse, before any work, an ansatz of ``slots * binomial(D + n, n)`` unknowns above :data:`MAX_UNKNOWNS`."""
-    unknowns = slots * math.comb(degree + n, n) if degree < 10**4 else math.inf
+    unknowns = Ansatz.size(n, degree, slots) if degree < 10**4 else math.inf
     if unknowns > MAX_UNKNOWNS:
         shown = unknowns if unknowns != math.inf else "> 10^12"
         raise ResourceLimitError(
             f"an ansatz of degree {degree} in {n} coordinates has {shown} unknowns; at most {MAX_UNKNOWNS} are accepted "
             "(lower the degree or the order)"
         )
-
-
-def _monomials(n, degree):
-    mons = [e for e in product(range(degree + 1), repeat=n) if sum(e) <= degree]
-    # lexicographic with x_N highest, highest degree first (the priority order of normal forms)
-    return sorted(mons, key=lambda e: (tuple(reversed(e))), reverse=True)
 
 
 def _lift(alg, value):
@@ -241,17 +236,6 @@ class _Solver:
         sums = [sum(g for b, g in enumerate(self.gdeg) if b != a) for a in range(self.slots)]
         return max(1, max(rhs_deg + 1 - s for s in sums)), max(sums)
 
-    def _priority(self, columns, slot_order):
-        index = {c: k for k, c in enumerate(columns)}
-        zero = tuple([0] * self.n)
-        out = [index[(a, zero)] for a in range(self.slots) if (a, zero) in index]
-        for a in slot_order:
-            own = [m[: self.n] for m in self.hams[a].keys()]
-            own = sorted(set(own), key=lambda e: tuple(reversed(e)), reverse=True)
-            out += [index[(a, e)] for e in own if (a, e) in index and index[(a, e)] not in out]
-            out += [index[c] for c in columns if c[0] == a and index[c] not in out]
-        return out
-
     # -- one order -----------------------------------------------------------------
     def solve_order(self, j, corrections) -> OrderSolution:
         alg = self.alg
@@ -273,55 +257,34 @@ class _Solver:
                 f"ansatz degree {D} cannot match the h^{j} field of degree {rhs_deg} "
                 f"(corrections need degree >= {needed}); pass degree >= {needed} or None"
             )
-        if self.max_unknowns is not None and self.slots * math.comb(D + self.n, self.n) > self.max_unknowns:
+        if self.max_unknowns is not None and Ansatz.size(self.n, D, self.slots) > self.max_unknowns:
             # bounded work (issue 17): the exact solve is refused up front, the order stays undecided
             return OrderSolution(j, "refused", degree=D, rhs=rhs)
         _check_ansatz_size(self.slots, self.n, D)
-        monos = _monomials(self.n, D)
-        columns = [(a, e) for a in range(self.slots) for e in monos]
-        row_index: dict = {}
-
-        def row(i, mono):
-            key = (i, mono)
-            if key not in row_index:
-                row_index[key] = len(row_index)
-            return row_index[key]
-
-        col_vectors = []
-        for a, e in columns:
-            vec = {}
-            for i, comp in enumerate(self._column_field(a, e)):
-                for m, c in comp.items():
-                    vec[row(i, m[: self.n])] = c
-            col_vectors.append(vec)
+        ansatz = Ansatz(self.n, D, self.slots)
+        rows = Rows()
+        col_vectors = [rows.field(self._column_field(a, e), self.n) for a, e in ansatz.columns]
         by_power: dict = {}
         for i, comp in enumerate(comps):
             for m, c in comp.items():
                 k = m[self.alpha_index]
                 by_power.setdefault(k, {})
-                r = row(i, m[: self.n])
+                r = rows((i, m[: self.n]))
                 by_power[k][r] = by_power[k].get(r, alg.domain.zero) + c
         powers = sorted(by_power)
         domain = alg.domain
         rhs_list = [by_power[k] for k in powers]
-        prio0 = self._priority(columns, list(range(self.slots)))
-        prio1 = self._priority(columns, list(reversed(range(self.slots))))
+        prio0, prio1 = ansatz.priorities(self.hams)
 
-        def solve(prio):
-            # rref with the highest-priority columns last: free columns are set to zero, so the
-            # particular solution is the normal form modulo the kernel (linear.normal_form, cheaper)
-            order = list(reversed(prio))
-            res = solve_affine([col_vectors[c] for c in order], rhs_list, len(row_index), domain)
-            back = lambda vec: {order[c]: v for c, v in vec.items()}  # noqa: E731
-            return res, ([back(p) for p in res.particular] if res.consistent else None), [back(k) for k in res.kernel]
-
-        sol, member0, kernel = solve(prio0)
+        # the canonical members straight from the elimination (one rule: algebra/ansatz.py)
+        sol = Ansatz.solve_canonical(col_vectors, rhs_list, len(rows), domain, prio0)
+        member0, kernel = sol.particular, sol.kernel
         if not sol.consistent:
-            inverse = {v: k for k, v in row_index.items()}
+            inverse = rows.keys()
             cert = {}
             for r, v in sol.certificate.items():
                 i, mono = inverse[r]
-                cert[(alg.coordinates[i], self._mono_expr(mono))] = domain.to_sympy(v)
+                cert[(alg.coordinates[i], ansatz.monomial(mono, alg.coordinates))] = domain.to_sympy(v)
             value = sum(
                 (domain.to_sympy(sum((v * by_power[k].get(r, domain.zero) for r, v in sol.certificate.items()), domain.zero)) * ALPHA**k
                  for k in powers),
@@ -329,17 +292,17 @@ class _Solver:
             )
             return OrderSolution(j, "obstructed", degree=D, certificate=cert, obstruction_value=sympy.factor(value),
                                  kernel_dim=len(sol.kernel), rhs=rhs)
-        _, member1, _ = solve(prio1) if self.slots > 1 else (None, member0, None)
+        member1 = (Ansatz.solve_canonical(col_vectors, rhs_list, len(rows), domain, prio1, certificate=False).particular
+                   if self.slots > 1 else member0)
         members = [member0, member1]
         # family = (1 - alpha) member0 + alpha member1, each member a polynomial in alpha
         fam = [alg.zero for _ in range(self.slots)]
         mem_polys = []
+        pad = (0,) * (len(alg.gens) - self.n - 1)
         for member in members:
             polys = [alg.zero for _ in range(self.slots)]
             for k, vec in zip(powers, member):
-                for col, v in vec.items():
-                    a, e = columns[col]
-                    polys[a] += alg.ring.from_dict({e + (0,) * (len(alg.gens) - self.n - 1) + (k,): v})
+                polys = [p + q for p, q in zip(polys, ansatz.polynomials(vec, alg.ring, pad + (k,)))]
             mem_polys.append(polys)
         one_minus = alg.convert(1 - ALPHA)
         al = alg.convert(ALPHA)
@@ -347,29 +310,19 @@ class _Solver:
             fam[a] = one_minus * mem_polys[0][a] + al * mem_polys[1][a]
         for a in range(self.slots):
             corrections[(a, j)] = fam[a]
-        gauge = [self._vector_to_slots(v, columns) for v in kernel]
-        psi_dim = self._psi_dim(columns, D, kernel) if self.slots == 2 else None
+        gauge = [ansatz.expressions(v, alg.coordinates, domain) for v in kernel]
+        psi_dim = self._psi_dim(ansatz, D) if self.slots == 2 else None
         return OrderSolution(
             j, "solved", degree=D, corrections=tuple(alg.to_sympy(f) for f in fam),
             members=tuple(tuple(alg.to_sympy(p) for p in polys) for polys in mem_polys),
             gauge=gauge, kernel_dim=len(kernel), psi_dim=psi_dim, rhs=rhs,
         )
 
-    def _mono_expr(self, mono):
-        return sympy.Mul(*(x**e for x, e in zip(self.alg.coordinates, mono)))
-
-    def _vector_to_slots(self, vec, columns):
-        out = [sympy.Integer(0)] * self.slots
-        for col, v in vec.items():
-            a, e = columns[col]
-            out[a] += self.alg.domain.to_sympy(v) * self._mono_expr(e)
-        return tuple(out)
-
-    def _psi_dim(self, columns, D, kernel):
+    def _psi_dim(self, ansatz, D):
         """Rank of ``{(psi_G, -psi_H) : psi = H^p G^q}`` within the ansatz (they lie in the kernel)."""
         alg = self.alg
         Hp, Gp = self.hams
-        index = {c: k for k, c in enumerate(columns)}
+        index = ansatz.index
         vecs = []
         dh, dg = (max(_total_degree(Hp, self.n), 1), max(_total_degree(Gp, self.n), 1))
         for p in range(D + 2):
@@ -392,7 +345,7 @@ class _Solver:
                         break
                 if ok and vec:
                     vecs.append(vec)
-        return rank(vecs, len(columns), alg.domain) if vecs else 0
+        return rank(vecs, len(ansatz), alg.domain) if vecs else 0
 
 
 def direct_route(system, word, order: int = 2, degree=None, max_unknowns=None, progress=None) -> DirectResult:

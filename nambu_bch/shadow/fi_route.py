@@ -51,6 +51,7 @@ from itertools import product
 import sympy
 
 from ..algebra import liouville_field
+from ..algebra.ansatz import Ansatz
 from ..algebra.elimination import Echelon, kernel_rref, normal_form, rank, solve_affine
 from ..bch import expand_terms, formal_bch
 from ..bch.expansion import piece_evaluator, term_evaluator
@@ -59,7 +60,6 @@ from ..checks import is_int
 from ..errors import InvalidOrderError, NambuBCHError
 from ..integrators.composition import composition_for
 from ..symbols import ALPHA, STEP
-from .direct_route import _monomials
 from .fi_nested import RawOps, nested_hull
 from .fundamental_identity import representations, single_representations
 from .liouville_terms import LiouvilleSum
@@ -511,7 +511,7 @@ def fi_route(system, word, order: int = 2, degree=None, terms=None) -> FIResult:
         degree = max(degree, 1)
     elif not is_int(degree, 1):
         raise InvalidOrderError(f"degree must be a positive integer (the ansatz degree) or None, got {degree!r}")
-    monos = _monomials(alg.n, degree)
+    monos = Ansatz(alg.n, degree).monomials
     # columns: weights (t, r), then corrections (a, monomial)
     wcols = [(t, r) for t, c in enumerate(commutators) for r in range(len(c.representations))]
     ccols = [(a, e) for a in range(slots) for e in monos]
@@ -759,7 +759,7 @@ def _solve_order(system, ctx, ops, memo, series, j, corrections, degree) -> FIOr
         return FIOrder(j, "vanishes", corrections=(sympy.Integer(0),) * slots, commutators=commutators)
     if degree is None:
         degree = max(_max_degree([base, *dvecs, *rhs_sums.values()]), 1)
-    monos = _monomials(alg.n, degree)
+    monos = Ansatz(alg.n, degree).monomials
     ccols = [(a, e) for a in range(slots) for e in monos]
     keys: dict = {}
 
