@@ -18,8 +18,8 @@ vanishing rule (:class:`~nambu_bch.shadow.liouville_terms.LiouvilleSum`).  The
 unknowns are the weights and the monomial coefficients of ``dH, dG``; the
 condition is linear and is solved exactly (:mod:`nambu_bch.algebra.elimination`).
 The result is the whole solution family (particular + kernel), its two
-canonical members and their alpha-family (same rule as the direct route, see
-:mod:`nambu_bch.shadow.direct_route`), and :meth:`FIResult.check_member` to
+canonical members and their alpha-family (the direct route's rule, one
+implementation: :mod:`nambu_bch.algebra.ansatz`), and :meth:`FIResult.check_member` to
 test a given choice, e.g. the paper's Eqs. (CL5a)-(CL8a) with (SH12321a).
 
 Higher orders (``order`` up to ``MAX_FI_ORDER = 6``; issue 13).  At ``h^j`` the
@@ -51,8 +51,8 @@ from itertools import product
 import sympy
 
 from ..algebra import liouville_field
-from ..algebra.ansatz import Ansatz
-from ..algebra.elimination import Echelon, kernel_rref, normal_form, rank, solve_affine
+from ..algebra.ansatz import Ansatz, Rows
+from ..algebra.elimination import Echelon, kernel_rref, rank, solve_affine
 from ..bch import expand_terms, formal_bch
 from ..bch.expansion import piece_evaluator, term_evaluator
 from ..bch.lyndon import is_bracket
@@ -296,16 +296,8 @@ class FIResult:
 
     def kernel_corrections(self) -> list:
         """The ``(dH, dG, ...)`` part of every homogeneous solution (weights dropped), as sympy expressions."""
-        alg, nw, ccols = self._ctx["algebra"], self._ctx["nw"], self._ctx["ccols"]
-        out = []
-        for vec in self.kernel:
-            corr = [sympy.Integer(0)] * len(self.system.hamiltonians)
-            for col, v in vec.items():
-                if col >= nw:
-                    a, e = ccols[col - nw]
-                    corr[a] += alg.domain.to_sympy(v) * sympy.Mul(*(x**p for x, p in zip(alg.coordinates, e)))
-            out.append(tuple(corr))
-        return out
+        alg, nw, ansatz = self._ctx["algebra"], self._ctx["nw"], self._ctx["ansatz"]
+        return [ansatz.expressions(vec, alg.coordinates, alg.domain, offset=nw) for vec in self.kernel]
 
     def to_text(self) -> str:
         lines = [f"FI route, {self.composition.name}, h^{self.power}:"]
@@ -511,65 +503,44 @@ def fi_route(system, word, order: int = 2, degree=None, terms=None) -> FIResult:
         degree = max(degree, 1)
     elif not is_int(degree, 1):
         raise InvalidOrderError(f"degree must be a positive integer (the ansatz degree) or None, got {degree!r}")
-    monos = Ansatz(alg.n, degree).monomials
-    # columns: weights (t, r), then corrections (a, monomial)
+    ansatz = Ansatz(alg.n, degree, slots)
+    # columns: weights (t, r), then the ansatz's corrections (a, monomial)
     wcols = [(t, r) for t, c in enumerate(commutators) for r in range(len(c.representations))]
-    ccols = [(a, e) for a in range(slots) for e in monos]
-    keys: dict = {}
-
-    def row(key):
-        if key not in keys:
-            keys[key] = len(keys)
-        return keys[key]
-
+    rows = Rows()
     columns = []
     for t, r in wcols:
         comm = commutators[t]
         scaled = comm.representations[r].formal.scale(comm.coefficient)
-        vec = {row(("k", k)): v for k, v in scaled.terms.items()}
-        vec[row(("w", t))] = alg.domain.one
+        vec = {rows(("k", k)): v for k, v in scaled.terms.items()}
+        vec[rows(("w", t))] = alg.domain.one
         columns.append(vec)
-    for a, e in ccols:
+    for a, e in ansatz.columns:
         formal = _monomial_column(ctx, a, e)
-        columns.append({row(("k", k)): -v for k, v in formal.terms.items()})
-    rhs = {row(("w", t)): alg.domain.one for t in range(len(commutators))}
-    sol = solve_affine(columns, [rhs], len(keys), alg.domain)
+        columns.append({rows(("k", k)): -v for k, v in formal.terms.items()})
+    rhs = {rows(("w", t)): alg.domain.one for t in range(len(commutators))}
+    sol = solve_affine(columns, [rhs], len(rows), alg.domain)
     result = FIResult(system, comp, power, commutators, sol.consistent, degree, _ctx=ctx)
     if not sol.consistent:
-        inverse = {v: k for k, v in keys.items()}
+        inverse = rows.keys()
         result.certificate = {str(inverse[r]): alg.domain.to_sympy(v) for r, v in sol.certificate.items()}
         return result
     nw = len(wcols)
-    ctx.update(nw=nw, ccols=ccols)
-    index = {c: nw + k for k, c in enumerate(ccols)}
-    zero = (0,) * alg.n
-
-    def priority(slot_order):
-        out = [index[(a, zero)] for a in range(slots)]
-        for a in slot_order:
-            own = sorted({m[: alg.n] for m in alg.convert(hams[a]).keys()}, key=lambda e: tuple(reversed(e)), reverse=True)
-            out += [index[(a, e)] for e in own if (a, e) in index and index[(a, e)] not in out]
-            out += [index[c] for c in ccols if c[0] == a and index[c] not in out]
-        return out + list(range(nw))
-
+    ctx.update(nw=nw, ansatz=ansatz)
+    # the canonical members (one rule: algebra/ansatz.py), the weights cleared last
+    prios = ansatz.priorities([alg.convert(Hk).keys() for Hk in hams], offset=nw, rest=range(nw))
     members = []
-    for prio in (priority(range(slots)), priority(reversed(range(slots)))):
-        vec = normal_form(sol.particular[0], sol.kernel, prio, alg.domain)
+    for prio in prios:
+        vec, = Ansatz.canonical(sol.particular, sol.kernel, prio, alg.domain)
         weights = [[sympy.Integer(0)] * len(c.representations) for c in commutators]
-        corr = [sympy.Integer(0)] * slots
         for col, v in vec.items():
-            v = alg.domain.to_sympy(v)
             if col < nw:
                 t, r = wcols[col]
-                weights[t][r] = v
-            else:
-                a, e = ccols[col - nw]
-                corr[a] += v * sympy.Mul(*(x**p for x, p in zip(alg.coordinates, e)))
-        members.append(FIMember(weights, tuple(corr)))
+                weights[t][r] = alg.domain.to_sympy(v)
+        members.append(FIMember(weights, ansatz.expressions(vec, alg.coordinates, alg.domain, offset=nw)))
     result.members = tuple(members)
     result.corrections = tuple(sympy.expand((1 - ALPHA) * c0 + ALPHA * c1)
                                for c0, c1 in zip(members[0].corrections, members[1].corrections))
-    result.kernel = kernel_rref(sol.kernel, priority(range(slots)), alg.domain)
+    result.kernel = kernel_rref(sol.kernel, prios[0], alg.domain)
     if order > power:
         _higher_orders(result, order, degree if user_degree else None)
     return result
@@ -617,20 +588,16 @@ def _max_degree(sums) -> int:
     return max((sum(v) for f in sums for key in f.terms for kind, v in key if kind == 0), default=1)
 
 
-def _direct_kernel_dim(alg, hams, monos) -> int:
-    """``dim ker (dH, dG) -> X_{dH,G} + X_{H,dG}`` on polynomials with these monomials (the direct route's gauge)."""
-    rows: dict = {}
+def _direct_kernel_dim(alg, hams, ansatz) -> int:
+    """``dim ker (dH, dG) -> X_{dH,G} + X_{H,dG}`` on the polynomials of ``ansatz`` (the direct route's gauge)."""
+    rows = Rows()
     vecs = []
     ring_hams = [alg.convert(Hk) for Hk in hams]
-    for a in range(len(hams)):
-        for e in monos:
-            slots = list(ring_hams)
-            slots[a] = alg.ring.from_dict({e + (0,) * (len(alg.ring.gens) - alg.n): alg.domain.one})
-            vec = {}
-            for i, comp in enumerate(liouville_field(alg, *slots).components):
-                for m, c in comp.items():
-                    vec[rows.setdefault((i, m), len(rows))] = c
-            vecs.append(vec)
+    pad = (0,) * (len(alg.ring.gens) - alg.n)
+    for a, e in ansatz.columns:
+        slots = list(ring_hams)
+        slots[a] = alg.ring.from_dict({e + pad: alg.domain.one})
+        vecs.append(rows.field(liouville_field(alg, *slots).components, len(alg.ring.gens)))
     return len(vecs) - rank(vecs, len(rows), alg.domain)
 
 
@@ -759,61 +726,35 @@ def _solve_order(system, ctx, ops, memo, series, j, corrections, degree) -> FIOr
         return FIOrder(j, "vanishes", corrections=(sympy.Integer(0),) * slots, commutators=commutators)
     if degree is None:
         degree = max(_max_degree([base, *dvecs, *rhs_sums.values()]), 1)
-    monos = Ansatz(alg.n, degree).monomials
-    ccols = [(a, e) for a in range(slots) for e in monos]
-    keys: dict = {}
-
-    def vector(f, sign=1):
-        return {keys.setdefault(k, len(keys)): sign * v for k, v in f.terms.items()}
-
-    columns = [vector(v) for v in dvecs]
-    for a, e in ccols:
-        columns.append(vector(_monomial_column(ctx, a, e), -1))
+    ansatz = Ansatz(alg.n, degree, slots)
+    rows = Rows()
+    columns = [rows.vector(v.terms) for v in dvecs]
+    for a, e in ansatz.columns:
+        columns.append(rows.vector(_monomial_column(ctx, a, e).terms, -1))
     powers = sorted(rhs_sums)
-    rhs = [vector(rhs_sums[k]) for k in powers]
+    rhs = [rows.vector(rhs_sums[k].terms) for k in powers]
     nw = len(dvecs)
-    sol = solve_affine(columns, rhs, len(keys), domain)
+    sol = solve_affine(columns, rhs, len(rows), domain)
     out = FIOrder(j, "solved", degree, commutators, directions)
     if not sol.consistent:
-        inverse = {v: k for k, v in keys.items()}
+        inverse = rows.keys()
         out.status = "obstructed"
         out.certificate = {str(inverse[r]): domain.to_sympy(v) for r, v in sol.certificate.items()}
         return out
-    index = {c: nw + k for k, c in enumerate(ccols)}
-    zero = (0,) * alg.n
-
-    def priority(slot_order):
-        prio = [index[(a, zero)] for a in range(slots)]
-        for a in slot_order:
-            own = sorted({m[: alg.n] for m in alg.convert(hams[a]).keys()}, key=lambda e: tuple(reversed(e)), reverse=True)
-            prio += [index[(a, e)] for e in own if (a, e) in index and index[(a, e)] not in prio]
-            prio += [index[c] for c in ccols if c[0] == a and index[c] not in prio]
-        return prio + list(range(nw))
-
-    def mono(e):
-        return sympy.Mul(*(x**p for x, p in zip(alg.coordinates, e)))
-
+    # the canonical members (one rule: algebra/ansatz.py), the FI directions' weights cleared last
+    prios = ansatz.priorities([alg.convert(Hk).keys() for Hk in hams], offset=nw, rest=range(nw))
     members = []
-    for prio in (priority(range(slots)), priority(reversed(range(slots)))):
+    for prio in prios:
         corr = [sympy.Integer(0)] * slots
-        for k, part in zip(powers, sol.particular):
-            for col, v in normal_form(part, sol.kernel, prio, domain).items():
-                if col >= nw:
-                    a, e = ccols[col - nw]
-                    corr[a] += ALPHA**k * domain.to_sympy(v) * mono(e)
+        for k, part in zip(powers, Ansatz.canonical(sol.particular, sol.kernel, prio, domain)):
+            corr = [c + ALPHA**k * d for c, d in zip(corr, ansatz.expressions(part, alg.coordinates, domain, offset=nw))]
         members.append(tuple(sympy.expand(c) for c in corr))
     out.members = tuple(members)
     out.corrections = tuple(sympy.expand((1 - ALPHA) * c0 + ALPHA * c1) for c0, c1 in zip(*members))
     projected = [{col: v for col, v in vec.items() if col >= nw} for vec in sol.kernel]
     projected = [p for p in projected if p]
-    basis = kernel_rref(projected, priority(range(slots))[: len(ccols)], domain) if projected else []
-    out.kernel = []
-    for vec in basis:
-        corr = [sympy.Integer(0)] * slots
-        for col, v in vec.items():
-            a, e = ccols[col - nw]
-            corr[a] += domain.to_sympy(v) * mono(e)
-        out.kernel.append(tuple(corr))
+    basis = kernel_rref(projected, prios[0][: len(ansatz)], domain) if projected else []
+    out.kernel = [ansatz.expressions(vec, alg.coordinates, domain, offset=nw) for vec in basis]
     out.fi_dim = len(basis)
-    out._direct = (alg, hams, monos)
+    out._direct = (alg, hams, ansatz)
     return out
