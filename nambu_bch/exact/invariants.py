@@ -2,7 +2,8 @@
 
 Method.  Take the ansatz ``I = sum_mu c_mu x^mu`` over all monomials of total
 degree ``1..d`` in the coordinates (constants are trivially invariant and left
-out), with unknown coefficients ``c_mu`` in the field ``K = QQ(parameters, h)``.
+out: :class:`~nambu_bch.algebra.ansatz.Ansatz` with ``lowest=1``, graded order),
+with unknown coefficients ``c_mu`` in the field ``K = QQ(parameters, h)``.
 Substituting the exact composed map (:func:`~nambu_bch.integrators.composed_map`)
 makes ``I(Phi_h(x)) - I(x)`` a polynomial in ``x`` whose coefficients are
 linear in the ``c_mu``; setting them to zero is a linear system over ``K``,
@@ -27,7 +28,10 @@ whose correction ``I - T``
 This rule reproduces every choice of the paper: Eq. (CQPV) for position
 Verlet on ``ho``, Eqs. (CQ12321H), (CQ12321G) and each row of Table (table) for
 the six words on ``ho3``; these are exactly the normalisations for which
-``X_eff = F(omega h) X_{H_c,G_c}`` (Eq. Xeff2) holds.
+``X_eff = F(omega h) X_{H_c,G_c}`` (Eq. Xeff2) holds.  It is deliberately not the
+shadow routes' canonical-member rule (:mod:`nambu_bch.algebra.ansatz`): that one
+fixes a member of an affine family modulo a gauge, this one a vector of ``V``
+against a target, with ``h``-dependent coefficients.
 
 References
 ----------
@@ -38,13 +42,14 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 from functools import lru_cache
-from itertools import combinations, combinations_with_replacement
+from itertools import combinations
 from math import comb, prod
 
 import sympy
 from sympy.polys.domains import QQ
 from sympy.polys.rings import ring
 
+from ..algebra.ansatz import Ansatz, Rows
 from ..algebra.elimination import nullspace, rank, solve_affine
 from ..errors import InvalidOrderError, InvalidSystemError, NoExactResultError, ResourceLimitError
 from ..integrators import composed_map, composition_for
@@ -90,12 +95,8 @@ class _Setup:
             self.phi = None
 
     def monomials(self, degree):
-        n = len(self.coords)
-        out = []
-        for d in range(1, degree + 1):
-            for combo in combinations_with_replacement(range(n), d):
-                out.append(tuple(combo.count(i) for i in range(n)))
-        return out
+        """The ansatz's monomials: total degree ``1..degree``, graded (:mod:`nambu_bch.algebra.ansatz`)."""
+        return list(Ansatz(len(self.coords), degree, lowest=1, order="graded").monomials)
 
 
 def image_terms(phi, monos) -> int:
@@ -184,17 +185,15 @@ def _invariant_basis(setup: _Setup, degree: int):
     R, phi = setup.R, setup.phi
     monos = setup.monomials(degree)
     columns = _ring_images(setup, monos) if phi is not None else _exp_images(setup, monos)
-    rows: dict = {}
-    for diff in columns:
-        for m in diff.keys():
-            rows.setdefault(m, len(rows))
-    if not rows:  # the map is the identity: every monomial is invariant
+    rows = Rows()
+    vectors = [rows.vector(diff) for diff in columns]
+    if not len(rows):  # the map is the identity: every monomial is invariant
         return [R({mu: setup.K.one}) for mu in monos]
     mat: dict = {}
-    for col, diff in enumerate(columns):
-        for key, c in diff.items():
+    for col, vec in enumerate(vectors):
+        for r, c in vec.items():
             if c:
-                mat.setdefault(rows[key], {})[col] = c
+                mat.setdefault(r, {})[col] = c
     kernel = nullspace(mat, len(rows), len(monos), setup.K)
     return [R({monos[c]: v for c, v in sorted(vec.items()) if v}) for vec in kernel]
 
