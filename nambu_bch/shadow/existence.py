@@ -70,6 +70,7 @@ from itertools import combinations, product
 import numpy as np
 import sympy
 
+from ..algebra.ansatz import Ansatz, Rows
 from ..algebra.elimination import solve_affine
 from ..checks import is_int
 from ..errors import NambuBCHError
@@ -215,22 +216,17 @@ def exact_average(system, g, max_unknowns: int = MAX_EXACT_UNKNOWNS):
     hdeg = [sympy.Poly(H, *coords).total_degree() for H in hams]
     reach = sum(d - 1 for d in hdeg)
     Dp = max(1, deg_g + 1 - reach) + SLACK
-    pmonos = [e for e in product(range(Dp + 1), repeat=n) if 0 < sum(e) <= Dp]
     names = [sympy.Symbol(s) for s in _names(system)]
     cmonos = [e for e in product(range(deg_g + 1), repeat=len(hams))
               if sum(d * k for d, k in zip(hdeg, e)) <= deg_g]
-    if len(pmonos) + len(cmonos) > max_unknowns:
+    if Ansatz.size(n, Dp, lowest=1) + len(cmonos) > max_unknowns:  # refused before the monomials are built
         return None
+    pmonos = sorted(Ansatz(n, Dp, lowest=1).monomials)  # p: degree 1..Dp, ascending lexicographic
     X = system.vector_field
-    rows: dict = {}
+    rows = Rows()
 
     def vec(expr):
-        p = expr if hasattr(expr, "ring") else alg.convert(sympy.expand(expr))
-        out = {}
-        for m, c in p.items():
-            key = rows.setdefault(m, len(rows))
-            out[key] = c
-        return out
+        return rows.vector(expr if hasattr(expr, "ring") else alg.convert(sympy.expand(expr)))
 
     cols = [vec(X.apply(alg.convert(sympy.Mul(*(x**k for x, k in zip(coords, e)))))) for e in pmonos]
     ccols = [vec(sympy.Mul(*(H**k for H, k in zip(hams, e)))) for e in cmonos]
