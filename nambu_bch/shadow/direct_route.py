@@ -163,6 +163,35 @@ def _check_ansatz_size(slots, n, degree):
         )
 
 
+def operator_columns(alg, hams, ansatz, rows, memo=None) -> list:
+    """The columns of ``L`` in Eq. (*): ``X_{H^1, .., x^mu, .., H^{N-1}}`` (``x^mu`` in slot ``a``) per ansatz column.
+
+    Parameters
+    ----------
+    alg : PolynomialAlgebra -- the ring of ``hams`` (extra constant generators allowed)
+    hams : sequence of ring elements -- the Hamiltonians ``H^1 .. H^{N-1}``
+    ansatz : Ansatz -- the unknown corrections (its slots are the Hamiltonians')
+    rows : Rows -- interns ``(component, exponent tuple[:n])``
+    memo : dict, optional -- ``(slot, mu) -> components``, shared by the orders of one solve
+
+    Returns
+    -------
+    list of sparse row vectors ``{row: coefficient}``, one per ansatz column.
+    """
+    pad = (0,) * (len(alg.gens) - alg.n)
+    out = []
+    for a, e in ansatz.columns:
+        comps = None if memo is None else memo.get((a, e))
+        if comps is None:
+            slots = list(hams)
+            slots[a] = alg.ring.from_dict({e + pad: alg.domain.one})
+            comps = liouville_field(alg, *slots).components
+            if memo is not None:
+                memo[(a, e)] = comps
+        out.append(rows.field(comps, alg.n))
+    return out
+
+
 def _lift(alg, value):
     """A ring element of the effective field's algebra as an element of ``alg`` (which has the extra ``alpha``)."""
     if not hasattr(value, "ring"):
@@ -202,15 +231,6 @@ class _Solver:
     # -- fields ------------------------------------------------------------------
     def _field(self, slots):
         return liouville_field(self.alg, *slots)
-
-    def _column_field(self, a, mono):
-        key = (a, mono)
-        if key not in self._columns:
-            m = self.alg.ring.from_dict({mono + (0,) * (len(self.alg.gens) - self.n): self.alg.domain.one})
-            slots = list(self.hams)
-            slots[a] = m
-            self._columns[key] = self._field(slots).components
-        return self._columns[key]
 
     def _cross(self, j, corrections):
         """``sum`` over assignments of lower orders to two or more slots (the cross terms at ``h^j``)."""
@@ -263,7 +283,7 @@ class _Solver:
         _check_ansatz_size(self.slots, self.n, D)
         ansatz = Ansatz(self.n, D, self.slots)
         rows = Rows()
-        col_vectors = [rows.field(self._column_field(a, e), self.n) for a, e in ansatz.columns]
+        col_vectors = operator_columns(alg, self.hams, ansatz, rows, self._columns)
         by_power: dict = {}
         for i, comp in enumerate(comps):
             for m, c in comp.items():

@@ -50,7 +50,6 @@ from itertools import product
 
 import sympy
 
-from ..algebra import liouville_field
 from ..algebra.ansatz import Ansatz, Rows
 from ..algebra.elimination import Echelon, kernel_rref, rank, solve_affine
 from ..bch import expand_terms, formal_bch
@@ -60,6 +59,7 @@ from ..checks import is_int
 from ..errors import InvalidOrderError, NambuBCHError
 from ..integrators.composition import composition_for
 from ..symbols import ALPHA, STEP
+from .direct_route import operator_columns
 from .fi_nested import RawOps, nested_hull
 from .fundamental_identity import representations, single_representations
 from .liouville_terms import LiouvilleSum
@@ -591,13 +591,7 @@ def _max_degree(sums) -> int:
 def _direct_kernel_dim(alg, hams, ansatz) -> int:
     """``dim ker (dH, dG) -> X_{dH,G} + X_{H,dG}`` on the polynomials of ``ansatz`` (the direct route's gauge)."""
     rows = Rows()
-    vecs = []
-    ring_hams = [alg.convert(Hk) for Hk in hams]
-    pad = (0,) * (len(alg.ring.gens) - alg.n)
-    for a, e in ansatz.columns:
-        slots = list(ring_hams)
-        slots[a] = alg.ring.from_dict({e + pad: alg.domain.one})
-        vecs.append(rows.field(liouville_field(alg, *slots).components, len(alg.ring.gens)))
+    vecs = operator_columns(alg, [alg.convert(Hk) for Hk in hams], ansatz, rows)
     return len(vecs) - rank(vecs, len(rows), alg.domain)
 
 
