@@ -155,3 +155,15 @@ def test_bad_ansatz_is_refused_with_one_line(kwargs):
 def test_huge_ansatz_is_refused_before_building():
     with pytest.raises(ResourceLimitError, match=str(MAX_COLUMNS)):
         Ansatz(12, 40, slots=2)
+
+
+def test_priority_reads_ring_elements_like_exponent_tuples():
+    """The Hamiltonians may be given as ring elements of an algebra with extra constants (alpha): only the first n
+    exponents count.  ho3 (Eqs. H, G) in QQ(m, omega)[x1, x2, x3, alpha]."""
+    from nambu_bch import model
+
+    S = model("ho3")
+    alg = S.algebra.with_constants(sympy.Symbol("alpha"))
+    hams = [alg.convert(H) for H in S.hamiltonians]
+    A = Ansatz(3, 3, slots=2)
+    assert A.priorities(hams) == A.priorities([[(0, 0, 1), (0, 2, 0)], [(0, 0, 1), (2, 0, 0)]])
