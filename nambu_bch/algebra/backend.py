@@ -424,11 +424,11 @@ class ExpressionBackend:
     laurent = False
     domain = None  # scalars are sympy numbers
 
-    def __init__(self, algebra, fields: dict):
+    def __init__(self, algebra, fields: dict = None):
         self.algebra = algebra
         self.coordinates = tuple(algebra.coordinates)
         self.zero, self.one = sympy.Integer(0), sympy.Integer(1)
-        self.fields = {k: self.from_vector_field(X) for k, X in fields.items()}
+        self.fields = {k: self.from_vector_field(X) for k, X in (fields or {}).items()}
 
     def from_vector_field(self, V: VectorField) -> tuple:
         return tuple(sympy.expand(self.algebra.to_sympy(c)) for c in V.components)
