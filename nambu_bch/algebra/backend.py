@@ -109,6 +109,12 @@ class _Field:
         self._derivatives = None
 
 
+def _new_derivatives(X: _Field, n: int) -> list:
+    """An empty table ``[i][j] -> D_j X^i`` (``None``: not computed yet), kept with ``X``."""
+    X._derivatives = [[None] * n for _ in range(n)]
+    return X._derivatives
+
+
 class PolynomialBackend:
     """Vector fields with exact sparse-polynomial components over the parameter field.
 
@@ -264,29 +270,40 @@ class PolynomialBackend:
             return f.diff(self._value_coords[i])
         return self.algebra.diff(f, i)
 
-    def _derivatives(self, X: _Field):
-        if X._derivatives is None:
-            n = self.algebra.n
-            if self.laurent:
-                gens = self._bracket_coords
-                X._derivatives = tuple(tuple(c.diff(x) for x in gens) for c in X.components)
-            else:
-                X._derivatives = tuple(tuple(self.algebra.diff(c, j) for j in range(n)) for c in X.components)
-        return X._derivatives
+    def _diff(self, c, j: int):
+        """``D_j c`` for a component in :attr:`bracket_ring`."""
+        if self.laurent:
+            return c.diff(self._bracket_coords[j])
+        return self.algebra.diff(c, j)
 
     def bracket(self, X: _Field, Y: _Field) -> _Field:
-        """``[X, Y]^i = X^j D_j Y^i - Y^j D_j X^i`` (operator commutator, Eq. CL1)."""
+        """``[X, Y]^i = X^j D_j Y^i - Y^j D_j X^i`` (operator commutator, Eq. CL1).
+
+        The derivatives ``D_j X^i`` are computed when first needed (only where the other field's ``j``-th
+        component is non-zero) and kept with the field: memoised leaves of a BCH series reuse them.
+        """
         n = self.algebra.n
-        dX, dY = self._derivatives(X), self._derivatives(Y)
+        Xc, Yc = X.components, Y.components
+        dX = X._derivatives or _new_derivatives(X, n)
+        dY = Y._derivatives or _new_derivatives(Y, n)
         zero = self.bracket_ring.zero
         comps = []
         for i in range(n):
             total = zero
+            dXi, dYi = dX[i], dY[i]
             for j in range(n):
-                if X.components[j] and dY[i][j]:
-                    total = total + X.components[j] * dY[i][j]
-                if Y.components[j] and dX[i][j]:
-                    total = total - Y.components[j] * dX[i][j]
+                if Xc[j]:
+                    d = dYi[j]
+                    if d is None:
+                        d = dYi[j] = self._diff(Yc[i], j)
+                    if d:
+                        total = total + Xc[j] * d
+                if Yc[j]:
+                    d = dXi[j]
+                    if d is None:
+                        d = dXi[j] = self._diff(Xc[i], j)
+                    if d:
+                        total = total - Yc[j] * d
             comps.append(self.reduce(total))
         if self._integral:
             return _Field(comps, X.scale * Y.scale)
