@@ -10,7 +10,8 @@ does, exactly, what the routes to ``X_eff`` and the shadow routes need:
 * ``combine(pairs) = sum c X`` and ``scaled_combine(den, pairs) = (1/den) sum n X``,
   returned as :class:`~nambu_bch.algebra.VectorField` (the sympy edge);
 * ``is_zero(X)``, ``is_zero_function(f)``: exact zero tests;
-* ``from_vector_field`` / ``to_vector_field`` / ``field(values)`` / ``values(X)``: conversions;
+* ``from_vector_field`` / ``to_vector_field`` / ``field(values)`` / ``values(X)``, ``function(expr)`` /
+  ``function_to_sympy(f)``: conversions (the sympy edge);
 * ``constants(numbers)``, ``rational(q)``: exact numbers as scalars of the backend.
 
 :class:`PolynomialBackend` works on exact sparse polynomials over the parameter
@@ -53,6 +54,7 @@ from sympy.polys.constructor import construct_domain
 from sympy.polys.domains import ZZ
 from sympy.polys.rings import PolyElement, ring
 
+from ..errors import NambuBCHError
 from .vector_field import VectorField
 
 
@@ -88,6 +90,10 @@ class FieldBackend(Protocol):
     def values(self, X) -> tuple: ...
 
     def from_vector_field(self, V: VectorField): ...
+
+    def function(self, expr): ...
+
+    def function_to_sympy(self, f): ...
 
     def to_vector_field(self, X) -> VectorField: ...
 
@@ -242,11 +248,28 @@ class PolynomialBackend:
             return self.field(V.components)
         parts = [self._from_algebra(c) for c in V.components]
         if any(p is None for p in parts):
-            raise ValueError(f"{V} has a coefficient whose denominator is not a monomial in the parameters")
+            raise NambuBCHError(
+                f"{V} has a coefficient whose denominator is not a monomial in the parameters; "
+                "the Laurent backend accepts only monomial denominators (use laurent=False)")
         return self.field(parts)
 
     def to_vector_field(self, X: _Field) -> VectorField:
         return self.combine([(1, X)])
+
+    def function(self, expr):
+        """A polynomial function (sympy expression or algebra element) as an element of :attr:`ring`."""
+        value = self.algebra.convert(expr)
+        if not self.algebra.is_polynomial(value):
+            raise NambuBCHError(f"{expr} is not a polynomial in {self.algebra.coordinates} over the parameter field")
+        if not self.laurent:
+            return value
+        out = self._from_algebra(value)
+        if out is None:
+            raise NambuBCHError(f"{expr} has a denominator that is not a monomial in the parameters")
+        return out
+
+    def function_to_sympy(self, f):
+        return self.algebra.to_sympy(self.to_algebra(self.reduce(f)))
 
     # -- calculus -----------------------------------------------------------------
     def reduce(self, poly):
@@ -452,6 +475,13 @@ class ExpressionBackend:
 
     def to_vector_field(self, X) -> VectorField:
         return VectorField(self.algebra, X)
+
+    def function(self, expr):
+        return sympy.expand(self.algebra.to_sympy(expr))
+
+    @staticmethod
+    def function_to_sympy(f):
+        return f
 
     def field(self, values) -> tuple:
         return tuple(values)
