@@ -5,8 +5,8 @@ pieces of a splitting, Liouville terms, ...) in an internal representation and
 does, exactly, what the routes to ``X_eff`` and the shadow routes need:
 
 * ``bracket(X, Y)``: ``[X, Y]^i = X(Y^i) - Y(X^i)``, the operator commutator (Eq. CL1);
-* ``apply(X, f) = sum_i X^i D_i f`` (``D_i`` the algebra's derivative: ``d/dx_i``, or
-  the total derivative on jets);
+* ``apply(X, f) = sum_i X^i D_i f`` and ``derivative(f, i) = D_i f`` (``D_i`` the algebra's
+  derivative: ``d/dx_i``, or the total derivative on jets);
 * ``combine(pairs) = sum c X`` and ``scaled_combine(den, pairs) = (1/den) sum n X``,
   returned as :class:`~nambu_bch.algebra.VectorField` (the sympy edge);
 * ``is_zero(X)``, ``is_zero_function(f)``: exact zero tests;
@@ -76,6 +76,8 @@ class FieldBackend(Protocol):
     def bracket(self, X, Y): ...
 
     def apply(self, X, f): ...
+
+    def derivative(self, f, i: int): ...
 
     def combine(self, pairs) -> VectorField: ...
 
