@@ -33,7 +33,8 @@ SURFACE = {
         "single_split", "step_function",
     ),
     "nambu_bch.algebra": (
-        "PolynomialAlgebra", "VectorField", "is_symplectic", "jacobian", "lie_bracket", "liouville_field",
+        "ExpressionBackend", "FieldBackend", "PolynomialAlgebra", "PolynomialBackend", "VectorField",
+        "field_backend", "is_symplectic", "jacobian", "lie_bracket", "liouville_field",
         "nambu_bracket", "poisson_bracket", "satisfies_nambu_condition",
     ),
     "nambu_bch.bch": (

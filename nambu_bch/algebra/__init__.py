@@ -1,13 +1,18 @@
-"""Brackets, Liouville fields, Lie brackets and structure conditions."""
+"""Exact polynomials, brackets, Liouville fields, vector fields and their backends, structure conditions."""
 
+from .backend import ExpressionBackend, FieldBackend, PolynomialBackend, field_backend
 from .brackets import liouville_field, nambu_bracket, poisson_bracket
 from .polynomial import PolynomialAlgebra
 from .structure import is_symplectic, jacobian, satisfies_nambu_condition
 from .vector_field import VectorField, lie_bracket
 
 __all__ = [
+    "ExpressionBackend",
+    "FieldBackend",
     "PolynomialAlgebra",
+    "PolynomialBackend",
     "VectorField",
+    "field_backend",
     "is_symplectic",
     "jacobian",
     "lie_bracket",

@@ -121,6 +121,21 @@ class PolynomialAlgebra:
             return not value
         return is_zero(value)
 
+    @cached_property
+    def ring_backend(self):
+        """The :class:`~nambu_bch.algebra.backend.PolynomialBackend` on this ring (``diff`` as derivative):
+        the arithmetic behind :class:`~nambu_bch.algebra.VectorField` for polynomial components."""
+        from .backend import PolynomialBackend
+
+        return PolynomialBackend.on_ring(self)
+
+    @cached_property
+    def expression_backend(self):
+        """The :class:`~nambu_bch.algebra.backend.ExpressionBackend` on these coordinates (sympy components)."""
+        from .backend import ExpressionBackend
+
+        return ExpressionBackend(self)
+
     def common(self, *values):
         """The values in one representation: all ring elements if possible, else all sympy."""
         if all(isinstance(v, PolyElement) for v in values):

@@ -54,25 +54,26 @@ class VectorField:
 
     # -- action ---------------------------------------------------------------------
     def apply(self, f):
-        """``X f = sum_i X^i df/dx_i`` (``f`` a sympy expression or ring element)."""
+        """``X f = sum_i X^i df/dx_i`` (``f`` a sympy expression or ring element).
+
+        The arithmetic is the algebra's field backend (:mod:`nambu_bch.algebra.backend`):
+        exact polynomials when ``f`` and the components are ring elements, expanded sympy otherwise.
+        """
         A = self.algebra
         f, *components = A.common(A.convert(f), *self.components)
-        total = A.zero if A.is_polynomial(f) else sympy.Integer(0)
-        for i, c in enumerate(components):
-            if not A.is_zero(c):
-                total = total + c * A.diff(f, i)
-        return total if A.is_polynomial(total) else sympy.expand(total)
+        backend = A.ring_backend if A.is_polynomial(f) else A.expression_backend
+        return backend.apply(backend.field(components), f)
 
     __call__ = apply
 
     def bracket(self, other: "VectorField") -> "VectorField":
-        """The commutator ``[self, other]`` as differential operators."""
+        """The commutator ``[self, other]`` as differential operators (Eq. CL1), on the algebra's field backend."""
         other = self._aligned(other)
         A = self.algebra
-        comps = [
-            u - v for u, v in (A.common(self.apply(b), other.apply(a)) for a, b in zip(self.components, other.components))
-        ]
-        return VectorField(self.algebra, comps)
+        parts = A.common(*self.components, *other.components)
+        backend = A.ring_backend if A.is_polynomial(parts[0]) else A.expression_backend
+        X, Y = backend.field(parts[: A.n]), backend.field(parts[A.n:])
+        return VectorField(A, backend.values(backend.bracket(X, Y)))
 
     def divergence(self):
         """``div X = sum_i dX^i/dx_i`` (zero for every Liouville field)."""

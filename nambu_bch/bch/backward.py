@@ -24,10 +24,10 @@ from dataclasses import dataclass
 import sympy
 
 from ..algebra import VectorField
+from ..algebra.backend import field_backend
 from ..errors import InvalidOrderError
 from ..integrators.composition import composition_for
 from ..printing import Printable, aligned
-from .fast import FastFields, field_backend
 
 H = sympy.Symbol("h")
 MAX_ORDER = 16
@@ -54,43 +54,6 @@ def check_order(order, limit: int = MAX_ORDER) -> int:
     if order < 0 or order > limit:
         raise InvalidOrderError(f"order must be between 0 and {limit}, got {order}")
     return order
-
-
-class _HSeries:
-    """Truncation and coefficient extraction in the step ``h`` for ring elements or sympy expressions."""
-
-    def __init__(self, algebra):
-        self.algebra = algebra
-        self.index = algebra.n + algebra.constants.index(H)
-
-    def truncate(self, value, degree):
-        if self.algebra.is_polynomial(value):
-            return value.ring.from_dict({m: c for m, c in value.items() if m[self.index] <= degree})
-        poly = sympy.Poly(sympy.expand(value), H)
-        return sum((c * H**k for (k,), c in poly.terms() if k <= degree), sympy.Integer(0))
-
-    def coefficient(self, value, degree):
-        if self.algebra.is_polynomial(value):
-            i = self.index
-            return value.ring.from_dict(
-                {m[:i] + (0,) + m[i + 1:]: c for m, c in value.items() if m[i] == degree}
-            )
-        return sympy.expand(value).coeff(H, degree)
-
-
-def _exp_apply(series, field, scale, value, degree):
-    """``exp(scale * field) value`` truncated at ``h**degree`` (``scale`` carries the ``h``)."""
-    algebra = series.algebra
-    total, term = value, value
-    for n in range(1, degree + 1):
-        # non-polynomial fields (sin, H1(x1)) give sympy values: bring the factors to one kind
-        s, applied, r = algebra.common(algebra.convert(scale), field.apply(term), algebra.convert(sympy.Rational(1, n)))
-        term = series.truncate(s * applied * r, degree)
-        if algebra.is_zero(term):
-            break
-        total, term = algebra.common(total, term)
-        total = total + term
-    return total
 
 
 @dataclass(frozen=True, eq=False)
@@ -164,11 +127,11 @@ def effective_field(splitting, comp, order: int = 2, fast: bool = True) -> Effec
     order : int
         Highest power of ``h`` kept in ``X_eff``.
     fast : bool
-        Run the series graded by powers of ``h`` in Laurent polynomials of the
-        parameters over QQ (:mod:`nambu_bch.bch.fast`, no rational-function gcds),
-        or in expanded sympy expressions for non-polynomial fields; ``False`` runs
-        the reference recursion on the system's ring over ``QQ(parameters)``.
-        The result is the same exact field either way.
+        Run the series (graded by powers of ``h``) in Laurent polynomials of the
+        parameters over QQ when the fields allow it (:mod:`nambu_bch.algebra.backend`,
+        no rational-function gcds); ``False`` runs it on the system's ring over
+        ``QQ(parameters)``.  Non-polynomial fields run in expanded sympy
+        expressions either way.  The result is the same exact field.
 
     Examples
     --------
@@ -181,90 +144,12 @@ def effective_field(splitting, comp, order: int = 2, fast: bool = True) -> Effec
     comp = composition_for(comp, splitting)
     algebra = splitting.system.algebra.with_constants(H, extension=comp.extension)
     fields = [VectorField(algebra, p.field.to_sympy()) if comp.extension else p.field for p in splitting.pieces]
-    engine = field_backend(algebra, dict(enumerate(fields, 1)), fast)
-    if engine is not None:
-        ops = _LaurentOps(engine, comp) if isinstance(engine, FastFields) else _SympyOps(engine, comp)
-        return EffectiveField(_backward_graded(ops, comp, order), order, comp, splitting)
-    series = _HSeries(algebra)
-    h = algebra.convert(H)
-    top = order + 1
-    coords = algebra.gens[: algebra.n]
-    pulled = []
-    for x in coords:
-        value = x
-        for k, c in reversed(comp.factors()):
-            value = _exp_apply(series, fields[k - 1], h * algebra.convert(c), value, top)
-        pulled.append(value)
-    Z = []
-    for j in range(order + 1):
-        partial = VectorField.zero(algebra)
-        for l, Zl in enumerate(Z):
-            partial = partial + Zl.scale(H**l)
-        comps = []
-        for x, target in zip(coords, pulled):
-            current = _exp_apply(series, partial, h, x, j + 1)
-            target, current = algebra.common(target, current)
-            comps.append(series.coefficient(target - current, j + 1))
-        Z.append(VectorField(algebra, comps))
-    return EffectiveField(tuple(Z), order, comp, splitting)
+    backend = field_backend(algebra, dict(enumerate(fields, 1)), laurent=fast)
+    return EffectiveField(_backward_graded(backend, comp, order), order, comp, splitting)
 
 
-class _LaurentOps:
-    """Arithmetic of :func:`_backward_graded` on raw Laurent-ring elements (:class:`FastFields`)."""
-
-    def __init__(self, engine, comp):
-        self.engine, R = engine, engine.ring
-        self.coords = R.gens[: engine.algebra.n]
-        self.zero, self.one = R.zero, R.domain.one
-        self.fields = engine.rational_fields
-        self.coefficients = engine.coefficients(comp.coefficients)
-        self.rational = lambda q: R.domain.convert(q)
-
-    def apply(self, components, f):
-        total = self.zero
-        if not f:
-            return total
-        for c, x in zip(components, self.coords):
-            if c:
-                d = f.diff(x)
-                if d:
-                    total = total + c * d
-        return self.engine.reduce(total)
-
-    @staticmethod
-    def is_zero(f) -> bool:
-        return not f
-
-    def finish(self, comps) -> VectorField:
-        return VectorField(self.engine.algebra, [self.engine.to_algebra(self.engine.reduce(c)) for c in comps])
-
-
-class _SympyOps:
-    """The same on expanded sympy expressions (non-polynomial fields: ``cos(x1)``, ``H1(x1)``)."""
-
-    def __init__(self, backend, comp):
-        self.algebra = backend.algebra
-        self.coords = self.algebra.coordinates
-        self.zero, self.one = sympy.Integer(0), sympy.Integer(1)
-        self.fields = backend.fields
-        self.coefficients = list(comp.coefficients)
-        self.rational = lambda q: q
-
-    def apply(self, components, f):
-        if f == 0:
-            return self.zero
-        return sympy.expand(sum((c * sympy.diff(f, x) for c, x in zip(components, self.coords) if c != 0), self.zero))
-
-    @staticmethod
-    def is_zero(f) -> bool:
-        return f == 0
-
-    def finish(self, comps) -> VectorField:
-        return VectorField(self.algebra, [sympy.expand(c) for c in comps])
-
-
-def _backward_graded(ops, comp, order) -> tuple:
-    """The same recursion as :func:`effective_field`, graded by powers of ``h``.
+def _backward_graded(backend, comp, order) -> tuple:
+    """``Z_0 .. Z_order`` by backward error analysis on a field backend, graded by powers of ``h``.
 
     Series in ``h`` are lists ``[f_0, ..., f_top]`` of ``h``-free elements, so no
     product ever produces a power of ``h`` that is thrown away.  The pull-back
@@ -274,19 +159,20 @@ def _backward_graded(ops, comp, order) -> tuple:
     ``l <= n - k``; so ``Z_j^i = [h^(j+1)] Phi^* x_i - sum_{k >= 2} [h^(j+1)] U_k / k!``
     and every ``[h^n] U_k`` is computed once (Hairer-Lubich-Wanner IX.1).
     """
-    coords, zero = ops.coords, ops.zero
+    coords, zero = backend.coordinates, backend.zero
     n = len(coords)
     top = order + 1
+    one = backend.rational(sympy.Integer(1))
 
-    def exp_pullback(components, c, series):
+    def exp_pullback(field, c, series):
         out = [zero] * (top + 1)
         for m, f in enumerate(series):
-            term, scale = f, ops.one
+            term, scale = f, one
             for k in range(0, top - m + 1):
                 if k:
-                    term = ops.apply(components, term)
-                    scale = scale * c * ops.rational(sympy.Rational(1, k))
-                if ops.is_zero(term):
+                    term = backend.apply(field, term)
+                    scale = scale * c * backend.rational(sympy.Rational(1, k))
+                if backend.is_zero_function(term):
                     break
                 out[m + k] = out[m + k] + term * scale
         return out
@@ -294,13 +180,13 @@ def _backward_graded(ops, comp, order) -> tuple:
     pulled = []
     for x in coords:
         series = [x] + [zero] * top
-        for k, c in reversed(list(zip(comp.pieces, ops.coefficients))):
-            series = exp_pullback(ops.fields[k], c, series)
+        for k, c in reversed(list(zip(comp.pieces, backend.constants(comp.coefficients)))):
+            series = exp_pullback(backend.fields[k], c, series)
         pulled.append(series)
     Z = []
     # U[i][k][m] = [h^m] (hY)^k x_i
     U = [[[x] + [zero] * top] + [[zero] * (top + 1) for _ in range(top)] for x in coords]
-    inverse_factorial = [ops.rational(1 / sympy.factorial(k)) for k in range(top + 1)]
+    inverse_factorial = [backend.rational(1 / sympy.factorial(k)) for k in range(top + 1)]
     for j in range(order + 1):
         m = j + 1
         comps = []
@@ -310,11 +196,11 @@ def _backward_graded(ops, comp, order) -> tuple:
             for k in range(2, m + 1):
                 value = zero
                 for l in range(0, m - k + 1):
-                    value = value + ops.apply(Z[l], Ui[k - 1][m - 1 - l])
+                    value = value + backend.apply(Z[l], Ui[k - 1][m - 1 - l])
                 Ui[k][m] = value
                 rest = rest + value * inverse_factorial[k]
             comps.append(pulled[i][m] - rest)
-        Z.append(comps)
+        Z.append(backend.field(comps))
         for i in range(n):
             U[i][1][m] = comps[i]
-    return tuple(ops.finish(comps) for comps in Z)
+    return tuple(backend.vector_field(backend.values(Zj)) for Zj in Z)

@@ -18,14 +18,13 @@ from __future__ import annotations
 
 import weakref
 
-import sympy
 from sympy.polys.domains import QQ
 
 from ..algebra import VectorField
+from ..algebra.backend import field_backend
 from ..integrators.composition import composition_for
 from .backward import H, EffectiveField, check_order, effective_field
 from .evaluation import BracketEvaluator
-from .fast import field_backend
 from .formal import clear_cache as clear_formal_cache
 from .formal import formal_bch
 
@@ -40,10 +39,10 @@ def effective_field_bch(splitting, comp, order: int = 2, fast: bool = True) -> E
     order : int
         Highest power of ``h`` kept (``Z_0 .. Z_order``; the series is needed to degree ``order + 1``).
     fast : bool
-        Evaluate brackets in the fastest exact representation available
-        (:func:`nambu_bch.bch.fast.field_backend`: Laurent polynomials in the
-        parameters over QQ, or expanded sympy expressions for non-polynomial
-        fields); ``False`` uses the :class:`VectorField` methods on the system's ring.
+        Evaluate brackets in Laurent polynomials in the parameters over QQ when the
+        fields allow it (:func:`nambu_bch.algebra.backend.field_backend`); ``False``
+        uses the system's ring over ``QQ(parameters)``.  Non-polynomial fields run
+        in expanded sympy expressions either way.
 
     Returns
     -------
@@ -61,18 +60,16 @@ def effective_field_bch(splitting, comp, order: int = 2, fast: bool = True) -> E
     comp = composition_for(comp, splitting)
     algebra = splitting.system.algebra.with_constants(H, extension=comp.extension)
     series = formal_bch(comp, order + 1)
-    engine, evaluator, combine = _evaluator(splitting, algebra, comp.extension, fast)
+    backend, evaluator = _evaluator(splitting, algebra, comp.extension, fast)
     Z = []
     for j in range(order + 1):
-        if engine is not None and hasattr(engine, "scaled_combination") and (
-            series.domain == QQ or series.domain == engine.ring.domain
-        ):
+        if series.domain == QQ or series.domain == backend.domain:
             den, pairs = series.scaled_terms(j + 1)
             values = [(c, evaluator.value(tree)) for c, tree in pairs]
-            Z.append(engine.scaled_combination(den, [(c, X) for c, X in values if X is not None]))
+            Z.append(backend.scaled_combine(den, [(c, X) for c, X in values if X is not None]))
             continue
         values = [(c, evaluator.value(tree)) for c, tree in series.terms(j + 1)]
-        Z.append(combine([(c, X) for c, X in values if X is not None]))
+        Z.append(backend.combine([(c, X) for c, X in values if X is not None]))
     return EffectiveField(tuple(Z), order, comp, splitting)
 
 
@@ -105,19 +102,15 @@ _EVALUATORS: "weakref.WeakKeyDictionary" = weakref.WeakKeyDictionary()
 
 
 def _evaluator(splitting, algebra, extension, fast):
-    """``(backend or None, BracketEvaluator, combine)`` for ``splitting``, cached per extension and mode."""
+    """``(backend, BracketEvaluator)`` for ``splitting``, cached per extension and mode."""
     per_splitting = _EVALUATORS.setdefault(splitting, {})
     key = (tuple(extension), bool(fast))
     if key not in per_splitting:
         pieces = {p.number: p.field for p in splitting.pieces}
         if extension:
             pieces = {k: VectorField(algebra, X.to_sympy()) for k, X in pieces.items()}
-        engine = field_backend(algebra, pieces, fast)
-        if engine is not None:
-            evaluator = BracketEvaluator(engine.fields, engine.bracket, engine.is_zero)
-            per_splitting[key] = (engine, evaluator, engine.combination)
-        else:
-            per_splitting[key] = (None, BracketEvaluator(pieces), _combination(algebra))
+        backend = field_backend(algebra, pieces, laurent=fast)
+        per_splitting[key] = (backend, BracketEvaluator(backend.fields, backend.bracket, backend.is_zero))
     return per_splitting[key]
 
 
@@ -126,12 +119,3 @@ def clear_cache() -> None:
     _EVALUATORS.clear()
     clear_formal_cache()
 
-
-def _combination(algebra):
-    def combine(pairs):
-        total = VectorField.zero(algebra)
-        for c, X in pairs:
-            total = total + X.scale(sympy.sympify(c))
-        return total
-
-    return combine

@@ -23,9 +23,9 @@ from __future__ import annotations
 from itertools import product
 
 from ..algebra import liouville_field
+from ..algebra.backend import field_backend
 from ..errors import UnknownPieceError
 from .evaluation import BracketEvaluator
-from .fast import field_backend
 from .lyndon import is_bracket
 
 
@@ -41,11 +41,7 @@ def _expand_tree(tree, splitting):
 
 def _evaluator(algebra, fields: dict) -> BracketEvaluator:
     backend = field_backend(algebra, fields)
-    if backend is None:
-        return BracketEvaluator(fields)
-    return BracketEvaluator(
-        backend.fields, backend.bracket, backend.is_zero, to_field=lambda X: backend.combination([(1, X)])
-    )
+    return BracketEvaluator(backend.fields, backend.bracket, backend.is_zero, to_field=backend.to_vector_field)
 
 
 def piece_evaluator(splitting) -> BracketEvaluator:

@@ -46,9 +46,8 @@ from itertools import combinations
 from math import comb, prod
 
 import sympy
-from sympy.polys.domains import QQ
-from sympy.polys.rings import ring
 
+from ..algebra import PolynomialAlgebra
 from ..algebra.ansatz import Ansatz, Rows
 from ..algebra.elimination import nullspace, rank, solve_affine
 from ..errors import InvalidOrderError, InvalidSystemError, NoExactResultError, ResourceLimitError
@@ -83,10 +82,9 @@ class _Setup:
     def __init__(self, system, comp):
         self.system = system
         self.coords = system.coordinates
-        base = QQ.algebraic_field(*comp.extension) if comp.extension else QQ
-        self.K = base.frac_field(*system.parameters, H_STEP)
-        self.R, *gens = ring(list(self.coords), self.K)
-        self.gens = tuple(gens)
+        # the package's exact ring, with h among the parameters: K = QQ<ext>(parameters, h)
+        algebra = PolynomialAlgebra(self.coords, (*system.parameters, H_STEP), extension=comp.extension)
+        self.K, self.R, self.gens = algebra.domain, algebra.ring, algebra.gens
         phi = composed_map(system.splitting, comp)
         self.phi_exprs = tuple(sympy.sympify(e) for e in phi)
         try:

@@ -175,7 +175,8 @@ def integrands(result):
     bad = next(o for o in result.orders if o.status not in ("solved", "vanishes"))
     system = result.system
     R = [sympy.expand(c.subs(ALPHA, 0)) for c in bad.rhs.to_sympy()]
-    gs = [sympy.expand(sum(r * sympy.diff(H, x) for r, x in zip(R, system.coordinates))) for H in system.hamiltonians]
+    ops = system.algebra.expression_backend  # R . grad H = R(H), the field applied to H (expanded sympy)
+    gs = [ops.apply(ops.field(R), ops.function(H)) for H in system.hamiltonians]
     return gs, bad.order
 
 

@@ -40,7 +40,9 @@ import sympy
 from sympy.polys.domains import QQ
 from sympy.polys.rings import ring
 
+from ..algebra.backend import PolynomialBackend
 from ..algebra.elimination import solve_affine
+from ..bch.evaluation import BracketEvaluator
 from ..bch.formal import formal_bch
 from ..errors import InvalidOrderError
 
@@ -48,14 +50,24 @@ _EPS = {(1, 2, 3): 1, (2, 3, 1): 1, (3, 1, 2): 1, (1, 3, 2): -1, (3, 2, 1): -1, 
 
 
 class JetRing:
-    """Polynomials in the jets ``h{i}_{k} = H_i^{(k)}(x_i)``, ``g{i}_{k} = G_i^{(k)}(x_i)``, ``k <= max_order``."""
+    """Polynomials in the jets ``h{i}_{k} = H_i^{(k)}(x_i)``, ``g{i}_{k} = G_i^{(k)}(x_i)``, ``k <= max_order``.
+
+    A coefficient ring of its own (no coordinate generators: ``x_i`` enters only through the jets of
+    index ``i``); vector-field arithmetic on it is :class:`~nambu_bch.algebra.backend.PolynomialBackend`
+    with :meth:`diff` (the total derivative) as derivative, :attr:`backend`.
+    """
+
+    n = 3
+    domain = QQ
 
     def __init__(self, max_order: int = 6):
         self.K = max_order
         self.names = [f"{f}{i}_{k}" for f in "hg" for i in (1, 2, 3) for k in range(max_order + 1)]
         self.R, *gens = ring(self.names, QQ)
+        self.ring = self.R
         self.jet = {(f, i, k): gens[self.names.index(f"{f}{i}_{k}")] for f in "hg" for i in (1, 2, 3)
                     for k in range(max_order + 1)}
+        self.backend = PolynomialBackend.on_ring(self)
 
     def D(self, p, j):
         """Total derivative ``d/dx_j``."""
@@ -69,18 +81,16 @@ class JetRing:
                     out += c * self.jet[(f, j, k + 1)]
         return out
 
+    def diff(self, p, index: int):
+        """``D_{index + 1}`` (0-based ``index``, the derivative the field backend uses)."""
+        return self.D(p, index + 1)
+
     def field(self, A, B):
         """``X_{A,B}^i = {x_i, A, B}`` (Eq. NB) with total derivatives."""
         dA = [self.D(A, j) for j in (1, 2, 3)]
         dB = [self.D(B, j) for j in (1, 2, 3)]
         return tuple(sum((s * dA[j - 1] * dB[k - 1] for (a, j, k), s in _EPS.items() if a == i), self.R.zero)
                      for i in (1, 2, 3))
-
-    def apply(self, X, f):
-        return sum((X[j] * self.D(f, j + 1) for j in range(3)), self.R.zero)
-
-    def bracket(self, X, Y):
-        return tuple(self.apply(X, Y[i]) - self.apply(Y, X[i]) for i in range(3))
 
     def to_sympy(self, p):
         return p.as_expr()
@@ -119,19 +129,15 @@ def generic_nambu_h2(word: str = "12321", max_order: int = 6) -> GenericNambuRes
     # the full split, Eqs. (X1)-(X3): piece i moves x_i
     pieces = {1: add(J.field(H[2], G[3]), J.field(H[3], G[2])), 2: add(J.field(H[3], G[1]), J.field(H[1], G[3])),
               3: add(J.field(H[1], G[2]), J.field(H[2], G[1]))}
-    memo: dict = {}
-
-    def value(tree):
-        if isinstance(tree, int):
-            return pieces[tree]
-        if tree not in memo:
-            memo[tree] = J.bracket(value(tree[0]), value(tree[1]))
-        return memo[tree]
+    B = J.backend
+    evaluator = BracketEvaluator({k: B.field(X) for k, X in pieces.items()}, B.bracket, B.is_zero)
 
     series = formal_bch(word, 3)
     Z2 = (R.zero,) * 3
     for c, tree in series.terms(3):
-        Z2 = tuple(a + R.domain.convert(sympy.Rational(c)) * b for a, b in zip(Z2, value(tree)))
+        X = evaluator.value(tree)
+        if X is not None:
+            Z2 = tuple(a + R.domain.convert(sympy.Rational(c)) * b for a, b in zip(Z2, B.values(X)))
 
     def monomials(nh, ng):
         jh = [("h", i, k) for i in (1, 2, 3) for k in range(max_order)]

@@ -10,7 +10,9 @@ coordinates and the jet variables, and whose :meth:`diff` is the *total*
 derivative ``D_i = d/dx_i + sum A_{alpha+e_i} d/dA_alpha``.  Brackets and
 Liouville fields of the algebra package then work unchanged on sympy
 ``Function`` s, exactly and fast (sparse polynomials instead of ``expand`` of
-``Derivative`` products).
+``Derivative`` products): its ``ring_backend`` is the package's one
+vector-field arithmetic (:class:`~nambu_bch.algebra.backend.PolynomialBackend`)
+with the total derivative as derivative, not a copy of it.
 
 References
 ----------

@@ -1,0 +1,563 @@
+"""One protocol for vector-field arithmetic, two exact implementations.
+
+A *field backend* holds a set of vector fields ``X = X^i d/dx_i`` (the leaves:
+pieces of a splitting, Liouville terms, ...) in an internal representation and
+does, exactly, what the routes to ``X_eff`` and the shadow routes need:
+
+* ``bracket(X, Y)``: ``[X, Y]^i = X(Y^i) - Y(X^i)``, the operator commutator (Eq. CL1);
+* ``apply(X, f) = sum_i X^i D_i f`` and ``derivative(f, i) = D_i f`` (``D_i`` the algebra's
+  derivative: ``d/dx_i``, or the total derivative on jets);
+* ``combine(pairs) = sum c X`` and ``scaled_combine(den, pairs) = (1/den) sum n X``,
+  returned as :class:`~nambu_bch.algebra.VectorField` (the sympy edge);
+* ``is_zero(X)``, ``is_zero_function(f)``: exact zero tests;
+* ``from_vector_field`` / ``to_vector_field`` / ``field(values)`` / ``values(X)``, ``function(expr)`` /
+  ``function_to_sympy(f)``: conversions (the sympy edge);
+* ``constants(numbers)``, ``rational(q)``: exact numbers as scalars of the backend.
+
+:class:`PolynomialBackend` works on exact sparse polynomials over the parameter
+field (sympy ``PolyElement``).  When every coefficient of every leaf divides
+only by *monomials* in the parameters (``1/m``, ``1/I2 - 1/I3``: all built-in
+models) it runs in Laurent polynomials: a parameter ``p`` becomes two ordinary
+generators ``p``, ``p_inv`` over QQ (or ``QQ(2^(1/3))``), every product is
+brought back to the canonical form in which no monomial holds both (Laurent
+monomials are a basis, so the zero test stays structural), and, over QQ, each
+field's denominators are cleared once so that nested brackets run over ZZ (the
+product of the scales is carried along and divided out once in
+:meth:`PolynomialBackend.combine`).  No rational-function gcd is ever taken.
+Otherwise (``1/(m + 1)``, or ``laurent=False``) it runs in the algebra's own
+ring ``QQ(parameters)[x]`` -- which may be a :class:`~nambu_bch.shadow.jets.JetAlgebra`
+or any ring offering ``ring``, ``n``, ``domain`` and ``diff(value, i)``.
+
+:class:`ExpressionBackend` works on expanded sympy expressions, for
+non-polynomial fields (``cos(x1)``, undefined functions ``H1(x1)``): brackets
+are ``diff`` + ``expand``, the zero test is structural after ``expand``.  It
+never calls a non-zero field zero; an exotic zero that only ``simplify`` would
+see (``sin^2 + cos^2 - 1``) is kept, which costs a term but never changes a value.
+
+:func:`field_backend` picks the implementation.
+
+References
+----------
+Horikoshi, Eq. (CL1) (bracket convention); Laurent polynomial rings as
+localisations ``QQ[p, 1/p]``: Cox, Little, O'Shea, *Ideals, Varieties, and
+Algorithms*, Sect. 3.2 (the ``p y - 1`` trick, here reduced explicitly);
+Hairer, Lubich, Wanner, *Geometric Numerical Integration*, Sect. IX.1 and IX.4.
+"""
+
+from __future__ import annotations
+
+from math import lcm
+from typing import Protocol, runtime_checkable
+
+import sympy
+from sympy.polys.constructor import construct_domain
+from sympy.polys.domains import ZZ
+from sympy.polys.rings import PolyElement, ring
+
+from ..errors import NambuBCHError
+from .vector_field import VectorField
+
+
+@runtime_checkable
+class FieldBackend(Protocol):
+    """What the BCH route, backward error analysis and the shadow routes ask of vector-field arithmetic.
+
+    ``fields`` maps each leaf key to its internal field; ``coordinates`` are the
+    coordinate functions ``x_i``, ``zero``/``one`` the constant functions, all in
+    the internal representation of functions.
+    """
+
+    algebra: object
+    fields: dict
+    coordinates: tuple
+    zero: object
+    one: object
+
+    def bracket(self, X, Y): ...
+
+    def apply(self, X, f): ...
+
+    def derivative(self, f, i: int): ...
+
+    def combine(self, pairs) -> VectorField: ...
+
+    def scaled_combine(self, denominator: int, pairs) -> VectorField: ...
+
+    def is_zero(self, X) -> bool: ...
+
+    def is_zero_function(self, f) -> bool: ...
+
+    def field(self, values): ...
+
+    def values(self, X) -> tuple: ...
+
+    def from_vector_field(self, V: VectorField): ...
+
+    def function(self, expr): ...
+
+    def function_to_sympy(self, f): ...
+
+    def to_vector_field(self, X) -> VectorField: ...
+
+    def constants(self, numbers) -> list: ...
+
+    def rational(self, q): ...
+
+
+class _Field:
+    """A field of :class:`PolynomialBackend`: ``components / scale`` plus its value-ring components and
+    derivatives, each computed once."""
+
+    __slots__ = ("components", "scale", "_values", "_derivatives")
+
+    def __init__(self, components, scale=1, values=None):
+        self.components = tuple(components)
+        self.scale = scale
+        self._values = values
+        self._derivatives = None
+
+
+def _new_derivatives(X: _Field, n: int) -> list:
+    """An empty table ``[i][j] -> D_j X^i`` (``None``: not computed yet), kept with ``X``."""
+    X._derivatives = [[None] * n for _ in range(n)]
+    return X._derivatives
+
+
+class PolynomialBackend:
+    """Vector fields with exact sparse-polynomial components over the parameter field.
+
+    Use :meth:`build` (or :func:`field_backend`).  ``laurent`` is ``True`` when the
+    Laurent representation (module docstring) is in use.
+
+    Examples
+    --------
+    >>> from nambu_bch import model
+    >>> S = model("rigid-body").splitting
+    >>> F = PolynomialBackend.build(S.system.algebra, {p.number: p.field for p in S.pieces})
+    >>> F.laurent, F.ring.symbols[3:]
+    (True, (h, I1, I1_inv, I2, I2_inv, I3, I3_inv))
+    >>> F.combine([(1, F.bracket(F.fields[1], F.fields[2]))]) == S[1].field.bracket(S[2].field)
+    True
+    """
+
+    def __init__(self, algebra, value_ring, bracket_ring, laurent_pairs, laurent: bool):
+        self.algebra = algebra
+        self.laurent = laurent
+        self.ring = value_ring  # the values (rational coefficients)
+        self.bracket_ring = bracket_ring  # over ZZ in the Laurent case over QQ: brackets of integral components
+        self.domain = value_ring.domain
+        self._pairs = laurent_pairs  # [(index of p, index of p_inv)] in the ring's generators
+        self._integral = bracket_ring is not value_ring
+        self.fields: dict = {}
+        # the coordinate functions x_i (a ring without coordinate generators, such as a jet ring in one
+        # variable per coordinate, has none)
+        self.coordinates = tuple(value_ring.gens[: algebra.n]) if hasattr(algebra, "coordinates") else ()
+        self.zero, self.one = value_ring.zero, value_ring.one
+        self._bracket_coords = bracket_ring.gens[: algebra.n]
+        self._value_coords = value_ring.gens[: algebra.n]
+        self._monomials: dict = {}  # Laurent monomial -> its canonical QQ(parameters) coefficient
+
+    # -- construction -------------------------------------------------------------
+    @classmethod
+    def build(cls, algebra, fields: dict, laurent: bool = True):
+        """Convert ``{key: VectorField}`` (polynomial components), ``None`` if some component is not a ring element.
+
+        With ``laurent=True`` the Laurent representation is chosen when every
+        coefficient divides only by monomials in the parameters; otherwise the
+        algebra's own ring is used.
+        """
+        comps = [c for X in fields.values() for c in X.components]
+        if not all(isinstance(c, PolyElement) and c.ring == algebra.ring for c in comps):
+            return None
+        if laurent:
+            backend = cls._laurent(algebra, fields)
+            if backend is not None:
+                return backend
+        return cls.on_ring(algebra, {k: X.components for k, X in fields.items()})
+
+    @classmethod
+    def on_ring(cls, algebra, fields: dict = None):
+        """The backend on ``algebra``'s own ring (``algebra.ring``, ``algebra.n``, ``algebra.diff``), with
+        ``fields`` given as ``{key: tuple of ring elements}``.  This is how a jet ring (total derivatives)
+        gets the same arithmetic."""
+        self = cls(algebra, algebra.ring, algebra.ring, [], False)
+        for key, comps in (fields or {}).items():
+            self.fields[key] = self.field(comps)
+        return self
+
+    @classmethod
+    def _laurent(cls, algebra, fields):
+        params = algebra.parameters
+        base = algebra.domain.field.domain if params else algebra.domain
+        names = [str(s) for s in algebra.coordinates + algebra.constants]
+        for p in params:
+            names += [str(p), f"{p}_inv"]
+        if len(set(names)) != len(names):
+            return None
+        value_ring = ring(names, base)[0]
+        first = algebra.n + len(algebra.constants)
+        pairs = [(first + 2 * k, first + 2 * k + 1) for k in range(len(params))]
+        # brackets are multilinear: over QQ, clear each field's denominators and bracket over ZZ (Python ints,
+        # no rational normalisation), carrying the product of the scales along
+        bracket_ring = ring(names, ZZ)[0] if base.is_QQ else value_ring
+        self = cls(algebra, value_ring, bracket_ring, pairs, True)
+        for key, X in fields.items():
+            parts = [self._from_algebra(c) for c in X.components]
+            if any(p is None for p in parts):
+                return None
+            self.fields[key] = self.field(parts)
+        return self
+
+    def _from_algebra(self, poly):
+        """An algebra element in the Laurent ring, ``None`` when a coefficient's denominator is not a monomial."""
+        params = self.algebra.parameters
+        out = {}
+        for monom, coeff in poly.items():
+            if not params:
+                out[monom] = coeff
+                continue
+            numer, denom = coeff.numer, coeff.denom
+            if len(denom) != 1:
+                return None
+            [(dexp, dcoeff)] = denom.items()
+            for nexp, ncoeff in numer.items():
+                lexp = []
+                for a, b in zip(nexp, dexp):
+                    k = a - b
+                    lexp += [k, 0] if k >= 0 else [0, -k]
+                key = monom + tuple(lexp)
+                out[key] = out.get(key, 0) + ncoeff / dcoeff
+        return self.ring.from_dict({k: v for k, v in out.items() if v})
+
+    def field(self, values) -> _Field:
+        """The internal field whose components are ``values`` (elements of :attr:`ring`)."""
+        values = tuple(values)
+        if not self._integral:
+            return _Field(values, 1, values)
+        scale = lcm(1, *(int(c.denominator) for part in values for c in part.coeffs()))
+        parts = [self.bracket_ring.from_dict({m: ZZ(int(c * scale)) for m, c in part.items()}) for part in values]
+        return _Field(parts, scale, values)
+
+    def values(self, X: _Field) -> tuple:
+        """The components of ``X`` as elements of :attr:`ring` (scale divided out)."""
+        if X._values is None:
+            k = self.domain.convert(sympy.Rational(1, X.scale))
+            X._values = tuple(self.ring.from_dict({m: k * c for m, c in comp.items()}) for comp in X.components)
+        return X._values
+
+    def from_vector_field(self, V: VectorField) -> _Field:
+        if not self.laurent:
+            return self.field(V.components)
+        parts = [self._from_algebra(c) for c in V.components]
+        if any(p is None for p in parts):
+            raise NambuBCHError(
+                f"{V} has a coefficient whose denominator is not a monomial in the parameters; "
+                "the Laurent backend accepts only monomial denominators (use laurent=False)")
+        return self.field(parts)
+
+    def to_vector_field(self, X: _Field) -> VectorField:
+        return self.combine([(1, X)])
+
+    def function(self, expr):
+        """A polynomial function (sympy expression or algebra element) as an element of :attr:`ring`."""
+        value = self.algebra.convert(expr)
+        if not self.algebra.is_polynomial(value):
+            raise NambuBCHError(f"{expr} is not a polynomial in {self.algebra.coordinates} over the parameter field")
+        if not self.laurent:
+            return value
+        out = self._from_algebra(value)
+        if out is None:
+            raise NambuBCHError(f"{expr} has a denominator that is not a monomial in the parameters")
+        return out
+
+    def function_to_sympy(self, f):
+        return self.algebra.to_sympy(self.to_algebra(self.reduce(f)))
+
+    # -- calculus -----------------------------------------------------------------
+    def reduce(self, poly):
+        """Canonical Laurent form of a ring element: no monomial holds both ``p`` and ``p_inv`` (``p p_inv = 1``)."""
+        pairs = self._pairs
+        if not pairs or not any(m[i] and m[j] for m in poly.keys() for i, j in pairs):
+            return poly
+        out = {}
+        for m, c in poly.items():
+            m = list(m)
+            for i, j in pairs:
+                k = m[i] - m[j]
+                m[i], m[j] = (k, 0) if k >= 0 else (0, -k)
+            key = tuple(m)
+            out[key] = out.get(key, 0) + c
+        return poly.ring.from_dict({k: v for k, v in out.items() if v})
+
+    def derivative(self, f, i: int):
+        """``D_i f``: the coordinate derivative (Laurent) or the algebra's own ``diff`` (e.g. total derivative)."""
+        if self.laurent:
+            return f.diff(self._value_coords[i])
+        return self.algebra.diff(f, i)
+
+    def _diff(self, c, j: int):
+        """``D_j c`` for a component in :attr:`bracket_ring`."""
+        if self.laurent:
+            return c.diff(self._bracket_coords[j])
+        return self.algebra.diff(c, j)
+
+    def bracket(self, X: _Field, Y: _Field) -> _Field:
+        """``[X, Y]^i = X^j D_j Y^i - Y^j D_j X^i`` (operator commutator, Eq. CL1).
+
+        The derivatives ``D_j X^i`` are computed when first needed (only where the other field's ``j``-th
+        component is non-zero) and kept with the field: memoised leaves of a BCH series reuse them.
+        """
+        n = self.algebra.n
+        Xc, Yc = X.components, Y.components
+        dX = X._derivatives or _new_derivatives(X, n)
+        dY = Y._derivatives or _new_derivatives(Y, n)
+        zero = self.bracket_ring.zero
+        comps = []
+        for i in range(n):
+            total = zero
+            dXi, dYi = dX[i], dY[i]
+            for j in range(n):
+                if Xc[j]:
+                    d = dYi[j]
+                    if d is None:
+                        d = dYi[j] = self._diff(Yc[i], j)
+                    if d:
+                        total = total + Xc[j] * d
+                if Yc[j]:
+                    d = dXi[j]
+                    if d is None:
+                        d = dXi[j] = self._diff(Xc[i], j)
+                    if d:
+                        total = total - Yc[j] * d
+            comps.append(self.reduce(total))
+        if self._integral:
+            return _Field(comps, X.scale * Y.scale)
+        return _Field(comps, 1, tuple(comps))
+
+    def apply(self, X: _Field, f):
+        """``X f = sum_i X^i D_i f`` for ``f`` in :attr:`ring`."""
+        total = self.zero
+        if not f:
+            return total
+        for i, c in enumerate(self.values(X)):
+            if c:
+                d = self.derivative(f, i)
+                if d:
+                    total = total + c * d
+        return self.reduce(total)
+
+    @staticmethod
+    def is_zero(X: _Field) -> bool:
+        return not any(X.components)
+
+    @staticmethod
+    def is_zero_function(f) -> bool:
+        return not f
+
+    # -- scalars and linear combinations --------------------------------------------
+    def constants(self, numbers) -> list:
+        """Exact sympy numbers as elements of the ring's domain (algebraic ones via one primitive element)."""
+        numbers = list(numbers)
+        if not numbers:
+            return []
+        K, elems = construct_domain(numbers, extension=True)
+        if K == self.domain:
+            return list(elems)
+        if K.is_ZZ or K.is_QQ:
+            return [self.domain.convert_from(e, K) for e in elems]
+        return [self._constant(c) for c in numbers]
+
+    def rational(self, q):
+        return self.domain.convert(q)
+
+    def _constant(self, c):
+        if isinstance(c, (int, sympy.Basic)):
+            return self.domain.from_sympy(sympy.sympify(c))
+        return c  # already an element of the ring's domain
+
+    def combine(self, pairs) -> VectorField:
+        """``sum c X`` (``c`` exact sympy numbers or domain elements) as a :class:`VectorField` of the algebra."""
+        return self._combine([(self._constant(c), X) for c, X in pairs], self.domain.one)
+
+    def scaled_combine(self, denominator: int, pairs) -> VectorField:
+        """``(1/denominator) sum n X`` with integer (or domain-element) numerators ``n``: one division per field."""
+        return self._combine(pairs, self.domain.convert(sympy.Rational(1, denominator)))
+
+    def _combine(self, pairs, factor) -> VectorField:
+        algebra = self.algebra
+        if not pairs:
+            return VectorField.zero(algebra)
+        # accumulate monomial by monomial, one sum per scale (integers in the Laurent case over QQ): for the
+        # many small fields of a series this beats ring arithmetic, and rationals appear once per monomial
+        by_scale: dict = {}
+        for n, X in pairs:
+            totals = by_scale.setdefault(X.scale, [{} for _ in range(algebra.n)])
+            for acc, comp in zip(totals, X.components):
+                for monom, coeff in comp.items():
+                    acc[monom] = acc.get(monom, 0) + coeff * n
+        domain = self.domain
+        out = [{} for _ in range(algebra.n)]
+        for scale, totals in by_scale.items():
+            k = factor * domain.convert(sympy.Rational(1, scale)) if scale != 1 else factor
+            for acc, target in zip(totals, out):
+                for monom, c in acc.items():
+                    if c:
+                        target[monom] = target.get(monom, 0) + k * c
+        polys = [self.ring.from_dict({m: c for m, c in acc.items() if c}) for acc in out]
+        return VectorField(algebra, [self.to_algebra(p) for p in polys])
+
+    def vector_field(self, values) -> VectorField:
+        """Components in :attr:`ring` (e.g. of a series computed with :meth:`apply`) as a :class:`VectorField`."""
+        return VectorField(self.algebra, [self.to_algebra(self.reduce(c)) for c in values])
+
+    def to_algebra(self, poly):
+        """An element of :attr:`ring` back in the algebra's ring over ``QQ(parameters)``."""
+        algebra = self.algebra
+        if not self.laurent:
+            return poly
+        split = algebra.n + len(algebra.constants)
+        if not algebra.parameters:
+            return algebra.ring.from_dict(dict(poly.items())) if poly else algebra.ring.zero
+        field = algebra.domain.field
+        pring = field.ring
+        groups: dict = {}
+        for m, c in poly.items():
+            groups.setdefault(m[:split], []).append((m[split:], c))
+        out = {}
+        base = pring.domain
+        for head, items in groups.items():
+            if len(items) == 1 and base.is_QQ:
+                # one Laurent monomial r/s p^a q^-b: already canonical as (r p^a) / (s q^b), no gcd needed
+                (lexp, c), = items
+                key = (lexp, c.numerator, c.denominator)
+                value = self._monomials.get(key)
+                if value is None:
+                    up, down = tuple(lexp[0::2]), tuple(lexp[1::2])
+                    value = field.raw_new(
+                        pring.from_dict({up: base(c.numerator)}), pring.from_dict({down: base(c.denominator)})
+                    )
+                    self._monomials[key] = value
+                out[head] = value
+                continue
+            shift = [max((lexp[2 * k + 1] for lexp, _ in items), default=0) for k in range(len(algebra.parameters))]
+            numer = {}
+            for lexp, c in items:
+                e = tuple(lexp[2 * k] - lexp[2 * k + 1] + shift[k] for k in range(len(shift)))
+                numer[e] = numer.get(e, 0) + c
+            num = pring.from_dict(numer)
+            den = pring.from_dict({tuple(shift): pring.domain.one})
+            out[head] = field.new(num, den)
+        return algebra.ring.from_dict(out)
+
+
+class ExpressionBackend:
+    """Vector fields whose components are expanded sympy expressions (non-polynomial Hamiltonians).
+
+    Examples
+    --------
+    >>> import sympy
+    >>> from nambu_bch import System
+    >>> S = System("x1 x2", ["x2**2/2 - cos(x1)"], [], name="pendulum").splitting
+    >>> E = ExpressionBackend(S.system.algebra, {p.number: p.field for p in S.pieces})
+    >>> E.to_vector_field(E.bracket(E.fields[1], E.fields[2])).to_sympy()
+    (sin(x1), -x2*cos(x1))
+    """
+
+    laurent = False
+    domain = None  # scalars are sympy numbers
+
+    def __init__(self, algebra, fields: dict = None):
+        self.algebra = algebra
+        self.coordinates = tuple(algebra.coordinates)
+        self.zero, self.one = sympy.Integer(0), sympy.Integer(1)
+        self.fields = {k: self.from_vector_field(X) for k, X in (fields or {}).items()}
+
+    def from_vector_field(self, V: VectorField) -> tuple:
+        return tuple(sympy.expand(self.algebra.to_sympy(c)) for c in V.components)
+
+    def to_vector_field(self, X) -> VectorField:
+        return VectorField(self.algebra, X)
+
+    def function(self, expr):
+        return sympy.expand(self.algebra.to_sympy(expr))
+
+    @staticmethod
+    def function_to_sympy(f):
+        return f
+
+    def field(self, values) -> tuple:
+        return tuple(values)
+
+    @staticmethod
+    def values(X) -> tuple:
+        return X
+
+    def derivative(self, f, i: int):
+        return sympy.diff(f, self.coordinates[i])
+
+    def bracket(self, X, Y) -> tuple:
+        """``[X, Y]^i = X^j d_j Y^i - Y^j d_j X^i`` (Eq. CL1), expanded."""
+        coords = self.coordinates
+        out = []
+        for i in range(len(coords)):
+            total = sympy.Integer(0)
+            for j, x in enumerate(coords):
+                if X[j] != 0:
+                    total += X[j] * sympy.diff(Y[i], x)
+                if Y[j] != 0:
+                    total -= Y[j] * sympy.diff(X[i], x)
+            out.append(sympy.expand(total))
+        return tuple(out)
+
+    def apply(self, X, f):
+        """``X f = sum_i X^i d f / d x_i``, expanded."""
+        if f == 0:
+            return self.zero
+        return sympy.expand(sum((c * sympy.diff(f, x) for c, x in zip(X, self.coordinates) if c != 0), self.zero))
+
+    @staticmethod
+    def is_zero(X) -> bool:
+        return all(c == 0 for c in X)
+
+    @staticmethod
+    def is_zero_function(f) -> bool:
+        return f == 0
+
+    @staticmethod
+    def constants(numbers) -> list:
+        return [sympy.sympify(c) for c in numbers]
+
+    @staticmethod
+    def rational(q):
+        return q
+
+    def combine(self, pairs) -> VectorField:
+        totals = [sympy.Integer(0)] * self.algebra.n
+        for c, X in pairs:
+            totals = [t + sympy.sympify(c) * comp for t, comp in zip(totals, X)]
+        return VectorField(self.algebra, [sympy.expand(t) for t in totals])
+
+    def scaled_combine(self, denominator: int, pairs) -> VectorField:
+        return self.combine([(sympy.Rational(sympy.sympify(n), denominator), X) for n, X in pairs])
+
+    def vector_field(self, values) -> VectorField:
+        return VectorField(self.algebra, [sympy.expand(c) for c in values])
+
+
+def field_backend(algebra, fields: dict, laurent: bool = True) -> FieldBackend:
+    """The exact backend for ``{key: VectorField}`` on ``algebra``.
+
+    :class:`PolynomialBackend` when every component is a ring element (Laurent
+    representation when possible and ``laurent`` is true, else the algebra's ring
+    over ``QQ(parameters)``), :class:`ExpressionBackend` otherwise.
+
+    >>> from nambu_bch import model
+    >>> S = model("ho").splitting
+    >>> B = field_backend(S.system.algebra, {p.number: p.field for p in S.pieces})
+    >>> type(B).__name__, B.laurent
+    ('PolynomialBackend', True)
+    """
+    backend = PolynomialBackend.build(algebra, fields, laurent)
+    if backend is not None:
+        return backend
+    return ExpressionBackend(algebra, fields)
