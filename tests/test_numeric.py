@@ -377,3 +377,93 @@ def test_user_symbols_named_like_generated_ones():
     for _ in range(400):
         y = step(y, 0.1)
     assert np.allclose(x, y, rtol=1e-12, atol=1e-12)
+
+
+# -- issue 14: the batch path reads x0 in place, fuses the sample-0 copy and the result check ------------------
+
+
+@pytest.mark.parametrize("backend", [pytest.param("numba", marks=numba_only), "numpy"])
+def test_batch_reads_x0_in_place_and_leaves_it_unchanged(backend):
+    """The batch kernels read the caller's x0 (no copy) and never write it; x0 in any layout, dtype or
+    read-only gives the same bits, and every column equals its own single-trajectory run."""
+    from nambu_bch.numeric.iterate import SCAN_BATCH
+
+    rng = np.random.default_rng(14)
+    X = rng.normal(size=(3, SCAN_BATCH + 77))           # above SCAN_BATCH: the one-pass scan guards it
+    keep = X.copy()
+    a = iterate("ho3", "32123", 0.1, 40, X, every=7, backend=backend)
+    assert np.array_equal(X, keep) and np.array_equal(a[0], X)
+    frozen = X.copy()
+    frozen.flags.writeable = False
+    for variant in (np.asfortranarray(X), frozen, X.tolist()):
+        assert np.array_equal(iterate("ho3", "32123", 0.1, 40, variant, every=7, backend=backend), a)
+    ints = np.arange(3 * 9).reshape(3, 9) % 4 - 1          # int64: converted, same as its float64 copy
+    assert np.array_equal(iterate("ho3", "32123", 0.1, 40, ints, every=7, backend=backend),
+                          iterate("ho3", "32123", 0.1, 40, ints.astype(float), every=7, backend=backend))
+    for b in (0, 1234, X.shape[1] - 1):
+        assert np.array_equal(a[:, :, b], iterate("ho3", "32123", 0.1, 40, X[:, b], every=7, backend=backend))
+    assert np.array_equal(iterate("ho3", "32123", 0.1, 0, X, backend=backend), X[None])   # steps = 0: x0 only
+
+
+@pytest.mark.parametrize("backend", [pytest.param("numba", marks=numba_only), "numpy"])
+def test_batch_kernel_counts_non_finite_samples(backend):
+    """Kernel.run_batch returns 0 for a finite run and a positive count when a sample overflows; with
+    back=False the start states are only read, with start=True they are copied to out[0]."""
+    k = kernel(model("ho"), "TVT")
+    K = k.constants(2.5)                                   # omega h = 2.5: grows like 4^n
+    X = np.array([[1.0, 1e300, 0.5], [0.0, 0.0, 0.25]])
+    keep = X.copy()
+    out = np.full((3, 2, 3), -7.0)
+    assert k.run_batch(X, K, 2, 1, out, backend=backend, start=True, back=False) == 0
+    assert np.array_equal(X, keep) and np.array_equal(out[0], X) and np.all(np.isfinite(out))
+    out = np.empty((3, 2, 3))
+    with np.errstate(all="ignore"):
+        assert k.run_batch(X, K, 300, 150, out, backend=backend, start=True, back=False) > 0
+    assert np.array_equal(X, keep)
+    Y = X[:, [0, 2]].copy()
+    assert k.run_batch(Y, K, 2, 2, np.empty((2, 2, 2)), backend=backend) == 0 and not np.array_equal(Y, keep[:, [0, 2]])
+
+
+@pytest.mark.parametrize("segment_work", [None, 3000])
+def test_batch_overflow_names_the_same_steps_as_the_single_run(monkeypatch, segment_work):
+    """A batch whose one large state overflows mid-run raises the message of that state's own run (the
+    first non-finite sample), also when the run is cut into progress segments."""
+    import importlib
+
+    from nambu_bch.numeric.iterate import SCAN_BATCH
+
+    X = np.ones((2, SCAN_BATCH + 10))
+    X[:, 3000] = [1e200, 0.0]
+    with pytest.raises(NumericalRangeError, match="between steps") as single:
+        iterate("ho", "TVT", 2.5, 2000, X[:, 3000], every=40, check_stable=False)
+    if segment_work:
+        monkeypatch.setattr(importlib.import_module("nambu_bch.numeric.iterate"), "_SEGMENT_WORK", segment_work)
+    with pytest.raises(NumericalRangeError, match="between steps") as batch:
+        iterate("ho", "TVT", 2.5, 2000, X, every=40, check_stable=False, progress=bool(segment_work))
+    assert str(batch.value) == str(single.value)
+
+
+def test_scan_states_finds_the_extreme_states_across_blocks():
+    """guards.scan_states (numpy blocks) and the compiled Kernel.scan against the definition written
+    out on whole arrays: first state of largest / smallest max-norm and product, smallest non-zero."""
+    from nambu_bch.numeric.guards import scan_states
+
+    rng = np.random.default_rng(5)
+    X = rng.uniform(0.5, 1.5, size=(3, 5000)) * 10.0 ** rng.integers(-60, 60, size=(3, 5000))
+    X[:, 4000] = X[:, 17]                                   # ties: the first one counts
+    X[1, 2500] = 0.0
+    X[:, 99] = 0.0
+    A = np.abs(X)
+    small = np.where(A > 0, A, np.inf).min(axis=0)
+    prod = A[0] * A[1] * A[2]
+    want = {int(A.max(0).argmax()), int(A.max(0).argmin()), int(prod.argmax()), int(prod.argmin()),
+            int(small.argmin()), 0, X.shape[1] - 1}
+    for block in (7, 1024, 8192):
+        bad, sub, cols = scan_states(X, block)
+        assert (bad, sub) == (0, 0) and set(cols.tolist()) == want
+    if numba_available():
+        bad, sub, cols = kernel(model("ho3"), "32123").scan(X)
+        assert (bad, sub) == (0, 0) and set(cols.tolist()) == want
+    Y = X.copy()
+    Y[0, 10], Y[2, 4999] = np.nan, 1e-310
+    assert scan_states(Y, 64)[:2] == (1, 1)
