@@ -38,8 +38,11 @@ Horikoshi, Sect. 5.5 (numerical results) and Eqs. (hX1e)-(hX3e), (12321).
 from __future__ import annotations
 
 import hashlib
+import math
 from dataclasses import dataclass
+from fractions import Fraction
 from functools import lru_cache
+from math import factorial
 
 import sympy
 from sympy.codegen.cfunctions import expm1
@@ -346,6 +349,82 @@ def print_c(expr) -> str:
     return _CPrinter().doprint(expr)
 
 
+# -- shared exponentials ---------------------------------------------------------------------------------
+
+#: Below this ``|u|`` a shared pair ``expm1(|u|), expm1(-|u|)`` comes from the series of ``cosh - 1`` and
+#: ``sinh`` (:func:`pair_lines`); above it from the library ``expm1`` and ``-e / (1 + e)``.
+SERIES_LIMIT = 0.5
+#: ``1/n!`` correctly rounded: ``cosh a - 1 = z (1/2! + z/4! + ... + z^7/16!)``, ``sinh a - a =
+#: a z (1/3! + z/5! + ... + z^6/15!)`` with ``z = a^2``; the first omitted terms are below 2^-60 of
+#: ``a`` for ``a <= SERIES_LIMIT``.
+_COSH_COEFFS = tuple(repr(float(Fraction(1, factorial(n)))) for n in range(2, 17, 2))
+_SINH_COEFFS = tuple(repr(float(Fraction(1, factorial(n)))) for n in range(3, 16, 2))
+
+
+def _estrin(coeffs, z, z2, z4):
+    """``sum_i coeffs[i] z^i`` (degree <= 7) by Estrin's scheme: short dependency chains, same operations everywhere."""
+    pairs = [f"({coeffs[i]} + {coeffs[i + 1]}*{z})" if i + 1 < len(coeffs) else coeffs[i]
+             for i in range(0, len(coeffs), 2)]
+    quads = [f"({pairs[i]} + {z2}*{pairs[i + 1]})" if i + 1 < len(pairs) else pairs[i]
+             for i in range(0, len(pairs), 2)]
+    return f"({quads[0]} + {z4}*{quads[1]})" if len(quads) == 2 else quads[0]
+
+
+def pair_lines(u, e, f, value, prefix="_", style="python"):
+    """Statements setting ``e = expm1(u)`` and ``f = expm1(-u)`` for ``u = value`` (one shared exponential).
+
+    For ``a = |u| <= SERIES_LIMIT``: ``c = cosh a - 1`` and ``r = sinh a - a`` from their Taylor
+    series (Estrin's scheme in ``z = a^2``), then ``expm1(a) = a + (c + r)`` and ``expm1(-a) =
+    (c - r) - a``: no library call and no division, both to about 1 ulp (the tails are below
+    0.27 a, so the last addition dominates; ``test_series_pair_is_accurate``).  For larger ``a``
+    (and NaN): ``e = expm1(a)`` from the library and ``f = -e / (1 + e)`` (``1 + e >= 1``: no
+    cancellation).  Swapped when ``u < 0``.  The mpmath prefix ``_mp_`` keeps the library
+    function at any precision.  ``style``: ``"python"`` (scalar, numba), ``"numpy"`` (arrays),
+    ``"c"`` (C99, the benchmark's reference) -- the same IEEE operations in the same order.
+
+    References
+    ----------
+    Estrin's scheme: Knuth, *TAOCP* vol. 2, Sect. 4.6.4; Higham, *Accuracy and Stability of
+    Numerical Algorithms*, Sect. 5.4.
+    """
+    a, z, z2, z4, c, r = (f"_{name}{u}" for name in ("a", "z", "zz", "z4", "ch", "sh"))
+    if prefix == "_mp_":
+        return [f"{u} = {value}", f"{e} = {prefix}expm1(abs({u}))", f"{f} = -{e} / (1.0 + {e})",
+                f"if {u} < 0: {e}, {f} = {f}, {e}"]
+    series = [f"{z} = {a}*{a}", f"{z2} = {z}*{z}", f"{z4} = {z2}*{z2}",
+              f"{c} = {z}*{_estrin(_COSH_COEFFS, z, z2, z4)}",
+              f"{r} = ({a}*{z})*{_estrin(_SINH_COEFFS, z, z2, z4)}"]
+    if style == "c":
+        body = " ".join(f"double {line};" for line in series)
+        return [f"double {u} = {value};", f"double {a} = fabs({u});", f"double {e}, {f};",
+                f"if ({a} <= {SERIES_LIMIT!r}) {{ {body} {e} = {a} + ({c} + {r}); {f} = ({c} - {r}) - {a}; }}",
+                f"else {{ {e} = expm1({a}); {f} = -{e} / (1.0 + {e}); }}",
+                f"if ({u} < 0) {{ double w_ = {e}; {e} = {f}; {f} = w_; }}"]
+    if style == "numpy":
+        big = f"_big{u}"
+        return [f"{u} = {value}", f"{a} = np.abs({u})", *series,
+                f"{e} = {a} + ({c} + {r})", f"{f} = ({c} - {r}) - {a}",
+                f"{big} = ~({a} <= {SERIES_LIMIT!r})",
+                f"if {big}.any(): {e}[{big}] = {prefix}expm1({a}[{big}]); {f}[{big}] = -{e}[{big}] / (1.0 + {e}[{big}])",
+                f"{e}, {f} = np.where({u} >= 0, {e}, {f}), np.where({u} >= 0, {f}, {e})"]
+    return [f"{u} = {value}", f"{a} = abs({u})", f"if {a} <= {SERIES_LIMIT!r}:",
+            *(f"    {line}" for line in series),
+            f"    {e} = {a} + ({c} + {r})", f"    {f} = ({c} - {r}) - {a}",
+            "else:", f"    {e} = {prefix}expm1({a})", f"    {f} = -{e} / (1.0 + {e})",
+            f"if {u} < 0: {e}, {f} = {f}, {e}"]
+
+
+def expm1_pair(u: float) -> tuple:
+    """``(expm1(u), expm1(-u))`` in float64 exactly as the generated kernels compute a shared pair.
+
+    >>> expm1_pair(0.0), expm1_pair(1e-300)
+    ((0.0, 0.0), (1e-300, -1e-300))
+    """
+    ns = {"_expm1": math.expm1}
+    exec("\n".join(pair_lines("u0", "e0", "f0", "_x")), {"_expm1": math.expm1, "_x": float(u)}, ns)  # noqa: S102
+    return ns["e0"], ns["f0"]
+
+
 # -- loop bodies ----------------------------------------------------------------------------------------
 
 
@@ -360,16 +439,8 @@ def body_lines(program: StepProgram, printer, kahan=False, c_syntax=False, vecto
     lines = []
     for u in program.updates:
         for us, es, fs, ue in u.pairs:
-            if c_syntax:
-                lines += [f"double {us} = {printer(ue)};", f"double {es} = expm1(fabs({us}));",
-                          f"double {fs} = -{es} / (1.0 + {es});",
-                          f"if ({us} < 0) {{ double w_ = {es}; {es} = {fs}; {fs} = w_; }}"]
-            elif vector:
-                lines += [f"{us} = {printer(ue)}", f"{es} = {prefix}expm1(np.abs({us}))", f"{fs} = -{es} / (1.0 + {es})",
-                          f"{es}, {fs} = np.where({us} >= 0, {es}, {fs}), np.where({us} >= 0, {fs}, {es})"]
-            else:
-                lines += [f"{us} = {printer(ue)}", f"{es} = {prefix}expm1(abs({us}))", f"{fs} = -{es} / (1.0 + {es})",
-                          f"if {us} < 0: {es}, {fs} = {fs}, {es}"]
+            lines += pair_lines(str(us), str(es), str(fs), printer(ue), prefix,
+                                "c" if c_syntax else "numpy" if vector else "python")
         names = []
         for j, (i, d) in enumerate(u.increments):
             lines.append(f"{decl}d{j} = {printer(d)}{end}")
@@ -390,7 +461,7 @@ def _c_scoped(program, lines, kahan):
     it = iter(lines)
     for u in program.updates:
         n = len(u.increments)
-        count = 4 * len(u.pairs) + n + n * (4 if kahan else 1)
+        count = len(pair_lines("u", "e", "f", "0", style="c")) * len(u.pairs) + n + n * (4 if kahan else 1)
         block = [next(it) for _ in range(count)]
         out.append("{ " + " ".join(block) + " }")
     return out
