@@ -143,9 +143,10 @@ def test_shared_exponential_is_accurate_for_both_signs():
 
 def test_series_pair_is_accurate():
     """The shared pair of the generated kernels (codegen.pair_lines, evaluated by expm1_pair): for
-    |u| <= SERIES_LIMIT the series of cosh - 1 and sinh give expm1(u) and expm1(-u) within 1.5 ulp
-    of mpmath at 40 digits (measured: 1.04 and 1.20 ulp); beyond it the library expm1 and -e/(1+e)
-    stay within 4 * 2^-52 relative, up to |u| = 700."""
+    |u| <= SERIES_LIMIT the series of cosh - 1 and sinh give expm1(|u|) within 1.5 ulp of mpmath at
+    40 digits (measured 1.11), and f = -e/(1+e) gives expm1(-|u|) within 2.5 ulp (measured 1.83;
+    2.25 with libm's e); beyond it libm's expm1 and -e/(1+e) stay within 4 * 2^-52 relative, up to
+    |u| = 700."""
     import math
 
     import mpmath
@@ -156,7 +157,7 @@ def test_series_pair_is_accurate():
     small = np.concatenate([rng.uniform(0, SERIES_LIMIT, 3000), 10.0 ** rng.uniform(-300, np.log10(SERIES_LIMIT), 1000),
                             [SERIES_LIMIT, np.nextafter(SERIES_LIMIT, 0), 5e-324, 2.0**-26, 2.0**-27]])
     large = np.concatenate([rng.uniform(SERIES_LIMIT, 5, 300), [np.nextafter(SERIES_LIMIT, 1), 40.0, 700.0]])
-    worst_ulp, worst_rel = 0.0, 0.0
+    worst_ulp, worst_rel = [0.0, 0.0], 0.0
     with mpmath.workdps(40):
         for values, series in ((small, True), (large, False)):
             for u in values:
@@ -168,10 +169,11 @@ def test_series_pair_is_accurate():
                             continue
                         err = abs(mpmath.mpf(g) - want)
                         if series:
-                            worst_ulp = max(worst_ulp, float(err / math.ulp(float(want))))
+                            which = 0 if want > 0 else 1
+                            worst_ulp[which] = max(worst_ulp[which], float(err / math.ulp(float(want))))
                         else:
                             worst_rel = max(worst_rel, float(err / abs(want)))
-    assert worst_ulp <= 1.5 and worst_rel < 4 * 2.0**-52, (worst_ulp, worst_rel)
+    assert worst_ulp[0] <= 1.5 and worst_ulp[1] <= 2.5 and worst_rel < 4 * 2.0**-52, (worst_ulp, worst_rel)
 
 
 @numba_only
@@ -201,6 +203,17 @@ def test_exponential_flows_agree_bitwise_in_the_series_range(tmp_path):
     x = X[:, 1].copy()
     lib.run(x.ctypes.data_as(dp), k.constants(0.05).ctypes.data_as(dp), 3000)
     assert np.array_equal(x, a[-1, :, 1])
+
+
+def test_lotka_volterra_pieces_keep_G_like_the_library_pair():
+    """Each piece X_{x_i, G} of the cyclic Lotka-Volterra splitting keeps G = x1 x2 x3 exactly (it scales
+    x_{i+1} by e^-u and x_{i+2} by e^u); in float64 G drifts by round-off only.  f = -e/(1+e) from the
+    rounded e keeps (1+e)(1+f) = 1 to rounding, so after 2e5 steps G has drifted 2e-14 (as with libm's
+    expm1: 1.9e-14, measured with a C loop against long double); an f from its own series drifted
+    1.5e-13 -- the bound separates the two."""
+    x = iterate("lotka-volterra", "12321", 0.1, 200_000, [0.7, 0.7, 0.7], every=200_000)
+    G = x.prod(axis=1)
+    assert abs(G[-1] / G[0] - 1) < 5e-14
 
 
 def test_exponential_flows_mix_series_and_library_ranges():
