@@ -373,47 +373,48 @@ def _estrin(coeffs, z, z2, z4):
 def pair_lines(u, e, f, value, prefix="_", style="python"):
     """Statements setting ``e = expm1(u)`` and ``f = expm1(-u)`` for ``u = value`` (one shared exponential).
 
-    For ``a = |u| <= SERIES_LIMIT``: ``expm1(a) = a + (c + r)`` with ``c = cosh a - 1`` and
-    ``r = sinh a - a`` from their Taylor series (Estrin's scheme in ``z = a^2``): no library call,
-    a short dependency chain, about 1 ulp (the tail ``c + r`` is below 0.27 a, so the last addition
-    dominates; ``test_series_pair_is_accurate``).  For larger ``a`` (and NaN) the library ``expm1``.
-    Then ``f = -e / (1 + e)`` in both cases (``1 + e >= 1``: no cancellation).  ``f`` is derived
-    from the rounded ``e`` on purpose: ``(1 + e)(1 + f) = 1`` up to the rounding of ``1 + e`` and
-    of the quotient, so a Lotka-Volterra piece keeps ``G = x1 x2 x3`` as well as with the library
-    ``expm1``; an ``f`` from its own series (``(c - r) - a``, as accurate per call) measured an 8x
-    larger drift of ``G`` over 2e6 steps.  Swapped when ``u < 0``.  The mpmath prefix ``_mp_`` keeps
-    the library function at any precision.  ``style``: ``"python"`` (scalar, numba), ``"numpy"``
-    (arrays), ``"c"`` (C99, the benchmark's reference) -- the same IEEE operations in the same order.
+    For ``a = |u| <= SERIES_LIMIT``: ``c = cosh a - 1`` and ``r = sinh a - a`` from their Taylor
+    series (Estrin's scheme in ``z = a^2``), ``e = expm1(a) = a + (c + r)`` and ``f0 = (c - r) - a``,
+    then one Newton step ``f = f0 - g (1 + f0)`` on ``g = (1 + e)(1 + f0) - 1 = (e + f0) + e f0``
+    (``e + f0`` is exact: ``e`` and ``-f0`` are within a factor 2, Sterbenz).  No library call and
+    no division: a short dependency chain.  ``e`` is within about 1 ulp of ``expm1(a)`` (the tail
+    ``c + r`` is below 0.27 a, so the last addition dominates) and ``f`` is ``-e/(1 + e)`` rounded
+    once, so ``(1 + e)(1 + f) = 1`` to half an ulp of ``f``: a Lotka-Volterra piece keeps
+    ``G = x1 x2 x3`` (``f0`` alone, as accurate per call, drifted ``G`` 8x more over 2e6 steps;
+    ``-e/fl(1 + e)`` 3x more; ``test_lotka_volterra_pieces_keep_G``).  For larger ``a`` (and NaN):
+    the library ``expm1`` and ``f = -e / (1 + e)`` (``1 + e >= 1``: no cancellation).  Swapped when
+    ``u < 0``.  The mpmath prefix ``_mp_`` keeps the library function at any precision.  ``style``:
+    ``"python"`` (scalar, numba), ``"numpy"`` (arrays), ``"c"`` (C99, the benchmark's reference) --
+    the same IEEE operations in the same order.
 
     References
     ----------
-    Estrin's scheme: Knuth, *TAOCP* vol. 2, Sect. 4.6.4; Higham, *Accuracy and Stability of
-    Numerical Algorithms*, Sect. 5.4.
+    Estrin's scheme: Knuth, *TAOCP* vol. 2, Sect. 4.6.4; Sterbenz's lemma and Newton's correction:
+    Higham, *Accuracy and Stability of Numerical Algorithms*, 2nd ed., Sects. 2.5 and 5.4.
     """
-    a, z, z2, z4, c, r = (f"_{name}{u}" for name in ("a", "z", "zz", "z4", "ch", "sh"))
+    a, z, z2, z4, c, r, f0, g = (f"_{name}{u}" for name in ("a", "z", "zz", "z4", "ch", "sh", "f", "g"))
     if prefix == "_mp_":
         return [f"{u} = {value}", f"{e} = {prefix}expm1(abs({u}))", f"{f} = -{e} / (1.0 + {e})",
                 f"if {u} < 0: {e}, {f} = {f}, {e}"]
     series = [f"{z} = {a}*{a}", f"{z2} = {z}*{z}", f"{z4} = {z2}*{z2}",
               f"{c} = {z}*{_estrin(_COSH_COEFFS, z, z2, z4)}",
               f"{r} = ({a}*{z})*{_estrin(_SINH_COEFFS, z, z2, z4)}",
-              f"{e} = {a} + ({c} + {r})"]
-    if style == "c":
-        body = " ".join(f"double {line};" for line in series[:-1])
-        return [f"double {u} = {value};", f"double {a} = fabs({u});", f"double {e};",
-                f"if ({a} <= {SERIES_LIMIT!r}) {{ {body} {series[-1]}; }} else {{ {e} = expm1({a}); }}",
-                f"double {f} = -{e} / (1.0 + {e});",
+              f"{e} = {a} + ({c} + {r})", f"{f0} = ({c} - {r}) - {a}",
+              f"{g} = ({e} + {f0}) + {e}*{f0}", f"{f} = {f0} - {g}*(1.0 + {f0})"]
+    library = [f"{e} = {prefix}expm1({a})", f"{f} = -{e} / (1.0 + {e})"]
+    if style == "c":  # temporaries declared where they are first set; e and f are declared before the branch
+        body = " ".join(("" if line.startswith((e + " ", f + " ")) else "double ") + line + ";" for line in series)
+        return [f"double {u} = {value};", f"double {a} = fabs({u});", f"double {e}, {f};",
+                f"if ({a} <= {SERIES_LIMIT!r}) {{ {body} }}",
+                f"else {{ {e} = expm1({a}); {f} = -{e} / (1.0 + {e}); }}",
                 f"if ({u} < 0) {{ double w_ = {e}; {e} = {f}; {f} = w_; }}"]
     if style == "numpy":
         big = f"_big{u}"
-        return [f"{u} = {value}", f"{a} = np.abs({u})", *series,
-                f"{big} = ~({a} <= {SERIES_LIMIT!r})",
-                f"if {big}.any(): {e}[{big}] = {prefix}expm1({a}[{big}])",
-                f"{f} = -{e} / (1.0 + {e})",
+        return [f"{u} = {value}", f"{a} = np.abs({u})", *series, f"{big} = ~({a} <= {SERIES_LIMIT!r})",
+                f"if {big}.any(): {e}[{big}] = {prefix}expm1({a}[{big}]); {f}[{big}] = -{e}[{big}] / (1.0 + {e}[{big}])",
                 f"{e}, {f} = np.where({u} >= 0, {e}, {f}), np.where({u} >= 0, {f}, {e})"]
     return [f"{u} = {value}", f"{a} = abs({u})", f"if {a} <= {SERIES_LIMIT!r}:",
-            *(f"    {line}" for line in series),
-            "else:", f"    {e} = {prefix}expm1({a})", f"{f} = -{e} / (1.0 + {e})",
+            *(f"    {line}" for line in series), "else:", *(f"    {line}" for line in library),
             f"if {u} < 0: {e}, {f} = {f}, {e}"]
 
 
@@ -421,7 +422,7 @@ def expm1_pair(u: float) -> tuple:
     """``(expm1(u), expm1(-u))`` in float64 exactly as the generated kernels compute a shared pair.
 
     >>> expm1_pair(0.0), expm1_pair(1e-300)
-    ((0.0, -0.0), (1e-300, -1e-300))
+    ((0.0, 0.0), (1e-300, -1e-300))
     """
     ns = {"_expm1": math.expm1}
     exec("\n".join(pair_lines("u0", "e0", "f0", "_x")), {"_expm1": math.expm1, "_x": float(u)}, ns)  # noqa: S102
