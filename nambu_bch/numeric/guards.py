@@ -238,7 +238,7 @@ def extreme_states(X, k=MAX_CHECKED):
 
 
 #: States per block of :func:`scan_states` (the block's temporaries stay in cache).
-SCAN_BLOCK = 8192
+SCAN_BLOCK = 16384
 
 
 def scan_states(X, block=SCAN_BLOCK):
@@ -258,14 +258,16 @@ def scan_states(X, block=SCAN_BLOCK):
     with np.errstate(all="ignore"):
         for b0 in range(0, B, block):
             A = np.abs(X[:, b0:b0 + block])
-            nonfinite += int(np.count_nonzero(~(A <= np.finfo(np.float64).max)))
-            subnormal += int(np.count_nonzero((A < TINY) & (A > 0)))
-            big = A.max(axis=0)
+            big = A.max(axis=0)                              # NaN propagates: a bad block shows in big.max()
+            if not big.max() <= np.finfo(np.float64).max:
+                nonfinite += int(np.count_nonzero(~(A <= np.finfo(np.float64).max)))
             prod = A[0].copy()
             for row in A[1:]:
                 prod *= row
             np.copyto(A, np.inf, where=~(A > 0))
             small = A.min(axis=0)
+            if small.min() < TINY:                           # the smallest non-zero magnitude is subnormal
+                subnormal += int(np.count_nonzero(A < TINY))
             for slot, (values, take_max) in enumerate(((big, True), (big, False), (prod, True), (prod, False),
                                                        (small, False))):
                 i = int(values.argmax() if take_max else values.argmin())
