@@ -506,6 +506,20 @@ def test_batch_reads_x0_in_place_and_leaves_it_unchanged(backend):
     assert np.array_equal(iterate("ho3", "32123", 0.1, 0, X, backend=backend), X[None])   # steps = 0: x0 only
 
 
+def test_segmented_kahan_batch_carries_the_compensation(monkeypatch, capsys):
+    """A Kahan batch cut into progress segments (each starting from the last sample written, the
+    compensation carried in place) gives the bits of the uncut run and of each state's own run."""
+    import importlib
+
+    X = np.random.default_rng(2).normal(size=(3, 40))
+    whole = iterate("ho3", "32123", 0.01, 700, X, every=70, kahan=True)
+    monkeypatch.setattr(importlib.import_module("nambu_bch.numeric.iterate"), "_SEGMENT_WORK", 5000)
+    cut = iterate("ho3", "32123", 0.01, 700, X, every=70, kahan=True, progress=True)
+    assert np.array_equal(whole, cut)
+    assert np.array_equal(whole[:, :, 7], iterate("ho3", "32123", 0.01, 700, X[:, 7], every=70, kahan=True))
+    capsys.readouterr()
+
+
 @pytest.mark.parametrize("backend", [pytest.param("numba", marks=numba_only), "numpy"])
 def test_batch_kernel_counts_non_finite_samples(backend):
     """Kernel.run_batch returns 0 for a finite run and a positive count when a sample overflows; with
