@@ -16,8 +16,9 @@ are turned into a :class:`StepProgram`:
 The program is then printed with sympy's code printers -- Python for numba and
 the pure-Python / numpy / mpmath fallbacks, C (``ccode``) for the reference loop
 of ``benchmarks/bench_iterate.py``.  Every printer emits the same operations in
-the same order, so the backends agree bit for bit on polynomial flows (on
-``exp`` flows up to the last bits of the libraries' ``expm1``).
+the same order, so the backends agree bit for bit on polynomial flows, and on
+``exp`` flows while the shared exponentials stay in the range of their series
+(:func:`pair_lines`); beyond it up to the last bits of the libraries' ``expm1``.
 
 Operator order: the updates run in word order, left to right, exactly as the
 sub-flows act on a state (:mod:`nambu_bch.integrators.composition`).
@@ -424,9 +425,10 @@ def expm1_pair(u: float) -> tuple:
     >>> expm1_pair(0.0), expm1_pair(1e-300)
     ((0.0, 0.0), (1e-300, -1e-300))
     """
-    ns = {"_expm1": math.expm1}
-    exec("\n".join(pair_lines("u0", "e0", "f0", "_x")), {"_expm1": math.expm1, "_x": float(u)}, ns)  # noqa: S102
-    return ns["e0"], ns["f0"]
+    scope = {}
+    # the generated statements themselves (internal names, the float u as a variable: no text is formatted in)
+    exec("\n".join(pair_lines("u0", "e0", "f0", "_x")), {"_expm1": math.expm1, "_x": float(u)}, scope)  # noqa: S102
+    return scope["e0"], scope["f0"]
 
 
 # -- loop bodies ----------------------------------------------------------------------------------------
