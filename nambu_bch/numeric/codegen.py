@@ -409,6 +409,16 @@ def pair_lines(u, e, f, value, prefix="_", style="python"):
                 f"if ({a} <= {SERIES_LIMIT!r}) {{ {body} }}",
                 f"else {{ {e} = expm1({a}); {f} = -{e} / (1.0 + {e}); }}",
                 f"if ({u} < 0) {{ double w_ = {e}; {e} = {f}; {f} = w_; }}"]
+    if style == "cselect":  # the C twin of "select"
+        body = " ".join(("" if line.startswith((e + " ", f + " ")) else "double ") + line + ";" for line in series)
+        w = f"_w{u}"
+        return [f"double {u} = {value};", f"double {a} = fabs({u});", f"over += {a} <= {SERIES_LIMIT!r} ? 0 : 1;",
+                f"double {e}, {f}; {body}",
+                f"double {w} = {e}; {e} = {u} < 0 ? {f} : {e}; {f} = {u} < 0 ? {w} : {f};"]
+    if style == "select":  # branch-free (vectorisable): the series for every state, ``over`` counts |u| beyond it
+        w = f"_w{u}"
+        return [f"{u} = {value}", f"{a} = abs({u})", f"over += 0 if {a} <= {SERIES_LIMIT!r} else 1", *series,
+                f"{w} = {e}", f"{e} = {f} if {u} < 0 else {e}", f"{f} = {w} if {u} < 0 else {f}"]
     if style == "numpy":
         big = f"_big{u}"
         return [f"{u} = {value}", f"{a} = np.abs({u})", *series, f"{big} = ~({a} <= {SERIES_LIMIT!r})",
@@ -434,19 +444,20 @@ def expm1_pair(u: float) -> tuple:
 # -- loop bodies ----------------------------------------------------------------------------------------
 
 
-def body_lines(program: StepProgram, printer, kahan=False, c_syntax=False, vector=False, prefix="_"):
+def body_lines(program: StepProgram, printer, kahan=False, c_syntax=False, vector=False, prefix="_", select=False):
     """Statements of one step, ``s_i`` / ``k_j`` / ``d_j`` / ``c_i`` named as in the generated kernels.
 
     ``vector``: numpy arrays (the shared-exponential swap is a ``np.where``); ``prefix``: of the
-    function names (``_``, ``_np_``, ``_mp_``); ``c_syntax``: C99.
+    function names (``_``, ``_np_``, ``_mp_``); ``c_syntax``: C99; ``select``: shared exponentials
+    without branches (:func:`pair_lines` style ``"select"``, for the vectorised batch loop).
     """
     end = ";" if c_syntax else ""
     decl = "double " if c_syntax else ""
     lines = []
     for u in program.updates:
         for us, es, fs, ue in u.pairs:
-            lines += pair_lines(str(us), str(es), str(fs), printer(ue), prefix,
-                                "c" if c_syntax else "numpy" if vector else "python")
+            style = ("cselect" if select else "c") if c_syntax else "numpy" if vector else "select" if select else "python"
+            lines += pair_lines(str(us), str(es), str(fs), printer(ue), prefix, style)
         names = []
         for j, (i, d) in enumerate(u.increments):
             lines.append(f"{decl}d{j} = {printer(d)}{end}")
@@ -458,16 +469,16 @@ def body_lines(program: StepProgram, printer, kahan=False, c_syntax=False, vecto
             else:
                 lines.append(f"s{i} += {d}{end}")
     if c_syntax:  # C declares each temporary once per scope: one brace block per update
-        return _c_scoped(program, lines, kahan)
+        return _c_scoped(program, lines, kahan, "cselect" if select else "c")
     return lines
 
 
-def _c_scoped(program, lines, kahan):
+def _c_scoped(program, lines, kahan, style="c"):
     out = []
     it = iter(lines)
     for u in program.updates:
         n = len(u.increments)
-        count = len(pair_lines("u", "e", "f", "0", style="c")) * len(u.pairs) + n + n * (4 if kahan else 1)
+        count = len(pair_lines("u", "e", "f", "0", style=style)) * len(u.pairs) + n + n * (4 if kahan else 1)
         block = [next(it) for _ in range(count)]
         out.append("{ " + " ".join(block) + " }")
     return out
@@ -575,9 +586,10 @@ def {name}({args}):
         # the chunk's rows in one buffer, each row 64-byte aligned: an allocation only 16- or 32-byte aligned
         # splits every 8-wide (AVX-512) load across two cache lines, measured 1.8x slower
         rows = [f"S{i}" for i in range(N)] + ([f"Q{i}" for i in range(N)] if kahan else [])
-        alloc = ["W = (chunk + 7) // 8 * 8", f"buf = np.empty({len(rows)} * W + 8)",
+        spare = [f"R{q}" for q in range(len(rows))] if any(u.pairs for u in program.updates) else []
+        alloc = ["W = (chunk + 7) // 8 * 8", f"buf = np.empty({len(rows) + len(spare)} * W + 8)",
                  "off = (8 - (buf.ctypes.data // 8) % 8) % 8"]
-        alloc += [f"{r} = buf[off + {q} * W:off + {q} * W + chunk]" for q, r in enumerate(rows)]
+        alloc += [f"{r} = buf[off + {q} * W:off + {q} * W + chunk]" for q, r in enumerate(rows + spare)]
         # whole-row slice copies (numba compiles them to tight vector loops; element loops over the
         # three rows at once measured 3-4x slower on these memory passes)
         gather = [f"S{i}[:nb] = X[{i}, b0:b0 + nb]" for i in range(N)] + ([f"Q{i}[:nb] = C[{i}, b0:b0 + nb]" for i in range(N)] if kahan else [])
@@ -587,6 +599,17 @@ def {name}({args}):
         inner_load = [f"s{i} = S{i}[b]" for i in range(N)] + ([f"c{i} = Q{i}[b]" for i in range(N)] if kahan else [])
         inner_store = [f"S{i}[b] = s{i}" for i in range(N)] + ([f"Q{i}[b] = c{i}" for i in range(N)] if kahan else [])
         chunk_step = ["for b in range(nb):", *("    " + line for line in inner_load + body + inner_store)]
+        if any(u.pairs for u in program.updates):
+            # shared exponentials: one branch-free pass over the chunk (vectorised); if some |u| left the
+            # series range, the chunk's step is undone and redone with the library branch -- the same bits
+            # as the branchy loop either way
+            fast = body_lines(program, scalar, kahan, select=True)
+            saved = [f"R{q}[:nb] = {r}[:nb]" for q, r in enumerate(rows)]
+            restore = [f"{r}[:nb] = R{q}[:nb]" for q, r in enumerate(rows)]
+            chunk_step = [*saved, "over = 0", "for b in range(nb):",
+                          *("    " + line for line in inner_load + fast + inner_store),
+                          "if over:", *("    " + line for line in restore),
+                          *("    " + line for line in chunk_step)]
         chunk_sample = []
         for i in range(N):  # the sample, row by row, counting non-finite values as it is written
             chunk_sample += [f"row = out[j, {i}, b0:b0 + nb]", "for b in range(nb):",
@@ -742,7 +765,8 @@ def c_source(program: StepProgram) -> str:
     ``long run(double *x, const double *K, long steps)`` advances one state in place;
     ``void run_batch(double *X, const double *K, long steps, long B, long chunk)``
     advances ``X`` of shape (N, B) (row-major) chunk by chunk, inner loop over the chunk,
-    exactly like the numba batch kernel (without sampling).
+    exactly like the numba batch kernel (without sampling; with shared exponentials, the same
+    branch-free pass and redo).
     """
     N = program.N
     body = body_lines(program, print_c, c_syntax=True)
@@ -754,6 +778,27 @@ def c_source(program: StepProgram) -> str:
     scatter = " ".join(f"X[{i} * B + b0 + b] = S{i}[b];" for i in range(N))
     inner_load = " ".join(f"double s{i} = S{i}[b];" for i in range(N))
     inner_store = " ".join(f"S{i}[b] = s{i};" for i in range(N))
+    step = f"""for (long b = 0; b < nb; ++b) {{
+                {inner_load}
+                {chr(10).join('                ' + b for b in body).strip()}
+                {inner_store}
+            }}"""
+    if any(u.pairs for u in program.updates):  # as the numba batch kernel: branch-free pass, redo when needed
+        fast = body_lines(program, print_c, c_syntax=True, select=True)
+        arrays += " " + " ".join(f"double R{i}[chunk];" for i in range(N))
+        save = " ".join(f"R{i}[b] = S{i}[b];" for i in range(N))
+        restore = " ".join(f"S{i}[b] = R{i}[b];" for i in range(N))
+        step = f"""for (long b = 0; b < nb; ++b) {{ {save} }}
+            long over = 0;
+            for (long b = 0; b < nb; ++b) {{
+                {inner_load}
+                {chr(10).join('                ' + b for b in fast).strip()}
+                {inner_store}
+            }}
+            if (over) {{
+            for (long b = 0; b < nb; ++b) {{ {restore} }}
+            {step}
+            }}"""
     return f"""/* Generated by nambu_bch.numeric.codegen (template {TEMPLATE_VERSION}) */
 #include <math.h>
 
@@ -774,11 +819,7 @@ void run_batch(double *restrict X, const double *restrict K, long steps, long B,
         long nb = chunk < B - b0 ? chunk : B - b0;
         for (long b = 0; b < nb; ++b) {{ {gather} }}
         for (long n = 0; n < steps; ++n) {{
-            for (long b = 0; b < nb; ++b) {{
-                {inner_load}
-                {chr(10).join('                ' + b for b in body).strip()}
-                {inner_store}
-            }}
+            {step}
         }}
         for (long b = 0; b < nb; ++b) {{ {scatter} }}
     }}
