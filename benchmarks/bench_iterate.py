@@ -1,10 +1,12 @@
 """Speed of nambu_bch.numeric.iterate against a C reference loop, measured in one run.
 
 Prints nanoseconds per trajectory-step (best of --repeats, both sides warm: compiled and loaded
-before timing) for
+before timing; the contenders are called in turn in every round, so a change of load on a shared
+machine hits them alike, and the load average is printed with the numbers) for
   C (gcc -O3 -march=native, the strongest build; generated from the same step program)
                                                      -- single trajectory and batch,
   C (gcc -O2, for context)                           -- single trajectory and batch,
+  C with one exp per piece (hand-written; Lotka-Volterra only) -- single trajectory,
   our numba kernel                                   -- single trajectory and batch (--batch states),
   our numpy fallback                                 -- batch (vectorised) and single (scalar Python loop),
   a plain Python loop over nambu_bch.integrators.step_function,
@@ -48,6 +50,18 @@ def best(fn, repeats):
         fn()
         times.append(time.perf_counter() - start)
     return min(times)
+
+
+def alternate(work, repeats):
+    """Seconds per trajectory-step of each ``{name: (fn, steps per call)}``: the best of ``repeats`` calls,
+    the contenders called in turn in every round, so a change of load hits them all alike."""
+    times = {name: [] for name in work}
+    for _ in range(repeats):
+        for name, (fn, _) in work.items():
+            start = time.perf_counter()
+            fn()
+            times[name].append(time.perf_counter() - start)
+    return {name: min(times[name]) / steps for name, (_, steps) in work.items()}
 
 
 COMPILE_SNIPPET = """
@@ -127,7 +141,9 @@ def main(argv=None):
         print(f"first iterate() of a process, 100 steps: empty cache {cold['first_iterate']:.3f} s, "
               f"kernel cached {warm['first_iterate']:.3f} s (target < 0.05 s; cached source used: {warm['from_cache']})")
 
-    # -- C reference ---------------------------------------------------------------------------------------
+    # -- the contenders: (callable, trajectory-steps per call); all warmed up, then timed alternately ------------
+    work = {}
+    batch_work = args.batch_steps * args.batch
     cref = None
     try:
         from bench_iterate_c import CReference, c_compiler
@@ -136,87 +152,72 @@ def main(argv=None):
             cref = CReference(k.program, flags=("-O3", "-march=native"))
     except Exception as exc:  # no compiler, or compilation failed: report and go on
         print(f"(no C reference: {exc})")
+    finals, closers = {}, []
     if cref is not None:
-        x = x0.copy()
-        X = X0.copy()
+        closers.append(cref)
+        x, X = x0.copy(), X0.copy()
 
         def c_single():
             x[:] = x0
             cref.run(x, K, args.steps)
 
-        def c_batch():
+        def c_batch():  # the C loop advances X in place: a fresh copy of the start states each call (counted)
             np.copyto(X, X0)
             cref.run_batch(X, K, args.batch_steps, NUMBA_CHUNK)
 
-        c_single(), c_batch()  # warm
-        results["c_single"] = best(c_single, args.repeats) / args.steps
-        results["c_batch"] = best(c_batch, args.repeats) / (args.batch_steps * args.batch)
-        c_final, c_batch_final = x.copy(), X.copy()
+        c_single(), c_batch()
+        finals["c_single"], finals["c_batch"] = x.copy(), X.copy()
+        work["c_single"] = (c_single, args.steps)
+        work["c_batch"] = (c_batch, batch_work)
         try:  # the plain -O2 build, for context
             o2 = CReference(k.program, flags=("-O2",))
-            results["c_o2_single"] = best(lambda: o2.run(x0.copy(), K, args.steps), args.repeats) / args.steps
-            results["c_o2_batch"] = best(lambda: o2.run_batch(X0.copy(), K, args.batch_steps, NUMBA_CHUNK),
-                                         args.repeats) / (args.batch_steps * args.batch)
-            o2.close()
+            closers.append(o2)
+            work["c_o2_single"] = (lambda: o2.run(x0.copy(), K, args.steps), args.steps)
+            work["c_o2_batch"] = (lambda: o2.run_batch(X0.copy(), K, args.batch_steps, NUMBA_CHUNK), batch_work)
         except Exception as exc:  # pragma: no cover - depends on the compiler
             print(f"(no -O2 build: {exc})")
 
-    # -- Lotka-Volterra: the hand-written one-exp-per-piece C loop (issue 14's reference) --------------------
+    # Lotka-Volterra: the hand-written one-exp-per-piece C loop (issue 14's reference)
     if cref is not None and system.name == "lotka-volterra":
         from bench_iterate_c import CSource, lotka_volterra_one_exp_source
 
         factors = k.composition.factors()
         lv = CSource(lotka_volterra_one_exp_source(factors))
+        closers.append(lv)
         KL = np.array([float(c) * args.h for _, c in factors])
         xl = x0.copy()
-        lv.run(xl, KL, 10)
-        results["c_one_exp_single"] = best(lambda: lv.run(x0.copy(), KL, args.steps), args.repeats) / args.steps
-        xl = x0.copy()
         lv.run(xl, KL, args.steps)
-        lv_final = xl
-        lv.close()
+        finals["c_one_exp_single"] = xl
+        work["c_one_exp_single"] = (lambda: lv.run(x0.copy(), KL, args.steps), args.steps)
 
-    # -- numba -------------------------------------------------------------------------------------------------
+    holder = {}
     if numba_available():
         iterate(system, args.word, args.h, 10, x0)            # compile / load outside the timing
         iterate(system, args.word, args.h, 10, X0[:, :10])
-        holder = {}
-        results["numba_single"] = best(lambda: holder.__setitem__(
-            "x", iterate(system, args.word, args.h, args.steps, x0, every=args.steps)), args.repeats) / args.steps
-        results["numba_batch"] = best(lambda: holder.__setitem__(
-            "X", iterate(system, args.word, args.h, args.batch_steps, X0, every=args.batch_steps)),
-            args.repeats) / (args.batch_steps * args.batch)
+        work["numba_single"] = (lambda: holder.__setitem__(
+            "x", iterate(system, args.word, args.h, args.steps, x0, every=args.steps)), args.steps)
+        work["numba_batch"] = (lambda: holder.__setitem__(
+            "X", iterate(system, args.word, args.h, args.batch_steps, X0, every=args.batch_steps)), batch_work)
         out = np.empty((2, N, args.batch))
-        X = X0.copy()
+        Xk = X0.copy()
 
-        def kernel_batch():
-            np.copyto(X, X0)
-            k.run_batch(X, K, args.batch_steps, args.batch_steps, out)
+        def kernel_batch():  # like the C loop: a fresh copy of the start states, advanced in place
+            np.copyto(Xk, X0)
+            k.run_batch(Xk, K, args.batch_steps, args.batch_steps, out)
 
-        results["numba_batch_kernel"] = best(kernel_batch, args.repeats) / (args.batch_steps * args.batch)
-        if cref is not None:
-            same_single = np.array_equal(holder["x"][-1], c_final)
-            same_batch = np.array_equal(holder["X"][-1], c_batch_final)
-            print(f"numba == C bit for bit: single {same_single}, batch {same_batch}")
-        if "c_one_exp_single" in results:
-            rel = float(np.max(np.abs(holder["x"][-1] - lv_final) / np.abs(lv_final)))
-            print(f"numba vs the one-exp C loop after {args.steps} steps: max relative difference {rel:.1e} (rounding)")
+        work["numba_batch_kernel"] = (kernel_batch, batch_work)
 
-    # -- numpy fallback and plain Python ----------------------------------------------------------------------
-    results["numpy_batch"] = best(lambda: iterate(system, args.word, args.h, args.numpy_steps, X0,
-                                                  every=args.numpy_steps, backend="numpy"),
-                                  args.repeats) / (args.numpy_steps * args.batch)
-    X = X0.copy()
-    out = np.empty((2, N, args.batch))
+    work["numpy_batch"] = (lambda: iterate(system, args.word, args.h, args.numpy_steps, X0, every=args.numpy_steps,
+                                           backend="numpy"), args.numpy_steps * args.batch)
+    Xn, outn = X0.copy(), np.empty((2, N, args.batch))
 
     def numpy_kernel():
-        np.copyto(X, X0)
-        k.run_batch(X, K, args.numpy_steps, args.numpy_steps, out, backend="numpy")
+        np.copyto(Xn, X0)
+        k.run_batch(Xn, K, args.numpy_steps, args.numpy_steps, outn, backend="numpy")
 
-    results["numpy_batch_kernel"] = best(numpy_kernel, args.repeats) / (args.numpy_steps * args.batch)
-    results["numpy_single_python"] = best(lambda: iterate(system, args.word, args.h, args.python_steps, x0,
-                                                          every=args.python_steps, backend="numpy"),
-                                          max(1, args.repeats // 2)) / args.python_steps
+    work["numpy_batch_kernel"] = (numpy_kernel, args.numpy_steps * args.batch)
+    work["numpy_single_python"] = (lambda: iterate(system, args.word, args.h, args.python_steps, x0,
+                                                   every=args.python_steps, backend="numpy"), args.python_steps)
     step = step_function(system.splitting, args.word)
 
     def plain():
@@ -224,10 +225,25 @@ def main(argv=None):
         for _ in range(args.python_steps // 4):
             x = step(x, args.h)
 
-    results["plain_python_loop"] = best(plain, max(1, args.repeats // 2)) / (args.python_steps // 4)
+    work["plain_python_loop"] = (plain, args.python_steps // 4)
+    for fn, _ in work.values():  # warm: compiled, loaded, caches touched
+        fn()
+    load_before = os.getloadavg()
+    results.update(alternate(work, args.repeats))
+    results["load_average"] = [round(v, 2) for v in load_before + os.getloadavg()]
+    print(f"load average (1, 5, 15 min) before {load_before[0]:.2f} {load_before[1]:.2f} {load_before[2]:.2f}, "
+          f"after {results['load_average'][3]:.2f} on {os.cpu_count()} CPUs (best of {args.repeats}, run alternately)")
+    if "numba_single" in work and "c_single" in finals:
+        same_single = np.array_equal(holder["x"][-1], finals["c_single"])
+        same_batch = np.array_equal(holder["X"][-1], finals["c_batch"])
+        print(f"numba == C bit for bit: single {same_single}, batch {same_batch}")
+    if "numba_single" in work and "c_one_exp_single" in finals:
+        ref = finals["c_one_exp_single"]
+        rel = float(np.max(np.abs(holder["x"][-1] - ref) / np.abs(ref)))
+        print(f"numba vs the one-exp C loop after {args.steps} steps: max relative difference {rel:.1e} (rounding)")
 
     # -- report --------------------------------------------------------------------------------------------------
-    ns = {key: v * 1e9 for key, v in results.items() if not key.startswith(("compile", "first"))}
+    ns = {key: v * 1e9 for key, v in results.items() if not key.startswith(("compile", "first", "load"))}
     labels = {
         "c_single": "C -O3 -march=native, single trajectory",
         "c_batch": f"C -O3 -march=native, batch of {args.batch:.0e}",
@@ -258,9 +274,9 @@ def main(argv=None):
             print(f"  {labels[a]:44s} / {labels[b]:36s}: {r:7.2f}{verdict}")
     if args.json:
         print(json.dumps({"system": system.name, "word": args.word, "ns_per_step": ns,
-                          **{k2: v for k2, v in results.items() if k2.startswith(("compile", "first"))}}))
-    if cref is not None:
-        cref.close()
+                          **{k2: v for k2, v in results.items() if k2.startswith(("compile", "first", "load"))}}))
+    for c in closers:
+        c.close()
 
 
 if __name__ == "__main__":

@@ -64,8 +64,10 @@ def _exact_verlet(steps, h, x):
 
 # -- item 5: no user text in generated source --------------------------------------------------------------
 
-_INTERNAL = re.compile(r"(?:[skpcdytSQ]\d+|_[A-Za-z_0-9]*|a|abs|max|big|prod|small|nonfinite|subnormal|res|i|c|x|X|K|P|C|h|n|j|m|b|b0|b1|B|nb|chunk|steps|every|out|"
-                       r"math|np|range|min|constants|run\w*|progress)")
+_INTERNAL = re.compile(r"(?:[skpcdytSQRefu]\d+|_[A-Za-z_0-9]*|a|abs|max|big|prod|small|nonfinite|subnormal|res|i|c|x|X|K|P|C|h|n|j|m|b|b0|b1|B|nb|chunk|steps|every|out|"
+                       r"math|np|range|min|constants|run\w*|progress|"
+                       # the batch loops' flags and the compiled scan's block reductions (issue 14)
+                       r"start|back|bad|buf|off|over|v\d*|N|W|row|g|nf|sb|top|I[bps]|i?[bps]m(?:ax|in)|m\d)")
 
 
 def _identifiers(source):
@@ -88,6 +90,12 @@ def test_generated_source_uses_internal_names_only(fresh_cache):
     # the run is still right: kk = 1 is the harmonic oscillator, position Verlet in exact rationals
     x = iterate(system, "121", 0.125, 40, [1.0, 0.5], params={"kk_marker": 1.0})[-1]
     assert np.allclose(x, _exact_verlet(40, Fraction(1, 8), (1, Fraction(1, 2))), rtol=0, atol=1e-14)
+    # an exponential flow too (shared pairs, the vectorised batch step and its redo): internal names only
+    a, b, c = sympy.symbols("aa_marker bb_marker cc_marker")
+    lv = nambu_bch.System([a, b, c], [a + b + c, a * b * c], name="lv_marker", split="single")
+    names, strings = _identifiers(K.kernel(lv, "12321").source)
+    assert all(_INTERNAL.fullmatch(n) for n in names), sorted(n for n in names if not _INTERNAL.fullmatch(n))
+    assert len(strings) == 1 and "marker" not in strings[0]
 
 
 def test_hostile_name_and_word_execute_nothing(fresh_cache, tmp_path):

@@ -115,7 +115,10 @@ def test_exponential_flows_use_expm1():
     assert all("expm1" in str(d) for u in prog.updates for _, d in u.expanded())
     # one expm1 per sub-flow: each Lotka-Volterra piece scales one coordinate by e^u, another by e^-u
     assert all(len(u.pairs) == 1 and len(u.increments) == 2 for u in prog.updates)
-    assert python_source(prog).count("_expm1(abs(") == 4 * len(prog.updates)  # run, run_batch and their Kahan forms
+    # run, run_batch and their Kahan forms: one library call per sub-flow, only above the series range
+    src = python_source(prog)
+    assert src.count("    e0 = _expm1(_au0)") == 4 and src.count("= _expm1(") == 4 * len(prog.updates)
+    assert src.count("_np_expm1(") == 2 * len(prog.updates)        # run_numpy and its Kahan form
 
 
 def test_shared_exponential_is_accurate_for_both_signs():
@@ -136,6 +139,117 @@ def test_shared_exponential_is_accurate_for_both_signs():
                 for got, want in ((a, mpmath.expm1(x)), (b, mpmath.expm1(-x))):
                     worst = max(worst, float(abs((mpmath.mpf(got) - want) / want)))
     assert worst < 4 * 2.0**-52, worst
+
+
+def test_series_pair_is_accurate():
+    """The shared pair of the generated kernels (codegen.pair_lines, evaluated by expm1_pair): for
+    |u| <= SERIES_LIMIT the series of cosh - 1 and sinh give expm1(|u|) within 1.5 ulp of mpmath at
+    40 digits (measured 1.11), and the Newton-corrected f = -e/(1+e) gives expm1(-|u|) within 2 ulp
+    (measured 1.35; libm's expm1 with -e/fl(1+e): 0.82 and 2.25); beyond it libm's expm1 and
+    -e/(1+e) stay within 4 * 2^-52 relative, up to |u| = 700."""
+    import math
+
+    import mpmath
+
+    from nambu_bch.numeric.codegen import SERIES_LIMIT, expm1_pair
+
+    rng = np.random.default_rng(7)
+    small = np.concatenate([rng.uniform(0, SERIES_LIMIT, 3000), 10.0 ** rng.uniform(-300, np.log10(SERIES_LIMIT), 1000),
+                            [SERIES_LIMIT, np.nextafter(SERIES_LIMIT, 0), 5e-324, 2.0**-26, 2.0**-27]])
+    large = np.concatenate([rng.uniform(SERIES_LIMIT, 5, 300), [np.nextafter(SERIES_LIMIT, 1), 40.0, 700.0]])
+    worst_ulp, worst_rel = [0.0, 0.0], 0.0
+    with mpmath.workdps(40):
+        for values, series in ((small, True), (large, False)):
+            for u in values:
+                for x in (float(u), -float(u)):
+                    got = expm1_pair(x)
+                    for g, want in zip(got, (mpmath.expm1(x), mpmath.expm1(-x))):
+                        if want == 0:
+                            assert g == 0
+                            continue
+                        err = abs(mpmath.mpf(g) - want)
+                        if series:
+                            which = 0 if want > 0 else 1
+                            worst_ulp[which] = max(worst_ulp[which], float(err / math.ulp(float(want))))
+                        else:
+                            worst_rel = max(worst_rel, float(err / abs(want)))
+    assert worst_ulp[0] <= 1.5 and worst_ulp[1] <= 2.0 and worst_rel < 4 * 2.0**-52, (worst_ulp, worst_rel)
+
+
+@numba_only
+def test_exponential_flows_agree_bitwise_in_the_series_range(tmp_path):
+    """Lotka-Volterra with |u| <= SERIES_LIMIT: numba, the numpy batch, the scalar Python loop and
+    the generated C give the same bits (the shared pair is plain arithmetic, no library call); the
+    numba and C batch loops agree bit for bit also when some |u| leaves the series range."""
+    import ctypes
+    import shutil
+    import subprocess
+
+    X = np.array([[0.9, 1.1, 1.0], [1.2, 0.7, 1.3], [0.5, 2.0, 1.5]]).T
+    a = iterate("lotka-volterra", "12321", 0.05, 3000, X, every=1000, backend="numba")
+    b = iterate("lotka-volterra", "12321", 0.05, 3000, X, every=1000, backend="numpy")
+    c = iterate("lotka-volterra", "12321", 0.05, 3000, X[:, 1], every=1000, backend="numpy")
+    assert np.array_equal(a, b) and np.array_equal(a[:, :, 1], c)
+    assert np.abs(a).max() < 0.5 / 0.05                      # every |u| = c h x stayed in the series range
+    cc = shutil.which("gcc") or shutil.which("cc")
+    if cc is None:
+        return
+    k = kernel(model("lotka-volterra"), "12321")
+    (tmp_path / "step.c").write_text(c_source(k.program))
+    subprocess.run([cc, "-O2", "-std=c99", "-shared", "-fPIC", "-o", str(tmp_path / "step.so"), str(tmp_path / "step.c"),
+                    "-lm"], check=True, capture_output=True)
+    lib = ctypes.CDLL(str(tmp_path / "step.so"))
+    dp = ctypes.POINTER(ctypes.c_double)
+    lib.run.argtypes = [dp, dp, ctypes.c_long]
+    x = X[:, 1].copy()
+    lib.run(x.ctypes.data_as(dp), k.constants(0.05).ctypes.data_as(dp), 3000)
+    assert np.array_equal(x, a[-1, :, 1])
+    # the batch loops (branch-free pass, redo of a chunk whose |u| left the series range) at h = 0.4
+    lib.run_batch.argtypes = [dp, dp, ctypes.c_long, ctypes.c_long, ctypes.c_long]
+    Y = np.random.default_rng(4).uniform(0.2, 2.0, size=(3, 700))
+    Z = Y.copy()
+    lib.run_batch(Z.ctypes.data_as(dp), k.constants(0.4).ctypes.data_as(dp), 30, Z.shape[1], 256)
+    b = iterate("lotka-volterra", "12321", 0.4, 30, Y, every=30, backend="numba")
+    assert np.array_equal(Z, b[-1]) and 0.4 * np.abs(b).max() > 0.5
+
+
+@numba_only
+def test_lotka_volterra_pieces_keep_G_like_the_library_pair():
+    """Each piece X_{x_i, G} of the cyclic Lotka-Volterra splitting keeps G = x1 x2 x3 exactly (it scales
+    x_{i+1} by e^-u and x_{i+2} by e^u); in float64 G drifts by round-off only.  The shared pair's f is
+    -e/(1+e) rounded once (the Newton step of codegen.pair_lines), so (1+e)(1+f) = 1 to half an ulp of
+    f and after 2e6 steps (h = 0.1) G has drifted 9.9e-14.  Measured with C loops against long double
+    on the same orbit: libm's expm1 with -e/fl(1+e) 1.5e-13, the series e with -e/fl(1+e) 3.1e-13,
+    an f from its own series 1.3e-12; the bound separates the last two from the first."""
+    x = iterate("lotka-volterra", "12321", 0.1, 2_000_000, [0.7, 0.7, 0.7], every=2_000_000)
+    G = x.prod(axis=1)
+    assert abs(G[-1] / G[0] - 1) < 2e-13
+
+
+def test_exponential_flows_mix_series_and_library_ranges():
+    """h = 0.4 on Lotka-Volterra: |u| = c h x falls on both sides of SERIES_LIMIT within one run, so the
+    numpy batch takes its masked library branch.  numba and the scalar Python loop (both libm's expm1)
+    agree bit for bit; the numpy batch uses numpy's expm1, which differs from libm's in the last bit
+    for ~10% of arguments: equal after one step, within 1e-12 after 50 (measured 2e-14).  Every piece
+    X_{x_i, G} keeps G = x1 x2 x3 (it scales x_{i+1} by e^-u and x_{i+2} by e^u): conserved to round-off."""
+    from nambu_bch.numeric.codegen import SERIES_LIMIT
+
+    X = np.array([[0.9, 1.1, 1.0], [2.5, 0.4, 3.0], [0.2, 4.0, 0.6]]).T
+    for steps in (1, 50):
+        b = iterate("lotka-volterra", "12321", 0.4, steps, X, every=10, backend="numpy")
+        c = np.stack([iterate("lotka-volterra", "12321", 0.4, steps, X[:, i], every=10, backend="numpy")
+                      for i in range(3)], axis=-1)
+        assert np.allclose(b, c, rtol=1e-12 if steps > 1 else 0, atol=0)
+        if numba_available():
+            assert np.array_equal(iterate("lotka-volterra", "12321", 0.4, steps, X, every=10, backend="numba"), c)
+    u = 0.4 * np.abs(c)                                      # |u| of the full-step piece (coefficient 1)
+    assert u.max() > SERIES_LIMIT and u.min() < SERIES_LIMIT
+    if numba_available():  # the vectorised batch step redoes a chunk whose |u| left the series range: same bits
+        kb = iterate("lotka-volterra", "12321", 0.4, 50, X, every=10, kahan=True, backend="numba")
+        ks = np.stack([iterate("lotka-volterra", "12321", 0.4, 50, X[:, i], every=10, kahan=True, backend="numpy")
+                       for i in range(3)], axis=-1)
+        assert np.array_equal(kb, ks)
+    assert np.abs(c.prod(axis=1) / X.prod(axis=0) - 1).max() < 1e-13
 
 
 def test_generated_c_loop_gives_the_same_bits(tmp_path):
@@ -377,3 +491,107 @@ def test_user_symbols_named_like_generated_ones():
     for _ in range(400):
         y = step(y, 0.1)
     assert np.allclose(x, y, rtol=1e-12, atol=1e-12)
+
+
+# -- issue 14: the batch path reads x0 in place, fuses the sample-0 copy and the result check ------------------
+
+
+@pytest.mark.parametrize("backend", [pytest.param("numba", marks=numba_only), "numpy"])
+def test_batch_reads_x0_in_place_and_leaves_it_unchanged(backend):
+    """The batch kernels read the caller's x0 (no copy) and never write it; x0 in any layout, dtype or
+    read-only gives the same bits, and every column equals its own single-trajectory run."""
+    from nambu_bch.numeric.iterate import SCAN_BATCH
+
+    rng = np.random.default_rng(14)
+    X = rng.normal(size=(3, SCAN_BATCH + 77))           # above SCAN_BATCH: the one-pass scan guards it
+    keep = X.copy()
+    a = iterate("ho3", "32123", 0.1, 40, X, every=7, backend=backend)
+    assert np.array_equal(X, keep) and np.array_equal(a[0], X)
+    frozen = X.copy()
+    frozen.flags.writeable = False
+    for variant in (np.asfortranarray(X), frozen, X.tolist()):
+        assert np.array_equal(iterate("ho3", "32123", 0.1, 40, variant, every=7, backend=backend), a)
+    ints = np.arange(3 * 9).reshape(3, 9) % 4 - 1          # int64: converted, same as its float64 copy
+    assert np.array_equal(iterate("ho3", "32123", 0.1, 40, ints, every=7, backend=backend),
+                          iterate("ho3", "32123", 0.1, 40, ints.astype(float), every=7, backend=backend))
+    for b in (0, 1234, X.shape[1] - 1):
+        assert np.array_equal(a[:, :, b], iterate("ho3", "32123", 0.1, 40, X[:, b], every=7, backend=backend))
+    assert np.array_equal(iterate("ho3", "32123", 0.1, 0, X, backend=backend), X[None])   # steps = 0: x0 only
+
+
+def test_segmented_kahan_batch_carries_the_compensation(monkeypatch, capsys):
+    """A Kahan batch cut into progress segments (each starting from the last sample written, the
+    compensation carried in place) gives the bits of the uncut run and of each state's own run."""
+    import importlib
+
+    X = np.random.default_rng(2).normal(size=(3, 40))
+    whole = iterate("ho3", "32123", 0.01, 700, X, every=70, kahan=True)
+    monkeypatch.setattr(importlib.import_module("nambu_bch.numeric.iterate"), "_SEGMENT_WORK", 5000)
+    cut = iterate("ho3", "32123", 0.01, 700, X, every=70, kahan=True, progress=True)
+    assert np.array_equal(whole, cut)
+    assert np.array_equal(whole[:, :, 7], iterate("ho3", "32123", 0.01, 700, X[:, 7], every=70, kahan=True))
+    capsys.readouterr()
+
+
+@pytest.mark.parametrize("backend", [pytest.param("numba", marks=numba_only), "numpy"])
+def test_batch_kernel_counts_non_finite_samples(backend):
+    """Kernel.run_batch returns 0 for a finite run and a positive count when a sample overflows; with
+    back=False the start states are only read, with start=True they are copied to out[0]."""
+    k = kernel(model("ho"), "TVT")
+    K = k.constants(2.5)                                   # omega h = 2.5: grows like 4^n
+    X = np.array([[1.0, 1e300, 0.5], [0.0, 0.0, 0.25]])
+    keep = X.copy()
+    out = np.full((3, 2, 3), -7.0)
+    assert k.run_batch(X, K, 2, 1, out, backend=backend, start=True, back=False) == 0
+    assert np.array_equal(X, keep) and np.array_equal(out[0], X) and np.all(np.isfinite(out))
+    out = np.empty((3, 2, 3))
+    with np.errstate(all="ignore"):
+        assert k.run_batch(X, K, 300, 150, out, backend=backend, start=True, back=False) > 0
+    assert np.array_equal(X, keep)
+    Y = X[:, [0, 2]].copy()
+    assert k.run_batch(Y, K, 2, 2, np.empty((2, 2, 2)), backend=backend) == 0 and not np.array_equal(Y, keep[:, [0, 2]])
+
+
+@pytest.mark.parametrize("segment_work", [None, 3000])
+def test_batch_overflow_names_the_same_steps_as_the_single_run(monkeypatch, segment_work):
+    """A batch whose one large state overflows mid-run raises the message of that state's own run (the
+    first non-finite sample), also when the run is cut into progress segments."""
+    import importlib
+
+    from nambu_bch.numeric.iterate import SCAN_BATCH
+
+    X = np.ones((2, SCAN_BATCH + 10))
+    X[:, 3000] = [1e200, 0.0]
+    with pytest.raises(NumericalRangeError, match="between steps") as single:
+        iterate("ho", "TVT", 2.5, 2000, X[:, 3000], every=40, check_stable=False)
+    if segment_work:
+        monkeypatch.setattr(importlib.import_module("nambu_bch.numeric.iterate"), "_SEGMENT_WORK", segment_work)
+    with pytest.raises(NumericalRangeError, match="between steps") as batch:
+        iterate("ho", "TVT", 2.5, 2000, X, every=40, check_stable=False, progress=bool(segment_work))
+    assert str(batch.value) == str(single.value)
+
+
+def test_scan_states_finds_the_extreme_states_across_blocks():
+    """guards.scan_states (numpy blocks) and the compiled Kernel.scan against the definition written
+    out on whole arrays: first state of largest / smallest max-norm and product, smallest non-zero."""
+    from nambu_bch.numeric.guards import scan_states
+
+    rng = np.random.default_rng(5)
+    X = rng.uniform(0.5, 1.5, size=(3, 5000)) * 10.0 ** rng.integers(-60, 60, size=(3, 5000))
+    X[:, 4000] = X[:, 17]                                   # ties: the first one counts
+    X[1, 2500] = 0.0
+    X[:, 99] = 0.0
+    A = np.abs(X)
+    small = np.where(A > 0, A, np.inf).min(axis=0)
+    prod = A[0] * A[1] * A[2]
+    want = {int(A.max(0).argmax()), int(A.max(0).argmin()), int(prod.argmax()), int(prod.argmin()),
+            int(small.argmin()), 0, X.shape[1] - 1}
+    for block in (7, 1024, 8192):
+        bad, sub, cols = scan_states(X, block)
+        assert (bad, sub) == (0, 0) and set(cols.tolist()) == want
+    if numba_available():
+        bad, sub, cols = kernel(model("ho3"), "32123").scan(X)
+        assert (bad, sub) == (0, 0) and set(cols.tolist()) == want
+    Y = X.copy()
+    Y[0, 10], Y[2, 4999] = np.nan, 1e-310
+    assert scan_states(Y, 64)[:2] == (1, 1)

@@ -16,8 +16,9 @@ are turned into a :class:`StepProgram`:
 The program is then printed with sympy's code printers -- Python for numba and
 the pure-Python / numpy / mpmath fallbacks, C (``ccode``) for the reference loop
 of ``benchmarks/bench_iterate.py``.  Every printer emits the same operations in
-the same order, so the backends agree bit for bit on polynomial flows (on
-``exp`` flows up to the last bits of the libraries' ``expm1``).
+the same order, so the backends agree bit for bit on polynomial flows, and on
+``exp`` flows while the shared exponentials stay in the range of their series
+(:func:`pair_lines`); beyond it up to the last bits of the libraries' ``expm1``.
 
 Operator order: the updates run in word order, left to right, exactly as the
 sub-flows act on a state (:mod:`nambu_bch.integrators.composition`).
@@ -38,8 +39,11 @@ Horikoshi, Sect. 5.5 (numerical results) and Eqs. (hX1e)-(hX3e), (12321).
 from __future__ import annotations
 
 import hashlib
+import math
 from dataclasses import dataclass
+from fractions import Fraction
 from functools import lru_cache
+from math import factorial
 
 import sympy
 from sympy.codegen.cfunctions import expm1
@@ -54,7 +58,7 @@ from ..integrators.flows import TIME, exact_flow
 STEP = sympy.Symbol("h")
 
 #: Bump when the generated source changes meaning (part of the cache key).
-TEMPLATE_VERSION = "3"
+TEMPLATE_VERSION = "4"
 
 _FUNCTIONS = ("exp", "expm1", "log", "sin", "cos", "tan", "sinh", "cosh", "tanh", "sqrt", "atan", "asin", "acos")
 
@@ -346,30 +350,114 @@ def print_c(expr) -> str:
     return _CPrinter().doprint(expr)
 
 
+# -- shared exponentials ---------------------------------------------------------------------------------
+
+#: Below this ``|u|`` the ``expm1(|u|)`` of a shared pair comes from the series of ``cosh - 1`` and ``sinh``
+#: (:func:`pair_lines`), above it from the library ``expm1``.
+SERIES_LIMIT = 0.5
+#: ``1/n!`` correctly rounded: ``cosh a - 1 = z (1/2! + z/4! + ... + z^7/16!)``, ``sinh a - a =
+#: a z (1/3! + z/5! + ... + z^6/15!)`` with ``z = a^2``; the first omitted terms are below 2^-60 of
+#: ``a`` for ``a <= SERIES_LIMIT``.
+_COSH_COEFFS = tuple(repr(float(Fraction(1, factorial(n)))) for n in range(2, 17, 2))
+_SINH_COEFFS = tuple(repr(float(Fraction(1, factorial(n)))) for n in range(3, 16, 2))
+
+
+def _estrin(coeffs, z, z2, z4):
+    """``sum_i coeffs[i] z^i`` (degree <= 7) by Estrin's scheme: short dependency chains, same operations everywhere."""
+    pairs = [f"({coeffs[i]} + {coeffs[i + 1]}*{z})" if i + 1 < len(coeffs) else coeffs[i]
+             for i in range(0, len(coeffs), 2)]
+    quads = [f"({pairs[i]} + {z2}*{pairs[i + 1]})" if i + 1 < len(pairs) else pairs[i]
+             for i in range(0, len(pairs), 2)]
+    return f"({quads[0]} + {z4}*{quads[1]})" if len(quads) == 2 else quads[0]
+
+
+def pair_lines(u, e, f, value, prefix="_", style="python"):
+    """Statements setting ``e = expm1(u)`` and ``f = expm1(-u)`` for ``u = value`` (one shared exponential).
+
+    For ``a = |u| <= SERIES_LIMIT``: ``c = cosh a - 1`` and ``r = sinh a - a`` from their Taylor
+    series (Estrin's scheme in ``z = a^2``), ``e = expm1(a) = a + (c + r)`` and ``f0 = (c - r) - a``,
+    then one Newton step ``f = f0 - g (1 + f0)`` on ``g = (1 + e)(1 + f0) - 1 = (e + f0) + e f0``
+    (``e + f0`` is exact: ``e`` and ``-f0`` are within a factor 2, Sterbenz).  No library call and
+    no division: a short dependency chain.  ``e`` is within about 1 ulp of ``expm1(a)`` (the tail
+    ``c + r`` is below 0.27 a, so the last addition dominates) and ``f`` is ``-e/(1 + e)`` rounded
+    once, so ``(1 + e)(1 + f) = 1`` to half an ulp of ``f``: a Lotka-Volterra piece keeps
+    ``G = x1 x2 x3`` (``f0`` alone, as accurate per call, drifted ``G`` 8x more over 2e6 steps;
+    ``-e/fl(1 + e)`` 3x more; ``test_lotka_volterra_pieces_keep_G``).  For larger ``a`` (and NaN):
+    the library ``expm1`` and ``f = -e / (1 + e)`` (``1 + e >= 1``: no cancellation).  Swapped when
+    ``u < 0``.  The mpmath prefix ``_mp_`` keeps the library function at any precision.  ``style``:
+    ``"python"`` (scalar, numba), ``"numpy"`` (arrays), ``"c"`` (C99, the benchmark's reference) --
+    the same IEEE operations in the same order.
+
+    References
+    ----------
+    Estrin's scheme: Knuth, *TAOCP* vol. 2, Sect. 4.6.4; Sterbenz's lemma and Newton's correction:
+    Higham, *Accuracy and Stability of Numerical Algorithms*, 2nd ed., Sects. 2.5 and 5.4.
+    """
+    a, z, z2, z4, c, r, f0, g = (f"_{name}{u}" for name in ("a", "z", "zz", "z4", "ch", "sh", "f", "g"))
+    if prefix == "_mp_":
+        return [f"{u} = {value}", f"{e} = {prefix}expm1(abs({u}))", f"{f} = -{e} / (1.0 + {e})",
+                f"if {u} < 0: {e}, {f} = {f}, {e}"]
+    series = [f"{z} = {a}*{a}", f"{z2} = {z}*{z}", f"{z4} = {z2}*{z2}",
+              f"{c} = {z}*{_estrin(_COSH_COEFFS, z, z2, z4)}",
+              f"{r} = ({a}*{z})*{_estrin(_SINH_COEFFS, z, z2, z4)}",
+              f"{e} = {a} + ({c} + {r})", f"{f0} = ({c} - {r}) - {a}",
+              f"{g} = ({e} + {f0}) + {e}*{f0}", f"{f} = {f0} - {g}*(1.0 + {f0})"]
+    library = [f"{e} = {prefix}expm1({a})", f"{f} = -{e} / (1.0 + {e})"]
+    if style == "c":  # temporaries declared where they are first set; e and f are declared before the branch
+        body = " ".join(("" if line.startswith((e + " ", f + " ")) else "double ") + line + ";" for line in series)
+        return [f"double {u} = {value};", f"double {a} = fabs({u});", f"double {e}, {f};",
+                f"if ({a} <= {SERIES_LIMIT!r}) {{ {body} }}",
+                f"else {{ {e} = expm1({a}); {f} = -{e} / (1.0 + {e}); }}",
+                f"if ({u} < 0) {{ double w_ = {e}; {e} = {f}; {f} = w_; }}"]
+    if style == "cselect":  # the C twin of "select"
+        body = " ".join(("" if line.startswith((e + " ", f + " ")) else "double ") + line + ";" for line in series)
+        w = f"_w{u}"
+        return [f"double {u} = {value};", f"double {a} = fabs({u});", f"over += {a} <= {SERIES_LIMIT!r} ? 0 : 1;",
+                f"double {e}, {f}; {body}",
+                f"double {w} = {e}; {e} = {u} < 0 ? {f} : {e}; {f} = {u} < 0 ? {w} : {f};"]
+    if style == "select":  # branch-free (vectorisable): the series for every state, ``over`` counts |u| beyond it
+        w = f"_w{u}"
+        return [f"{u} = {value}", f"{a} = abs({u})", f"over += 0 if {a} <= {SERIES_LIMIT!r} else 1", *series,
+                f"{w} = {e}", f"{e} = {f} if {u} < 0 else {e}", f"{f} = {w} if {u} < 0 else {f}"]
+    if style == "numpy":
+        big = f"_big{u}"
+        return [f"{u} = {value}", f"{a} = np.abs({u})", *series, f"{big} = ~({a} <= {SERIES_LIMIT!r})",
+                f"if {big}.any(): {e}[{big}] = {prefix}expm1({a}[{big}]); {f}[{big}] = -{e}[{big}] / (1.0 + {e}[{big}])",
+                f"{e}, {f} = np.where({u} >= 0, {e}, {f}), np.where({u} >= 0, {f}, {e})"]
+    return [f"{u} = {value}", f"{a} = abs({u})", f"if {a} <= {SERIES_LIMIT!r}:",
+            *(f"    {line}" for line in series), "else:", *(f"    {line}" for line in library),
+            f"if {u} < 0: {e}, {f} = {f}, {e}"]
+
+
+def expm1_pair(u: float) -> tuple:
+    """``(expm1(u), expm1(-u))`` in float64 exactly as the generated kernels compute a shared pair.
+
+    >>> expm1_pair(0.0), expm1_pair(1e-300)
+    ((0.0, 0.0), (1e-300, -1e-300))
+    """
+    scope = {}
+    # the generated statements themselves (internal names, the float u as a variable: no text is formatted in)
+    exec("\n".join(pair_lines("u0", "e0", "f0", "_x")), {"_expm1": math.expm1, "_x": float(u)}, scope)  # noqa: S102
+    return scope["e0"], scope["f0"]
+
+
 # -- loop bodies ----------------------------------------------------------------------------------------
 
 
-def body_lines(program: StepProgram, printer, kahan=False, c_syntax=False, vector=False, prefix="_"):
+def body_lines(program: StepProgram, printer, kahan=False, c_syntax=False, vector=False, prefix="_", select=False):
     """Statements of one step, ``s_i`` / ``k_j`` / ``d_j`` / ``c_i`` named as in the generated kernels.
 
     ``vector``: numpy arrays (the shared-exponential swap is a ``np.where``); ``prefix``: of the
-    function names (``_``, ``_np_``, ``_mp_``); ``c_syntax``: C99.
+    function names (``_``, ``_np_``, ``_mp_``); ``c_syntax``: C99; ``select``: shared exponentials
+    without branches (:func:`pair_lines` style ``"select"``, for the vectorised batch loop).
     """
     end = ";" if c_syntax else ""
     decl = "double " if c_syntax else ""
     lines = []
     for u in program.updates:
         for us, es, fs, ue in u.pairs:
-            if c_syntax:
-                lines += [f"double {us} = {printer(ue)};", f"double {es} = expm1(fabs({us}));",
-                          f"double {fs} = -{es} / (1.0 + {es});",
-                          f"if ({us} < 0) {{ double w_ = {es}; {es} = {fs}; {fs} = w_; }}"]
-            elif vector:
-                lines += [f"{us} = {printer(ue)}", f"{es} = {prefix}expm1(np.abs({us}))", f"{fs} = -{es} / (1.0 + {es})",
-                          f"{es}, {fs} = np.where({us} >= 0, {es}, {fs}), np.where({us} >= 0, {fs}, {es})"]
-            else:
-                lines += [f"{us} = {printer(ue)}", f"{es} = {prefix}expm1(abs({us}))", f"{fs} = -{es} / (1.0 + {es})",
-                          f"if {us} < 0: {es}, {fs} = {fs}, {es}"]
+            style = ("cselect" if select else "c") if c_syntax else "numpy" if vector else "select" if select else "python"
+            lines += pair_lines(str(us), str(es), str(fs), printer(ue), prefix, style)
         names = []
         for j, (i, d) in enumerate(u.increments):
             lines.append(f"{decl}d{j} = {printer(d)}{end}")
@@ -381,16 +469,16 @@ def body_lines(program: StepProgram, printer, kahan=False, c_syntax=False, vecto
             else:
                 lines.append(f"s{i} += {d}{end}")
     if c_syntax:  # C declares each temporary once per scope: one brace block per update
-        return _c_scoped(program, lines, kahan)
+        return _c_scoped(program, lines, kahan, "cselect" if select else "c")
     return lines
 
 
-def _c_scoped(program, lines, kahan):
+def _c_scoped(program, lines, kahan, style="c"):
     out = []
     it = iter(lines)
     for u in program.updates:
         n = len(u.increments)
-        count = 4 * len(u.pairs) + n + n * (4 if kahan else 1)
+        count = len(pair_lines("u", "e", "f", "0", style=style)) * len(u.pairs) + n + n * (4 if kahan else 1)
         block = [next(it) for _ in range(count)]
         out.append("{ " + " ".join(block) + " }")
     return out
@@ -411,7 +499,7 @@ _sin, _cos, _tan, _sinh, _cosh, _tanh = math.sin, math.cos, math.tan, math.sinh,
 _atan, _asin, _acos, _isfinite = math.atan, math.asin, math.acos, math.isfinite
 _np_exp, _np_expm1, _np_log, _np_sqrt = np.exp, np.expm1, np.log, np.sqrt
 _np_sin, _np_cos, _np_tan, _np_sinh, _np_cosh, _np_tanh = np.sin, np.cos, np.tan, np.sinh, np.cosh, np.tanh
-_np_atan, _np_asin, _np_acos = np.arctan, np.arcsin, np.arccos
+_np_atan, _np_asin, _np_acos, _np_isfinite = np.arctan, np.arcsin, np.arccos, np.isfinite
 _INF, _MAX, _TINY = math.inf, 1.7976931348623157e308, 2.2250738585072014e-308
 '''
 
@@ -450,11 +538,17 @@ def python_source(program: StepProgram) -> str:
 
     * ``run(x, K, steps, every, out)`` and ``run_kahan(x, c, K, steps, every, out)`` --
       one trajectory, ``x`` of shape (N,), ``out`` of shape (n_samples, N);
-    * ``run_batch(X, K, steps, every, out, chunk)`` and ``run_batch_kahan(X, C, ...)`` --
-      ``X`` of shape (N, batch), ``out`` of shape (n_samples, N, batch); the batch is
-      processed in chunks that stay in cache, the inner loop runs over the chunk;
-    * ``run_numpy(X, K, steps, every, out, chunk)`` and ``run_numpy_kahan(X, C, ...)`` --
-      the vectorised numpy fallback for batches (same operations, same order).
+    * ``run_batch(X, K, steps, every, out, chunk, start, back)`` and ``run_batch_kahan(X, C, ...)`` --
+      ``X`` of shape (N, batch) holds the start states, ``out`` of shape (n_samples, N, batch);
+      the batch is processed in chunks that stay in cache, the inner loop runs over the chunk.
+      ``start``: also copy ``X`` into ``out[0]`` (in the same pass that loads the chunk);
+      ``back``: write the final states back into ``X`` (without it ``X`` is only read, and the
+      final states are ``out[-1]``).  ``C`` (Kahan compensation) is always updated in place.
+      They return the number of non-finite values among the samples written (``out[1:]``), so
+      the caller checks the result without another pass over it;
+    * ``run_numpy(...)`` and ``run_numpy_kahan(...)`` -- the vectorised numpy fallback for
+      batches (same arguments, same operations in the same order; it returns a positive number
+      when a sample is not finite, 0 otherwise).
     """
     N = program.N
     s = [f"s{i}" for i in range(N)]
@@ -483,74 +577,165 @@ def {name}({args}):
     {comp_store if kahan else ''}
     return n
 """)
-        # batch: chunks of states kept in small contiguous arrays, inner loop over the chunk
+        # batch: chunks of states kept in small contiguous arrays, inner loop over the chunk; the
+        # start states are read from X (copied into out[0] when ``start``), the final ones written back
+        # into X only when ``back``; the sample pass counts non-finite values (the result check)
         name = "run_batch_kahan" if kahan else "run_batch"
-        args = "X, C, K, steps, every, out, chunk" if kahan else "X, K, steps, every, out, chunk"
-        alloc = [f"S{i} = np.empty(chunk)" for i in range(N)] + ([f"Q{i} = np.empty(chunk)" for i in range(N)] if kahan else [])
-        gather = [f"S{i}[b] = X[{i}, b0 + b]" for i in range(N)] + ([f"Q{i}[b] = C[{i}, b0 + b]" for i in range(N)] if kahan else [])
-        scatter = [f"X[{i}, b0 + b] = S{i}[b]" for i in range(N)] + ([f"C[{i}, b0 + b] = Q{i}[b]" for i in range(N)] if kahan else [])
+        args = ("X, C, K, steps, every, out, chunk, start, back" if kahan else
+                "X, K, steps, every, out, chunk, start, back")
+        # the chunk's rows in one buffer, each row 64-byte aligned: an allocation only 16- or 32-byte aligned
+        # splits every 8-wide (AVX-512) load across two cache lines, measured 1.8x slower
+        rows = [f"S{i}" for i in range(N)] + ([f"Q{i}" for i in range(N)] if kahan else [])
+        spare = [f"R{q}" for q in range(len(rows))] if any(u.pairs for u in program.updates) else []
+        alloc = ["W = (chunk + 7) // 8 * 8", f"buf = np.empty({len(rows) + len(spare)} * W + 8)",
+                 "off = (8 - (buf.ctypes.data // 8) % 8) % 8"]
+        alloc += [f"{r} = buf[off + {q} * W:off + {q} * W + chunk]" for q, r in enumerate(rows + spare)]
+        # whole-row slice copies (numba compiles them to tight vector loops; element loops over the
+        # three rows at once measured 3-4x slower on these memory passes)
+        gather = [f"S{i}[:nb] = X[{i}, b0:b0 + nb]" for i in range(N)] + ([f"Q{i}[:nb] = C[{i}, b0:b0 + nb]" for i in range(N)] if kahan else [])
+        first = [f"out[0, {i}, b0:b0 + nb] = S{i}[:nb]" for i in range(N)]
+        scatter = [f"X[{i}, b0:b0 + nb] = S{i}[:nb]" for i in range(N)]
+        comp_back = [f"C[{i}, b0:b0 + nb] = Q{i}[:nb]" for i in range(N)] if kahan else []
         inner_load = [f"s{i} = S{i}[b]" for i in range(N)] + ([f"c{i} = Q{i}[b]" for i in range(N)] if kahan else [])
         inner_store = [f"S{i}[b] = s{i}" for i in range(N)] + ([f"Q{i}[b] = c{i}" for i in range(N)] if kahan else [])
         chunk_step = ["for b in range(nb):", *("    " + line for line in inner_load + body + inner_store)]
-        chunk_sample = ["for b in range(nb):", *(f"    out[j, {i}, b0 + b] = S{i}[b]" for i in range(N))]
+        if any(u.pairs for u in program.updates):
+            # shared exponentials: one branch-free pass over the chunk (vectorised); if some |u| left the
+            # series range, the chunk's step is undone and redone with the library branch -- the same bits
+            # as the branchy loop either way
+            fast = body_lines(program, scalar, kahan, select=True)
+            saved = [f"R{q}[:nb] = {r}[:nb]" for q, r in enumerate(rows)]
+            restore = [f"{r}[:nb] = R{q}[:nb]" for q, r in enumerate(rows)]
+            chunk_step = [*saved, "over = 0", "for b in range(nb):",
+                          *("    " + line for line in inner_load + fast + inner_store),
+                          "if over:", *("    " + line for line in restore),
+                          *("    " + line for line in chunk_step)]
+        chunk_sample = []
+        for i in range(N):  # the sample, row by row, counting non-finite values as it is written
+            chunk_sample += [f"row = out[j, {i}, b0:b0 + nb]", "for b in range(nb):",
+                             f"    v = S{i}[b]; row[b] = v; bad += 0 if abs(v) <= _MAX else 1"]
         src.append(f"""
 def {name}({args}):
 {_indent(consts, 4)}
     B = X.shape[1]
+    bad = 0
 {_indent(alloc, 4)}
     for b0 in range(0, B, chunk):
         nb = min(chunk, B - b0)
-        for b in range(nb):
-{_indent(gather, 12)}
+{_indent(gather, 8)}
+        if start:
+{_indent(first, 12)}
 {_indent(_sampling_loop(chunk_step, chunk_sample), 8)}
-        for b in range(nb):
+        if back:
 {_indent(scatter, 12)}
-    return steps
+{_indent(comp_back, 8)}
+    return bad
 """)
         # numpy fallback: the same statements on chunk arrays
         name = "run_numpy_kahan" if kahan else "run_numpy"
         vbody = body_lines(program, vector, kahan, vector=True, prefix="_np_")
         vload = [f"s{i} = X[{i}, b0:b1].copy()" for i in range(N)] + ([f"c{i} = C[{i}, b0:b1].copy()" for i in range(N)] if kahan else [])
-        vstore = [f"X[{i}, b0:b1] = s{i}" for i in range(N)] + ([f"C[{i}, b0:b1] = c{i}" for i in range(N)] if kahan else [])
+        vfirst = [f"out[0, {i}, b0:b1] = s{i}" for i in range(N)]
+        vstore = [f"X[{i}, b0:b1] = s{i}" for i in range(N)]
+        vcomp = [f"C[{i}, b0:b1] = c{i}" for i in range(N)] if kahan else []
+        vsample = [f"out[j, {i}, b0:b1] = s{i}" for i in range(N)]
+        vsample.append("bad += 0 if (" + " and ".join(f"_np_isfinite(s{i}).all()" for i in range(N)) + ") else 1")
         src.append(f"""
 def {name}({args}):
 {_indent(consts, 4)}
     B = X.shape[1]
+    bad = 0
     for b0 in range(0, B, chunk):
         b1 = min(b0 + chunk, B)
 {_indent(vload, 8)}
-{_indent(_sampling_loop(vbody, [f"out[j, {i}, b0:b1] = s{i}" for i in range(N)]), 8)}
-{_indent(vstore, 8)}
-    return steps
+        if start:
+{_indent(vfirst, 12)}
+{_indent(_sampling_loop(vbody, vsample), 8)}
+        if back:
+{_indent(vstore, 12)}
+{_indent(vcomp, 8)}
+    return bad
 """)
     src.append(_SCAN)
     return "\n".join(src)
 
 
-#: One pass over a batch ``X`` (N, B): what the input guards need, compiled with the kernel.
+#: One pass over a batch ``X`` (N, B): what the input guards need, compiled with the kernel.  Blocks of
+#: ``W`` states: the per-state max-norm, product and smallest non-zero magnitude (rows combined in
+#: order, as :func:`~nambu_bch.numeric.guards.extreme_states`), then the block's extremes.  Those
+#: are found on the IEEE bit patterns as int64 -- ordered like the values for the non-negative
+#: doubles compared here -- so the reductions vectorise without fast-math; the first state reaching
+#: a new extreme is kept, like ``numpy.argmax``.  (A non-finite input makes the columns meaningless;
+#: the caller then refuses the batch on the counts.)
 _SCAN = """
 def scan(X, res):
+    N = X.shape[0]
     B = X.shape[1]
-    big = np.zeros(B)
-    prod = np.ones(B)
-    small = np.full(B, _INF)
+    W = 1024
+    big = np.empty(W)
+    prod = np.empty(W)
+    small = np.empty(W)
+    Ib = big.view(np.int64)
+    Ip = prod.view(np.int64)
+    Is = small.view(np.int64)
     nonfinite = 0
     subnormal = 0
-    for i in range(X.shape[0]):
-        for b in range(B):
-            a = abs(X[i, b])
-            nonfinite += 0 if a <= _MAX else 1
-            subnormal += 1 if (a < _TINY and a > 0.0) else 0
-            big[b] = max(big[b], a)
-            prod[b] *= a
-            small[b] = min(small[b], a if a > 0.0 else _INF)
+    top = np.int64(9223372036854775807)
+    bmax = np.int64(-1); bmin = top; pmax = np.int64(-1); pmin = top; smin = top
+    ibmax = 0; ibmin = 0; ipmax = 0; ipmin = 0; ismin = 0
+    for b0 in range(0, B, W):
+        nb = min(W, B - b0)
+        row = X[0, b0:b0 + nb]
+        for b in range(nb):
+            a = abs(row[b])
+            big[b] = a
+            prod[b] = a
+            small[b] = a if a > 0.0 else _INF
+        for i in range(1, N):
+            row = X[i, b0:b0 + nb]
+            for b in range(nb):
+                a = abs(row[b])
+                g = big[b]
+                big[b] = a if a > g else g
+                prod[b] *= a
+                m = small[b]
+                small[b] = a if (a < m) & (a > 0.0) else m
+        for i in range(N):
+            row = X[i, b0:b0 + nb]
+            nf = 0
+            sb = 0
+            for b in range(nb):
+                a = abs(row[b])
+                nf += 0 if a <= _MAX else 1
+                sb += 1 if (a < _TINY) & (a > 0.0) else 0
+            nonfinite += nf
+            subnormal += sb
+        m1 = Ib[0]; m2 = Ib[0]; m3 = Ip[0]; m4 = Ip[0]; m5 = Is[0]
+        for b in range(nb):
+            v = Ib[b]
+            m1 = max(m1, v)
+            m2 = min(m2, v)
+            v = Ip[b]
+            m3 = max(m3, v)
+            m4 = min(m4, v)
+            m5 = min(m5, Is[b])
+        if m1 > bmax:
+            bmax = m1; ibmax = b0 + np.argmax(Ib[:nb] == m1)
+        if m2 < bmin:
+            bmin = m2; ibmin = b0 + np.argmax(Ib[:nb] == m2)
+        if m3 > pmax:
+            pmax = m3; ipmax = b0 + np.argmax(Ip[:nb] == m3)
+        if m4 < pmin:
+            pmin = m4; ipmin = b0 + np.argmax(Ip[:nb] == m4)
+        if m5 < smin:
+            smin = m5; ismin = b0 + np.argmax(Is[:nb] == m5)
     res[0] = nonfinite
     res[1] = subnormal
-    res[2] = np.argmax(big)
-    res[3] = np.argmin(big)
-    res[4] = np.argmax(prod)
-    res[5] = np.argmin(prod)
-    res[6] = np.argmin(small)
+    res[2] = ibmax
+    res[3] = ibmin
+    res[4] = ipmax
+    res[5] = ipmin
+    res[6] = ismin
     return nonfinite + subnormal
 """
 
@@ -580,7 +765,8 @@ def c_source(program: StepProgram) -> str:
     ``long run(double *x, const double *K, long steps)`` advances one state in place;
     ``void run_batch(double *X, const double *K, long steps, long B, long chunk)``
     advances ``X`` of shape (N, B) (row-major) chunk by chunk, inner loop over the chunk,
-    exactly like the numba batch kernel (without sampling).
+    exactly like the numba batch kernel (without sampling; with shared exponentials, the same
+    branch-free pass and redo).
     """
     N = program.N
     body = body_lines(program, print_c, c_syntax=True)
@@ -592,6 +778,27 @@ def c_source(program: StepProgram) -> str:
     scatter = " ".join(f"X[{i} * B + b0 + b] = S{i}[b];" for i in range(N))
     inner_load = " ".join(f"double s{i} = S{i}[b];" for i in range(N))
     inner_store = " ".join(f"S{i}[b] = s{i};" for i in range(N))
+    step = f"""for (long b = 0; b < nb; ++b) {{
+                {inner_load}
+                {chr(10).join('                ' + b for b in body).strip()}
+                {inner_store}
+            }}"""
+    if any(u.pairs for u in program.updates):  # as the numba batch kernel: branch-free pass, redo when needed
+        fast = body_lines(program, print_c, c_syntax=True, select=True)
+        arrays += " " + " ".join(f"double R{i}[chunk];" for i in range(N))
+        save = " ".join(f"R{i}[b] = S{i}[b];" for i in range(N))
+        restore = " ".join(f"S{i}[b] = R{i}[b];" for i in range(N))
+        step = f"""for (long b = 0; b < nb; ++b) {{ {save} }}
+            long over = 0;
+            for (long b = 0; b < nb; ++b) {{
+                {inner_load}
+                {chr(10).join('                ' + b for b in fast).strip()}
+                {inner_store}
+            }}
+            if (over) {{
+            for (long b = 0; b < nb; ++b) {{ {restore} }}
+            {step}
+            }}"""
     return f"""/* Generated by nambu_bch.numeric.codegen (template {TEMPLATE_VERSION}) */
 #include <math.h>
 
@@ -612,11 +819,7 @@ void run_batch(double *restrict X, const double *restrict K, long steps, long B,
         long nb = chunk < B - b0 ? chunk : B - b0;
         for (long b = 0; b < nb; ++b) {{ {gather} }}
         for (long n = 0; n < steps; ++n) {{
-            for (long b = 0; b < nb; ++b) {{
-                {inner_load}
-                {chr(10).join('                ' + b for b in body).strip()}
-                {inner_store}
-            }}
+            {step}
         }}
         for (long b = 0; b < nb; ++b) {{ {scatter} }}
     }}

@@ -75,13 +75,16 @@ def check_count(value, what, minimum):
     return int(value)
 
 
-def check_inputs(system, h, steps, every, x0, params=None, exact=False, scan=None):
+def check_inputs(system, h, steps, every, x0, params=None, exact=False, scan=None, copy=True):
     """Validate a run's arguments; returns ``(h, steps, every, x0 array, params dict)``.
 
     ``x0`` must have shape ``(N,)`` or ``(N, batch)``; with ``exact=True`` (the mpmath
-    path) strings and mpf values are kept as they are (object array).  ``scan``: a compiled
-    one-pass scan of a batch (:meth:`~nambu_bch.numeric.kernels.Kernel.scan`) used instead of
-    numpy passes for the finiteness and underflow checks.
+    path) strings and mpf values are kept as they are (object array).  ``scan``: a one-pass
+    scan of a batch returning ``(non-finite count, subnormal count, columns)``
+    (:meth:`~nambu_bch.numeric.kernels.Kernel.scan` or :func:`scan_states`) used instead of
+    whole-array numpy passes for the finiteness and underflow checks.  ``copy``: return a fresh
+    array (a float64 run advances it in place); with ``copy=False`` a C-contiguous, aligned,
+    writeable float64 ``x0`` is returned as it is (the caller only reads it).
     """
     h = _real(h, "step h")
     steps = check_count(steps, "steps", 0)
@@ -91,8 +94,11 @@ def check_inputs(system, h, steps, every, x0, params=None, exact=False, scan=Non
     for k, v in (params or {}).items():
         _real(v, f"parameter {k}")
     values = parameter_values(system, params)  # unknown names -> InvalidSystemError
-    try:  # a fresh C-ordered copy: the float64 run advances it in place
-        arr = np.array(x0, dtype=object if exact else np.float64, order="C")
+    try:  # a fresh C-ordered copy (the float64 run advances it in place) unless the caller only reads it
+        convert = np.array if copy or exact else np.asarray
+        arr = convert(x0, dtype=object if exact else np.float64, order="C")
+        if not (arr.flags.c_contiguous and arr.flags.aligned and arr.flags.writeable):
+            arr = np.array(arr, order="C")  # one layout for the compiled kernels (no recompilation)
     except (TypeError, ValueError):
         raise InvalidRunError(f"x0 must be an array of {system.N} real numbers (or shape ({system.N}, batch)), got {x0!r}") from None
     if arr.ndim not in (1, 2) or arr.shape[0] != system.N or (arr.ndim == 2 and arr.shape[1] == 0):
@@ -223,21 +229,53 @@ MAX_CHECKED = 64
 
 def extreme_states(X, k=MAX_CHECKED):
     """Column indices of the most extreme states of ``X`` (N, B) (all of them if ``B <= k``): largest
-    and smallest max-norm, largest and smallest product of magnitudes, smallest non-zero component."""
+    and smallest max-norm, largest and smallest product of magnitudes, smallest non-zero component
+    (and the first and last state)."""
     B = X.shape[1]
     if B <= k:
         return np.arange(B)
-    with np.errstate(all="ignore"):  # row by row: elementwise passes over contiguous rows, no (N, B) temporaries
-        big = np.abs(X[0])
-        prod = big.copy()
-        small = np.where(big > 0, big, np.inf)
-        for row in X[1:]:
-            a = np.abs(row)
-            np.maximum(big, a, out=big)
-            np.multiply(prod, a, out=prod)               # saturates at 0 / inf: still the extreme
-            np.minimum(small, np.where(a > 0, a, np.inf), out=small)
-    picks = [big.argmax(), big.argmin(), prod.argmax(), prod.argmin(), small.argmin(), 0, B - 1]
-    return np.unique(np.array(picks, dtype=np.int64))
+    return scan_states(X)[2]
+
+
+#: States per block of :func:`scan_states` (the block's temporaries stay in cache).
+SCAN_BLOCK = 16384
+
+
+def scan_states(X, block=SCAN_BLOCK):
+    """One blocked pass over a batch ``X`` (N, B): ``(non-finite count, subnormal count, columns)``.
+
+    The numpy twin of the compiled :meth:`~nambu_bch.numeric.kernels.Kernel.scan`: ``columns``
+    are the states with the largest and smallest max-norm, largest and smallest product of
+    magnitudes (rows multiplied in order) and smallest non-zero component -- the first one of each
+    (like ``numpy.argmax``) -- plus the first and last state.  Each block of ``block`` states is
+    reduced while its temporaries are in cache, instead of whole-array passes.
+    """
+    X = np.asarray(X, dtype=np.float64)
+    N, B = X.shape
+    nonfinite = subnormal = 0
+    # (best value, column) of: max of big, min of big, max of prod, min of prod, min of small
+    best = [[-1.0, 0], [np.inf, 0], [-1.0, 0], [np.inf, 0], [np.inf, 0]]
+    with np.errstate(all="ignore"):
+        for b0 in range(0, B, block):
+            A = np.abs(X[:, b0:b0 + block])
+            big = A.max(axis=0)                              # NaN propagates: a bad block shows in big.max()
+            if not big.max() <= np.finfo(np.float64).max:
+                nonfinite += int(np.count_nonzero(~(A <= np.finfo(np.float64).max)))
+            prod = A[0].copy()
+            for row in A[1:]:
+                prod *= row
+            np.copyto(A, np.inf, where=~(A > 0))
+            small = A.min(axis=0)
+            if small.min() < TINY:                           # the smallest non-zero magnitude is subnormal
+                subnormal += int(np.count_nonzero(A < TINY))
+            for slot, (values, take_max) in enumerate(((big, True), (big, False), (prod, True), (prod, False),
+                                                       (small, False))):
+                i = int(values.argmax() if take_max else values.argmin())
+                v = values[i]
+                if (v > best[slot][0]) if take_max else (v < best[slot][0]):
+                    best[slot] = [v, b0 + i]
+    columns = np.unique(np.array([c for _, c in best] + [0, B - 1], dtype=np.int64))
+    return nonfinite, subnormal, columns
 
 
 def check_range(kernel, x0, K, max_mpmath=64, columns=None):

@@ -29,7 +29,7 @@ import numpy as np
 from ..errors import InvalidRunError, InvalidSystemError
 from ..progress import Progress, progress_wanted
 from ..systems import System, model
-from .guards import check_count, check_inputs, check_range, check_result, check_stability
+from .guards import check_count, check_inputs, check_range, check_result, check_stability, scan_states
 from .kernels import kernel, resolve_backend
 from .precision import check_dps, run_mpmath
 from .samples import n_samples, sample_steps
@@ -125,33 +125,59 @@ def iterate(system, word, h, steps, x0, params=None, every=1, *, kahan=False, dp
         raise InvalidRunError(f"{count} samples of {system.N} x {batch} states need {nbytes / 2**30:.1f} GiB "
                               f"(limit {MAX_SAMPLE_BYTES / 2**30:.0f} GiB); sample less often (larger every)")
     out = np.empty((count, system.N) if single else (count, system.N, batch), dtype=np.float64)
-    state = X  # check_inputs made a fresh C-ordered float64 copy: advanced in place
-    out[0] = state
-    comp = np.zeros_like(state) if kahan else None
-
+    what = f"{system.name} under {kern.word} with h = {h!r}"
     reporter = Progress(steps * batch, f"iterate {system.name} {kern.word}",
                         enabled=_enabled(progress, steps * batch * (30 if be == "numpy" and single else 1)))
     segment = steps if not reporter.enabled else max(every, (_SEGMENT_WORK // batch) // every * every)
+    if not single:
+        with reporter:
+            _run_batch(kern, X, K, steps, every, out, kahan, be, chunk, segment, reporter, what)
+        return out
+    state = X  # check_inputs made a fresh float64 copy: advanced in place
+    out[0] = state
+    comp = np.zeros_like(state) if kahan else None
     done, j = 0, 0
     with reporter, np.errstate(over="ignore", invalid="ignore"):
         while done < steps:
             seg = min(segment, steps - done)
             nseg = n_samples(seg, every)
-            view = out[j:j + nseg]
-            if single:
-                n = kern.run(state, K, seg, every, view, kahan=kahan, comp=comp, backend=be)
-            else:
-                n = kern.run_batch(state, K, seg, every, view, kahan=kahan, comp=comp, backend=be, chunk=chunk)
+            n = kern.run(state, K, seg, every, out[j:j + nseg], kahan=kahan, comp=comp, backend=be)
             if n < seg:  # stopped at a non-finite sample: the rest is undefined
                 out[j + n_samples(n, every):] = np.nan
                 break
             done += seg
             j += nseg - 1
-            reporter.update(done * batch)
+            reporter.update(done)
     if count > 1:  # sample 0 is x0, checked before the run
-        check_result(out[1:], sample_steps(steps, every)[1:], f"{system.name} under {kern.word} with h = {h!r}",
-                     start=0)
+        check_result(out[1:], sample_steps(steps, every)[1:], what, start=0)
     return out
+
+
+def _run_batch(kern, X, K, steps, every, out, kahan, be, chunk, segment, reporter, what):
+    """Fill ``out`` with the samples of a batch: ``X`` (the caller's start states) is only read.
+
+    The kernel copies ``X`` into ``out[0]`` while it loads each chunk, starts every later segment
+    from the last sample written, and counts non-finite values as it writes the samples; only a
+    positive count costs a pass over the samples (:func:`check_result` names the step).
+    """
+    if steps == 0:
+        out[0] = X
+        return
+    comp = np.zeros_like(X) if kahan else None
+    source, done, j = X, 0, 0
+    with np.errstate(over="ignore", invalid="ignore"):
+        while done < steps:
+            seg = min(segment, steps - done)
+            nseg = n_samples(seg, every)
+            bad = kern.run_batch(source, K, seg, every, out[j:j + nseg], kahan=kahan, comp=comp, backend=be,
+                                 chunk=chunk, start=j == 0, back=False)
+            if bad:
+                grid = sample_steps(steps, every)
+                check_result(out[1:j + nseg], grid[1:j + nseg], what, start=0)
+            done += seg
+            j += nseg - 1
+            source = out[j]
+            reporter.update(done * X.shape[1])
 
 
 #: Runs at most this long (trajectory-steps of one state) take the interpreter when ``backend="auto"``
@@ -182,15 +208,19 @@ def _prepare(system, kern, h, steps, every, x0, params, backend, chunk, check_st
                  (steps <= SMALL_BATCH_STEPS and len(shape) == 2 and shape[1] <= SMALL_BATCH_STATES))
         if small:
             be = "numpy"
-    # a large batch on numba: one compiled pass finds non-finite, subnormal and extreme states
+    # a large batch: one pass (compiled on numba, blocked numpy otherwise) finds non-finite, subnormal and
+    # extreme states; the batch itself is only read by the run, so it is not copied
+    batch = len(shape) == 2
     scanned = {}
-    if be == "numba" and len(shape) == 2 and shape[1] > SCAN_BATCH:
+    if batch and shape[1] > SCAN_BATCH:
+        scanner = kern.scan if be == "numba" else scan_states
+
         def scan(arr):
-            scanned["result"] = kern.scan(arr)
+            scanned["result"] = scanner(arr)
             return scanned["result"]
     else:
         scan = None
-    h, steps, every, X, _ = check_inputs(system, h, steps, every, x0, params, scan=scan)
+    h, steps, every, X, _ = check_inputs(system, h, steps, every, x0, params, scan=scan, copy=not batch)
     if chunk is not None:
         chunk = check_count(chunk, "chunk", 1)
     K = kern.constants(float(h), params)
@@ -200,7 +230,8 @@ def _prepare(system, kern, h, steps, every, x0, params, backend, chunk, check_st
     return _Run(h=h, steps=steps, every=every, X=X, backend=be, K=K, chunk=chunk)
 
 
-#: Batches with more states than this are scanned by the compiled kernel (one pass) instead of numpy.
+#: Batches with more states than this are scanned in one pass (compiled, or numpy blocks) instead of
+#: whole-array numpy passes.
 SCAN_BATCH = 4096
 
 #: Samples per block of :func:`iterate_chunks` (a few MB per block for N = 3).

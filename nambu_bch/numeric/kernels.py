@@ -390,7 +390,7 @@ class Kernel:
             X = np.zeros((N, 1))
             out = np.zeros((2, N, 1))
             args = (X, np.zeros((N, 1))) if kahan else (X,)
-            fn(*args, K, 1, 1, out, NUMBA_CHUNK)
+            fn(*args, K, 1, 1, out, NUMBA_CHUNK, 1, 1)
         else:
             x = np.zeros(N)
             out = np.zeros((2, N))
@@ -434,15 +434,23 @@ class Kernel:
             comp[:] = cs
         return int(n)
 
-    def run_batch(self, X, K, steps, every, out, *, kahan=False, comp=None, backend="numba", chunk=None) -> int:
-        """Advance states ``X`` (shape (N, batch), float64, in place); ``out`` of shape (n, N, batch)."""
+    def run_batch(self, X, K, steps, every, out, *, kahan=False, comp=None, backend="numba", chunk=None,
+                  start=False, back=True) -> int:
+        """Advance states ``X`` (shape (N, batch), float64); ``out`` of shape (n, N, batch), ``out[1:]`` is filled.
+
+        ``start``: also copy ``X`` into ``out[0]`` (fused with the pass that loads the states);
+        ``back``: write the final states into ``X`` (in place); with ``back=False`` ``X`` is only
+        read (the caller's array can be passed as it is) and the final states are ``out[-1]``.
+        Returns 0 when every sample written is finite, a positive number otherwise.
+        """
         name = "run_batch_kahan" if kahan else "run_batch"
         args = (X, comp) if kahan else (X,)
+        flags = (int(bool(start)), int(bool(back)))
         if backend == "numba":
             self.compile(kahan=kahan, batch=True)
-            return int(self.function(name)(*args, K, int(steps), int(every), out, int(chunk or NUMBA_CHUNK)))
+            return int(self.function(name)(*args, K, int(steps), int(every), out, int(chunk or NUMBA_CHUNK), *flags))
         fn = self.function(name, "numpy")
-        return int(fn(*args, [float(k) for k in K], int(steps), int(every), out, int(chunk or NUMPY_CHUNK)))
+        return int(fn(*args, [float(k) for k in K], int(steps), int(every), out, int(chunk or NUMPY_CHUNK), *flags))
 
 
 def kernel(system, word) -> Kernel:
