@@ -1,17 +1,17 @@
-"""Run order only: the long tests go first, longest first, so that under ``pytest -n 2`` no worker is left alone with
-one at the end.
+"""Run order only: the long tests go first (roughly longest first), so that under ``pytest -n 2`` no worker is left
+alone with one at the end.
 
 Nothing here changes what a test does or asserts; the order among the other tests is kept (a stable sort).
 
 Why this balances: ``--dist worksteal`` (pyproject ``addopts``) hands each of the two workers one contiguous half of
 the collection, and a worker that runs dry steals the *last* half of the other's queue.  With the long tests at the
 front they all start early in the first worker's queue, and what is stolen and run at the end are short tests, so
-both workers finish within about one short test of each other (measured: docs/suite_time.md).
+both workers finish within seconds of each other (measured: docs/suite_time.md).
 """
 
 from __future__ import annotations
 
-# (file, test name prefix) of the tests that take >= 3 s of CPU each on the two-core machine, longest first
+# (file, test name prefix) of the tests that take >= 3 s of CPU each on the two-core machine, roughly longest first
 # (a cold ``pytest -n 2`` with per-test CPU, own and of child processes: docs/suite_time.md)
 LONG = (
     ("test_notebooks.py", "test_notebook_executes"),                        # 2.4-10.8 s each, in a kernel process

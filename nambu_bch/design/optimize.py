@@ -177,7 +177,7 @@ def _newton_float(prob, z, steps=80):
 
 
 def _newton_mp(prob, z, tol, steps=30):
-    """Newton on the Lagrange system in mpmath from a float64 root; ``None`` unless the residual reaches ``tol * 10**6``.
+    """Newton on the Lagrange system in mpmath from a float64 root; ``None`` if the residual stays above ``tol * 1e6``.
 
     Newton converges quadratically from a float64 root (three steps from ``1e-16`` to ``1e-40``); once the residual
     stops decreasing it sits at the round-off level of the working precision and further steps only move ``z`` by
