@@ -217,6 +217,12 @@ def designed():
     return optimize_composition("strang", parts=3, order=4, stages=5)
 
 
+@pytest.fixture(scope="module")
+def designed_rational():
+    """The same template's 30-digit rational form (``exact=False``)."""
+    return optimize_composition("strang", parts=3, order=4, stages=5, exact=False)
+
+
 def test_designed_composition_beats_triple_jump_and_suzuki(designed):
     D = designed
     assert D.exact and D.error_bound == 0 and D.order == 4
@@ -271,8 +277,8 @@ def test_designed_composition_has_order_four_numerically(designed, system, param
     assert all(a > b for a, b in zip(errs, errs[1:]))
 
 
-def test_rational_fallback_states_its_bound(designed):
-    R = optimize_composition("strang", parts=3, order=4, stages=5, exact=False)
+def test_rational_fallback_states_its_bound(designed, designed_rational):
+    R = designed_rational
     assert not R.exact and 0 < R.error_bound < 1e-25
     assert all(c.is_Rational for c in R.coefficients)
     E = error_analysis(R, 3)
@@ -301,10 +307,10 @@ def test_optimize_finds_yoshidas_sixth_order_solution():
     assert abs(error_constant(D, 2) - error_constant(yoshida, 2)) < 1e-10
 
 
-def test_rational_form_keeps_the_degree_one_conditions_exact():
+def test_rational_form_keeps_the_degree_one_conditions_exact(designed_rational):
     """Module docstring of design/optimize, step 5: the 30-digit rationals are re-solved on the degree-1 conditions
     (consistency, one per piece: the coefficients of each piece sum to 1), so those hold exactly, not to 1e-30."""
-    R = optimize_composition("strang", parts=3, order=4, stages=5, exact=False)
+    R = designed_rational
     for k in (1, 2, 3):
         assert sum(c for p, c in zip(R.pieces, R.coefficients) if p == k) == 1
     assert R.error_bound > 0                                          # the higher conditions only to the bound
