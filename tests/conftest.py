@@ -1,21 +1,39 @@
-"""Run order only: the few long tests go first, so that under ``pytest -n 2`` no worker is left alone with one at the end.
+"""Run order only: the long tests go first (roughly longest first), so that under ``pytest -n 2`` no worker is left
+alone with one at the end.
 
 Nothing here changes what a test does or asserts; the order among the other tests is kept (a stable sort).
+
+Why this balances: ``--dist worksteal`` (pyproject ``addopts``) hands each of the two workers one contiguous half of
+the collection, and a worker that runs dry steals the *last* half of the other's queue.  With the long tests at the
+front they all start early in the first worker's queue, and what is stolen and run at the end are short tests, so
+both workers finish within seconds of each other (measured: docs/suite_time.md).
 """
 
 from __future__ import annotations
 
-# (file, test name prefix) of the tests that take 5-11 s each on the two-core machine (``--durations``)
+# (file, test name prefix) of the tests that take >= 3 s of CPU each on the two-core machine, roughly longest first
+# (a cold ``pytest -n 2`` with per-test CPU, own and of child processes: docs/suite_time.md)
 LONG = (
-    ("test_notebooks.py", "test_notebook_executes"),
-    ("test_design.py", "test_optimize_finds_yoshidas_sixth_order_solution"),
+    ("test_notebooks.py", "test_notebook_executes"),                        # 2.4-10.8 s each, in a kernel process
+    ("test_bch_modular.py", "test_sparse_engine_equals_dense_engine"),      # 12 s at [12-12], cold: numba compile
     ("test_any_system.py", "test_concrete_equals_generic_substituted_to_h4"),
-    ("test_bch_modular.py", "test_sparse_engine_equals_dense_engine"),
+    ("test_testing.py", "test_example_suite_"),                             # two pytest subprocesses
+    ("test_cli.py", "test_every_subcommand_runs_as_a_subprocess"),
+    ("test_shadow.py", "test_shadow_pair_reproduces_effective_field"),
+    ("test_shadow.py", "test_eight_representations_for_generic_functions"),
+    ("test_any_system.py", "test_rigid_body_lp_check_runs_and_keeps_the_casimir"),
+    ("test_any_system.py", "test_lie_poisson_bch_member_with_casimir_kept"),
+    ("test_existence.py", "test_issue_example_non_symmetric_word_drifts"),
+    ("test_shadow.py", "test_n4_full_split_is_obstructed"),
+    ("test_fi_route.py", "test_h4_hull_equals_brute_force_enumeration"),
 )
 
 
 def pytest_collection_modifyitems(session, config, items):
-    def first(item) -> int:
-        return 0 if any(item.path.name == f and item.name.startswith(n) for f, n in LONG) else 1
+    def rank(item) -> int:
+        for i, (f, n) in enumerate(LONG):
+            if item.path.name == f and item.name.startswith(n):
+                return i
+        return len(LONG)
 
-    items.sort(key=first)
+    items.sort(key=rank)

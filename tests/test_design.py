@@ -217,6 +217,12 @@ def designed():
     return optimize_composition("strang", parts=3, order=4, stages=5)
 
 
+@pytest.fixture(scope="module")
+def designed_rational():
+    """The same template's 30-digit rational form (``exact=False``)."""
+    return optimize_composition("strang", parts=3, order=4, stages=5, exact=False)
+
+
 def test_designed_composition_beats_triple_jump_and_suzuki(designed):
     D = designed
     assert D.exact and D.error_bound == 0 and D.order == 4
@@ -271,8 +277,8 @@ def test_designed_composition_has_order_four_numerically(designed, system, param
     assert all(a > b for a, b in zip(errs, errs[1:]))
 
 
-def test_rational_fallback_states_its_bound(designed):
-    R = optimize_composition("strang", parts=3, order=4, stages=5, exact=False)
+def test_rational_fallback_states_its_bound(designed, designed_rational):
+    R = designed_rational
     assert not R.exact and 0 < R.error_bound < 1e-25
     assert all(c.is_Rational for c in R.coefficients)
     E = error_analysis(R, 3)
@@ -299,6 +305,30 @@ def test_optimize_finds_yoshidas_sixth_order_solution():
     assert not D.exact and D.error_bound < 1e-26                     # no radical form: 30-digit rationals
     assert round(error_constant(D, 2), 2) == 16.17
     assert abs(error_constant(D, 2) - error_constant(yoshida, 2)) < 1e-10
+
+
+def test_rational_form_keeps_the_degree_one_conditions_exact(designed_rational):
+    """Module docstring of design/optimize, step 5: the 30-digit rationals are re-solved on the degree-1 conditions
+    (consistency, one per piece: the coefficients of each piece sum to 1), so those hold exactly, not to 1e-30."""
+    R = designed_rational
+    for k in (1, 2, 3):
+        assert sum(c for p, c in zip(R.pieces, R.coefficients) if p == k) == 1
+    assert R.error_bound > 0                                          # the higher conditions only to the bound
+
+
+def test_quotient_dimension_is_the_degree_of_the_shape_polynomial():
+    """In shape position k[x]/I = k[x_n]/(q) (Cox, Little, O'Shea, Sect. 5.3): the number of standard monomials of a
+    grevlex basis equals deg q of the lex basis (computed independently), and it is counted only up to limit + 1."""
+    from nambu_bch.design.optimize import _quotient_dimension
+
+    g1, g2 = sympy.symbols("gamma1 gamma2")
+    system = [2 * g1 + g2 - 1, 2 * g1**3 + g2**3]                   # the triple jump (HLW, Sect. V.3.2)
+    lex = sympy.groebner(system, g1, g2, order="lex")
+    q = sympy.Poly(lex.exprs[-1], g2)
+    assert _quotient_dimension(sympy.groebner(system, g1, g2, order="grevlex"), 10) == q.degree() == 3
+    x, y = sympy.symbols("x y")
+    G = sympy.groebner([x**3 - 1, y**2 - x], x, y, order="grevlex")  # 3 * 2 = 6 points
+    assert _quotient_dimension(G, 10) == 6 and _quotient_dimension(G, 4) == 5
 
 
 def test_optimize_bad_input():

@@ -345,12 +345,18 @@ def symbolic_defects(T: Template, degree: int) -> dict:
     Homogeneous of degree ``q`` for ``q >= 2``; at the first non-vanishing degree these are the
     Lyndon defects of ``Phi - exp(sum X)`` whose 2-norm is the error constant.
     """
+    return {w: p.as_expr() for w, p in defect_polynomials(T, degree).items()}
+
+
+def defect_polynomials(T: Template, degree: int) -> dict:
+    """:func:`symbolic_defects` as sparse polynomials of ``QQ[unknowns]`` (sympy ``PolyElement``, generators in
+    the order of ``T.unknowns``), for callers that go on computing with them."""
     _check_work(T.parts, degree, len(T.pieces) * degree, f"template {T.name!r}")
     R, *_ = ring([str(u) for u in T.unknowns], QQ)
     factors = [(k, R.from_expr(c) if c.free_symbols else R(c)) for k, c in zip(T.pieces, T.coefficients)]
     d = log_coefficients(factors, T.parts, degree, R.one, R.zero, lambda a, b: R(sympy.Rational(a, b)))
     scale = 1 if degree == 1 else factorial(degree)
-    return {w: (p * scale).as_expr() for w, p in d.items()}
+    return {w: p * scale for w, p in d.items()}
 
 
 def order_conditions(spec, order: int, parts: int | None = None, stages: int | None = None) -> OrderConditions:
