@@ -21,7 +21,8 @@ from nambu_bch.bch.backward import effective_field
 from nambu_bch.bch.concrete import effective_field_bch
 from nambu_bch.errors import InvalidSystemError, NambuBCHError, NoExactFlowError, NotSeparableError
 from nambu_bch.integrators.flows import exact_flow
-from nambu_bch.shadow.generic import bch_shadow, generic_shadow, is_zero, poisson_structure, substitute
+from nambu_bch.algebra.zero import is_zero
+from nambu_bch.shadow.generic import bch_shadow, generic_shadow, poisson_structure, substitute
 from nambu_bch.systems import System, infer_bracket
 
 x1, x2 = sympy.symbols("x1 x2")

@@ -1,11 +1,13 @@
 """The package's one exact zero test of a sympy expression (cheap structural tests first).
 
-An expression is zero when its expansion is ``0``; else, when it holds algebraic
-numbers such as ``2**(1/3)`` (the triple-jump coefficients of Yoshida, Phys. Lett. A
-150 (1990) 262, Eq. 5.5), when rationalising the denominators (``radsimp``) brings the
-expansion to ``0``; else when ``simplify`` proves it.  ``simplify`` only ever answers
-``0`` for an expression that is zero, so a ``True`` is exact; a ``False`` means that
-none of the three found the zero.
+Rational functions are decided by ``cancel``.  Otherwise an expression is zero when its
+expansion is ``0``; else, when it holds algebraic numbers such as ``2**(1/3)`` (the
+triple-jump coefficients of Yoshida, Phys. Lett. A 150 (1990) 262, Eq. 5.5), when
+rationalising the denominators (``radsimp``) brings the expansion to ``0``; else, with
+exponentials or trigonometric functions, when their rewriting as exponentials does; else
+when ``simplify`` proves it.  Each tier only ever answers ``0`` for an expression that is
+zero, so a ``True`` is exact; outside rational functions a ``False`` means that none of the
+tiers found the zero.
 """
 
 from __future__ import annotations
@@ -23,17 +25,33 @@ def has_radicals(expr) -> bool:
 
 
 def is_zero(expr) -> bool:
-    """Exact zero test: ``expand``, then ``radsimp`` for radicals, then ``simplify``.
+    """Exact zero test, cheapest decisive tier first.
+
+    1. A rational function of its symbols with rational coefficients is zero exactly when
+       ``cancel`` gives ``0`` (decisive both ways: ``QQ(symbols)`` is a field).
+    2. Otherwise the expansion; with algebraic numbers, the expansion after rationalising
+       the denominators (``radsimp``).
+    3. With ``exp`` and trigonometric functions, everything rewritten as exponentials and
+       combined, which decides identities between polynomials in ``exp(a x)``, ``cos``, ``sin``.
+    4. ``simplify`` as the last resort.
 
     >>> x = sympy.Symbol("x"); c = sympy.cbrt(2)
     >>> is_zero((x + 1)**2 - x**2 - 2*x - 1), is_zero(1/(2 - c) - (4 + 2*c + c**2)/6), is_zero(sympy.sin(x)**2 + sympy.cos(x)**2 - 1)
     (True, True, True)
-    >>> is_zero(x - 1)
-    False
+    >>> is_zero(1/(1 + x) - 1/(x + 1)**2 * (x + 1)), is_zero(x - 1)
+    (True, False)
     """
-    expr = sympy.expand(sympy.sympify(expr))
-    if expr == 0:
+    expr = sympy.sympify(expr)
+    radicals = has_radicals(expr)
+    if not radicals and expr.is_rational_function(*sorted(expr.free_symbols, key=str)):
+        return sympy.cancel(sympy.together(expr)) == 0
+    e = sympy.expand(expr)
+    if e == 0:
         return True
-    if has_radicals(expr) and sympy.expand(sympy.radsimp(sympy.together(expr))) == 0:
+    if radicals and sympy.expand(sympy.radsimp(sympy.together(e))) == 0:
         return True
-    return sympy.simplify(expr) == 0
+    if e.has(sympy.exp, sympy.sin, sympy.cos, sympy.tan, sympy.sinh, sympy.cosh, sympy.tanh):
+        r = sympy.expand(sympy.powsimp(sympy.expand(e.rewrite(sympy.exp)), combine="exp"))
+        if r == 0 or sympy.cancel(sympy.together(r)) == 0:
+            return True
+    return sympy.simplify(e) == 0

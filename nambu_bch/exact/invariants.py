@@ -49,6 +49,7 @@ import sympy
 
 from ..algebra import PolynomialAlgebra
 from ..algebra.ansatz import Ansatz, Rows
+from ..algebra.zero import is_zero
 from ..algebra.elimination import nullspace, rank, solve_affine
 from ..errors import InvalidOrderError, InvalidSystemError, NoExactResultError, ResourceLimitError
 from ..integrators import composed_map, composition_for
@@ -365,7 +366,7 @@ def is_invariant(system, word, quantity) -> bool:
     """
     phi = composed_map(system.splitting, word)
     image = sympy.sympify(quantity).subs(dict(zip(system.coordinates, phi)), simultaneous=True)
-    return sympy.expand(image - quantity) == 0 or sympy.simplify(image - quantity) == 0
+    return is_zero(image - quantity)
 
 
 def conserved_quantities(system, word, degree=None) -> ConservedQuantities:

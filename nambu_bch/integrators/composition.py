@@ -54,6 +54,7 @@ from functools import lru_cache
 import sympy
 from sympy.polys.domains import QQ
 
+from ..algebra.zero import is_zero
 from ..checks import is_int
 from ..errors import InconsistentCoefficientsError, InvalidCompositionError, UnknownPieceError
 
@@ -107,7 +108,7 @@ class Composition:
         coeffs = tuple(_exact(c, self.name) for c in self.coefficients)
         object.__setattr__(self, "coefficients", coeffs)
         sums = {k: sympy.nsimplify(sum(c for p, c in zip(self.pieces, coeffs) if p == k)) for k in set(self.pieces)}
-        bad = {k: s for k, s in sums.items() if sympy.simplify(s - 1) != 0}
+        bad = {k: s for k, s in sums.items() if not is_zero(s - 1)}
         if bad:
             detail = ", ".join(f"piece {k}: {s}" for k, s in sorted(bad.items()))
             raise InconsistentCoefficientsError(
@@ -118,7 +119,7 @@ class Composition:
     def symmetric(self) -> bool:
         """Palindromic pieces and coefficients: ``Phi_{-h} o Phi_h = id``."""
         return self.pieces == self.pieces[::-1] and all(
-            sympy.simplify(a - b) == 0 for a, b in zip(self.coefficients, self.coefficients[::-1])
+            is_zero(a - b) for a, b in zip(self.coefficients, self.coefficients[::-1])
         )
 
     @property

@@ -52,6 +52,7 @@ import sympy
 
 from ..algebra.ansatz import Ansatz, Rows
 from ..algebra.elimination import Echelon, kernel_rref, rank, solve_affine
+from ..algebra.zero import is_zero
 from ..bch import expand_terms, formal_bch
 from ..bch.expansion import piece_evaluator, term_evaluator
 from ..bch.lyndon import is_bracket
@@ -269,7 +270,7 @@ class FIResult:
             for key, value in items:
                 rep = self._rep(comm, key)
                 total = total + rep.formal.scale(comm.coefficient * sympy.sympify(value))
-            if sympy.simplify(sum(sympy.sympify(v) for _, v in (w.items() if isinstance(w, dict) else enumerate(w))) - 1) != 0:
+            if not is_zero(sum(sympy.sympify(v) for _, v in (w.items() if isinstance(w, dict) else enumerate(w))) - 1):
                 raise NambuBCHError(f"the weights of commutator {t} ({comm.label()}) must sum to 1, got {w}")
         return total
 

@@ -40,6 +40,7 @@ from dataclasses import dataclass, field
 import sympy
 
 from ..algebra import liouville_field, nambu_bracket, poisson_bracket
+from ..algebra.zero import is_zero
 from ..bch.backward import check_order, effective_field
 from ..bch.evaluation import BracketEvaluator
 from ..bch.formal import formal_bch
@@ -261,34 +262,6 @@ def _tidy(expr):
     if expr.has(sympy.exp):
         return sympy.expand(sympy.powsimp(expr, combine="exp"))
     return expr
-
-
-def is_zero(expr) -> bool:
-    """Exact zero test for the expressions met here (polynomial, rational, exp, trigonometric, undefined functions).
-
-    Rational functions are cancelled; exponentials and trigonometric functions are
-    rewritten as exponentials and combined, which decides every identity between
-    polynomials in ``exp(a x)``, ``cos``, ``sin``; ``simplify`` only as the last resort.
-
-    >>> x = sympy.Symbol("x")
-    >>> is_zero(sympy.sin(x)**2 + sympy.cos(x)**2 - 1), is_zero(1/(1 + x) - 1/(x + 1)**2 * (x + 1))
-    (True, True)
-    """
-    expr = sympy.sympify(expr)
-    symbols = sorted(expr.free_symbols, key=str)
-    if expr.is_rational_function(*symbols):
-        return sympy.cancel(sympy.together(expr)) == 0
-    e = sympy.expand(expr)
-    if e == 0:
-        return True
-    if e.has(sympy.exp, sympy.sin, sympy.cos, sympy.tan, sympy.sinh, sympy.cosh, sympy.tanh):
-        r = sympy.expand(sympy.powsimp(sympy.expand(e.rewrite(sympy.exp)), combine="exp"))
-        if r == 0:
-            return True
-        r = sympy.cancel(sympy.together(r))
-        if r == 0:
-            return True
-    return sympy.simplify(e) == 0
 
 
 def check_against_backward(result: PoissonShadow) -> None:
