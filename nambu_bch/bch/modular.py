@@ -134,136 +134,91 @@ def lyndon_table(g: int, n: int):
     return _lyndon_table_kernel(g, n, _duval_count(g, n))
 
 
-# -- the Lyndon matrix <P_v, w> -------------------------------------------------------------------------------
+# -- the Lyndon matrix <P_v, w>, through the chains v = a^k u -------------------------------------------------
 
 
 @numba.njit(cache=True)
-def _pruned(v, x, st, words, lengths, content, prefix, g):
-    """``True`` when ``x[st:st+|v|]`` is outside the support of ``P_v``: other content, ``< v``, reversal ``< v``."""
-    L = lengths[v]
-    for a in range(g):
-        if prefix[st + L, a] - prefix[st, a] != content[v, a]:
-            return True
-    for i in range(L):
-        if x[st + i] != words[v, i]:
-            if x[st + i] < words[v, i]:
-                return True
-            break
-    for i in range(L):
-        if x[st + L - 1 - i] != words[v, i]:
-            if x[st + L - 1 - i] < words[v, i]:
-                return True
-            break
-    return False
+def _chains(words, lengths, left, right):
+    """Per Lyndon word ``v``: ``K`` (letters peeled as ``P_{a u} = [a, P_u]``, ``a`` the first letter), core, lead, span.
 
-
-@numba.njit(cache=True)
-def _pvalue(v0, x, tid, words, lengths, left, right, content, prefix, g, memo_row, memo_val, memo_stamp, stack):
-    """``<P_v0, x>``: ``<[P_u, P_u'], y> = <P_u, y[:|u|]><P_u', y[|u|:]> - <P_u', y[:|u'|]><P_u, y[|u'|:]>``.
-
-    Exact pruning (:func:`_pruned`) and a memo of ``<P_u, x[st:st+|u|]>`` for the current word
-    ``x`` (stamped ``tid``); iterative with an explicit stack of frames ``(v, st, stage, total, saved)``."""
-    top = 0
-    stack[0, 0], stack[0, 1], stack[0, 2], stack[0, 3], stack[0, 4] = v0, 0, 0, 0, 0
-    result = 0
-    returning = False
-    while top >= 0:
-        v, st, stage = stack[top, 0], stack[top, 1], stack[top, 2]
-        if not returning:
-            if lengths[v] == 1:
-                result = 1 if x[st] == words[v, 0] else 0
-                top -= 1
-                returning = True
-                continue
-            row = memo_row[v]
-            if row >= 0 and memo_stamp[row, st] == tid:
-                result = memo_val[row, st]
-                top -= 1
-                returning = True
-                continue
-            if _pruned(v, x, st, words, lengths, content, prefix, g):
-                result = 0
-                if row >= 0:
-                    memo_stamp[row, st] = tid
-                    memo_val[row, st] = 0
-                top -= 1
-                returning = True
-                continue
-            stack[top, 2], stack[top, 3] = 1, 0
-            top += 1
-            stack[top, 0], stack[top, 1], stack[top, 2] = left[v], st, 0
-            continue
-        returning = False
-        u, u2 = left[v], right[v]
-        done = False
-        if stage == 1:  # result = <P_u, y[:|u|]>
-            if result != 0:
-                stack[top, 4], stack[top, 2] = result, 2
-                top += 1
-                stack[top, 0], stack[top, 1], stack[top, 2] = u2, st + lengths[u], 0
-            else:
-                stack[top, 2] = 3
-                top += 1
-                stack[top, 0], stack[top, 1], stack[top, 2] = u2, st, 0
-        elif stage == 2:  # result = <P_u', y[|u|:]>
-            stack[top, 3] += stack[top, 4] * result
-            stack[top, 2] = 3
-            top += 1
-            stack[top, 0], stack[top, 1], stack[top, 2] = u2, st, 0
-        elif stage == 3:  # result = <P_u', y[:|u'|]>
-            if result != 0:
-                stack[top, 4], stack[top, 2] = result, 4
-                top += 1
-                stack[top, 0], stack[top, 1], stack[top, 2] = u, st + lengths[u2], 0
-            else:
-                result = stack[top, 3]
-                done = True
-        else:  # result = <P_u, y[|u'|:]>
-            result = stack[top, 3] - stack[top, 4] * result
-            done = True
-        if done:
-            row = memo_row[v]
-            if row >= 0:
-                memo_stamp[row, st] = tid
-                memo_val[row, st] = result
-            top -= 1
-            returning = True
-    return result
+    ``v = a^K u`` with ``P_v = ad_a^K P_u`` (the standard factorisation's left factor is the
+    letter ``a`` ``K`` times in a row); ``u`` is the core; ``lead`` counts the leading ``a``'s;
+    ``span`` is the last ``j`` with ``v[j:]`` still starting with ``a`` (``K``, or ``K - 1`` when
+    the core starts with a larger letter)."""
+    count = lengths.shape[0]
+    span = np.zeros(count, dtype=np.int64)
+    K = np.zeros(count, dtype=np.int64)
+    core = np.arange(count)
+    lead = np.zeros(count, dtype=np.int64)
+    for i in range(count):
+        a = words[i, 0]
+        j = 0
+        while j < lengths[i] and words[i, j] == a:
+            j += 1
+        lead[i] = j
+        c, k = i, 0
+        while lengths[c] > 1 and lengths[left[c]] == 1 and words[left[c], 0] == a:
+            c = right[c]
+            k += 1
+        K[i], core[i] = k, c
+        span[i] = k if words[c, 0] == a else k - 1
+    return K, core, lead, span
 
 
 _LANES = 8  # words evaluated together by one program sweep (8 x int32: one AVX2 vector)
 
 
 @numba.njit(cache=True)
-def _solve(z, primes, words, lengths, left, right, order, class_start, g):
-    """Eq. (1) in place, all primes at once: ``z_w -= <P_v, w> z_v`` over ``v < w`` of ``w``'s content class.
+def _solve(z, primes, words, lengths, left, right, members, class_start, K, core, lead, span, g, d):
+    """Eq. (1) in place, all primes at once, for every degree ``<= d`` through the content classes of degree ``d``.
 
-    Rows run in (degree, content, lex) order.  Per class one straight-line program
-    (:func:`_class_program`) gives every ``<P_v, w>`` in one sweep, for :data:`_LANES` words
-    ``w`` side by side (int32: ``|<P_u, x>| <= 2^(|u|-1)`` and each product of two children is
-    at most ``2^(|u|-2)``, exact for ``|u| <= 31``); the matrix is never stored, a class whose
-    word coefficients all vanish is skipped, and ``<P_v, w>`` is used only when ``z_v != 0``.
-    Returns the number of program nodes run (times lanes)."""
+    Chains.  Let ``a`` be the smallest letter of a class (every member starts with it) and
+    ``v = a^k u`` with ``P_v = ad_a^k P_u`` (``k <= K_v``).  A Lyndon word ``w`` of length ``>= 2``
+    does not end with ``a``, so of ``ad_a^k P_u = sum_i C(k,i) (-1)^(k-i) a^i P_u a^(k-i)`` only
+    ``i = k`` meets it:
+
+        ``<P_v, w> = [w starts with a^k] <P_u, w[k:]>``.                                   (2)
+
+    Hence for members ``v < w`` of a class of degree ``d`` the same number
+    ``c = <P_{core v}, w[K_v:]>`` is the entry of every pair of suffixes ``(v[j:], w[j:])``,
+    ``j <= min(span_v, span_w)`` (suffixes still starting with ``a``, :func:`_chains`), and every
+    pair of equal-content Lyndon words of lower degree ``d - j`` and smallest letter ``a``
+    (length ``>= 2``) is such a pair of suffixes of exactly one pair of degree ``d`` (prefix
+    ``a^j``: ``a^j x`` is Lyndon with ``P = ad_a^j P_x``).  So only the classes of
+    degree ``d`` are walked, in lexicographic order (a suffix ``v[j:]`` is final once ``v`` is),
+    and ``c`` is applied along the chains.
+
+    Per class one straight-line program (:func:`_class_program`) for the cores gives every
+    ``c`` in one sweep, for :data:`_LANES` words ``w`` side by side (int32: ``|<P_u, x>| <=
+    2^(|u|-1)``, exact for ``|u| <= 31``); the matrix is never stored, a class whose word
+    coefficients all vanish is skipped, and ``c`` is used only when a suffix of ``v`` has
+    ``z != 0``.  Returns the number of program nodes run (times lanes)."""
     k = primes.shape[0]
-    m = order.shape[0]
+    m = members.shape[0]
     live = np.zeros(m, dtype=np.bool_)
     x = np.zeros((_LANES, 64), dtype=np.int64)
-    acc = np.zeros(k, dtype=np.int64)
+    acc = np.zeros((d, k), dtype=np.int64)
+    block = 1 << max(0, 35 - d)
     work = 0
     r0 = 0
     while r0 < m:
         r1 = r0
         while r1 < m and class_start[r1] == r0:
             r1 += 1
+        size = r1 - r0
+        chain = np.full((size, d), -1, dtype=np.int64)  # chain[r, j]: index of members[r0 + r][j:]
         any_nonzero = False
-        for r in range(r0, r1):
-            for i in range(k):
-                if z[order[r], i] != 0:
-                    any_nonzero = True
-        d = lengths[order[r0]]
-        block = 1 << max(0, 35 - d)
-        if any_nonzero and d > 1 and r1 - r0 > 1:
-            kids, roots = _class_program(order[r0:r1], words, lengths, left, right, g, d)
+        for r in range(size):
+            c = members[r0 + r]
+            chain[r, 0] = c
+            for j in range(1, span[c] + 1):
+                chain[r, j] = right[chain[r, j - 1]]
+            for j in range(span[c] + 1):
+                for i in range(k):
+                    if z[chain[r, j], i] != 0:
+                        any_nonzero = True
+        if any_nonzero and size > 1:
+            kids, roots = _class_program(members[r0:r1], core, K, words, lengths, left, right, g, d)
             X = np.zeros((g * d + kids.shape[0], _LANES), dtype=np.int32)
             for b0 in range(r0, r1, _LANES):
                 b1 = min(b0 + _LANES, r1)
@@ -274,46 +229,56 @@ def _solve(z, primes, words, lengths, left, right, order, class_start, g):
                 if stop >= 0:
                     for r in range(b0, b1):
                         for i in range(d):
-                            x[r - b0, i] = words[order[r], i]
+                            x[r - b0, i] = words[members[r], i]
                     _run_program(kids, x, g, d, stop, X)
-                    work += (stop + 1) * _LANES
+                    work += max(0, stop + 1 - g * d) * _LANES
                 for r in range(b0, b1):
-                    w = order[r]
+                    w = members[r]
                     lane = r - b0
+                    kw, la = span[w], lead[w]
                     if stop >= 0:
-                        # sum c z_v in int64, reduced every ``block`` terms: |c| <= 2^(d-1), z_v < 2^28, so
+                        # sum c z in int64, reduced every ``block`` terms: |c| <= 2^(d-1), z < 2^28, so
                         # block * 2^(d+27) <= 2^62 (no integer division in the inner loop)
-                        acc[:] = 0
+                        acc[: kw + 1, :] = 0
                         terms = 0
                         for q in range(r0, r):
                             if live[q]:
-                                c = np.int64(X[roots[q - r0], lane])
-                                if c != 0:
-                                    v = order[q]
-                                    for i in range(k):
-                                        acc[i] += c * z[v, i]
-                                    terms += 1
-                                    if terms == block:
-                                        for i in range(k):
-                                            acc[i] %= primes[i]
-                                        terms = 0
+                                if K[members[q]] <= la:  # Eq. (2): w starts with a^K_v
+                                    c = np.int64(X[roots[q - r0], lane])
+                                    if c != 0:
+                                        for j in range(min(span[members[q]], kw) + 1):
+                                            v = chain[q - r0, j]
+                                            for i in range(k):
+                                                acc[j, i] += c * z[v, i]
+                                        terms += 1
+                                        if terms == block:
+                                            for j in range(kw + 1):
+                                                for i in range(k):
+                                                    acc[j, i] %= primes[i]
+                                            terms = 0
+                        for j in range(kw + 1):
+                            v = chain[r - r0, j]
+                            for i in range(k):
+                                z[v, i] = (z[v, i] - acc[j, i] % primes[i]) % primes[i]
+                    for j in range(kw + 1):
                         for i in range(k):
-                            z[w, i] = (z[w, i] - acc[i] % primes[i]) % primes[i]
-                    for i in range(k):
-                        if z[w, i] != 0:
-                            live[r] = True
+                            if z[chain[r - r0, j], i] != 0:
+                                live[r] = True
         else:
-            for r in range(r0, r1):
-                for i in range(k):
-                    if z[order[r], i] != 0:
-                        live[r] = True
+            for r in range(size):
+                for j in range(span[members[r0 + r]] + 1):
+                    for i in range(k):
+                        if z[chain[r, j], i] != 0:
+                            live[r0 + r] = True
         r0 = r1
     return work
 
 
 @numba.njit(cache=True)
-def _word_coefficients(letters, cpow, logk, primes, g, n, count):
+def _word_coefficients(letters, cpow, logk, primes, g, n, count, top):
     """``<log Phi, w> mod p`` for the Lyndon words ``w`` of length ``<= n`` in Duval order, every prime at once.
+
+    Words longer than ``top`` are skipped (left 0).
 
     ``cpow[i, t, r] = c_t^r / r!`` and ``logk[i, k] = (-1)^(k+1) / k`` modulo ``primes[i]``."""
     s = letters.shape[0]
@@ -339,38 +304,40 @@ def _word_coefficients(letters, cpow, logk, primes, g, n, count):
                 length -= 1
             extend = False
             continue
-        a = w[m - 1]
-        run[m] = run[m - 1] + 1 if m > 1 and w[m - 2] == a else 1
-        for j in range(m):
-            for i in range(k):
-                F[m, j, 0, i] = 0
-            for t in range(1, s + 1):
+        if m <= top:
+            a = w[m - 1]
+            run[m] = run[m - 1] + 1 if m > 1 and w[m - 2] == a else 1
+            for j in range(m):
                 for i in range(k):
-                    acc[i] = F[m, j, t - 1, i]
-                if letters[t - 1] == a:
-                    for r in range(1, min(run[m], m - j) + 1):
-                        for i in range(k):
-                            acc[i] += F[m - r, j, t - 1, i] * cpow[i, t - 1, r]
+                    F[m, j, 0, i] = 0
+                for t in range(1, s + 1):
                     for i in range(k):
-                        acc[i] %= primes[i]
-                for i in range(k):
-                    F[m, j, t, i] = acc[i]
-        for i in range(k):
-            A[m, 0, i] = 0
-        for kk in range(1, m + 1):
+                        acc[i] = F[m, j, t - 1, i]
+                    if letters[t - 1] == a:
+                        for r in range(1, min(run[m], m - j) + 1):
+                            for i in range(k):
+                                acc[i] += F[m - r, j, t - 1, i] * cpow[i, t - 1, r]
+                        for i in range(k):
+                            acc[i] %= primes[i]
+                    for i in range(k):
+                        F[m, j, t, i] = acc[i]
             for i in range(k):
-                acc[i] = 0
-            for j in range(kk - 1, m):
+                A[m, 0, i] = 0
+            for kk in range(1, m + 1):
                 for i in range(k):
-                    acc[i] += A[j, kk - 1, i] * F[m, j, s, i]
-            for i in range(k):
-                A[m, kk, i] = acc[i] % primes[i]
+                    acc[i] = 0
+                for j in range(kk - 1, m):
+                    for i in range(k):
+                        acc[i] += A[j, kk - 1, i] * F[m, j, s, i]
+                for i in range(k):
+                    A[m, kk, i] = acc[i] % primes[i]
         if not extend:
-            for i in range(k):
-                total = 0
-                for kk in range(1, m + 1):
-                    total += logk[i, kk] * A[m, kk, i]
-                out[idx, i] = total % primes[i]
+            if m <= top:
+                for i in range(k):
+                    total = 0
+                    for kk in range(1, m + 1):
+                        total += logk[i, kk] * A[m, kk, i]
+                    out[idx, i] = total % primes[i]
             idx += 1
             period = m
         if length < n:  # Duval: extend periodically, one letter (one row) at a time
@@ -426,7 +393,9 @@ def lyndon_numerators(letters, values, q, g, n, denominators, stats=None):
         return None
     words, lengths, left, right = lyndon_table(g, n)
     count = len(lengths)
-    order, class_start, content, memo_row = _class_order(g, n)
+    eriksen = _eriksen_sign(letters, g, n)
+    top = n - 1 if eriksen else n  # Eq. (3): the even top degree of log(e^A e^B) follows from the odd ones
+    members, class_start, K, core, lead, span = _class_order(g, n, top)
     primes = np.array(moduli, dtype=np.int64)
     cpow = np.zeros((len(moduli), len(values), n + 1), dtype=np.int64)
     logk = np.zeros((len(moduli), n + 1), dtype=np.int64)
@@ -439,10 +408,18 @@ def lyndon_numerators(letters, values, q, g, n, denominators, stats=None):
                 cpow[i, t, r] = pow(c, r, p) * inv_fact[r] % p
         for kk in range(1, n + 1):
             logk[i, kk] = (1 if kk % 2 else p - 1) * pow(kk, p - 2, p) % p
-    z = _word_coefficients(np.asarray(letters, dtype=np.int64), cpow, logk, primes, g, n, count)
-    work = _solve(z, primes, words, lengths, left, right, order, class_start, g)
+    z = _word_coefficients(np.asarray(letters, dtype=np.int64), cpow, logk, primes, g, n, count, top)
+    work = _solve(z, primes, words, lengths, left, right, members, class_start, K, core, lead, span, g, top)
+    if eriksen:
+        a = Fraction(int(values[letters.index(0)]), q)  # the coefficient of the letter 0
+        beta = np.zeros((len(moduli), n + 1), dtype=np.int64)
+        for kk, b in _tanh_half_coefficients(n).items():
+            value = eriksen * b * a**kk
+            for i, p in enumerate(moduli):
+                beta[i, kk] = value.numerator % p * pow(value.denominator % p, p - 2, p) % p
+        _even_top(z, primes, lengths, right, K, beta, n)
     if stats is not None:
-        stats.update(primes=len(moduli), program_nodes=int(work), lyndon=count)
+        stats.update(primes=len(moduli), program_nodes=int(work), lyndon=count, solved_degree=top)
     scale = np.array([[denominators[d] % p for p in moduli] for d in range(n + 1)], dtype=np.int64)
     residues = z * scale[lengths] % primes
     numerators = _garner(residues, moduli)
@@ -452,24 +429,65 @@ def lyndon_numerators(letters, values, q, g, n, denominators, stats=None):
     return out
 
 
+def _eriksen_sign(letters, g: int, n: int) -> int:
+    """``+1`` for ``e^{aA} e^{bB}``, ``-1`` for ``e^{bB} e^{aA}`` (two letters), at an even degree ``n``; else 0."""
+    if g == 2 and n % 2 == 0 and len(letters) == 2 and sorted(letters) == [0, 1]:
+        return 1 if list(letters) == [0, 1] else -1
+    return 0
+
+
+@lru_cache(maxsize=8)
+def _tanh_half_coefficients(n: int) -> dict:
+    """``{k: [x^k] tanh(x/2)}`` for odd ``k <= n``: ``2 (2^(k+1) - 1) B_(k+1) / (k+1)!`` (Bernoulli numbers)."""
+    out = {}
+    for k in range(1, n + 1, 2):
+        b = sympy.bernoulli(k + 1)
+        out[k] = Fraction(2 * (2 ** (k + 1) - 1) * int(b.p), int(b.q) * factorial(k + 1))
+    return out
+
+
+@numba.njit(cache=True)
+def _even_top(z, primes, lengths, right, K, beta, n):
+    """The even top degree ``n`` of ``Z = log(e^{aA} e^{bB})`` from its odd degrees (Eriksen 1968, Sect. III.A).
+
+    ``e^{aA} e^{bB} = e^{aA} (e^{bB} e^{aA}) e^{-aA}`` and ``log(e^{bB} e^{aA}) = sum_d (-1)^(d+1) Z_d``
+    give ``Z_even = tanh(a ad_A / 2) Z_odd`` (for ``e^{bB} e^{aA}`` the sign flips), and
+    ``ad_A^k P_v = P_{A^k v}`` for a Lyndon word ``v != A``, so
+
+        ``z_w = sum_{k odd, k <= K_w} beta_k z_{w[k:]}``,  ``beta_k = +-[x^k] tanh(x/2) a^k``.    (3)
+    """
+    k = primes.shape[0]
+    acc = np.zeros(k, dtype=np.int64)
+    for w in range(lengths.shape[0]):
+        if lengths[w] != n:
+            continue
+        acc[:] = 0
+        c = w
+        for j in range(1, K[w] + 1):
+            c = right[c]
+            if j % 2 == 1:
+                for i in range(k):
+                    acc[i] = (acc[i] + beta[i, j] * z[c, i]) % primes[i]
+        for i in range(k):
+            z[w, i] = acc[i]
+
+
 @lru_cache(maxsize=16)
-def _class_order(g: int, n: int):
-    """Lyndon indices sorted by (degree, content, lex), each position's class start, contents, memo rows."""
-    words, lengths, _, _ = lyndon_table(g, n)
-    inside = np.arange(n)[None, :] < lengths[:, None]  # rows are zero-padded beyond the word
-    content = np.zeros((len(lengths), g), dtype=np.int64)
+def _class_order(g: int, n: int, top: int):
+    """The Lyndon words of length ``top`` (table of length ``<= n``) in (content, lex) order, class starts, chains."""
+    words, lengths, left, right = lyndon_table(g, n)
+    K, core, lead, span = _chains(words, lengths, left, right)
+    members = np.flatnonzero(lengths == top)
+    content = np.zeros((len(members), g), dtype=np.int64)
     for a in range(g):
-        content[:, a] = ((words == a) & inside).sum(axis=1)
-    key = lengths.copy()
+        content[:, a] = (words[members, :top] == a).sum(axis=1)
+    key = np.zeros(len(members), dtype=np.int64)
     for a in range(g):
         key = key * (n + 1) + content[:, a]
     order = np.argsort(key, kind="stable")  # Duval order is lexicographic: kept within a class
     sorted_key = key[order]
     class_start = np.searchsorted(sorted_key, sorted_key, side="left")
-    inner = lengths < n  # only proper sub-brackets are memoised
-    memo_row = np.full(len(lengths), -1, dtype=np.int64)
-    memo_row[inner] = np.arange(int(inner.sum()))
-    return order, class_start, content, memo_row
+    return members[order], class_start, K, core, lead, span
 
 
 def _garner(residues, moduli):
@@ -493,22 +511,29 @@ def _garner(residues, moduli):
 
 
 @numba.njit(cache=True)
-def _class_program(members, words, lengths, left, right, g, d):
-    """A straight-line program for ``<P_v, x>``, every ``v`` in ``members`` (one content class, degree ``d``).
+def _class_program(members, core, K, words, lengths, left, right, g, d):
+    """A straight-line program for ``<P_u, x[K_v:]>``, ``u`` the core of ``v``, every ``v`` in ``members``.
 
-    Node ``(u, l)`` holds ``<P_u, x[l:l+|u|]>``; the ``g d`` leaves ``(a, l)`` hold ``[x_l = a]``; an
-    inner node is ``X[c1] X[c2] - X[c3] X[c4]`` with children ``(u1, l), (u2, l+|u1|), (u2, l),
-    (u1, l+|u2|)`` for ``P_u = [P_u1, P_u2]``.  Nodes are numbered children first, roots in
-    member order, so evaluating up to the root of a member evaluates all it needs."""
+    ``members`` is one content class of degree ``d`` (:func:`_solve`, Eq. (2)).  Node ``(u, l)``
+    holds ``<P_u, x[l:l+|u|]>``; the ``g d`` leaves ``(a, l)`` hold ``[x_l = a]``; an inner node is
+    ``X[c1] X[c2] - X[c3] X[c4]`` with children ``(u1, l), (u2, l+|u1|), (u2, l), (u1, l+|u2|)`` for
+    ``P_u = [P_u1, P_u2]``.  Nodes are numbered children first, roots in member order, so
+    evaluating up to the root of a member evaluates all it needs; a core that is a letter has a
+    leaf as its root."""
     index = numba.typed.Dict.empty(numba.types.int64, numba.types.int64)
     cap = 64
     kids = np.empty((cap, 4), dtype=np.int64)
     count = g * d
     roots = np.empty(members.shape[0], dtype=np.int64)
     stack = np.empty((4 * d * d + 8, 2), dtype=np.int64)
+    ks = np.empty(4, dtype=np.int64)
     for r in range(members.shape[0]):
+        u0, l0 = core[members[r]], K[members[r]]
+        if lengths[u0] == 1:
+            roots[r] = words[u0, 0] * d + l0
+            continue
         top = 0
-        stack[0, 0], stack[0, 1] = members[r], 0
+        stack[0, 0], stack[0, 1] = u0, l0
         while top >= 0:
             u, l = stack[top, 0], stack[top, 1]
             key = u * 64 + l
@@ -516,7 +541,6 @@ def _class_program(members, words, lengths, left, right, g, d):
                 top -= 1
                 continue
             u1, u2 = left[u], right[u]
-            ks = np.empty(4, dtype=np.int64)
             missing = False
             for c in range(4):
                 cu = u1 if c == 0 or c == 3 else u2
@@ -546,7 +570,7 @@ def _class_program(members, words, lengths, left, right, g, d):
             index[key] = count
             count += 1
             top -= 1
-        roots[r] = index[members[r] * 64]
+        roots[r] = index[u0 * 64 + l0]
     return kids[: count - g * d].copy(), roots
 
 
