@@ -68,6 +68,23 @@ PRIMES = tuple(int(p) for p in sympy.primerange(2**28 - 6000, 2**28))[::-1]
 MAX_PRIMES = 24
 
 
+# -- modular reduction ----------------------------------------------------------------------------------------
+
+@numba.njit(cache=True, inline="always")
+def _reduce(x, p, inv):
+    """``x mod p`` for ``|x| < 2^62``, ``p < 2^28``, ``inv = 1.0 / p``: a float64 quotient, one correction each way.
+
+    ``x * inv`` is within ``2^-17`` of ``x / p`` (53-bit mantissas, ``|x / p| < 2^34``), so
+    ``floor`` is off by at most one and ``x - q p`` lies in ``(-p, 2p)`` (no integer division)."""
+    q = np.int64(np.floor(np.float64(x) * inv))
+    r = x - q * p
+    if r < 0:
+        r += p
+    elif r >= p:
+        r -= p
+    return r
+
+
 # -- Lyndon table -------------------------------------------------------------------------------------------------
 
 @numba.njit(cache=True)
@@ -194,10 +211,13 @@ def _solve(z, primes, words, lengths, left, right, members, class_start, K, core
     coefficients all vanish is skipped, and ``c`` is used only when a suffix of ``v`` has
     ``z != 0``.  Returns the number of program nodes run (times lanes)."""
     k = primes.shape[0]
+    inv = 1.0 / primes.astype(np.float64)
     m = members.shape[0]
     live = np.zeros(m, dtype=np.bool_)
     x = np.zeros((_LANES, 64), dtype=np.int64)
-    acc = np.zeros((d, k), dtype=np.int64)
+    acc = np.zeros((_LANES, d, k), dtype=np.int64)
+    lane_span = np.zeros(_LANES, dtype=np.int64)
+    lane_lead = np.zeros(_LANES, dtype=np.int64)
     block = 1 << max(0, 35 - d)
     work = 0
     r0 = 0
@@ -232,34 +252,51 @@ def _solve(z, primes, words, lengths, left, right, members, class_start, K, core
                             x[r - b0, i] = words[members[r], i]
                     _run_program(kids, x, g, d, stop, X)
                     work += max(0, stop + 1 - g * d) * _LANES
-                for r in range(b0, b1):
-                    w = members[r]
-                    lane = r - b0
-                    kw, la = span[w], lead[w]
-                    if stop >= 0:
-                        # sum c z in int64, reduced every ``block`` terms: |c| <= 2^(d-1), z < 2^28, so
-                        # block * 2^(d+27) <= 2^62 (no integer division in the inner loop)
-                        acc[: kw + 1, :] = 0
-                        terms = 0
-                        for q in range(r0, r):
-                            if live[q]:
-                                if K[members[q]] <= la:  # Eq. (2): w starts with a^K_v
-                                    c = np.int64(X[roots[q - r0], lane])
+                nb = b1 - b0
+                for lane in range(nb):
+                    lane_span[lane], lane_lead[lane] = span[members[b0 + lane]], lead[members[b0 + lane]]
+                if stop >= 0:
+                    # sum c z in int64, reduced every ``block`` terms: |c| <= 2^(d-1), z < 2^28, so
+                    # block * 2^(d+27) <= 2^62 (no integer division in the inner loops)
+                    acc[:nb] = 0
+                    terms = 0
+                    for q in range(r0, b0):  # members before the group (final): one row of X for all lanes
+                        if live[q]:
+                            kv, sv, root = K[members[q]], span[members[q]], roots[q - r0]
+                            hit = False
+                            for lane in range(nb):
+                                if kv <= lane_lead[lane]:  # Eq. (2): w starts with a^K_v
+                                    c = np.int64(X[root, lane])
                                     if c != 0:
-                                        for j in range(min(span[members[q]], kw) + 1):
+                                        hit = True
+                                        for j in range(min(sv, lane_span[lane]) + 1):
                                             v = chain[q - r0, j]
                                             for i in range(k):
-                                                acc[j, i] += c * z[v, i]
-                                        terms += 1
-                                        if terms == block:
-                                            for j in range(kw + 1):
-                                                for i in range(k):
-                                                    acc[j, i] %= primes[i]
-                                            terms = 0
+                                                acc[lane, j, i] += c * z[v, i]
+                            if hit:
+                                terms += 1
+                                if terms >= block - _LANES:  # the group's own members add at most _LANES - 1
+                                    for lane in range(nb):
+                                        for j in range(lane_span[lane] + 1):
+                                            for i in range(k):
+                                                acc[lane, j, i] = _reduce(acc[lane, j, i], primes[i], inv[i])
+                                    terms = 0
+                for r in range(b0, b1):
+                    lane = r - b0
+                    kw, la = lane_span[lane], lane_lead[lane]
+                    if stop >= 0:
+                        for q in range(b0, r):  # members of the group before w (final by now)
+                            if live[q] and K[members[q]] <= la:
+                                c = np.int64(X[roots[q - r0], lane])
+                                if c != 0:
+                                    for j in range(min(span[members[q]], kw) + 1):
+                                        v = chain[q - r0, j]
+                                        for i in range(k):
+                                            acc[lane, j, i] += c * z[v, i]
                         for j in range(kw + 1):
                             v = chain[r - r0, j]
                             for i in range(k):
-                                z[v, i] = (z[v, i] - acc[j, i] % primes[i]) % primes[i]
+                                z[v, i] = _reduce(z[v, i] - acc[lane, j, i], primes[i], inv[i])
                     for j in range(kw + 1):
                         for i in range(k):
                             if z[chain[r - r0, j], i] != 0:
@@ -283,6 +320,7 @@ def _word_coefficients(letters, cpow, logk, primes, g, n, count, top):
     ``cpow[i, t, r] = c_t^r / r!`` and ``logk[i, k] = (-1)^(k+1) / k`` modulo ``primes[i]``."""
     s = letters.shape[0]
     k = primes.shape[0]
+    inv = 1.0 / primes.astype(np.float64)
     out = np.zeros((count, k), dtype=np.int64)
     F = np.zeros((n + 1, n + 1, s + 1, k), dtype=np.int64)  # F[m, j, t] = <E_1..E_t, w[j:m]>
     A = np.zeros((n + 1, n + 1, k), dtype=np.int64)  # A[m, kk] = <(Phi - 1)^kk, w[:m]>
@@ -307,7 +345,13 @@ def _word_coefficients(letters, cpow, logk, primes, g, n, count, top):
         if m <= top:
             a = w[m - 1]
             run[m] = run[m - 1] + 1 if m > 1 and w[m - 2] == a else 1
-            for j in range(m):
+            # <Phi, w[j:m]> = 0 unless w[j:m] is in X_{k_1}^* ... X_{k_s}^*: j >= lo (greedy from the right),
+            # and then so is every prefix w[j:m-r] (rows of shorter prefixes are valid from lo on)
+            lo = m
+            for t in range(s - 1, -1, -1):
+                while lo > 0 and w[lo - 1] == letters[t]:
+                    lo -= 1
+            for j in range(lo, m):
                 for i in range(k):
                     F[m, j, 0, i] = 0
                 for t in range(1, s + 1):
@@ -318,7 +362,7 @@ def _word_coefficients(letters, cpow, logk, primes, g, n, count, top):
                             for i in range(k):
                                 acc[i] += F[m - r, j, t - 1, i] * cpow[i, t - 1, r]
                         for i in range(k):
-                            acc[i] %= primes[i]
+                            acc[i] = _reduce(acc[i], primes[i], inv[i])
                     for i in range(k):
                         F[m, j, t, i] = acc[i]
             for i in range(k):
@@ -326,18 +370,18 @@ def _word_coefficients(letters, cpow, logk, primes, g, n, count, top):
             for kk in range(1, m + 1):
                 for i in range(k):
                     acc[i] = 0
-                for j in range(kk - 1, m):
+                for j in range(max(kk - 1, lo), m):
                     for i in range(k):
                         acc[i] += A[j, kk - 1, i] * F[m, j, s, i]
                 for i in range(k):
-                    A[m, kk, i] = acc[i] % primes[i]
+                    A[m, kk, i] = _reduce(acc[i], primes[i], inv[i])
         if not extend:
             if m <= top:
                 for i in range(k):
                     total = 0
                     for kk in range(1, m + 1):
                         total += logk[i, kk] * A[m, kk, i]
-                    out[idx, i] = total % primes[i]
+                    out[idx, i] = _reduce(total, primes[i], inv[i])
             idx += 1
             period = m
         if length < n:  # Duval: extend periodically, one letter (one row) at a time
@@ -457,6 +501,7 @@ def _even_top(z, primes, lengths, right, K, beta, n):
         ``z_w = sum_{k odd, k <= K_w} beta_k z_{w[k:]}``,  ``beta_k = +-[x^k] tanh(x/2) a^k``.    (3)
     """
     k = primes.shape[0]
+    inv = 1.0 / primes.astype(np.float64)
     acc = np.zeros(k, dtype=np.int64)
     for w in range(lengths.shape[0]):
         if lengths[w] != n:
@@ -467,7 +512,7 @@ def _even_top(z, primes, lengths, right, K, beta, n):
             c = right[c]
             if j % 2 == 1:
                 for i in range(k):
-                    acc[i] = (acc[i] + beta[i, j] * z[c, i]) % primes[i]
+                    acc[i] = _reduce(acc[i] + beta[i, j] * z[c, i], primes[i], inv[i])
         for i in range(k):
             z[w, i] = acc[i]
 
