@@ -42,6 +42,8 @@ Algebras*, Thm. 5.1 (Lyndon basis); Casas & Murua, J. Math. Phys. 50 (2009)
 
 from __future__ import annotations
 
+import gc
+from contextlib import contextmanager
 from dataclasses import dataclass, field
 from functools import lru_cache
 from math import comb, factorial, gcd, lcm
@@ -69,7 +71,7 @@ from .lyndon import (
 MAX_WORDS = 600_000
 #: Largest total size ``sum_d dim L_d 2^(d-1)`` of the Lyndon-basis expansions the dense projection walks.
 MAX_EXPANSION = 15_000_000
-#: Largest number of same-content Lyndon pairs ``(v, w)`` the sparse (modular) engine's solve may visit.
+#: Largest number of same-content Lyndon pairs ``(v, w)`` of the top degree the sparse (modular) engine's solve may visit.
 MAX_PAIRS = 2_500_000_000
 _HARD_DEGREE = 64  # beyond this not even the estimate is computed
 
@@ -109,7 +111,9 @@ def estimate_size(n_generators: int, max_degree: int) -> dict:
     """Sizes of the BCH computation: Lyndon basis elements (Witt), words, expansion entries, solve pairs.
 
     ``lyndon`` (Witt's formula) sizes the sparse engine's tables; ``pairs`` (same-content Lyndon
-    pairs, the unitriangular solve of :mod:`nambu_bch.bch.modular`) bounds its work;
+    pairs of the top degree: the unitriangular solve of :mod:`nambu_bch.bch.modular` walks only
+    the content classes of the top degree, the lower degrees ride along its ``ad_a`` chains)
+    bounds its work;
     ``words``/``top_words``/``expansion`` size the dense engine (associative words, and
     ``P_w`` of a word of length ``d`` has at most ``2^(d-1)`` terms).
 
@@ -122,7 +126,7 @@ def estimate_size(n_generators: int, max_degree: int) -> dict:
         "words": sum(g**d for d in range(1, max_degree + 1)),
         "top_words": g**max_degree,
         "expansion": sum(witt_dimension(g, d) * 2 ** (d - 1) for d in range(1, max_degree + 1)),
-        "pairs": sum(_class_pairs(g, d) for d in range(1, max_degree + 1)),
+        "pairs": _class_pairs(g, max_degree),
     }
 
 
@@ -588,13 +592,30 @@ def formal_bch(comp, max_degree: int, n_pieces: int | None = None) -> FormalBCH:
         big = lcm(*range(1, n + 1))
         dens = [factorial(d) * big * scalars.q**d for d in range(n + 1)]
         letters = [generators.index(k) for k in comp.pieces]
-        numerators = lyndon_numerators(letters, scalars.values, scalars.q, g, n, dens)
-        if numerators is not None:
-            trees = _duval_trees(g, n, generators)
-            elements = {d: (dens[d], tuple((c, trees[i]) for i, c in items)) for d, items in numerators.items()}
-            return FormalBCH(comp, generators, n, elements, None)
+        with _no_full_collection():
+            numerators = lyndon_numerators(letters, scalars.values, scalars.q, g, n, dens)
+            if numerators is not None:
+                trees = _duval_trees(g, n, generators)
+                elements = {d: (dens[d], tuple((c, trees[i]) for i, c in items)) for d, items in numerators.items()}
+                return FormalBCH(comp, generators, n, elements, None)
         check_degree(n, g, dense=True)  # coefficients too large for the primes: Python ints, dense engine
     return _formal_dense(comp, generators, n)
+
+
+@contextmanager
+def _no_full_collection():
+    """Pause the cyclic garbage collector while the sparse engine builds its (acyclic) tuples and ints.
+
+    Tens of thousands of new objects otherwise trigger a full collection that walks every object
+    of the interpreter (sympy's caches: about 70 ms, more than the whole computation at degree
+    16); nothing allocated here forms a cycle, so nothing is left for the collector to find."""
+    was_enabled = gc.isenabled()
+    gc.disable()
+    try:
+        yield
+    finally:
+        if was_enabled:
+            gc.enable()
 
 
 def _formal_dense(comp, generators: tuple, n: int) -> FormalBCH:

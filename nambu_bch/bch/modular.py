@@ -466,10 +466,11 @@ def lyndon_numerators(letters, values, q, g, n, denominators, stats=None):
         stats.update(primes=len(moduli), program_nodes=int(work), lyndon=count, solved_degree=top)
     scale = np.array([[denominators[d] % p for p in moduli] for d in range(n + 1)], dtype=np.int64)
     residues = z * scale[lengths] % primes
-    numerators = _garner(residues, moduli)
+    rows = np.flatnonzero(residues.any(axis=1))  # a zero residue vector is the numerator 0
+    numerators = _garner(residues[rows], moduli).tolist()
     out: dict = {}
-    for i in np.flatnonzero(numerators != 0).tolist():
-        out.setdefault(int(lengths[i]), []).append((i, int(numerators[i])))
+    for i, c in zip(rows.tolist(), numerators):
+        out.setdefault(int(lengths[i]), []).append((i, int(c)))
     return out
 
 
@@ -538,16 +539,25 @@ def _class_order(g: int, n: int, top: int):
 def _garner(residues, moduli):
     """Integers in ``(-M/2, M/2]`` (``M`` = product of ``moduli``) from ``residues[:, i]`` mod ``moduli[i]``.
 
-    Mixed-radix digits in int64 (Knuth, TAOCP vol. 2, Sect. 4.3.2), then one Python-int
-    combination per entry (object arrays)."""
+    Mixed-radix digits in int64 (Knuth, TAOCP vol. 2, Sect. 4.3.2); two digits at a time are
+    joined in int64 (``d_i + p_i d_(i+1) < 2^56``), then one Python-int combination per pair
+    (object arrays)."""
     digits = []
     for i, p in enumerate(moduli):
         x = residues[:, i].copy()
         for j in range(i):
             x = (x - digits[j]) % p * pow(moduli[j], p - 2, p) % p
         digits.append(x)
-    total = np.zeros(residues.shape[0], dtype=object)
-    for d, p in zip(reversed(digits), reversed(moduli)):
+    pairs, radices = [], []
+    for i in range(0, len(moduli), 2):
+        if i + 1 < len(moduli):
+            pairs.append(digits[i] + moduli[i] * digits[i + 1])
+            radices.append(moduli[i] * moduli[i + 1])
+        else:
+            pairs.append(digits[i])
+            radices.append(moduli[i])
+    total = pairs[-1].astype(object)
+    for d, p in zip(reversed(pairs[:-1]), reversed(radices[:-1])):
         total = total * p + d.astype(object)
     M = 1
     for p in moduli:
