@@ -20,7 +20,8 @@ R = sympy.Rational
 
 @pytest.fixture(autouse=True)
 def sparse_at_every_degree(monkeypatch):
-    """formal_bch uses the sparse engine from SPARSE_FROM_DEGREE on; here it is exercised at every degree."""
+    """formal_bch uses the sparse engine from SPARSE_FROM_DEGREE on (or above DENSE_COLD_WORDS words, or once it
+    has run); here it is exercised at every degree."""
     monkeypatch.setattr(formal_module, "SPARSE_FROM_DEGREE", 1)
 
 

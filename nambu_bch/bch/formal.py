@@ -43,6 +43,7 @@ Algebras*, Thm. 5.1 (Lyndon basis); Casas & Murua, J. Math. Phys. 50 (2009)
 from __future__ import annotations
 
 import gc
+import sys
 from contextlib import contextmanager
 from dataclasses import dataclass, field
 from functools import lru_cache
@@ -130,9 +131,14 @@ def estimate_size(n_generators: int, max_degree: int) -> dict:
     }
 
 
-#: From this degree on (or when the dense engine's arrays would be too large) rational series use the sparse
-#: modular engine; below it the dense engine is faster cold (bench_bch: 12321 degree 7, 0.03 s against 0.5 s).
-SPARSE_FROM_DEGREE = 10
+#: Rational series use the sparse modular engine from this degree on, when the dense engine would walk more than
+#: :data:`DENSE_COLD_WORDS` top-degree words, or once the compiled engine has run in this process.  Below that a
+#: fresh process answers faster with the dense engine, which needs no numba start-up (about 0.15 s); once numba is
+#: up the sparse engine is faster at every size (bch_c_reference / docs/performance.md: ``12`` degree 12, cold
+#: 0.11 s dense against 0.17 s sparse, warm 0.005 s against 0.002 s; ``12321`` degree 9, cold 0.21 s against 0.18 s).
+SPARSE_FROM_DEGREE = 32
+#: Largest ``g^n`` the dense engine takes in a process where the sparse engine has not run yet.
+DENSE_COLD_WORDS = 4096
 
 
 @lru_cache(maxsize=1024)
@@ -585,7 +591,9 @@ def formal_bch(comp, max_degree: int, n_pieces: int | None = None) -> FormalBCH:
     sparse = scalars.K is None and numba_available()
     n = check_degree(max_degree, g, dense=not sparse)
     # low degrees: the dense engine answers in milliseconds without loading numba (~0.4 s in a fresh process)
-    sparse = sparse and (n >= SPARSE_FROM_DEGREE or not _fits_dense(g, n))
+    sparse = sparse and (
+        n >= SPARSE_FROM_DEGREE or g**n > DENSE_COLD_WORDS or _sparse_engine_loaded() or not _fits_dense(g, n)
+    )
     if sparse:
         from .modular import lyndon_numerators  # compiled (numba); without it the dense engine below
 
@@ -600,6 +608,12 @@ def formal_bch(comp, max_degree: int, n_pieces: int | None = None) -> FormalBCH:
                 return FormalBCH(comp, generators, n, elements, None)
         check_degree(n, g, dense=True)  # coefficients too large for the primes: Python ints, dense engine
     return _formal_dense(comp, generators, n)
+
+
+def _sparse_engine_loaded() -> bool:
+    """The compiled engine has run in this process (numba's start-up is paid)."""
+    modular = sys.modules.get("nambu_bch.bch.modular")
+    return modular is not None and modular.runs > 0
 
 
 @contextmanager

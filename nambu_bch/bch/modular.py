@@ -66,6 +66,8 @@ import sympy
 PRIMES = tuple(int(p) for p in sympy.primerange(2**28 - 6000, 2**28))[::-1]
 #: Most primes the engine uses before leaving a series to the dense Python-int engine.
 MAX_PRIMES = 24
+#: Series computed by this engine in this process (``formal_bch`` prefers it once numba's start-up is paid).
+runs = 0
 
 
 # -- modular reduction ----------------------------------------------------------------------------------------
@@ -104,8 +106,9 @@ def _duval_count(g, n):
 
 
 @numba.njit(cache=True)
-def _lyndon_table_kernel(g, n, count):
+def _lyndon_table_kernel(g, n):
     """Lyndon words of length <= n in Duval (lexicographic) order, lengths, and standard factors."""
+    count = _duval_count(g, n)
     words = np.zeros((count, n), dtype=np.int8)
     lengths = np.zeros(count, dtype=np.int64)
     left = np.full(count, -1, dtype=np.int64)
@@ -148,7 +151,7 @@ def _lyndon_table_kernel(g, n, count):
 @lru_cache(maxsize=16)
 def lyndon_table(g: int, n: int):
     """``(words, lengths, left, right)`` for all Lyndon words of length ``<= n`` over ``0..g-1``, Duval order."""
-    return _lyndon_table_kernel(g, n, _duval_count(g, n))
+    return _lyndon_table_kernel(g, n)
 
 
 # -- the Lyndon matrix <P_v, w>, through the chains v = a^k u -------------------------------------------------
@@ -439,7 +442,7 @@ def lyndon_numerators(letters, values, q, g, n, denominators, stats=None):
     count = len(lengths)
     eriksen = _eriksen_sign(letters, g, n)
     top = n - 1 if eriksen else n  # Eq. (3): the even top degree of log(e^A e^B) follows from the odd ones
-    members, class_start, K, core, lead, span = _class_order(g, n, top)
+    members, class_start = _class_order(g, n, top)
     primes = np.array(moduli, dtype=np.int64)
     cpow = np.zeros((len(moduli), len(values), n + 1), dtype=np.int64)
     logk = np.zeros((len(moduli), n + 1), dtype=np.int64)
@@ -452,16 +455,17 @@ def lyndon_numerators(letters, values, q, g, n, denominators, stats=None):
                 cpow[i, t, r] = pow(c, r, p) * inv_fact[r] % p
         for kk in range(1, n + 1):
             logk[i, kk] = (1 if kk % 2 else p - 1) * pow(kk, p - 2, p) % p
-    z = _word_coefficients(np.asarray(letters, dtype=np.int64), cpow, logk, primes, g, n, count, top)
-    work = _solve(z, primes, words, lengths, left, right, members, class_start, K, core, lead, span, g, top)
+    beta = np.zeros((len(moduli), n + 1), dtype=np.int64)
     if eriksen:
         a = Fraction(int(values[letters.index(0)]), q)  # the coefficient of the letter 0
-        beta = np.zeros((len(moduli), n + 1), dtype=np.int64)
         for kk, b in _tanh_half_coefficients(n).items():
             value = eriksen * b * a**kk
             for i, p in enumerate(moduli):
                 beta[i, kk] = value.numerator % p * pow(value.denominator % p, p - 2, p) % p
-        _even_top(z, primes, lengths, right, K, beta, n)
+    z, work = _engine(np.asarray(letters, dtype=np.int64), cpow, logk, primes, beta, g, n, top,
+                      words, lengths, left, right, members, class_start)
+    global runs
+    runs += 1
     if stats is not None:
         stats.update(primes=len(moduli), program_nodes=int(work), lyndon=count, solved_degree=top)
     scale = np.array([[denominators[d] % p for p in moduli] for d in range(n + 1)], dtype=np.int64)
@@ -518,11 +522,22 @@ def _even_top(z, primes, lengths, right, K, beta, n):
             z[w, i] = acc[i]
 
 
+@numba.njit(cache=True)
+def _engine(letters, cpow, logk, primes, beta, g, n, top, words, lengths, left, right, members, class_start):
+    """Word coefficients, the chained solve of degree ``top``, and Eq. (3) when ``top < n``: one compiled entry
+    point (each entry point costs a cache load in a fresh process)."""
+    z = _word_coefficients(letters, cpow, logk, primes, g, n, lengths.shape[0], top)
+    K, core, lead, span = _chains(words, lengths, left, right)
+    work = _solve(z, primes, words, lengths, left, right, members, class_start, K, core, lead, span, g, top)
+    if top < n:
+        _even_top(z, primes, lengths, right, K, beta, n)
+    return z, work
+
+
 @lru_cache(maxsize=16)
 def _class_order(g: int, n: int, top: int):
-    """The Lyndon words of length ``top`` (table of length ``<= n``) in (content, lex) order, class starts, chains."""
-    words, lengths, left, right = lyndon_table(g, n)
-    K, core, lead, span = _chains(words, lengths, left, right)
+    """The Lyndon words of length ``top`` (table of length ``<= n``) in (content, lex) order, and class starts."""
+    words, lengths, _, _ = lyndon_table(g, n)
     members = np.flatnonzero(lengths == top)
     content = np.zeros((len(members), g), dtype=np.int64)
     for a in range(g):
@@ -533,7 +548,7 @@ def _class_order(g: int, n: int, top: int):
     order = np.argsort(key, kind="stable")  # Duval order is lexicographic: kept within a class
     sorted_key = key[order]
     class_start = np.searchsorted(sorted_key, sorted_key, side="left")
-    return members[order], class_start, K, core, lead, span
+    return members[order], class_start
 
 
 def _garner(residues, moduli):
