@@ -604,7 +604,10 @@ def formal_bch(comp, max_degree: int, n_pieces: int | None = None) -> FormalBCH:
             numerators = lyndon_numerators(letters, scalars.values, scalars.q, g, n, dens)
             if numerators is not None:
                 trees = _duval_trees(g, n, generators)
-                elements = {d: (dens[d], tuple((c, trees[i]) for i, c in items)) for d, items in numerators.items()}
+                elements = {}
+                for d, items in numerators.items():
+                    index, values = zip(*items)
+                    elements[d] = (dens[d], tuple(zip(values, map(trees.__getitem__, index))))
                 return FormalBCH(comp, generators, n, elements, None)
         check_degree(n, g, dense=True)  # coefficients too large for the primes: Python ints, dense engine
     return _formal_dense(comp, generators, n)

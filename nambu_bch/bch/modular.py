@@ -55,6 +55,7 @@ from __future__ import annotations
 
 from fractions import Fraction
 from functools import lru_cache
+from itertools import compress
 from math import factorial
 
 import numba
@@ -220,6 +221,7 @@ def _solve(z, primes, words, lengths, left, right, members, class_start, K, core
     x = np.zeros((_LANES, 64), dtype=np.int64)
     acc = np.zeros((_LANES, d, k), dtype=np.int64)
     lane_span = np.zeros(_LANES, dtype=np.int64)
+    memo = np.full((lengths.shape[0], d), -1, dtype=np.int64)  # node numbers of _class_program
     lane_lead = np.zeros(_LANES, dtype=np.int64)
     block = 1 << max(0, 35 - d)
     work = 0
@@ -241,7 +243,7 @@ def _solve(z, primes, words, lengths, left, right, members, class_start, K, core
                     if z[chain[r, j], i] != 0:
                         any_nonzero = True
         if any_nonzero and size > 1:
-            kids, roots = _class_program(members[r0:r1], core, K, words, lengths, left, right, g, d)
+            kids, roots = _class_program(members[r0:r1], core, K, words, lengths, left, right, g, d, memo)
             X = np.zeros((g * d + kids.shape[0], _LANES), dtype=np.int32)
             for b0 in range(r0, r1, _LANES):
                 b1 = min(b0 + _LANES, r1)
@@ -471,10 +473,12 @@ def lyndon_numerators(letters, values, q, g, n, denominators, stats=None):
     scale = np.array([[denominators[d] % p for p in moduli] for d in range(n + 1)], dtype=np.int64)
     residues = z * scale[lengths] % primes
     rows = np.flatnonzero(residues.any(axis=1))  # a zero residue vector is the numerator 0
-    numerators = _garner(residues[rows], moduli).tolist()
+    numerators = _garner(residues[rows], moduli).tolist()  # Python ints
+    degrees = lengths[rows]
     out: dict = {}
-    for i, c in zip(rows.tolist(), numerators):
-        out.setdefault(int(lengths[i]), []).append((i, int(c)))
+    for d in np.unique(degrees).tolist():
+        mask = degrees == d
+        out[d] = list(zip(rows[mask].tolist(), compress(numerators, mask.tolist())))
     return out
 
 
@@ -581,7 +585,7 @@ def _garner(residues, moduli):
 
 
 @numba.njit(cache=True)
-def _class_program(members, core, K, words, lengths, left, right, g, d):
+def _class_program(members, core, K, words, lengths, left, right, g, d, memo):
     """A straight-line program for ``<P_u, x[K_v:]>``, ``u`` the core of ``v``, every ``v`` in ``members``.
 
     ``members`` is one content class of degree ``d`` (:func:`_solve`, Eq. (2)).  Node ``(u, l)``
@@ -589,10 +593,10 @@ def _class_program(members, core, K, words, lengths, left, right, g, d):
     ``X[c1] X[c2] - X[c3] X[c4]`` with children ``(u1, l), (u2, l+|u1|), (u2, l), (u1, l+|u2|)`` for
     ``P_u = [P_u1, P_u2]``.  Nodes are numbered children first, roots in member order, so
     evaluating up to the root of a member evaluates all it needs; a core that is a letter has a
-    leaf as its root."""
-    index = numba.typed.Dict.empty(numba.types.int64, numba.types.int64)
+    leaf as its root.  ``memo[u, l]`` (all ``-1`` on entry and again on return) numbers the nodes."""
     cap = 64
     kids = np.empty((cap, 4), dtype=np.int64)
+    keys = np.empty((cap, 2), dtype=np.int64)
     count = g * d
     roots = np.empty(members.shape[0], dtype=np.int64)
     stack = np.empty((4 * d * d + 8, 2), dtype=np.int64)
@@ -606,8 +610,7 @@ def _class_program(members, core, K, words, lengths, left, right, g, d):
         stack[0, 0], stack[0, 1] = u0, l0
         while top >= 0:
             u, l = stack[top, 0], stack[top, 1]
-            key = u * 64 + l
-            if key in index:
+            if memo[u, l] >= 0:
                 top -= 1
                 continue
             u1, u2 = left[u], right[u]
@@ -623,7 +626,7 @@ def _class_program(members, core, K, words, lengths, left, right, g, d):
                 if lengths[cu] == 1:
                     ks[c] = words[cu, 0] * d + cl
                 else:
-                    node = index.get(cu * 64 + cl, -1)
+                    node = memo[cu, cl]
                     if node < 0:
                         missing = True
                         top += 1
@@ -631,16 +634,23 @@ def _class_program(members, core, K, words, lengths, left, right, g, d):
                     ks[c] = node
             if missing:
                 continue
-            if count - g * d == cap:
+            inner = count - g * d
+            if inner == cap:
                 cap *= 2
                 grown = np.empty((cap, 4), dtype=np.int64)
-                grown[: count - g * d] = kids[: count - g * d]
+                grown[:inner] = kids[:inner]
                 kids = grown
-            kids[count - g * d] = ks
-            index[key] = count
+                grown_keys = np.empty((cap, 2), dtype=np.int64)
+                grown_keys[:inner] = keys[:inner]
+                keys = grown_keys
+            kids[inner] = ks
+            keys[inner, 0], keys[inner, 1] = u, l
+            memo[u, l] = count
             count += 1
             top -= 1
-        roots[r] = index[u0 * 64 + l0]
+        roots[r] = memo[u0, l0]
+    for i in range(count - g * d):
+        memo[keys[i, 0], keys[i, 1]] = -1
     return kids[: count - g * d].copy(), roots
 
 
