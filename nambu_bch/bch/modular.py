@@ -107,14 +107,30 @@ def _duval_count(g, n):
 
 
 @numba.njit(cache=True)
+def _find(codes, by_length, start, L, code):
+    """Duval index of the Lyndon word of length ``L`` with base-``g`` code ``code``, or -1 (binary search:
+    within one length Duval order is numeric order of codes)."""
+    lo, hi = start[L], start[L + 1]
+    while lo < hi:
+        mid = (lo + hi) // 2
+        if codes[mid] < code:
+            lo = mid + 1
+        else:
+            hi = mid
+    if lo < start[L + 1] and codes[lo] == code:
+        return by_length[lo]
+    return -1
+
+
+@numba.njit(cache=True)
 def _lyndon_table_kernel(g, n):
     """Lyndon words of length <= n in Duval (lexicographic) order, lengths, and standard factors."""
     count = _duval_count(g, n)
     words = np.zeros((count, n), dtype=np.int8)
     lengths = np.zeros(count, dtype=np.int64)
+    code_of = np.zeros(count, dtype=np.int64)
     left = np.full(count, -1, dtype=np.int64)
     right = np.full(count, -1, dtype=np.int64)
-    index = numba.typed.Dict.empty(numba.types.int64, numba.types.int64)
     w = np.full(n + 1, -1, dtype=np.int64)
     length, k = 1, 0
     while length > 0:
@@ -124,7 +140,7 @@ def _lyndon_table_kernel(g, n):
             code = code * g + w[i]
             words[k, i] = w[i]
         lengths[k] = length
-        index[code * 64 + length] = k
+        code_of[k] = code
         k += 1
         m = length
         while length < n:
@@ -132,19 +148,31 @@ def _lyndon_table_kernel(g, n):
             length += 1
         while length > 0 and w[length - 1] == g - 1:
             length -= 1
-    for k in range(count):  # the longest proper Lyndon suffix (its words are shorter, already indexed)
+    start = np.zeros(n + 2, dtype=np.int64)  # words grouped by length (a stable counting sort)
+    for k in range(count):
+        start[lengths[k] + 1] += 1
+    for L in range(1, n + 2):
+        start[L] += start[L - 1]
+    fill = start.copy()
+    by_length = np.zeros(count, dtype=np.int64)
+    codes = np.zeros(count, dtype=np.int64)
+    for k in range(count):
+        by_length[fill[lengths[k]]] = k
+        codes[fill[lengths[k]]] = code_of[k]
+        fill[lengths[k]] += 1
+    for k in range(count):  # the longest proper Lyndon suffix
         L = lengths[k]
-        for start in range(1, L):
+        for first in range(1, L):
             code = 0
-            for i in range(start, L):
+            for i in range(first, L):
                 code = code * g + words[k, i]
-            j = index.get(code * 64 + (L - start), -1)
+            j = _find(codes, by_length, start, L - first, code)
             if j >= 0:
                 right[k] = j
                 code = 0
-                for i in range(start):
+                for i in range(first):
                     code = code * g + words[k, i]
-                left[k] = index[code * 64 + start]
+                left[k] = _find(codes, by_length, start, first, code)
                 break
     return words, lengths, left, right
 
