@@ -249,7 +249,7 @@ def _solve(z, primes, words, lengths, left, right, members, class_start, K, core
     x = np.zeros((_LANES, 64), dtype=np.int64)
     acc = np.zeros((_LANES, d, k), dtype=np.int64)
     lane_span = np.zeros(_LANES, dtype=np.int64)
-    memo = np.full((lengths.shape[0], d), -1, dtype=np.int64)  # node numbers of _class_program
+    memo = np.full((lengths.shape[0], d), -1, dtype=np.int32)  # node numbers of _class_program
     lane_lead = np.zeros(_LANES, dtype=np.int64)
     block = 1 << max(0, 35 - d)
     work = 0
