@@ -255,3 +255,16 @@ def test_tanh_half_coefficients():
     series = sympy.series(sympy.tanh(x / 2), x, 0, 12).removeO()
     got = modular._tanh_half_coefficients(11)
     assert {k: R(v.numerator, v.denominator) for k, v in got.items()} == {k: series.coeff(x, k) for k in range(1, 12, 2)}
+
+
+def test_number_theory_helpers_match_sympy():
+    """The size guard's and the bound's small helpers (no sympy on the hot path) against sympy: Möbius function and
+    divisors (Witt's formula, Reutenauer Cor. 4.14), sum_k (k-1)! S(d, k) (Stirling numbers, modular.numerator_bound)."""
+    from nambu_bch.bch.lyndon import divisors, mobius
+
+    assert [mobius(n) for n in range(1, 300)] == [int(sympy.mobius(n)) for n in range(1, 300)]
+    assert all(divisors(n) == sympy.divisors(n) for n in range(1, 120))
+    stirling = sympy.functions.combinatorial.numbers.stirling
+    assert [modular._surjection_sum(d) for d in range(1, 25)] == [
+        sum(factorial(k - 1) * int(stirling(d, k)) for k in range(1, d + 1)) for d in range(1, 25)
+    ]

@@ -60,7 +60,9 @@ from ..integrators.composition import composition as make_composition
 from ..compiled import numba_available
 from ..printing import Printable, bracket_sum
 from .lyndon import (
+    divisors,
     lyndon_expansion,
+    mobius,
     lyndon_words,
     standard_bracketing,
     tree_leaves,
@@ -89,11 +91,11 @@ def _class_pairs(g: int, d: int) -> int:
         for ci in c:
             gc = gcd(gc, ci)
         m = 0
-        for e in sympy.divisors(gc):
+        for e in divisors(gc):
             mult = factorial(d // e)
             for ci in c:
                 mult //= factorial(ci // e)
-            m += int(sympy.mobius(e)) * mult
+            m += mobius(e) * mult
         m //= d
         total += m * (m - 1) // 2
     return total

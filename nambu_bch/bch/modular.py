@@ -432,8 +432,17 @@ def _word_coefficients(letters, cpow, logk, primes, g, n, count, top):
 
 @lru_cache(maxsize=64)
 def _surjection_sum(d: int) -> int:
-    """``sum_k (k-1)! S(d, k)`` (``S`` Stirling numbers of the second kind) = ``d! [x^d] -log(2 - e^x)``."""
-    return sum(factorial(k - 1) * int(sympy.functions.combinatorial.numbers.stirling(d, k)) for k in range(1, d + 1))
+    """``sum_k (k-1)! S(d, k)`` (``S`` Stirling numbers of the second kind) = ``d! [x^d] -log(2 - e^x)``.
+
+    ``S(m, k) = k S(m-1, k) + S(m-1, k-1)`` row by row.
+
+    >>> [_surjection_sum(d) for d in range(1, 6)]
+    [1, 2, 6, 26, 150]
+    """
+    row = [1]  # S(0, k), k = 0..
+    for m in range(1, d + 1):
+        row = [0] + [k * (row[k] if k < len(row) else 0) + row[k - 1] for k in range(1, m + 1)]
+    return sum(factorial(k - 1) * row[k] for k in range(1, d + 1))
 
 
 def numerator_bound(d: int, total: Fraction, denominator: int) -> int:
@@ -519,12 +528,18 @@ def _eriksen_sign(letters, g: int, n: int) -> int:
 
 @lru_cache(maxsize=8)
 def _tanh_half_coefficients(n: int) -> dict:
-    """``{k: [x^k] tanh(x/2)}`` for odd ``k <= n``: ``2 (2^(k+1) - 1) B_(k+1) / (k+1)!`` (Bernoulli numbers)."""
-    out = {}
-    for k in range(1, n + 1, 2):
-        b = sympy.bernoulli(k + 1)
-        out[k] = Fraction(2 * (2 ** (k + 1) - 1) * int(b.p), int(b.q) * factorial(k + 1))
-    return out
+    """``{k: [x^k] tanh(x/2)}`` for odd ``k <= n`` (``= 2 (2^(k+1) - 1) B_(k+1) / (k+1)!``, Bernoulli numbers).
+
+    ``t = tanh(x/2)`` solves ``t' = (1 - t^2) / 2``, ``t(0) = 0``: ``(k+1) t_(k+1) = ([k = 0] - sum_i t_i t_(k-i)) / 2``.
+
+    >>> _tanh_half_coefficients(5)
+    {1: Fraction(1, 2), 3: Fraction(-1, 24), 5: Fraction(1, 240)}
+    """
+    t = [Fraction(0)] * (n + 1)
+    for k in range(n):
+        square = sum((t[i] * t[k - i] for i in range(k + 1)), Fraction(0))
+        t[k + 1] = ((1 if k == 0 else 0) - square) / (2 * (k + 1))
+    return {k: t[k] for k in range(1, n + 1, 2)}
 
 
 @numba.njit(cache=True)
