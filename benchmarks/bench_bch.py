@@ -103,7 +103,7 @@ def warm(fn, *args, repeat=3):
 def bench_formal(quick):
     comp = composition("12321")
     label = 6 if quick else 7
-    formal_bch(composition("123"), 9)  # warm = numba started (formal_bch then takes the sparse engine at every size)
+    formal_bch(composition("123"), 10)  # warm = numba started (3^10 words: sparse; then it is taken at every size)
     for spec, d in [("12321", 7), ("12321", 9), ("12321", 11)] + [("12", 16)] + ([] if quick else [("12", 20)]):
         t_cold, size = cold("ours", spec, d)
         print(f"[formal] {spec} degree {d}: {size} Lyndon terms; cold {t_cold:.4f} s (fresh interpreter, call alone), "
