@@ -12,7 +12,7 @@ Engines (exact, no floats).  Rational compositions run the sparse engine of
 (a walk of the prefix tree), a unitriangular solve per content class whose
 entries ``<P_v, w>`` come from a compiled straight-line program, all modulo
 primes, numerators rebuilt by the Chinese remainder theorem from a rigorous
-bound (Casas & Murua 2009; Hofstätter's ``bch``).  Its size guard counts the
+bound (Casas & Murua 2009; Hofstätter's ``bch``).  Its size guard counts the top-degree
 same-content Lyndon pairs of the solve.
 
 The dense engine serves algebraic coefficients (triple jump, ``2**(1/3)``, run
