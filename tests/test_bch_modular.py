@@ -268,3 +268,17 @@ def test_number_theory_helpers_match_sympy():
     assert [modular._surjection_sum(d) for d in range(1, 25)] == [
         sum(factorial(k - 1) * int(stirling(d, k)) for k in range(1, d + 1)) for d in range(1, 25)
     ]
+
+
+def test_engine_choice_dense_before_numba_starts_sparse_after(monkeypatch):
+    """formal.DENSE_COLD_WORDS: in a process where the sparse engine has not run, a small series (g^n <= 3^9) takes
+    the dense engine (no numba import); once the sparse engine has run, it takes the sparse one; same series."""
+    monkeypatch.setattr(formal_module, "SPARSE_FROM_DEGREE", 32)
+    monkeypatch.setattr(modular, "runs", 0)
+    dense = formal_bch("12321", 8)  # 3^8 words
+    assert modular.runs == 0
+    formal_bch("123", 10)  # 3^10 words > DENSE_COLD_WORDS: sparse
+    assert modular.runs == 1
+    sparse = formal_bch("12321", 8)
+    assert modular.runs == 2
+    assert _same(dense, sparse)
