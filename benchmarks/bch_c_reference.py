@@ -6,10 +6,16 @@ checkout; this script builds it with its own Makefile at its strongest flags
 
 * C, cold: a fresh ``bch`` process, single-threaded (``OMP_NUM_THREADS=1``), CPU time
   (user + sys, ``getrusage``) and peak RSS of the child; output to a file;
-* ours, cold: a fresh Python interpreter (package imported, numba's cached machine code on
-  disk), CPU time of the ``formal_bch`` call alone, and the RSS growth of that call;
-* ours, warm: the same call again in that interpreter, with the package's caches cleared
-  (Lyndon tables rebuilt; numba already initialised).
+* ours, cold: a fresh Python interpreter (``formal_bch`` imported, with sympy; numba not yet
+  imported, its cached machine code on disk), CPU time of the ``formal_bch`` call alone, which
+  includes importing and starting numba when the sparse engine runs, and the RSS growth of that call;
+* ours, data memory: in a third fresh interpreter, numba started first (a small sparse series),
+  the peak-RSS growth of the call: the engine's own memory, comparable with the C process's;
+* ours, warm: the same call again in that interpreter, numba started (if the cold call took the
+  dense engine, a small sparse series runs first, untimed) and every in-memory cache of the
+  package cleared (``nambu_bch.clear_caches``: Lyndon tables rebuilt).  The column ``engine``
+  names the engine of the cold / warm call: ``formal_bch`` takes the dense engine for small
+  problems in a process where numba has not started yet, the sparse one once it has.
 
 Every run is checked: the C table (``table_output=1``: index, degree, standard factors,
 coefficient) is rebuilt into Lyndon words and compared coefficient by coefficient with ours.
@@ -35,17 +41,34 @@ CFLAGS = "-O3 -fPIC -march=native -fopenmp -Wall"
 
 OURS = r"""
 import json, resource, sys, time
+from nambu_bch import clear_caches
 from nambu_bch.bch import formal_bch
-from nambu_bch.bch import formal, modular
 spec, n, out = sys.argv[1], int(sys.argv[2]), sys.argv[3]
 rss0 = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
-t = time.process_time(); B = formal_bch(spec, n); cold = time.process_time() - t
+t = time.process_time(); B = formal_bch(spec, n); cold = time.process_time() - t  # imports numba if it needs it
 rss1 = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
-for f in (modular.lyndon_table, modular._class_order, formal._duval_trees):
-    f.cache_clear()
+engine = "sparse" if "nambu_bch.bch.modular" in sys.modules and sys.modules["nambu_bch.bch.modular"].runs else "dense"
+from nambu_bch.bch import modular
+if not modular.runs:  # warm = numba started: a small sparse series first (3^10 words > DENSE_COLD_WORDS)
+    formal_bch("123", 10)
+clear_caches()  # every in-memory cache of the package (Lyndon tables, the dense engine's logs, ...)
+runs = modular.runs
 t = time.process_time(); formal_bch(spec, n); warm = time.process_time() - t
+engine_warm = "sparse" if modular.runs > runs else "dense"
 rows = [[list(w), str(c)] for d in range(1, n + 1) for c, w in B.words(d)]
-json.dump({"cold": cold, "warm": warm, "rss_kb": rss1 - rss0, "rss_total_kb": rss1, "terms": rows}, open(out, "w"))
+json.dump({"cold": cold, "warm": warm, "rss_kb": rss1 - rss0, "rss_total_kb": rss1, "terms": rows,
+           "engine": engine + "/" + engine_warm}, open(out, "w"))
+"""
+
+
+DATA = r"""
+import resource, sys
+from nambu_bch.bch import formal_bch
+formal_bch("123", 10)  # numba imported and started, engine code loaded (3^10 words: the sparse engine)
+spec, n = sys.argv[1], int(sys.argv[2])
+rss0 = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
+formal_bch(spec, n)
+print(resource.getrusage(resource.RUSAGE_SELF).ru_maxrss - rss0)
 """
 
 
@@ -58,8 +81,16 @@ def build(checkout: Path) -> Path:
     return exe
 
 
+TIME = Path("/usr/bin/time")
+
+
 def run_c(exe: Path, n: int, expression: str | None, out: Path):
-    """CPU seconds, peak RSS (kB) and the table of one cold single-threaded run."""
+    """CPU seconds, peak RSS (kB) and the table of one cold single-threaded run.
+
+    CPU time from this process's ``wait4`` on the ``bch`` child.  The peak RSS from a second run
+    under ``/usr/bin/time`` when it exists: Linux keeps ``ru_maxrss`` across ``execve``, so a child
+    forked from this (large) Python process reports at least this process's size.  Without
+    ``/usr/bin/time`` the value is that upper bound."""
     env = dict(os.environ, OMP_NUM_THREADS="1", LD_LIBRARY_PATH=str(exe.parent))
     args = [str(exe), f"N={n}", "table_output=1"]
     if expression:
@@ -70,7 +101,13 @@ def run_c(exe: Path, n: int, expression: str | None, out: Path):
         proc.returncode = os.waitstatus_to_exitcode(status)
     if proc.returncode:
         raise SystemExit(f"bch failed with exit code {proc.returncode}: {' '.join(args)}")
-    return usage.ru_utime + usage.ru_stime, usage.ru_maxrss, out.read_text().splitlines()
+    rss = usage.ru_maxrss
+    if TIME.exists():
+        report = out.with_suffix(".time")
+        subprocess.run([str(TIME), "-f", "%M", "-o", str(report)] + args, stdout=subprocess.DEVNULL, env=env,
+                       check=True)
+        rss = int(report.read_text().split()[-1])
+    return usage.ru_utime + usage.ru_stime, rss, out.read_text().splitlines()
 
 
 def c_terms(lines, letters: int) -> dict:
@@ -91,6 +128,9 @@ def run_ours(spec: str, n: int, out: Path):
     env = dict(os.environ, PYTHONPATH=str(ROOT) + os.pathsep + os.environ.get("PYTHONPATH", ""))
     subprocess.run([sys.executable, "-c", OURS, spec, str(n), str(out)], check=True, env=env, cwd=ROOT)
     data = json.loads(out.read_text())
+    memory = subprocess.run([sys.executable, "-c", DATA, spec, str(n)], check=True, env=env, cwd=ROOT,
+                            capture_output=True, text=True)
+    data["data_kb"] = int(memory.stdout.split()[-1])
     terms = {}
     for word, c in data["terms"]:
         key = tuple(k - 1 for k in word)  # piece k is the letter k - 1 (A = 1, B = 2, C = 3)
@@ -115,7 +155,7 @@ def main(argv=None):
     jobs += [("12321", d, "log(exp(1/2*A)*exp(1/2*B)*exp(C)*exp(1/2*B)*exp(1/2*A))") for d in (9, 11)]
     print(f"# C: {exe} built with CFLAGS='{CFLAGS}', OMP_NUM_THREADS=1; CPU seconds; both sides cold (fresh processes)")
     print(f"{'word':>6} {'N':>3} {'terms':>7} {'C cpu s':>9} {'ours cold':>10} {'ratio':>7} {'ours warm':>10} "
-          f"{'ratio':>7} {'C MB':>6} {'ours +MB':>8}  identical")
+          f"{'ratio':>7} {'C MB':>6} {'ours +MB':>8} {'data MB':>7}  identical  engine")
     for spec, n, expr in jobs:
         cpu, rss, lines = run_c(exe, n, expr, args.work / f"c_{spec}_{n}.txt")
         data, ours = run_ours(spec, n, args.work / f"ours_{spec}_{n}.json")
@@ -123,10 +163,12 @@ def main(argv=None):
         same = reference == ours
         print(f"{spec:>6} {n:>3} {len(ours):>7} {cpu:>9.4f} {data['cold']:>10.4f} {data['cold'] / max(cpu, 1e-4):>6.1f}x "
               f"{data['warm']:>10.4f} {data['warm'] / max(cpu, 1e-4):>6.1f}x {rss / 1024:>6.1f} {data['rss_kb'] / 1024:>8.1f}"
-              f"  {same}")
+              f" {data['data_kb'] / 1024:>7.1f}"
+              f"  {str(same):9}  {data['engine']}")
     print("# ratio = ours / C (CPU time; C's includes process start and writing the table; C times below 1e-4 s "
-          "count as 1e-4 s). 'ours +MB' is the peak-RSS growth of the call (the interpreter with sympy/numba "
-          "itself holds ~190 MB).")
+          "count as 1e-4 s). 'C MB': peak RSS of the C process. 'ours +MB': peak-RSS growth of the cold call "
+          "(importing numba included; the interpreter with sympy holds ~130 MB before it). 'data MB': peak-RSS "
+          "growth of the call in a fresh process where numba is already started (the engine's own memory).")
     return 0
 
 

@@ -20,7 +20,8 @@ R = sympy.Rational
 
 @pytest.fixture(autouse=True)
 def sparse_at_every_degree(monkeypatch):
-    """formal_bch uses the sparse engine from SPARSE_FROM_DEGREE on; here it is exercised at every degree."""
+    """formal_bch uses the sparse engine from SPARSE_FROM_DEGREE on (or above DENSE_COLD_WORDS words, or once it
+    has run); here it is exercised at every degree."""
     monkeypatch.setattr(formal_module, "SPARSE_FROM_DEGREE", 1)
 
 
@@ -175,11 +176,14 @@ def test_degrees_accepted_and_refused_by_the_sparse_estimate():
 
 
 def test_pair_estimate_matches_the_tables():
-    """``estimate_size(...)["pairs"]`` counts same-content Lyndon pairs: checked by grouping the words."""
+    """``estimate_size(...)["pairs"]`` counts the same-content Lyndon pairs of the top degree (the classes the
+    solve walks): checked by grouping the words."""
     for g, n in [(2, 10), (3, 6)]:
         words, lengths, _, _ = modular.lyndon_table(g, n)
         groups: dict = {}
         for i in range(len(lengths)):
+            if lengths[i] != n:
+                continue
             w = tuple(int(a) for a in words[i, : lengths[i]])
             key = (len(w),) + tuple(w.count(a) for a in range(g))
             groups[key] = groups.get(key, 0) + 1
@@ -197,3 +201,84 @@ def test_without_numba_the_dense_engine_gives_the_same_series(monkeypatch):
         dense = formal_bch(word, degree)
         monkeypatch.delenv("NAMBU_BCH_DISABLE_NUMBA")
         assert all(fast.terms(d) == dense.terms(d) for d in range(1, degree + 1))
+
+
+# -- chains and Eriksen's relation -----------------------------------------------------------------------
+
+@pytest.mark.parametrize("g,n", [(2, 9), (3, 6)])
+def test_chain_entries_are_the_core_entries(g, n):
+    """Eq. (2) of modular._solve: ``<P_v, w> = [w starts with a^K_v] <P_core, w[K_v:]>`` for equal-content Lyndon
+    words ``v < w``, against the full expansion of ``P_v`` (Reutenauer Thm. 5.1), and ``P_v = ad_a^K P_core``."""
+    from nambu_bch.bch.lyndon import lyndon_expansion, word_index
+
+    words, lengths, left, right = modular.lyndon_table(g, n)
+    K, core, lead, span = modular._chains(words, lengths, left, right)
+    word = [tuple(int(a) for a in words[i, : lengths[i]]) for i in range(len(lengths))]
+    checked = 0
+    for v in range(len(lengths)):
+        if lengths[v] < 2:
+            continue
+        a, kv, u = word[v][0], int(K[v]), word[core[v]]
+        assert word[v] == (a,) * kv + u and int(lead[v]) >= kv
+        assert standard_bracketing(word[v]) == _ad_power(a, kv, standard_bracketing(u))
+        idx, coef = lyndon_expansion(word[v], g)
+        full = dict(zip(idx.tolist(), coef.tolist()))
+        ui, uc = lyndon_expansion(u, g)
+        core_entries = dict(zip(ui.tolist(), uc.tolist()))
+        for w in range(len(lengths)):
+            if lengths[w] == lengths[v] and sorted(word[w]) == sorted(word[v]) and word[w] > word[v]:
+                starts = word[w][:kv] == (a,) * kv
+                expected = core_entries.get(word_index(word[w][kv:], g), 0) if starts else 0
+                assert full.get(word_index(word[w], g), 0) == expected
+                checked += 1
+    assert checked > 100
+
+
+def _ad_power(a, k, tree):
+    for _ in range(k):
+        tree = (a, tree)
+    return tree
+
+
+@pytest.mark.parametrize("spec", ["12", "21"])
+@pytest.mark.parametrize("degree", [2, 6, 10])
+def test_even_top_degree_by_eriksen_equals_the_dense_engine(spec, degree):
+    """Eriksen (J. Math. Phys. 9 (1968) 790, Sect. III.A): Z_even = tanh(ad_A/2) Z_odd for log(e^{aA} e^{bB}) (sign
+    flipped for e^{bB} e^{aA}); the sparse engine takes the even top degree from it, the dense engine expands."""
+    assert modular._eriksen_sign([0, 1] if spec[0] == "1" else [1, 0], 2, degree)
+    assert _same(formal_bch(spec, degree), _dense(spec, degree))
+
+
+def test_tanh_half_coefficients():
+    """tanh(x/2) = x/2 - x^3/24 + x^5/240 - 17 x^7/40320 + ... (the beta_k of Eq. (3) in modular._even_top)."""
+    x = sympy.Symbol("x")
+    series = sympy.series(sympy.tanh(x / 2), x, 0, 12).removeO()
+    got = modular._tanh_half_coefficients(11)
+    assert {k: R(v.numerator, v.denominator) for k, v in got.items()} == {k: series.coeff(x, k) for k in range(1, 12, 2)}
+
+
+def test_number_theory_helpers_match_sympy():
+    """The size guard's and the bound's small helpers (no sympy on the hot path) against sympy: Möbius function and
+    divisors (Witt's formula, Reutenauer Cor. 4.14), sum_k (k-1)! S(d, k) (Stirling numbers, modular.numerator_bound)."""
+    from nambu_bch.bch.lyndon import divisors, mobius
+
+    assert [mobius(n) for n in range(1, 300)] == [int(sympy.mobius(n)) for n in range(1, 300)]
+    assert all(divisors(n) == sympy.divisors(n) for n in range(1, 120))
+    stirling = sympy.functions.combinatorial.numbers.stirling
+    assert [modular._surjection_sum(d) for d in range(1, 25)] == [
+        sum(factorial(k - 1) * int(stirling(d, k)) for k in range(1, d + 1)) for d in range(1, 25)
+    ]
+
+
+def test_engine_choice_dense_before_numba_starts_sparse_after(monkeypatch):
+    """formal.DENSE_COLD_WORDS: in a process where the sparse engine has not run, a small series (g^n <= 3^9) takes
+    the dense engine (no numba import); once the sparse engine has run, it takes the sparse one; same series."""
+    monkeypatch.setattr(formal_module, "SPARSE_FROM_DEGREE", 32)
+    monkeypatch.setattr(modular, "runs", 0)
+    dense = formal_bch("12321", 8)  # 3^8 words
+    assert modular.runs == 0
+    formal_bch("123", 10)  # 3^10 words > DENSE_COLD_WORDS: sparse
+    assert modular.runs == 1
+    sparse = formal_bch("12321", 8)
+    assert modular.runs == 2
+    assert _same(dense, sparse)

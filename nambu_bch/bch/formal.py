@@ -12,7 +12,7 @@ Engines (exact, no floats).  Rational compositions run the sparse engine of
 (a walk of the prefix tree), a unitriangular solve per content class whose
 entries ``<P_v, w>`` come from a compiled straight-line program, all modulo
 primes, numerators rebuilt by the Chinese remainder theorem from a rigorous
-bound (Casas & Murua 2009; Hofstätter's ``bch``).  Its size guard counts the
+bound (Casas & Murua 2009; Hofstätter's ``bch``).  Its size guard counts the top-degree
 same-content Lyndon pairs of the solve.
 
 The dense engine serves algebraic coefficients (triple jump, ``2**(1/3)``, run
@@ -42,6 +42,9 @@ Algebras*, Thm. 5.1 (Lyndon basis); Casas & Murua, J. Math. Phys. 50 (2009)
 
 from __future__ import annotations
 
+import gc
+import sys
+from contextlib import contextmanager
 from dataclasses import dataclass, field
 from functools import lru_cache
 from math import comb, factorial, gcd, lcm
@@ -57,7 +60,9 @@ from ..integrators.composition import composition as make_composition
 from ..compiled import numba_available
 from ..printing import Printable, bracket_sum
 from .lyndon import (
+    divisors,
     lyndon_expansion,
+    mobius,
     lyndon_words,
     standard_bracketing,
     tree_leaves,
@@ -69,7 +74,7 @@ from .lyndon import (
 MAX_WORDS = 600_000
 #: Largest total size ``sum_d dim L_d 2^(d-1)`` of the Lyndon-basis expansions the dense projection walks.
 MAX_EXPANSION = 15_000_000
-#: Largest number of same-content Lyndon pairs ``(v, w)`` the sparse (modular) engine's solve may visit.
+#: Largest number of same-content Lyndon pairs ``(v, w)`` of the top degree the sparse (modular) engine's solve may visit.
 MAX_PAIRS = 2_500_000_000
 _HARD_DEGREE = 64  # beyond this not even the estimate is computed
 
@@ -86,11 +91,11 @@ def _class_pairs(g: int, d: int) -> int:
         for ci in c:
             gc = gcd(gc, ci)
         m = 0
-        for e in sympy.divisors(gc):
+        for e in divisors(gc):
             mult = factorial(d // e)
             for ci in c:
                 mult //= factorial(ci // e)
-            m += int(sympy.mobius(e)) * mult
+            m += mobius(e) * mult
         m //= d
         total += m * (m - 1) // 2
     return total
@@ -109,7 +114,9 @@ def estimate_size(n_generators: int, max_degree: int) -> dict:
     """Sizes of the BCH computation: Lyndon basis elements (Witt), words, expansion entries, solve pairs.
 
     ``lyndon`` (Witt's formula) sizes the sparse engine's tables; ``pairs`` (same-content Lyndon
-    pairs, the unitriangular solve of :mod:`nambu_bch.bch.modular`) bounds its work;
+    pairs of the top degree: the unitriangular solve of :mod:`nambu_bch.bch.modular` walks only
+    the content classes of the top degree, the lower degrees ride along its ``ad_a`` chains)
+    bounds its work;
     ``words``/``top_words``/``expansion`` size the dense engine (associative words, and
     ``P_w`` of a word of length ``d`` has at most ``2^(d-1)`` terms).
 
@@ -122,13 +129,19 @@ def estimate_size(n_generators: int, max_degree: int) -> dict:
         "words": sum(g**d for d in range(1, max_degree + 1)),
         "top_words": g**max_degree,
         "expansion": sum(witt_dimension(g, d) * 2 ** (d - 1) for d in range(1, max_degree + 1)),
-        "pairs": sum(_class_pairs(g, d) for d in range(1, max_degree + 1)),
+        "pairs": _class_pairs(g, max_degree),
     }
 
 
-#: From this degree on (or when the dense engine's arrays would be too large) rational series use the sparse
-#: modular engine; below it the dense engine is faster cold (bench_bch: 12321 degree 7, 0.03 s against 0.5 s).
-SPARSE_FROM_DEGREE = 10
+#: Rational series use the sparse modular engine from this degree on, when the dense engine would walk more than
+#: :data:`DENSE_COLD_WORDS` top-degree words, or once the compiled engine has run in this process.  Below that a
+#: fresh process answers faster with the dense engine: the sparse one first imports numba (about 0.2 s) and starts
+#: it (about 0.1 s).  Once numba is up the sparse engine is faster at every size (docs/performance.md, Sect. 1:
+#: fresh process, ``12`` degree 14: dense 0.19 s, sparse 0.28 s; ``12321`` degree 9: 0.15 s against 0.27 s;
+#: numba started: 0.005 s and 0.007 s sparse).
+SPARSE_FROM_DEGREE = 32
+#: Largest ``g^n`` the dense engine takes in a process where the sparse engine has not run yet (``3^9``).
+DENSE_COLD_WORDS = 19683
 
 
 @lru_cache(maxsize=1024)
@@ -581,20 +594,48 @@ def formal_bch(comp, max_degree: int, n_pieces: int | None = None) -> FormalBCH:
     sparse = scalars.K is None and numba_available()
     n = check_degree(max_degree, g, dense=not sparse)
     # low degrees: the dense engine answers in milliseconds without loading numba (~0.4 s in a fresh process)
-    sparse = sparse and (n >= SPARSE_FROM_DEGREE or not _fits_dense(g, n))
+    sparse = sparse and (
+        n >= SPARSE_FROM_DEGREE or g**n > DENSE_COLD_WORDS or _sparse_engine_loaded() or not _fits_dense(g, n)
+    )
     if sparse:
         from .modular import lyndon_numerators  # compiled (numba); without it the dense engine below
 
         big = lcm(*range(1, n + 1))
         dens = [factorial(d) * big * scalars.q**d for d in range(n + 1)]
         letters = [generators.index(k) for k in comp.pieces]
-        numerators = lyndon_numerators(letters, scalars.values, scalars.q, g, n, dens)
-        if numerators is not None:
-            trees = _duval_trees(g, n, generators)
-            elements = {d: (dens[d], tuple((c, trees[i]) for i, c in items)) for d, items in numerators.items()}
-            return FormalBCH(comp, generators, n, elements, None)
+        with _no_full_collection():
+            numerators = lyndon_numerators(letters, scalars.values, scalars.q, g, n, dens)
+            if numerators is not None:
+                trees = _duval_trees(g, n, generators)
+                elements = {}
+                for d, items in numerators.items():
+                    index, values = zip(*items)
+                    elements[d] = (dens[d], tuple(zip(values, map(trees.__getitem__, index))))
+                return FormalBCH(comp, generators, n, elements, None)
         check_degree(n, g, dense=True)  # coefficients too large for the primes: Python ints, dense engine
     return _formal_dense(comp, generators, n)
+
+
+def _sparse_engine_loaded() -> bool:
+    """The compiled engine has run in this process (numba's start-up is paid)."""
+    modular = sys.modules.get("nambu_bch.bch.modular")
+    return modular is not None and modular.runs > 0
+
+
+@contextmanager
+def _no_full_collection():
+    """Pause the cyclic garbage collector while the sparse engine builds its (acyclic) tuples and ints.
+
+    Tens of thousands of new objects otherwise trigger a full collection that walks every object
+    of the interpreter (sympy's caches: about 70 ms, more than the whole computation at degree
+    16); nothing allocated here forms a cycle, so nothing is left for the collector to find."""
+    was_enabled = gc.isenabled()
+    gc.disable()
+    try:
+        yield
+    finally:
+        if was_enabled:
+            gc.enable()
 
 
 def _formal_dense(comp, generators: tuple, n: int) -> FormalBCH:

@@ -83,8 +83,34 @@ def witt_dimension(n_letters: int, degree: int) -> int:
     """
     if degree < 1:
         return 0
-    total = sum(sympy.mobius(e) * n_letters ** (degree // e) for e in sympy.divisors(degree))
+    total = sum(mobius(e) * n_letters ** (degree // e) for e in divisors(degree))
     return int(total) // degree
+
+
+def divisors(n: int) -> list:
+    """The positive divisors of ``n >= 1``, increasing (trial division; ``n`` is a degree, small).
+
+    >>> divisors(12)
+    [1, 2, 3, 4, 6, 12]
+    """
+    return [e for e in range(1, n + 1) if n % e == 0]
+
+
+def mobius(n: int) -> int:
+    """The Möbius function: ``(-1)^k`` for ``n`` a product of ``k`` distinct primes, else 0 (``mobius(1) = 1``).
+
+    >>> [mobius(n) for n in range(1, 11)]
+    [1, -1, -1, 0, -1, 1, -1, 0, 0, 1]
+    """
+    sign, p = 1, 2
+    while p * p <= n:
+        if n % p == 0:
+            n //= p
+            if n % p == 0:
+                return 0
+            sign = -sign
+        p += 1
+    return -sign if n > 1 else sign
 
 
 def lyndon_words(n_letters: int, degree: int) -> list:
