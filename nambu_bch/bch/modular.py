@@ -692,13 +692,18 @@ def _class_program(members, core, K, words, lengths, left, right, g, d, memo):
             inner = count - g * d
             if inner == cap:
                 cap *= 2
+                # element loops, not slice assignments: a slice assignment makes numba compile its
+                # broadcasting error path with the unicode machinery (seconds of cold compile time)
                 grown = np.empty((cap, 4), dtype=np.int64)
-                grown[:inner] = kids[:inner]
-                kids = grown
                 grown_keys = np.empty((cap, 2), dtype=np.int64)
-                grown_keys[:inner] = keys[:inner]
+                for i in range(inner):
+                    for c in range(4):
+                        grown[i, c] = kids[i, c]
+                    grown_keys[i, 0], grown_keys[i, 1] = keys[i, 0], keys[i, 1]
+                kids = grown
                 keys = grown_keys
-            kids[inner] = ks
+            for c in range(4):
+                kids[inner, c] = ks[c]
             keys[inner, 0], keys[inner, 1] = u, l
             memo[u, l] = count
             count += 1
