@@ -135,3 +135,19 @@ def test_jet_ring_is_a_backend_instance():
     Xs, Ys = [to_functions(c) for c in X], [to_functions(c) for c in Y]
     expected = _sympy_bracket(Xs, Ys, xs)
     assert [sympy.expand(to_functions(z) - e) for z, e in zip(Z, expected)] == [0, 0, 0]
+
+
+def test_expression_backend_keeps_rational_functions_cancelled():
+    """Rational components (the 'rational' model, V = -1/(1 + x1^2)) are kept as p/q in lowest terms, a
+    canonical form: the bracket agrees with Eq. (CL1) computed by sympy alone, and a field that vanishes
+    only after cancellation is recognised as zero."""
+    S = model("rational").splitting
+    algebra = S.system.algebra
+    E = ExpressionBackend(algebra, {p.number: p.field for p in S.pieces})
+    XY = E.bracket(E.fields[1], E.fields[2])
+    expected = _sympy_bracket(*(E.fields[k] for k in (1, 2)), algebra.coordinates)
+    assert _same(XY, expected)
+    assert all(sympy.cancel(c) == c for c in XY)                      # already in lowest terms
+    hidden_zero = 1 / (1 + x1) - (1 - x1) / (1 - x1**2)
+    assert E.function(hidden_zero) == 0
+    assert E.is_zero(E.from_vector_field(VectorField(algebra, [hidden_zero, hidden_zero])))

@@ -28,9 +28,11 @@ Otherwise (``1/(m + 1)``, or ``laurent=False``) it runs in the algebra's own
 ring ``QQ(parameters)[x]`` -- which may be a :class:`~nambu_bch.shadow.jets.JetAlgebra`
 or any ring offering ``ring``, ``n``, ``domain`` and ``diff(value, i)``.
 
-:class:`ExpressionBackend` works on expanded sympy expressions, for
-non-polynomial fields (``cos(x1)``, undefined functions ``H1(x1)``): brackets
-are ``diff`` + ``expand``, the zero test is structural after ``expand``.  It
+:class:`ExpressionBackend` works on sympy expressions, for non-polynomial fields
+(``cos(x1)``, undefined functions ``H1(x1)``, ``1/(1 + x1**2)``): brackets are
+``diff`` followed by the normal form -- ``cancel`` (``p/q`` in lowest terms, a
+canonical form) for rational functions, ``expand`` otherwise -- and the zero test
+is structural after it.  It
 never calls a non-zero field zero; an exotic zero that only ``simplify`` would
 see (``sin^2 + cos^2 - 1``) is kept, which costs a term but never changes a value.
 
@@ -450,8 +452,16 @@ class PolynomialBackend:
         return algebra.ring.from_dict(out)
 
 
+def _normal(expr):
+    """The normal form of a component: ``p/q`` cancelled for a rational function, else the expansion."""
+    expr = sympy.sympify(expr)
+    if expr.is_rational_function() and not expr.is_polynomial():
+        return sympy.cancel(expr)
+    return sympy.expand(expr)
+
+
 class ExpressionBackend:
-    """Vector fields whose components are expanded sympy expressions (non-polynomial Hamiltonians).
+    """Vector fields whose components are sympy expressions in normal form (non-polynomial Hamiltonians).
 
     Examples
     --------
@@ -473,13 +483,13 @@ class ExpressionBackend:
         self.fields = {k: self.from_vector_field(X) for k, X in (fields or {}).items()}
 
     def from_vector_field(self, V: VectorField) -> tuple:
-        return tuple(sympy.expand(self.algebra.to_sympy(c)) for c in V.components)
+        return tuple(_normal(self.algebra.to_sympy(c)) for c in V.components)
 
     def to_vector_field(self, X) -> VectorField:
         return VectorField(self.algebra, X)
 
     def function(self, expr):
-        return sympy.expand(self.algebra.to_sympy(expr))
+        return _normal(self.algebra.to_sympy(expr))
 
     @staticmethod
     def function_to_sympy(f):
@@ -496,7 +506,7 @@ class ExpressionBackend:
         return sympy.diff(f, self.coordinates[i])
 
     def bracket(self, X, Y) -> tuple:
-        """``[X, Y]^i = X^j d_j Y^i - Y^j d_j X^i`` (Eq. CL1), expanded."""
+        """``[X, Y]^i = X^j d_j Y^i - Y^j d_j X^i`` (Eq. CL1), in normal form."""
         coords = self.coordinates
         out = []
         for i in range(len(coords)):
@@ -506,14 +516,14 @@ class ExpressionBackend:
                     total += X[j] * sympy.diff(Y[i], x)
                 if Y[j] != 0:
                     total -= Y[j] * sympy.diff(X[i], x)
-            out.append(sympy.expand(total))
+            out.append(_normal(total))
         return tuple(out)
 
     def apply(self, X, f):
-        """``X f = sum_i X^i d f / d x_i``, expanded."""
+        """``X f = sum_i X^i d f / d x_i``, in normal form."""
         if f == 0:
             return self.zero
-        return sympy.expand(sum((c * sympy.diff(f, x) for c, x in zip(X, self.coordinates) if c != 0), self.zero))
+        return _normal(sum((c * sympy.diff(f, x) for c, x in zip(X, self.coordinates) if c != 0), self.zero))
 
     @staticmethod
     def is_zero(X) -> bool:
@@ -535,13 +545,13 @@ class ExpressionBackend:
         totals = [sympy.Integer(0)] * self.algebra.n
         for c, X in pairs:
             totals = [t + sympy.sympify(c) * comp for t, comp in zip(totals, X)]
-        return VectorField(self.algebra, [sympy.expand(t) for t in totals])
+        return VectorField(self.algebra, [_normal(t) for t in totals])
 
     def scaled_combine(self, denominator: int, pairs) -> VectorField:
         return self.combine([(sympy.Rational(sympy.sympify(n), denominator), X) for n, X in pairs])
 
     def vector_field(self, values) -> VectorField:
-        return VectorField(self.algebra, [sympy.expand(c) for c in values])
+        return VectorField(self.algebra, [_normal(c) for c in values])
 
 
 def field_backend(algebra, fields: dict, laurent: bool = True) -> FieldBackend:
