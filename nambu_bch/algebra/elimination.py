@@ -225,8 +225,14 @@ class _AlgebraicSplit:
         return self._factors[key]
 
     def lift(self, v):
-        """``v`` in ``B`` as an element of ``K``."""
-        return self.domain.convert_from(v, self.base)
+        """``v`` in ``B`` as an element of ``K``: the same fraction (coprime over ``QQ``, hence over ``K``),
+        denominator made monic."""
+        if not self.params:
+            return self.algebraic.convert(v)
+        A, field = self.algebraic, self.domain.field
+        lc = v.denom.LC
+        coeffs = lambda p: {m: A.new([q / lc]) for m, q in p.items()}  # noqa: E731
+        return field.raw_new(field.ring.from_dict(coeffs(v.numer)), field.ring.from_dict(coeffs(v.denom)))
 
 
 def _rref(rows: dict, nrows: int, ncols: int, domain, lift: bool = True):
