@@ -142,15 +142,19 @@ def _timed_ours(args, queue):
 
 def _child(target, args, limit):
     """``target(args, queue)`` in a fresh process; its result, or ``None`` after ``limit`` seconds."""
+    import queue as queues
+
     queue = mp.Queue()
     proc = mp.Process(target=target, args=(args, queue))
     proc.start()
-    proc.join(limit)
+    try:
+        out = queue.get(timeout=limit)  # before join: a child with a large result waits until it is read
+    except queues.Empty:
+        out = None
     if proc.is_alive():
         proc.terminate()
-        proc.join()
-        return None
-    return queue.get()
+    proc.join()
+    return out
 
 
 ISSUE14 = [  # (row, system, word, order, goal in s)

@@ -235,12 +235,62 @@ class _AlgebraicSplit:
         return field.raw_new(field.ring.from_dict(coeffs(v.numer)), field.ring.from_dict(coeffs(v.denom)))
 
 
-def _rref(rows: dict, nrows: int, ncols: int, domain, lift: bool = True):
+def _rref(rows: dict, nrows: int, ncols: int, domain, lift: bool = True, link: int | None = None):
+    """The reduced row echelon form of ``{row: {column: value}}``, block by block: ``(R, pivots)``.
+
+    The rows and columns fall into blocks, the connected components of the graph in which a
+    row and a column ``< link`` are joined when the entry is non-zero; the reduced echelon form
+    of a block-diagonal matrix is the union of those of its blocks (rows ordered by pivot),
+    each computed by :func:`_rref_block`.  Columns ``>= link`` (right-hand sides) join no blocks:
+    they are carried along in every block, so that a pivot in such a column means that the
+    block's part of that right-hand side is not in the span of the block's columns, and ``R``
+    is then no longer one echelon form (two blocks may have their pivots in the same column).
+    """
+    if not FAST_PATHS:
+        return _rref_block(rows, nrows, ncols, domain, lift)
+    link = ncols if link is None else link
+    parent = list(range(link))
+
+    def find(x):
+        while parent[x] != x:
+            parent[x] = parent[parent[x]]
+            x = parent[x]
+        return x
+
+    live = {}
+    for i, r in rows.items():
+        r = {j: v for j, v in r.items() if v}
+        if not r:
+            continue
+        live[i] = r
+        cols = [j for j in r if j < link]
+        for j in cols[1:]:
+            a, b = find(cols[0]), find(j)
+            if a != b:
+                parent[a] = b
+    groups: dict = {}
+    for i, r in live.items():
+        cols = [j for j in r if j < link]
+        groups.setdefault(find(cols[0]) if cols else None, []).append(i)
+    if len(groups) <= 1:
+        return _rref_block(live, nrows, ncols, domain, lift)
+    out = []
+    for members in groups.values():
+        cols = sorted({j for i in members for j in live[i]})
+        index = {c: k for k, c in enumerate(cols)}
+        block = {k: {index[j]: v for j, v in live[i].items()} for k, i in enumerate(members)}
+        R, _ = _rref_block(block, len(members), len(cols), domain, lift)
+        out += [{cols[j]: v for j, v in row.items()} for row in R.values()]
+    out.sort(key=min)
+    return dict(enumerate(out)), tuple(min(row) for row in out)
+
+
+def _rref_block(rows: dict, nrows: int, ncols: int, domain, lift: bool = True):
     """The reduced row echelon form of the sparse matrix ``{row: {column: value}}``: ``(R, pivots)``.
 
     ``R`` is ``{row: {column: value}}`` (the ``rank`` non-zero rows, pivot entries one),
     ``pivots`` the pivot columns.  The reduced echelon form is unique, so every route gives
-    the same ``R``: dense ``fmpq_mat`` (python-flint) over ``QQ``; over an algebraic
+    the same ``R`` (:func:`_rref` calls it on each block): dense ``fmpq_mat`` (python-flint) over ``QQ``; over an algebraic
     extension, the base field when every entry lies in it (:class:`_AlgebraicSplit`);
     otherwise sympy's sparse Gauss-Jordan (``DomainMatrix.rref``).  ``lift=False``: the
     values of ``R`` may be left in the base field (for callers that need the pivots only).
@@ -255,7 +305,7 @@ def _rref(rows: dict, nrows: int, ncols: int, domain, lift: bool = True):
     if split is not None:
         base_rows = split.split_rows(rows)
         if base_rows is not None:
-            R, pivots = _rref(base_rows, nrows, ncols, split.base)
+            R, pivots = _rref_block(base_rows, nrows, ncols, split.base)
             if not lift:  # only the pivots are wanted
                 return R, pivots
             return {i: {j: split.lift(v) for j, v in r.items()} for i, r in R.items()}, pivots
@@ -323,7 +373,7 @@ def solve_affine(columns: list, rhs: list, nrows: int, domain, *, certificate: b
         for i, v in b.items():
             if v:
                 rows.setdefault(i, {})[ncols + k] = v
-    R, pivots = _rref(rows, nrows, ncols + len(rhs), domain)
+    R, pivots = _rref(rows, nrows, ncols + len(rhs), domain, link=ncols)
     col_pivots = [p for p in pivots if p < ncols]
     pivot_row = {p: r for r, p in enumerate(pivots)}
     kernel = _kernel(R, pivots, ncols, domain)
@@ -361,7 +411,7 @@ def _solve_split(split, rows, columns, rhs, nrows, certificate):
             for t, part in enumerate(parts):
                 if part:
                     base_rows.setdefault(i, {})[ncols + kd * k + t] = part
-    R, pivots = _rref(base_rows, nrows, ncols + kd * len(rhs), split.base)
+    R, pivots = _rref(base_rows, nrows, ncols + kd * len(rhs), split.base, link=ncols)
     col_pivots = [p for p in pivots if p < ncols]
     pivot_row = {p: r for r, p in enumerate(pivots)}
     kernel = [{c: split.lift(v) for c, v in vec.items()} for vec in _kernel(R, pivots, ncols, split.base)]
