@@ -6,9 +6,18 @@ routes reduce to an affine system ``L x = b`` over the coefficient field
 corrections, and affine weights in the FI route; rows = coordinates of a field
 or of a formal sum); the invariant search needs the nullspace of ``Phi - id``
 and ranks; the Liouville-term canonicaliser needs the rank of integer
-exponent vectors.  Everything here is sympy ``DomainMatrix`` arithmetic
-(sparse Gauss-Jordan ``rref``) over ``K``, never ``sympy.solve``.  Vectors are
-sparse dicts ``{index: value}`` with values in the domain.
+exponent vectors.  Everything here is an exact reduced row echelon form
+(:func:`_rref`), never ``sympy.solve``.  Vectors are sparse dicts
+``{index: value}`` with values in the domain.
+
+The echelon form is unique, so its routes are interchangeable and give identical
+results: the matrix is split into the blocks of its sparsity graph; over ``QQ`` a block
+is eliminated densely by python-flint's ``fmpq_mat`` (optional extra ``fast``;
+``NAMBU_BCH_DISABLE_FLINT=1`` switches it off); over ``QQ<theta>`` or
+``QQ<theta>(parameters)`` (triple-jump coefficients) a matrix with entries in the base
+field is eliminated there, right-hand sides split along ``1, theta, ..``
+(:class:`_AlgebraicSplit`); everything else is sympy's sparse Gauss-Jordan
+``DomainMatrix.rref`` over the field.  ``FAST_PATHS = False`` keeps to the last one.
 
 * :func:`solve_affine` returns a particular solution and a kernel basis of
   ``L``, or, when ``b`` is not in the image, a *certificate*: a left null
@@ -28,7 +37,7 @@ sparse dicts ``{index: value}`` with values in the domain.
 
 References
 ----------
-sympy ``DomainMatrix`` (``sympy/polys/matrices``); Horikoshi, Sect. 4.2
+sympy ``DomainMatrix`` (``sympy/polys/matrices``); FLINT ``fmpq_mat_rref``; Horikoshi, Sect. 4.2
 (the identification ``X_eff = X_{H_S,G_S}``, Eq. L2, is linear order by order).
 """
 
@@ -129,7 +138,7 @@ class _AlgebraicSplit:
 
     def __init__(self, domain, algebraic, base):
         self.domain, self.algebraic, self.base = domain, algebraic, base
-        self.k = algebraic.ext.minpoly.degree()
+        self.k = len(algebraic.mod.to_list()) - 1  # ANP coefficients are on powers of the primitive element
         self.params = not domain.is_AlgebraicField
         self._factors: dict = {}
 
