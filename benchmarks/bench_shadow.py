@@ -1,6 +1,7 @@
 """Benchmark of nambu_bch.shadow: both routes, and the direct route against a plain-sympy baseline.
 
-Run:  /work/venv/bin/python benchmarks/bench_shadow.py
+Run:  /work/venv/bin/python benchmarks/bench_shadow.py            (the rows below, then the issue-14 rows)
+      /work/venv/bin/python benchmarks/bench_shadow.py --issue14  (the issue-14 rows only)
 
 Prints, measured in this one run (process CPU time, best of a few repeats):
 * all six ho3 words through the FI route and the direct route at O(h^2);
@@ -11,6 +12,12 @@ Prints, measured in this one run (process CPU time, best of a few repeats):
   and the ratio baseline / ours.
 The baseline reproduces the same member (it solves for all unknowns and sets the
 free ones to zero), and its result is checked against ours.
+
+The issue-14 rows (docs/performance.md, Sect. 3) time the whole ``shadow_hamiltonians`` call
+in a fresh child process each (cold, CPU seconds), ours against the package's previous
+elimination (``nambu_bch.algebra.elimination.FAST_PATHS = False``: sympy's sparse
+``DomainMatrix.rref`` over the full coefficient field), and for row c also against the
+plain-sympy baseline; the two results are compared (members alpha = 0 and 1).
 """
 
 from __future__ import annotations
@@ -24,7 +31,7 @@ import sympy
 
 from timing import cpu  # benchmarks/timing.py (the script's directory is on sys.path)
 
-from nambu_bch import PAPER_WORDS, liouville_field, model
+from nambu_bch import PAPER_WORDS, System, liouville_field, model
 from nambu_bch.bch import effective_field
 from nambu_bch.shadow import shadow_hamiltonians
 
@@ -88,9 +95,21 @@ def check_solution(system, word, order, shadows):
     return True
 
 
+N4 = ["x1**2/2 + x2**2/2 + x3**2/2 + x4**2/2", "x1**2/2 + x2**2 + 3*x3**2/2 + 2*x4**2", "x1 + x2 + x3 + x4"]
+
+
+def make_system(name):
+    """The systems of the benchmark by name (catalog models, rigid body with I = 1, 2, 3, N = 4 single split)."""
+    if name == "rigid-body[I=1,2,3]":
+        return model("rigid-body").substitute({"I1": 1, "I2": 2, "I3": 3})
+    if name == "n4-single":
+        return System("x1 x2 x3 x4", N4, name="n4-single", split="single")
+    return model(name)
+
+
 def _timed_baseline(args, queue):
     name, word, order, degrees = args
-    system = model(name)
+    system = make_system(name)
     t = time.process_time()
     out = baseline(system, word, order, degrees)
     queue.put((time.process_time() - t, out is not None and check_solution(system, word, order, out)))
@@ -109,6 +128,81 @@ def baseline_with_limit(name, word, order, degrees, limit):
     return queue.get()
 
 
+def _timed_ours(args, queue):
+    name, word, order, fast = args
+    from nambu_bch.algebra import elimination
+
+    elimination.FAST_PATHS = fast
+    system = make_system(name)
+    t = time.process_time()
+    fam = shadow_hamiltonians(system, word, order)
+    dt = time.process_time() - t
+    queue.put((dt, [tuple(map(str, fam.member(alpha=a))) for a in (0, 1)], fam.degree))
+
+
+def _child(target, args, limit):
+    """``target(args, queue)`` in a fresh process; its result, or ``None`` after ``limit`` seconds."""
+    import queue as queues
+
+    queue = mp.Queue()
+    proc = mp.Process(target=target, args=(args, queue))
+    proc.start()
+    try:
+        out = queue.get(timeout=limit)  # before join: a child with a large result waits until it is read
+    except queues.Empty:
+        out = None
+    if proc.is_alive():
+        proc.terminate()
+    proc.join()
+    return out
+
+
+ISSUE14 = [  # (row, system, word, order, goal in s)
+    ("a: rigid body, symbolic I, 12321, h^8", "rigid-body", "12321", 8, 3.0),
+    ("b: rigid body, symbolic I, yoshida:12321, h^4", "rigid-body", "yoshida:12321", 4, 3.0),
+    ("b: ho3 yoshida:12321, h^8", "ho3", "yoshida:12321", 8, 3.0),
+    ("c: rigid body, I = 1, 2, 3, 12321, h^8", "rigid-body[I=1,2,3]", "12321", 8, None),
+    ("c: rigid body, I = 1, 2, 3, 12321, h^10", "rigid-body[I=1,2,3]", "12321", 10, None),
+    ("c: rigid body, I = 1, 2, 3, 12321, h^12", "rigid-body[I=1,2,3]", "12321", 12, None),
+    ("d: N = 4 single split, 1234321, h^4", "n4-single", "1234321", 4, 5.0),
+    ("d: N = 4 single split, 1234321, h^6", "n4-single", "1234321", 6, 30.0),
+]
+
+
+def issue14(limit: float = 150.0):
+    """The issue-14 rows: ours and the previous elimination, each cold in a child process (CPU s)."""
+    import os
+
+    print(f"issue 14 rows (cold child process each, CPU s; load average {os.getloadavg()[0]:.1f})")
+    rows = []
+    for label, name, word, order, goal in ISSUE14:
+        ours = _child(_timed_ours, (name, word, order, True), limit)
+        before = _child(_timed_ours, (name, word, order, False), limit)
+        t_ours = ours[0] if ours else None
+        t_before = before[0] if before else limit
+        same = None if not (ours and before) else ours[1] == before[1] or _same_members(name, ours[1], before[1])
+        line = (f"{label}: ours {'>' + str(limit) if t_ours is None else f'{t_ours:.2f}'} s, previous elimination "
+                f"{'>' if before is None else ''}{t_before:.2f} s")
+        if t_ours:
+            line += f", ratio {'>' if before is None else ''}{t_before / t_ours:.1f}x"
+        if goal:
+            line += f", goal < {goal:g} s: {'met' if t_ours is not None and t_ours < goal else 'not met'}"
+        line += f"  (same members: {same})"
+        if name == "rigid-body[I=1,2,3]" and order == 8 and ours:
+            t_base, ok = baseline_with_limit(name, word, order, ours[2], 60.0)
+            line += (f"; plain sympy (exact map + sympy.solve) {'>' if ok is None else ''}{t_base:.2f} s, "
+                     f"ratio {'>' if ok is None else ''}{t_base / t_ours:.1f}x (goal >= 50x; baseline valid: {ok})")
+        print(line, flush=True)
+        rows.append((label, t_ours, t_before, same))
+    return rows
+
+
+def _same_members(name, u, v):
+    """The members printed differently: equal as expressions (algebraic fields have no unique normal form)."""
+    return all(sympy.expand(sympy.together(sympy.sympify(p) - sympy.sympify(q))) == 0
+               for mu, mv in zip(u, v) for p, q in zip(mu, mv))
+
+
 def main(limit: float = 60.0):
     ho3, rb = model("ho3"), model("rigid-body")
     print("nambu_bch.shadow benchmark (process CPU seconds, best of 3)")
@@ -121,7 +215,7 @@ def main(limit: float = 60.0):
     for label, name, word, order in [("ho3 12321 O(h^6)", "ho3", "12321", 6), ("ho3 32123 O(h^4)", "ho3", "32123", 4),
                                      ("rigid-body 12321 O(h^2)", "rigid-body", "12321", 2),
                                      ("rigid-body 12321 O(h^4)", "rigid-body", "12321", 4)]:
-        system = model(name)
+        system = make_system(name)
         t_ours, fam = cpu(lambda: shadow_hamiltonians(system, word, order), repeat=2)
         ours_ok = check_solution(system, word, order, fam.member(alpha=0))
         t_base, ok = baseline_with_limit(name, word, order, fam.degree, limit)
@@ -133,4 +227,8 @@ def main(limit: float = 60.0):
 
 
 if __name__ == "__main__":
-    sys.exit(0 if all(r[3] is not False and r[4] for r in main()) else 1)
+    ok = True
+    if "--issue14" not in sys.argv:
+        ok = all(r[3] is not False and r[4] for r in main())
+    ok = all(r[3] is not False for r in issue14()) and ok
+    sys.exit(0 if ok else 1)

@@ -6,9 +6,18 @@ routes reduce to an affine system ``L x = b`` over the coefficient field
 corrections, and affine weights in the FI route; rows = coordinates of a field
 or of a formal sum); the invariant search needs the nullspace of ``Phi - id``
 and ranks; the Liouville-term canonicaliser needs the rank of integer
-exponent vectors.  Everything here is sympy ``DomainMatrix`` arithmetic
-(sparse Gauss-Jordan ``rref``) over ``K``, never ``sympy.solve``.  Vectors are
-sparse dicts ``{index: value}`` with values in the domain.
+exponent vectors.  Everything here is an exact reduced row echelon form
+(:func:`_rref`), never ``sympy.solve``.  Vectors are sparse dicts
+``{index: value}`` with values in the domain.
+
+The echelon form is unique, so its routes are interchangeable and give identical
+results: the matrix is split into the blocks of its sparsity graph; over ``QQ`` a block
+is eliminated densely by python-flint's ``fmpq_mat`` (optional extra ``fast``;
+``NAMBU_BCH_DISABLE_FLINT=1`` switches it off); over ``QQ<theta>`` or
+``QQ<theta>(parameters)`` (triple-jump coefficients) a matrix with entries in the base
+field is eliminated there, right-hand sides split along ``1, theta, ..``
+(:class:`_AlgebraicSplit`); everything else is sympy's sparse Gauss-Jordan
+``DomainMatrix.rref`` over the field.  ``FAST_PATHS = False`` keeps to the last one.
 
 * :func:`solve_affine` returns a particular solution and a kernel basis of
   ``L``, or, when ``b`` is not in the image, a *certificate*: a left null
@@ -28,14 +37,17 @@ sparse dicts ``{index: value}`` with values in the domain.
 
 References
 ----------
-sympy ``DomainMatrix`` (``sympy/polys/matrices``); Horikoshi, Sect. 4.2
+sympy ``DomainMatrix`` (``sympy/polys/matrices``); FLINT ``fmpq_mat_rref``; Horikoshi, Sect. 4.2
 (the identification ``X_eff = X_{H_S,G_S}``, Eq. L2, is linear order by order).
 """
 
 from __future__ import annotations
 
+import importlib
+import os
 from dataclasses import dataclass
 
+from sympy.polys.domains import QQ
 from sympy.polys.matrices import DomainMatrix
 from sympy.polys.matrices.sdm import SDM
 
@@ -66,6 +78,248 @@ class AffineSolution:
 
 def _sdm(rows: dict, nrows: int, ncols: int, domain) -> DomainMatrix:
     return DomainMatrix.from_rep(SDM({i: dict(r) for i, r in rows.items() if r}, (nrows, ncols), domain))
+
+
+#: Largest matrix (rows x columns) eliminated densely by python-flint's ``fmpq_mat``; larger ones stay sparse.
+FLINT_DENSE_LIMIT = 4_000_000
+
+#: ``False`` sends every elimination to sympy's sparse ``DomainMatrix.rref`` over the given domain (the
+#: reference path the tests compare the faster routes with).
+FAST_PATHS = True
+
+_FLINT: list = []
+
+
+def flint_available() -> bool:
+    """python-flint is installed and not disabled by ``NAMBU_BCH_DISABLE_FLINT=1`` (read at every call).
+
+    python-flint is an optional extra (``pip install nambu_bch[fast]``); without it every
+    elimination runs on sympy's ``DomainMatrix`` alone, with the same results.
+    """
+    if os.environ.get("NAMBU_BCH_DISABLE_FLINT", "").strip().lower() in ("1", "true", "yes", "on"):
+        return False
+    if not _FLINT:
+        try:
+            _FLINT.append(importlib.import_module("flint"))
+        except ImportError:
+            _FLINT.append(None)
+    return _FLINT[0] is not None and hasattr(_FLINT[0], "fmpq_mat")
+
+
+def _rref_flint_qq(rows: dict, nrows: int, ncols: int):
+    """Reduced echelon form over ``QQ`` with flint's dense ``fmpq_mat.rref`` (exact, fraction-free inside)."""
+    flint = _FLINT[0]
+    native = QQ.dtype is flint.fmpq  # sympy's ground types are flint: no conversion
+    M = flint.fmpq_mat(nrows, ncols)
+    for i, row in rows.items():
+        for j, v in row.items():
+            M[i, j] = v if native else flint.fmpq(int(v.numerator), int(v.denominator))
+    R, rank = M.rref()
+    entries = R.entries()
+    out, pivots = {}, []
+    for i in range(rank):
+        row = entries[i * ncols:(i + 1) * ncols]
+        out[i] = {j: (v if native else QQ(int(v.p), int(v.q))) for j, v in enumerate(row) if v}
+        pivots.append(min(out[i]))
+    return out, tuple(pivots)
+
+
+class _AlgebraicSplit:
+    """``K = QQ<theta>`` or ``QQ<theta>(params)`` as ``k`` copies of its base ``B = QQ`` or ``QQ(params)``.
+
+    ``1, theta, .., theta^(k-1)`` (``k`` the degree of the minimal polynomial of
+    ``theta``, irreducible over ``B`` too) is a basis of ``K`` over ``B``.  Hence a matrix
+    with entries in ``B`` has the same reduced echelon form over ``B`` and over ``K``
+    (Gauss-Jordan never leaves ``B``), and ``L x = b`` with ``L`` over ``B`` and
+    ``b = sum_i theta^i b_i`` is the ``k`` systems ``L x_i = b_i``, ``x = sum_i theta^i x_i``
+    (same pivots, same free columns).  This replaces arithmetic in ``K`` -- a polynomial gcd
+    over an algebraic number field at every operation -- by arithmetic in ``B``.
+    """
+
+    def __init__(self, domain, algebraic, base):
+        self.domain, self.algebraic, self.base = domain, algebraic, base
+        self.k = len(algebraic.mod.to_list()) - 1  # ANP coefficients are on powers of the primitive element
+        self.params = not domain.is_AlgebraicField
+        self._factors: dict = {}
+
+    @classmethod
+    def of(cls, domain):
+        if domain.is_AlgebraicField:
+            return cls(domain, domain, QQ)
+        if getattr(domain, "is_FractionField", False) and domain.domain.is_AlgebraicField:
+            return cls(domain, domain.domain, QQ.frac_field(*domain.symbols))
+        return None
+
+    def split(self, v):
+        """``[b_0, .., b_{k-1}]`` in ``B`` with ``v = sum_i theta^i b_i``, or ``None`` (denominator not in ``B``)."""
+        if not self.params:
+            rep = v.to_list()
+            return [QQ.convert(rep[-1 - i]) if i < len(rep) else QQ.zero for i in range(self.k)]
+        num, den = v.numer, v.denom
+        dB = {}
+        for m, c in den.items():
+            rep = c.to_list()
+            if len(rep) > 1:
+                return None
+            dB[m] = rep[0]
+        field = self.base.field
+        den_b = field.ring.from_dict(dB)
+        parts = [{} for _ in range(self.k)]
+        for m, c in num.items():
+            rep = c.to_list()
+            for i in range(len(rep)):
+                if rep[-1 - i]:
+                    parts[i][m] = rep[-1 - i]
+        return [field.new(field.ring.from_dict(p), den_b) if p else self.base.zero for p in parts]
+
+    def split_rows(self, rows: dict):
+        """The rows over ``B`` when every entry lies in ``B``; else ``None``."""
+        out = {}
+        for i, row in rows.items():
+            new = {}
+            for j, v in row.items():
+                parts = self.split(v)
+                if parts is None or any(parts[1:]):
+                    return None
+                if parts[0]:
+                    new[j] = parts[0]
+            out[i] = new
+        return out
+
+    def join(self, parts):
+        """``sum_i theta^i parts[i]`` in ``K`` (``parts`` in ``B``), built as one fraction over ``B``'s denominators.
+
+        The common denominator ``d`` lies in ``B``; rational common factors of ``d`` and the
+        numerator's components are divided out over ``B``.  When every irreducible factor of
+        ``d`` over ``QQ`` is linear (irreducible over ``K`` too) nothing more can cancel and the
+        fraction is used as it is; otherwise sympy cancels it over ``K``.
+        """
+        A, K = self.algebraic, self.domain
+        if not self.params:
+            return A.new([QQ.convert(parts[i]) if parts[i] else QQ.zero for i in reversed(range(self.k))])
+        nz = [(i, p) for i, p in enumerate(parts) if p]
+        if not nz:
+            return K.zero
+        if len(nz) == 1 and nz[0][0] == 0:
+            return self.lift(nz[0][1])
+        d = nz[0][1].denom
+        for _, p in nz[1:]:
+            d = d.lcm(p.denom)
+        nums = {i: p.numer * d.exquo(p.denom) for i, p in nz}
+        g = d
+        for num in nums.values():
+            g = g.gcd(num)
+        if g != 1:
+            d = d.exquo(g)
+            nums = {i: num.exquo(g) for i, num in nums.items()}
+        lc = d.LC
+        if lc != 1:  # a monic denominator, as sympy's own arithmetic in K leaves it
+            d = d.quo_ground(lc)
+            nums = {i: num.quo_ground(lc) for i, num in nums.items()}
+        coeffs: dict = {}
+        for i, num in nums.items():
+            for m, c in num.items():
+                coeffs.setdefault(m, [QQ.zero] * self.k)[i] = c
+        field = K.field
+        numer = field.ring.from_dict({m: A.new(v[::-1]) for m, v in coeffs.items()})
+        denom = field.ring.from_dict({m: A.new([c]) for m, c in d.items()})
+        if self._linear_factors(d):
+            return field.raw_new(numer, denom)
+        return field.new(numer, denom)
+
+    def _linear_factors(self, d) -> bool:
+        key = tuple(sorted(d.items()))
+        if key not in self._factors:
+            self._factors[key] = all(max(map(sum, f.monoms())) <= 1 for f, _ in d.factor_list()[1])
+        return self._factors[key]
+
+    def lift(self, v):
+        """``v`` in ``B`` as an element of ``K``: the same fraction (coprime over ``QQ``, hence over ``K``),
+        denominator made monic."""
+        if not self.params:
+            return self.algebraic.convert(v)
+        A, field = self.algebraic, self.domain.field
+        lc = v.denom.LC
+        coeffs = lambda p: {m: A.new([q / lc]) for m, q in p.items()}  # noqa: E731
+        return field.raw_new(field.ring.from_dict(coeffs(v.numer)), field.ring.from_dict(coeffs(v.denom)))
+
+
+def _rref(rows: dict, nrows: int, ncols: int, domain, lift: bool = True, link: int | None = None):
+    """The reduced row echelon form of ``{row: {column: value}}``, block by block: ``(R, pivots)``.
+
+    The rows and columns fall into blocks, the connected components of the graph in which a
+    row and a column ``< link`` are joined when the entry is non-zero; the reduced echelon form
+    of a block-diagonal matrix is the union of those of its blocks (rows ordered by pivot),
+    each computed by :func:`_rref_block`.  Columns ``>= link`` (right-hand sides) join no blocks:
+    they are carried along in every block, so that a pivot in such a column means that the
+    block's part of that right-hand side is not in the span of the block's columns, and ``R``
+    is then no longer one echelon form (two blocks may have their pivots in the same column).
+    """
+    if not FAST_PATHS:
+        return _rref_block(rows, nrows, ncols, domain, lift)
+    link = ncols if link is None else link
+    parent = list(range(link))
+
+    def find(x):
+        while parent[x] != x:
+            parent[x] = parent[parent[x]]
+            x = parent[x]
+        return x
+
+    live = {}
+    for i, r in rows.items():
+        r = {j: v for j, v in r.items() if v}
+        if not r:
+            continue
+        live[i] = r
+        cols = [j for j in r if j < link]
+        for j in cols[1:]:
+            a, b = find(cols[0]), find(j)
+            if a != b:
+                parent[a] = b
+    groups: dict = {}
+    for i, r in live.items():
+        cols = [j for j in r if j < link]
+        groups.setdefault(find(cols[0]) if cols else None, []).append(i)
+    if len(groups) <= 1:
+        return _rref_block(live, nrows, ncols, domain, lift)
+    out = []
+    for members in groups.values():
+        cols = sorted({j for i in members for j in live[i]})
+        index = {c: k for k, c in enumerate(cols)}
+        block = {k: {index[j]: v for j, v in live[i].items()} for k, i in enumerate(members)}
+        R, _ = _rref_block(block, len(members), len(cols), domain, lift)
+        out += [{cols[j]: v for j, v in row.items()} for row in R.values()]
+    out.sort(key=min)
+    return dict(enumerate(out)), tuple(min(row) for row in out)
+
+
+def _rref_block(rows: dict, nrows: int, ncols: int, domain, lift: bool = True):
+    """The reduced row echelon form of the sparse matrix ``{row: {column: value}}``: ``(R, pivots)``.
+
+    ``R`` is ``{row: {column: value}}`` (the ``rank`` non-zero rows, pivot entries one),
+    ``pivots`` the pivot columns.  The reduced echelon form is unique, so every route gives
+    the same ``R`` (:func:`_rref` calls it on each block): dense ``fmpq_mat`` (python-flint) over ``QQ``; over an algebraic
+    extension, the base field when every entry lies in it (:class:`_AlgebraicSplit`);
+    otherwise sympy's sparse Gauss-Jordan (``DomainMatrix.rref``).  ``lift=False``: the
+    values of ``R`` may be left in the base field (for callers that need the pivots only).
+    """
+    rows = {i: {j: v for j, v in r.items() if v} for i, r in rows.items()}
+    rows = {i: r for i, r in rows.items() if r}
+    if not rows:
+        return {}, ()
+    if FAST_PATHS and domain.is_QQ and nrows * ncols <= FLINT_DENSE_LIMIT and flint_available():
+        return _rref_flint_qq(rows, nrows, ncols)
+    split = _AlgebraicSplit.of(domain) if FAST_PATHS else None
+    if split is not None:
+        base_rows = split.split_rows(rows)
+        if base_rows is not None:
+            R, pivots = _rref_block(base_rows, nrows, ncols, split.base)
+            if not lift:  # only the pivots are wanted
+                return R, pivots
+            return {i: {j: split.lift(v) for j, v in r.items()} for i, r in R.items()}, pivots
+    R, pivots = _sdm(rows, nrows, ncols, domain).rref()
+    return R.rep.to_sdm(), tuple(pivots)
 
 
 def _kernel(R, pivots, ncols: int, domain) -> list:
@@ -119,13 +373,16 @@ def solve_affine(columns: list, rhs: list, nrows: int, domain, *, certificate: b
         for i, v in col.items():
             if v:
                 rows.setdefault(i, {})[j] = v
+    split = _AlgebraicSplit.of(domain) if FAST_PATHS else None
+    if split is not None:
+        out = _solve_split(split, rows, columns, rhs, nrows, certificate)
+        if out is not None:
+            return out
     for k, b in enumerate(rhs):
         for i, v in b.items():
             if v:
                 rows.setdefault(i, {})[ncols + k] = v
-    M = _sdm(rows, nrows, ncols + len(rhs), domain)
-    R, pivots = M.rref()
-    R = R.rep.to_sdm()
+    R, pivots = _rref(rows, nrows, ncols + len(rhs), domain, link=ncols)
     col_pivots = [p for p in pivots if p < ncols]
     pivot_row = {p: r for r, p in enumerate(pivots)}
     kernel = _kernel(R, pivots, ncols, domain)
@@ -145,12 +402,49 @@ def solve_affine(columns: list, rhs: list, nrows: int, domain, *, certificate: b
     return AffineSolution(True, particular, kernel, None, None, tuple(col_pivots))
 
 
+def _solve_split(split, rows, columns, rhs, nrows, certificate):
+    """:func:`solve_affine` over ``K = B<theta>`` when ``L`` lies in ``B``: one elimination over ``B`` with the
+    ``k`` components of every right-hand side (:class:`_AlgebraicSplit`); ``None`` when ``L`` or a
+    right-hand side does not split."""
+    base_rows = split.split_rows(rows)
+    if base_rows is None:
+        return None
+    ncols, kd = len(columns), split.k
+    for k, b in enumerate(rhs):
+        for i, v in b.items():
+            if not v:
+                continue
+            parts = split.split(v)
+            if parts is None:
+                return None
+            for t, part in enumerate(parts):
+                if part:
+                    base_rows.setdefault(i, {})[ncols + kd * k + t] = part
+    R, pivots = _rref(base_rows, nrows, ncols + kd * len(rhs), split.base, link=ncols)
+    col_pivots = [p for p in pivots if p < ncols]
+    pivot_row = {p: r for r, p in enumerate(pivots)}
+    kernel = [{c: split.lift(v) for c, v in vec.items()} for vec in _kernel(R, pivots, ncols, split.base)]
+    bad = [(p - ncols) // kd for p in pivots if p >= ncols]
+    if bad:
+        k = bad[0]
+        y = _certificate(columns, rhs[k], nrows, split.domain) if certificate else None
+        return AffineSolution(False, None, kernel, y, k, tuple(col_pivots))
+    particular = []
+    for k in range(len(rhs)):
+        sol = {}
+        for p in col_pivots:
+            row = R.get(pivot_row[p], {})
+            v = split.join([row.get(ncols + kd * k + t) for t in range(kd)])
+            if v:
+                sol[p] = v
+        particular.append(sol)
+    return AffineSolution(True, particular, kernel, None, None, tuple(col_pivots))
+
+
 def _certificate(columns, b, nrows, domain) -> dict:
     """A sparsest-found left null vector ``y`` of ``L`` with ``y . b != 0``."""
     rows = {j: {i: v for i, v in col.items() if v} for j, col in enumerate(columns)}
-    LT = _sdm(rows, len(columns), nrows, domain)
-    R, pivots = LT.rref()
-    R = R.rep.to_sdm()
+    R, pivots = _rref(rows, len(columns), nrows, domain)
     pivot_row = {p: r for r, p in enumerate(pivots)}
     best = None
     for f in range(nrows):
@@ -193,9 +487,7 @@ def normal_form(vector: dict, kernel: list, priority: list, domain) -> dict:
         return dict(vector)
     position = {c: i for i, c in enumerate(priority)}
     rows = {r: {position[c]: v for c, v in vec.items() if v} for r, vec in enumerate(kernel)}
-    K = _sdm(rows, len(kernel), len(priority), domain)
-    R, pivots = K.rref()
-    R = R.rep.to_sdm()
+    R, pivots = _rref(rows, len(kernel), len(priority), domain)
     x = {position[c]: v for c, v in vector.items() if v}
     for r, p in enumerate(pivots):
         v = x.get(p)
@@ -213,8 +505,7 @@ def kernel_rref(kernel: list, priority: list, domain) -> list:
         return []
     position = {c: i for i, c in enumerate(priority)}
     rows = {r: {position[c]: v for c, v in vec.items() if v} for r, vec in enumerate(kernel)}
-    R, pivots = _sdm(rows, len(kernel), len(priority), domain).rref()
-    R = R.rep.to_sdm()
+    R, pivots = _rref(rows, len(kernel), len(priority), domain)
     return [{priority[c]: v for c, v in R.get(r, {}).items()} for r in range(len(pivots))]
 
 
@@ -228,7 +519,7 @@ def rank(vectors: list, ncols: int, domain) -> int:
     if not vectors:
         return 0
     rows = {r: {c: v for c, v in vec.items() if v} for r, vec in enumerate(vectors)}
-    return len(_sdm(rows, len(vectors), ncols, domain).rref()[1])
+    return len(_rref(rows, len(vectors), ncols, domain, lift=False)[1])
 
 
 def nullspace(rows: dict, nrows: int, ncols: int, domain) -> list:
@@ -241,8 +532,8 @@ def nullspace(rows: dict, nrows: int, ncols: int, domain) -> list:
     >>> [{c: int(v) for c, v in k.items()} for k in nullspace({0: {0: QQ(1), 1: QQ(1)}}, 1, 3, QQ)]
     [{1: 1, 0: -1}, {2: 1}]
     """
-    R, pivots = _sdm(rows, nrows, ncols, domain).rref()
-    return _kernel(R.rep.to_sdm(), pivots, ncols, domain)
+    R, pivots = _rref(rows, nrows, ncols, domain)
+    return _kernel(R, pivots, ncols, domain)
 
 
 class Echelon:
