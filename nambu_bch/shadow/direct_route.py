@@ -324,10 +324,11 @@ class _Solver:
             for k, vec in zip(powers, member):
                 polys = [p + q for p, q in zip(polys, ansatz.polynomials(vec, alg.ring, pad + (k,)))]
             mem_polys.append(polys)
-        one_minus = alg.convert(1 - ALPHA)
-        al = alg.convert(ALPHA)
+        # (1 - alpha) m0 + alpha m1 written as m0 + alpha (m1 - m0): a shift of monomials instead of products
+        # of coefficients, each of which would cancel a fraction (slow over QQ<2^(1/3)>(parameters))
+        alpha = tuple(int(i == self.alpha_index) for i in range(len(alg.gens)))
         for a in range(self.slots):
-            fam[a] = one_minus * mem_polys[0][a] + al * mem_polys[1][a]
+            fam[a] = mem_polys[0][a] + (mem_polys[1][a] - mem_polys[0][a]).mul_monom(alpha)
         for a in range(self.slots):
             corrections[(a, j)] = fam[a]
         gauge = [ansatz.expressions(v, alg.coordinates, domain) for v in kernel]
