@@ -204,7 +204,7 @@ def _same_members(name, u, v):
 
 
 def main(limit: float = 60.0):
-    ho3, rb = model("ho3"), model("rigid-body")
+    ho3 = model("ho3")
     print("nambu_bch.shadow benchmark (process CPU seconds, best of 3)")
 
     t_fi, _ = cpu(lambda: [shadow_hamiltonians(ho3, w, 2, route="fi") for w in PAPER_WORDS])

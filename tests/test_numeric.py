@@ -176,14 +176,28 @@ def test_series_pair_is_accurate():
     assert worst_ulp[0] <= 1.5 and worst_ulp[1] <= 2.0 and worst_rel < 4 * 2.0**-52, (worst_ulp, worst_rel)
 
 
+def _c_library(tmp_path, program):
+    """The benchmark's C reference of ``program`` (``bench_iterate_c``'s source), built with -O2 and loaded; skips
+    the test when there is no C compiler."""
+    import ctypes
+    import shutil
+    import subprocess
+
+    cc = shutil.which("gcc") or shutil.which("cc")
+    if cc is None:
+        pytest.skip("no C compiler")
+    (tmp_path / "step.c").write_text(c_source(program))
+    subprocess.run([cc, "-O2", "-std=c99", "-shared", "-fPIC", "-o", str(tmp_path / "step.so"), str(tmp_path / "step.c"),
+                    "-lm"], check=True, capture_output=True)
+    return ctypes.CDLL(str(tmp_path / "step.so"))
+
+
 @numba_only
 def test_exponential_flows_agree_bitwise_in_the_series_range(tmp_path):
     """Lotka-Volterra with |u| <= SERIES_LIMIT: numba, the numpy batch, the scalar Python loop and
     the generated C give the same bits (the shared pair is plain arithmetic, no library call); the
     numba and C batch loops agree bit for bit also when some |u| leaves the series range."""
     import ctypes
-    import shutil
-    import subprocess
 
     X = np.array([[0.9, 1.1, 1.0], [1.2, 0.7, 1.3], [0.5, 2.0, 1.5]]).T
     a = iterate("lotka-volterra", "12321", 0.05, 3000, X, every=1000, backend="numba")
@@ -191,14 +205,8 @@ def test_exponential_flows_agree_bitwise_in_the_series_range(tmp_path):
     c = iterate("lotka-volterra", "12321", 0.05, 3000, X[:, 1], every=1000, backend="numpy")
     assert np.array_equal(a, b) and np.array_equal(a[:, :, 1], c)
     assert np.abs(a).max() < 0.5 / 0.05                      # every |u| = c h x stayed in the series range
-    cc = shutil.which("gcc") or shutil.which("cc")
-    if cc is None:
-        return
     k = kernel(model("lotka-volterra"), "12321")
-    (tmp_path / "step.c").write_text(c_source(k.program))
-    subprocess.run([cc, "-O2", "-std=c99", "-shared", "-fPIC", "-o", str(tmp_path / "step.so"), str(tmp_path / "step.c"),
-                    "-lm"], check=True, capture_output=True)
-    lib = ctypes.CDLL(str(tmp_path / "step.so"))
+    lib = _c_library(tmp_path, k.program)
     dp = ctypes.POINTER(ctypes.c_double)
     lib.run.argtypes = [dp, dp, ctypes.c_long]
     x = X[:, 1].copy()
@@ -255,17 +263,9 @@ def test_exponential_flows_mix_series_and_library_ranges():
 def test_generated_c_loop_gives_the_same_bits(tmp_path):
     """The C reference of the benchmark performs the same operations: bit-identical to the kernels."""
     import ctypes
-    import shutil
-    import subprocess
 
-    cc = shutil.which("gcc") or shutil.which("cc")
-    if cc is None:
-        pytest.skip("no C compiler")
     k = kernel(model("ho3"), "32123")
-    (tmp_path / "step.c").write_text(c_source(k.program))
-    subprocess.run([cc, "-O2", "-std=c99", "-shared", "-fPIC", "-o", str(tmp_path / "step.so"), str(tmp_path / "step.c"),
-                    "-lm"], check=True, capture_output=True)
-    lib = ctypes.CDLL(str(tmp_path / "step.so"))
+    lib = _c_library(tmp_path, k.program)
     dp = ctypes.POINTER(ctypes.c_double)
     lib.run.argtypes = [dp, dp, ctypes.c_long]
     K = k.constants(0.1)
