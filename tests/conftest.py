@@ -15,8 +15,9 @@ from __future__ import annotations
 # (a cold ``pytest -n 2`` with per-test CPU, own and of child processes: docs/suite_time.md)
 LONG = (
     ("test_notebooks.py", "test_notebook_executes"),                        # 2.4-10.8 s each, in a kernel process
-    ("test_bch_modular.py", "test_sparse_engine_equals_dense_engine"),      # 12 s at [12-12], cold: numba compile
-    ("test_any_system.py", "test_concrete_equals_generic_substituted_to_h4"),
+    ("test_bch_modular.py", "test_sparse_engine_equals_dense_engine"),      # 8.5 s at [12-12], cold: numba compile
+    ("test_numeric.py", "test_exponential_flows_"),                         # 4-6 s each: Lotka-Volterra kernels, a C build
+    ("test_elimination.py", "test_solve_affine_matches_plain_domainmatrix"),
     ("test_testing.py", "test_example_suite_"),                             # two pytest subprocesses
     ("test_cli.py", "test_every_subcommand_runs_as_a_subprocess"),
     ("test_shadow.py", "test_shadow_pair_reproduces_effective_field"),
