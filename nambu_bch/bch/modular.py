@@ -103,18 +103,26 @@ def _reduce(x, p, inv):
 # -- Lyndon table -------------------------------------------------------------------------------------------------
 
 @numba.njit(cache=True)
+def _duval_next(w, length, n, g):
+    """Duval's step after the Lyndon word ``w[:length]`` has been used: extend periodically to length ``n``, drop
+    trailing maximal letters; returns the new length (0: done).  The caller increments ``w[length - 1]``."""
+    m = length
+    while length < n:
+        w[length] = w[length - m]
+        length += 1
+    while length > 0 and w[length - 1] == g - 1:
+        length -= 1
+    return length
+
+
+@numba.njit(cache=True)
 def _duval_count(g, n):
     w = np.full(n + 1, -1, dtype=np.int64)
     length, count = 1, 0
     while length > 0:
         w[length - 1] += 1
         count += 1
-        m = length
-        while length < n:
-            w[length] = w[length - m]
-            length += 1
-        while length > 0 and w[length - 1] == g - 1:
-            length -= 1
+        length = _duval_next(w, length, n, g)
     return count
 
 
@@ -154,12 +162,7 @@ def _lyndon_table_kernel(g, n):
         lengths[k] = length
         code_of[k] = code
         k += 1
-        m = length
-        while length < n:
-            w[length] = w[length - m]
-            length += 1
-        while length > 0 and w[length - 1] == g - 1:
-            length -= 1
+        length = _duval_next(w, length, n, g)
     start = np.zeros(n + 2, dtype=np.int64)  # words grouped by length (a stable counting sort)
     for k in range(count):
         start[lengths[k] + 1] += 1
