@@ -1,4 +1,4 @@
-"""Run order only: the long tests go first (roughly longest first), so that under ``pytest -n 2`` no worker is left
+"""The tests directory on ``sys.path`` (shared helpers), and the run order: the long tests go first (roughly longest first), so that under ``pytest -n 2`` no worker is left
 alone with one at the end.
 
 Nothing here changes what a test does or asserts; the order among the other tests is kept (a stable sort).
@@ -10,6 +10,13 @@ both workers finish within seconds of each other (measured: docs/suite_time.md).
 """
 
 from __future__ import annotations
+
+import sys
+from pathlib import Path
+
+# the suite's shared helpers (reference_fields.py, strategies.py) are imported by name from this directory; with
+# ``--import-mode=importlib`` pytest does not put it on sys.path itself
+sys.path.insert(0, str(Path(__file__).parent))
 
 # (file, test name prefix) of the tests that take >= 3 s of CPU each on the two-core machine, roughly longest first
 # (a cold ``pytest -n 2`` with per-test CPU, own and of child processes: docs/suite_time.md)

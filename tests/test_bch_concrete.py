@@ -1,7 +1,5 @@
 """Concrete X_eff(h): BCH route vs backward error analysis, literature values, numerical order convention."""
 
-import sys
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -13,8 +11,7 @@ from nambu_bch.bch import EffectiveField, effective_field, effective_field_bch
 from nambu_bch.errors import InvalidOrderError, UnknownPieceError
 from nambu_bch.integrators import PAPER_WORDS, composition, step_function
 
-sys.path.insert(0, str(Path(__file__).parent))
-from reference_fields import effective_field_bch_reference, effective_field_reference  # noqa: E402
+from reference_fields import effective_field_bch_reference, effective_field_reference
 
 h = sympy.Symbol("h")
 x1, x2, x3, m, omega = sympy.symbols("x1 x2 x3 m omega")

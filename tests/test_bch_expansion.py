@@ -1,8 +1,6 @@
 """Term-by-term expansion into Liouville terms: Eqs. (BCH3), (BCH4) and pruning."""
 
 import re
-import sys
-from pathlib import Path
 
 import pytest
 import sympy
@@ -19,8 +17,7 @@ from nambu_bch.bch import (
 from nambu_bch.bch.expansion import piece_evaluator, term_evaluator
 from nambu_bch.errors import UnknownPieceError
 
-sys.path.insert(0, str(Path(__file__).parent))
-from reference_fields import effective_field_reference  # noqa: E402
+from reference_fields import effective_field_reference
 
 R = sympy.Rational
 x1, x2, x3 = sympy.symbols("x1 x2 x3")

@@ -1,8 +1,6 @@
 """Exact representations behind the BCH engine (nambu_bch.algebra.backend): Laurent polynomials, the system's
 ring, the sympy backend, caches."""
 
-import sys
-from pathlib import Path
 
 import pytest
 import sympy
@@ -13,8 +11,7 @@ from nambu_bch import System, model
 from nambu_bch.bch import clear_cache, effective_field, effective_field_bch
 from nambu_bch.algebra.backend import ExpressionBackend, FieldBackend, PolynomialBackend, field_backend
 
-sys.path.insert(0, str(Path(__file__).parent))
-from reference_fields import effective_field_reference  # noqa: E402
+from reference_fields import effective_field_reference
 
 x1, x2, x3 = sympy.symbols("x1 x2 x3")
 I1, I2, I3 = sympy.symbols("I1 I2 I3")

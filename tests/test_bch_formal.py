@@ -18,6 +18,7 @@ from nambu_bch.bch import (
 )
 from nambu_bch.errors import InvalidCompositionError, InvalidOrderError, NambuBCHError
 from nambu_bch.integrators import PAPER_WORDS, Composition, composition
+from strategies import compositions
 
 R = sympy.Rational
 
@@ -268,17 +269,6 @@ def test_matrix_check_detects_a_wrong_high_degree_coefficient():
 
 
 # -- property tests -----------------------------------------------------------------------------------------
-
-@st.composite
-def compositions(draw, max_generators=3, max_factors=5):
-    g = draw(st.integers(1, max_generators))
-    pieces = draw(st.lists(st.integers(1, g), min_size=1, max_size=max_factors))
-    coeffs = [R(draw(st.integers(-4, 4)), draw(st.integers(1, 5))) for _ in pieces]
-    for k in set(pieces):  # consistency: every piece's coefficients sum to one
-        last = max(i for i, p in enumerate(pieces) if p == k)
-        coeffs[last] = 1 - sum(c for i, (p, c) in enumerate(zip(pieces, coeffs)) if p == k and i != last)
-    return Composition(tuple(pieces), tuple(coeffs), "random")
-
 
 @settings(max_examples=25, deadline=None)
 @given(compositions())

@@ -6,14 +6,14 @@ import numpy as np
 import pytest
 import sympy
 from hypothesis import given, settings
-from hypothesis import strategies as st
 
 from nambu_bch.bch import formal_bch, lyndon_words, standard_bracketing, witt_dimension
 from nambu_bch.bch import formal as formal_module
 from nambu_bch.bch import modular
 from nambu_bch.bch.lyndon import standard_factorization
 from nambu_bch.errors import InvalidOrderError
-from nambu_bch.integrators import Composition, composition
+from nambu_bch.integrators import composition
+from strategies import compositions
 
 R = sympy.Rational
 
@@ -81,19 +81,8 @@ def test_algebraic_coefficients_use_the_dense_engine():
     assert B.domain != sympy.QQ and B.degrees == (1, 5)
 
 
-@st.composite
-def compositions(draw, max_generators=3, max_factors=6):
-    g = draw(st.integers(1, max_generators))
-    pieces = draw(st.lists(st.integers(1, g), min_size=1, max_size=max_factors))
-    coeffs = [R(draw(st.integers(-9, 9)), draw(st.integers(1, 7))) for _ in pieces]
-    for k in set(pieces):  # consistency: every piece's coefficients sum to one
-        last = max(i for i, p in enumerate(pieces) if p == k)
-        coeffs[last] = 1 - sum(c for i, (p, c) in enumerate(zip(pieces, coeffs)) if p == k and i != last)
-    return Composition(tuple(pieces), tuple(coeffs), "random")
-
-
 @settings(max_examples=30, deadline=None)
-@given(compositions())
+@given(compositions(max_factors=6, numerators=9, denominators=7))
 def test_property_sparse_equals_dense(comp):
     """Random consistent rational compositions (zeros, negatives, repeated letters): identical series."""
     n = 7 if len(set(comp.pieces)) < 3 else 6
