@@ -445,16 +445,8 @@ def _certificate(columns, b, nrows, domain) -> dict:
     """A sparsest-found left null vector ``y`` of ``L`` with ``y . b != 0``."""
     rows = {j: {i: v for i, v in col.items() if v} for j, col in enumerate(columns)}
     R, pivots = _rref(rows, len(columns), nrows, domain)
-    pivot_row = {p: r for r, p in enumerate(pivots)}
     best = None
-    for f in range(nrows):
-        if f in pivot_row:
-            continue
-        y = {f: domain.one}
-        for p in pivots:
-            v = R.get(pivot_row[p], {}).get(f)
-            if v:
-                y[p] = -v
+    for y in _kernel(R, pivots, nrows, domain):  # the left null space, one vector per free row index
         value = sum((y[i] * b[i] for i in y if i in b), domain.zero)
         if value and (best is None or len(y) < len(best)):
             best = y
