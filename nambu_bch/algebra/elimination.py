@@ -83,6 +83,11 @@ def _sdm(rows: dict, nrows: int, ncols: int, domain) -> DomainMatrix:
 #: Largest matrix (rows x columns) eliminated densely by python-flint's ``fmpq_mat``; larger ones stay sparse.
 FLINT_DENSE_LIMIT = 4_000_000
 
+#: Without python-flint, ``QQ`` blocks with at least this many non-zero rows and columns (and at most
+#: :data:`FLINT_DENSE_LIMIT` entries) are eliminated multi-modularly (:mod:`nambu_bch.algebra.modular_rref`);
+#: smaller ones by sympy's sparse ``DomainMatrix.rref``.
+MODULAR_MIN = 8
+
 #: ``False`` sends every elimination to sympy's sparse ``DomainMatrix.rref`` over the given domain (the
 #: reference path the tests compare the faster routes with).
 FAST_PATHS = True
@@ -244,6 +249,55 @@ class _AlgebraicSplit:
         return field.raw_new(field.ring.from_dict(coeffs(v.numer)), field.ring.from_dict(coeffs(v.denom)))
 
 
+def _blocks(live: dict, link: int) -> dict:
+    """The rows of ``{row: {column: value}}`` (no zero entries) grouped by the connected components of the graph
+    joining a row and a column ``< link`` with a non-zero entry: ``{component: [rows]}`` (key ``None``: rows
+    with entries in columns ``>= link`` only)."""
+    parent = list(range(link))
+
+    def find(x):
+        while parent[x] != x:
+            parent[x] = parent[parent[x]]
+            x = parent[x]
+        return x
+
+    for r in live.values():
+        cols = [j for j in r if j < link]
+        for j in cols[1:]:
+            a, b = find(cols[0]), find(j)
+            if a != b:
+                parent[a] = b
+    groups: dict = {}
+    for i, r in live.items():
+        cols = [j for j in r if j < link]
+        groups.setdefault(find(cols[0]) if cols else None, []).append(i)
+    return groups
+
+
+def elimination_cost(columns: list, nrows: int) -> int:
+    """An estimate of the work of :func:`solve_affine` on the matrix with these sparse columns (``{row: value}``).
+
+    The matrix is eliminated block by block (:func:`_rref`); a dense Gauss-Jordan elimination of an
+    ``r x c`` block takes at most ``min(r, c)`` pivot steps of ``r c`` operations each, so the estimate is
+    ``sum over blocks of r c min(r, c)`` (field or word operations; the bounded-work guard of the direct
+    route compares it with its budget before anything is eliminated).
+
+    >>> from sympy.polys.domains import QQ
+    >>> elimination_cost([{0: QQ(1)}, {0: QQ(2), 1: QQ(1)}, {2: QQ(1)}], 3)   # blocks 2 x 2 and 1 x 1
+    9
+    """
+    rows: dict = {}
+    for j, col in enumerate(columns):
+        for i, v in col.items():
+            if v:
+                rows.setdefault(i, {})[j] = v
+    total = 0
+    for members in _blocks(rows, len(columns)).values():
+        r, c = len(members), len({j for i in members for j in rows[i]})
+        total += r * c * min(r, c)
+    return total
+
+
 def _rref(rows: dict, nrows: int, ncols: int, domain, lift: bool = True, link: int | None = None):
     """The reduced row echelon form of ``{row: {column: value}}``, block by block: ``(R, pivots)``.
 
@@ -258,29 +312,9 @@ def _rref(rows: dict, nrows: int, ncols: int, domain, lift: bool = True, link: i
     if not FAST_PATHS:
         return _rref_block(rows, nrows, ncols, domain, lift)
     link = ncols if link is None else link
-    parent = list(range(link))
-
-    def find(x):
-        while parent[x] != x:
-            parent[x] = parent[parent[x]]
-            x = parent[x]
-        return x
-
-    live = {}
-    for i, r in rows.items():
-        r = {j: v for j, v in r.items() if v}
-        if not r:
-            continue
-        live[i] = r
-        cols = [j for j in r if j < link]
-        for j in cols[1:]:
-            a, b = find(cols[0]), find(j)
-            if a != b:
-                parent[a] = b
-    groups: dict = {}
-    for i, r in live.items():
-        cols = [j for j in r if j < link]
-        groups.setdefault(find(cols[0]) if cols else None, []).append(i)
+    live = {i: {j: v for j, v in r.items() if v} for i, r in rows.items()}
+    live = {i: r for i, r in live.items() if r}
+    groups = _blocks(live, link)
     if len(groups) <= 1:
         return _rref_block(live, nrows, ncols, domain, lift)
     out = []
@@ -308,8 +342,13 @@ def _rref_block(rows: dict, nrows: int, ncols: int, domain, lift: bool = True):
     rows = {i: r for i, r in rows.items() if r}
     if not rows:
         return {}, ()
-    if FAST_PATHS and domain.is_QQ and nrows * ncols <= FLINT_DENSE_LIMIT and flint_available():
-        return _rref_flint_qq(rows, nrows, ncols)
+    if FAST_PATHS and domain.is_QQ and nrows * ncols <= FLINT_DENSE_LIMIT:
+        if flint_available():
+            return _rref_flint_qq(rows, nrows, ncols)
+        if min(len(rows), ncols) >= MODULAR_MIN:
+            from .modular_rref import rref_qq
+
+            return rref_qq(rows, nrows, ncols)
     split = _AlgebraicSplit.of(domain) if FAST_PATHS else None
     if split is not None:
         base_rows = split.split_rows(rows)
