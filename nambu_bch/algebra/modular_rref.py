@@ -136,8 +136,14 @@ def _reconstruct(u: int, M: int, bound: int):
 
 
 def _rationals(X: np.ndarray, M: int):
-    """The rational matrix with residues ``X`` (object array of ints in ``[0, M)``), row by row with a running
-    denominator (an entry ``u`` with ``u D mod M`` small is ``(u D mod M) / D``); None when some entry fails."""
+    """The rational matrix with residues ``X`` (object array of ints in ``[0, M)``), row by row: ``[(D, entries)]``,
+    an entry ``(n, d)`` meaning ``n / d`` with ``d | D``, or None for zero; None when some entry fails.
+
+    A running row denominator ``D`` (the lcm of the denominators so far): an entry ``u`` with ``v = u D mod M``
+    (symmetric) at most ``B = sqrt(M / 2)`` is ``v / D``; otherwise Wang's reconstruction of ``u`` itself.  Both are
+    right once ``M > 2 H^2`` (``H`` bounds every minor, so numerators and ``D``, a divisor of the pivot minor, are
+    below ``B``: ``|v b - a D| <= 2 B H < M`` for the true ``a / b``); before that a wrong candidate is possible and
+    :func:`_verify` rejects it."""
     bound = math.isqrt(M // 2)
     half = M // 2
     out = []
@@ -154,13 +160,13 @@ def _rationals(X: np.ndarray, M: int):
             if abs(v) <= bound:
                 vals.append((v, D))
                 continue
-            nd = _reconstruct(v % M, M, bound)
+            nd = _reconstruct(u, M, bound)
             if nd is None:
                 return None
-            D *= nd[1]
+            D = math.lcm(D, nd[1])
             if D > bound:
                 return None
-            vals.append((nd[0], D))
+            vals.append(nd)
         out.append((D, vals))
     return out
 
@@ -233,28 +239,21 @@ def rref_qq(rows: dict, nrows: int, ncols: int):
     ri_a, ci_a = np.array(ri, dtype=np.intp), np.array(ci, dtype=np.intp)
     best: list | None = None
     X = M = None
-    used = 0
-    limit = None
-    k = 0
-    while True:
+    # Hadamard: every minor is below 2^bits; at most bits/30 primes (> 2^30) divide the pivot minor (unlucky),
+    # and (2 bits + 1)/30 lucky ones give M > 2 H^2 (reconstruction exact): the loop ends within this many primes
+    bits = hadamard_bits(ri, vals, min(m, ncols))
+    limit = (3 * bits + 1) // 30 + 4
+    for k in range(limit):
         p = prime(k)
-        k += 1
         A = np.zeros((m, ncols), dtype=np.int64)
         A[ri_a, ci_a] = _residues(vals, p, small)
         Rp, piv = rref_mod_p(A, p)
-        if limit is None or (best is not None and len(piv) > len(best)):
-            bits = hadamard_bits(ri, vals, max(len(piv), 1))
-            per = 30  # every prime exceeds 2^30
-            limit = 2 * (2 * bits + 2) // per + 4
-        if k > limit:
-            raise ResourceLimitError(
-                f"the modular elimination of a {nrows} x {ncols} matrix over QQ needed more than {limit} primes "
-                "(the Hadamard bound): refused")
         if best is None or _better(piv, best):
-            best, X, M, used = piv, None, 1, 0
+            best, X, M = piv, None, 1
+            pivot_set = set(best)
+            free = [c for c in range(ncols) if c not in pivot_set]
         elif piv != best:
             continue  # unlucky prime
-        free = [c for c in range(ncols) if c not in set(best)]
         res = Rp[:, free] if free else np.zeros((len(best), 0), dtype=np.int64)
         if X is None:
             X = res.astype(object)
@@ -263,7 +262,6 @@ def rref_qq(rows: dict, nrows: int, ncols: int):
             t = (res - Xp) % p * pow(M % p, -1, p) % p
             X = X + M * t.astype(object)
         M *= p
-        used += 1
         cand = _rationals(X, M)
         if cand is None or not _verify(ri, ci, vals, best, free, cand):
             continue
@@ -275,3 +273,6 @@ def rref_qq(rows: dict, nrows: int, ncols: int):
                     out[j] = QQ(e[0], e[1])
             R[r] = out
         return R, tuple(best)
+    raise ResourceLimitError(
+        f"the modular elimination of a {nrows} x {ncols} matrix over QQ needed more than {limit} primes "
+        "(the Hadamard bound): refused")
