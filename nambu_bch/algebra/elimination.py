@@ -13,7 +13,8 @@ exponent vectors.  Everything here is an exact reduced row echelon form
 The echelon form is unique, so its routes are interchangeable and give identical
 results: the matrix is split into the blocks of its sparsity graph; over ``QQ`` a block
 is eliminated densely by python-flint's ``fmpq_mat`` (optional extra ``fast``;
-``NAMBU_BCH_DISABLE_FLINT=1`` switches it off); over ``QQ<theta>`` or
+``NAMBU_BCH_DISABLE_FLINT=1`` switches it off), without it multi-modularly in numpy with an exact check of the
+result (:mod:`nambu_bch.algebra.modular_rref`, blocks of at least :data:`MODULAR_MIN` rows and columns); over ``QQ<theta>`` or
 ``QQ<theta>(parameters)`` (triple-jump coefficients) a matrix with entries in the base
 field is eliminated there, right-hand sides split along ``1, theta, ..``
 (:class:`_AlgebraicSplit`); everything else is sympy's sparse Gauss-Jordan
@@ -37,7 +38,8 @@ field is eliminated there, right-hand sides split along ``1, theta, ..``
 
 References
 ----------
-sympy ``DomainMatrix`` (``sympy/polys/matrices``); FLINT ``fmpq_mat_rref``; Horikoshi, Sect. 4.2
+sympy ``DomainMatrix`` (``sympy/polys/matrices``); FLINT ``fmpq_mat_rref``; Cabay (1971) and von zur Gathen &
+Gerhard, *Modern Computer Algebra*, ch. 5 (the modular route); Horikoshi, Sect. 4.2
 (the identification ``X_eff = X_{H_S,G_S}``, Eq. L2, is linear order by order).
 """
 
@@ -334,7 +336,8 @@ def _rref_block(rows: dict, nrows: int, ncols: int, domain, lift: bool = True):
 
     ``R`` is ``{row: {column: value}}`` (the ``rank`` non-zero rows, pivot entries one),
     ``pivots`` the pivot columns.  The reduced echelon form is unique, so every route gives
-    the same ``R`` (:func:`_rref` calls it on each block): dense ``fmpq_mat`` (python-flint) over ``QQ``; over an algebraic
+    the same ``R`` (:func:`_rref` calls it on each block): dense ``fmpq_mat`` (python-flint) over ``QQ``, else
+    :func:`~nambu_bch.algebra.modular_rref.rref_qq` for blocks of at least :data:`MODULAR_MIN` rows and columns; over an algebraic
     extension, the base field when every entry lies in it (:class:`_AlgebraicSplit`);
     otherwise sympy's sparse Gauss-Jordan (``DomainMatrix.rref``).  ``lift=False``: the
     values of ``R`` may be left in the base field (for callers that need the pivots only).
