@@ -24,11 +24,12 @@ largest rank and, among those, lexicographically first, since a minor non-zero m
 is non-zero over ``QQ``; a prime with a worse pattern is dropped, a better one restarts the
 accumulation.  Termination: every minor is at most the Hadamard bound ``H`` (product of the
 ``r`` largest row norms), so once the product ``M`` of the lucky primes exceeds ``2 H^2``
-reconstruction is exact (MCA Thm. 5.26) and at most ``log_p H`` primes per needed minor are
-unlucky; :func:`rref_qq` stops at that many primes with a one-line
-:class:`~nambu_bch.errors.ResourceLimitError` (never reached for a correct implementation: the
-bound is the proof that the loop ends).  In practice two to four primes suffice
-(the shadow systems' echelon entries have 40-bit numerators and denominators).
+reconstruction is exact (numerator and denominator below ``sqrt(M / 2)``, MCA Sect. 5.10) and at
+most ``log_p H`` primes divide the pivot minor (unlucky); :func:`rref_qq` stops after
+``(3 log2 H + 1) / 30 + 4`` primes with a one-line :class:`~nambu_bch.errors.ResourceLimitError`
+(never reached for a correct implementation: the bound is the proof that the loop ends).  In
+practice three primes suffice for the N = 4 shadow systems (echelon entries with 40-bit
+numerators and 34-bit denominators).
 
 References
 ----------
