@@ -228,3 +228,18 @@ def test_rigid_body_shadows_match_plain_path(values, word, order, flint_switch):
         for p, q in zip(m_fast, m_ref):
             assert sympy.expand(sympy.together(p - q)) == 0
     assert [o.kernel_dim for o in fast.details.orders] == [o.kernel_dim for o in ref.details.orders]
+
+
+def test_elimination_cost_counts_blocks_and_weights_parameter_fields():
+    """elimination_cost: sum over the blocks of r c min(r, c), counted here by hand for a matrix with a 3 x 2 block
+    (rows 0, 1, 2; columns 0, 1), a 1 x 1 block (row 3, column 2) and a zero column: 3*2*2 + 1 = 13 over QQ and over
+    QQ<2^(1/3)> (eliminated over QQ), FIELD_WEIGHT times that over QQ(a, b); the blocks are those _rref eliminates."""
+    for name, weight in (("QQ", 1), ("QQ<2^(1/3)>", 1), ("QQ(a,b)", E.FIELD_WEIGHT)):
+        K = DOMAINS[name]
+        one = K.one
+        columns = [{0: one, 1: one}, {1: one, 2: one + one}, {3: one}, {}]
+        assert E.elimination_cost(columns, 4, K) == 13 * weight
+    rows = {0: {0: QQ(1), 1: QQ(1)}, 1: {1: QQ(1)}, 2: {1: QQ(2)}, 3: {2: QQ(1)}}
+    blocks = E._blocks(rows, 4)
+    assert sorted(map(sorted, blocks.values())) == [[0, 1, 2], [3]]
+

@@ -153,7 +153,8 @@ class DirectResult:
 MAX_UNKNOWNS = 4000
 #: Bounded work (``max_unknowns`` given): an order whose elimination is estimated above this many operations
 #: (:func:`~nambu_bch.algebra.elimination.elimination_cost`, from the block structure of the built matrix) is
-#: refused up front.  The N = 4 single split at h^6 (1485 unknowns) is 2.1e8: 0.5 s multi-modular, 0.1 s flint.
+#: refused up front.  The N = 4 single split at h^6 (1485 unknowns) is 2.1e8: 1.1 s multi-modular, 0.5 s flint; the
+#: rigid body with symbolic I at h^10 (910 unknowns over QQ(I1, I2, I3)) 3.5e9: refused, as before (generic route).
 SOLVE_COST = 2 * 10**9
 
 
@@ -289,7 +290,7 @@ class _Solver:
         ansatz = Ansatz(self.n, D, self.slots)
         rows = Rows()
         col_vectors = operator_columns(alg, self.hams, ansatz, rows, self._columns)
-        if self.max_unknowns is not None and elimination_cost(col_vectors, len(rows)) > SOLVE_COST:
+        if self.max_unknowns is not None and elimination_cost(col_vectors, len(rows), alg.domain) > SOLVE_COST:
             return OrderSolution(j, "refused", degree=D, rhs=rhs)  # bounded work: the elimination would be too long
         by_power: dict = {}
         for i, comp in enumerate(comps):
