@@ -64,6 +64,24 @@ def test_expressions_and_polynomials_round_trip():
     assert A.expressions(shifted, (x1, x2), QQ, offset=4) == (-x1 / 2, 3 * x1 * x2)
 
 
+def test_expressions_equal_the_term_by_term_sum_and_the_ring_polynomials():
+    """expressions() builds one Add per slot: structurally equal (==) to the running sum of the terms, and to the
+    ring's polynomials() converted to sympy (two independent constructions), on a dense vector of mixed rationals."""
+    from sympy.polys.rings import ring
+
+    xs = sympy.symbols("x1 x2 x3")
+    R, *_ = ring("x1 x2 x3", QQ)
+    A = Ansatz(3, 3, slots=2)
+    vec = {k: QQ((-1) ** k * (k + 1), 1 + k % 5) for k in range(len(A)) if k % 3}
+    running = [sympy.Integer(0)] * 2
+    for k, v in vec.items():
+        a, e = A.columns[k]
+        running[a] += QQ.to_sympy(v) * A.monomial(e, xs)
+    got = A.expressions(vec, xs, QQ)
+    assert got == tuple(running)
+    assert [sympy.expand(g - p.as_expr()) for g, p in zip(got, A.polynomials(vec, R))] == [0, 0]
+
+
 def test_priority_rule_for_ho3():
     """ho3 (Eqs. H, G): H = m w^2 x3/2 + x2^2/(2m), G = x3 - x1^2.  alpha = 0: constants, then H's own monomials
     x3, x2^2 in slot 0 (in the ansatz order), then slot 0's other monomials, then G's x3, x1^2, then slot 1's rest."""

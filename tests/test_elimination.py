@@ -7,6 +7,8 @@ same certificate as sympy's sparse Gauss-Jordan ``DomainMatrix.rref`` over the f
 
 * dense ``fmpq_mat.rref`` of python-flint over ``QQ`` (and, with ``NAMBU_BCH_DISABLE_FLINT=1``,
   the pure-sympy path the package keeps when python-flint is absent);
+* without python-flint, the multi-modular elimination over ``QQ`` (``algebra/modular_rref.py``; route
+  ``modular``: every ``QQ`` block, however small, sent there by ``MODULAR_MIN = 1``);
 * ``QQ<2^(1/3)>`` and ``QQ<2^(1/3)>(a, b)`` written over ``QQ`` / ``QQ(a, b)`` with the basis
   ``1, theta, theta^2`` when the matrix lies in the base field (``_AlgebraicSplit``).
 
@@ -42,9 +44,9 @@ BASE_VALUES = [sympy.Integer(1), sympy.Integer(-2), sympy.Rational(3, 5), a, b, 
 EXTENSION_VALUES = [THETA, THETA**2 / 3, 1 + THETA, a * THETA, THETA**2 / b]
 
 
-@pytest.fixture(params=["flint", "sympy-only"])
+@pytest.fixture(params=["flint", "modular", "sympy-only"])
 def flint_switch(request, monkeypatch):
-    """Both the python-flint route and the pure-sympy route (python-flint switched off)."""
+    """The python-flint route, and without python-flint the multi-modular and the pure-sympy routes."""
     return _switch(request.param, monkeypatch)
 
 
@@ -55,8 +57,9 @@ def route_switch(route, monkeypatch):
 
 
 def _switch(route, monkeypatch):
-    if route == "sympy-only":
+    if route in ("sympy-only", "modular"):
         monkeypatch.setenv("NAMBU_BCH_DISABLE_FLINT", "1")
+        monkeypatch.setattr(E, "MODULAR_MIN", 1 if route == "modular" else 10**9)
     else:
         monkeypatch.delenv("NAMBU_BCH_DISABLE_FLINT", raising=False)
         if not E.flint_available():
@@ -124,10 +127,10 @@ def _reference(fn, *args):
 
 
 DOMAIN_NAMES = list(DOMAINS)
-# python-flint only ever eliminates over QQ (directly, or as the base field of QQ<theta>): over the parameter
-# fields both switches run the same code, so those run once, with python-flint switched off
+# python-flint and the modular route only ever eliminate over QQ (directly, or as the base field of QQ<theta>):
+# over the parameter fields all switches run the same code, so those run once, with python-flint switched off
 ROUTES = [pytest.param(name, route, id=f"{route}-{name}")
-          for name in DOMAIN_NAMES for route in ("flint", "sympy-only")
+          for name in DOMAIN_NAMES for route in ("flint", "modular", "sympy-only")
           if route == "sympy-only" or not DOMAINS[name].is_FractionField]
 
 
@@ -225,3 +228,18 @@ def test_rigid_body_shadows_match_plain_path(values, word, order, flint_switch):
         for p, q in zip(m_fast, m_ref):
             assert sympy.expand(sympy.together(p - q)) == 0
     assert [o.kernel_dim for o in fast.details.orders] == [o.kernel_dim for o in ref.details.orders]
+
+
+def test_elimination_cost_counts_blocks_and_weights_parameter_fields():
+    """elimination_cost: sum over the blocks of r c min(r, c), counted here by hand for a matrix with a 3 x 2 block
+    (rows 0, 1, 2; columns 0, 1), a 1 x 1 block (row 3, column 2) and a zero column: 3*2*2 + 1 = 13 over QQ and over
+    QQ<2^(1/3)> (eliminated over QQ), FIELD_WEIGHT times that over QQ(a, b); the blocks are those _rref eliminates."""
+    for name, weight in (("QQ", 1), ("QQ<2^(1/3)>", 1), ("QQ(a,b)", E.FIELD_WEIGHT)):
+        K = DOMAINS[name]
+        one = K.one
+        columns = [{0: one, 1: one}, {1: one, 2: one + one}, {3: one}, {}]
+        assert E.elimination_cost(columns, 4, K) == 13 * weight
+    rows = {0: {0: QQ(1), 1: QQ(1)}, 1: {1: QQ(1)}, 2: {1: QQ(2)}, 3: {2: QQ(1)}}
+    blocks = E._blocks(rows, 4)
+    assert sorted(map(sorted, blocks.values())) == [[0, 1, 2], [3]]
+

@@ -133,11 +133,12 @@ def test_inconsistent_word_is_refused_not_reported_as_an_obstruction():
 
 def test_issue_example_has_a_smooth_pair_not_polynomial(ex17, ex17_12321):
     """H = x1^2/2 + x2^2/2 + x2^4/4 + x3^2, G = x1^2/2 + x1^4/8 + x2^2/2 + x3^2/2 + x3^4/4, Phi^{12321}, h^2:
-    the polynomial solve (degree 14) is refused up front (bounded work) and the averages vanish exactly by
+    the polynomial solve (degree 14, 1360 unknowns: within the default bounded work since issue 14, about 1 s) is
+    obstructed -- a certificate that no polynomial pair of degree <= 14 exists -- and the averages vanish exactly by
     reversibility (x_i -> -x_i fixes H, G and makes R_2.grad H, R_2.grad G odd; HGW Sect. XI.1), numerically too."""
     F = ex17_12321
     assert F.exists is True and F.polynomial is False and F.shadows == ()
-    assert F.details.orders[-1].status == "refused" and F.degree[2] == 14
+    assert F.details.orders[-1].status == "obstructed" and F.degree[2] == 14
     ev = F.evidence
     assert ev["method"] == "symmetry" and ev["outcome"] == "smooth" and ev["orbits_closed"] >= 4
     assert all(max(abs(a) for a in o["averages"]) < 1e-9 for o in ev["orbits"] if o["closed"])
@@ -150,6 +151,33 @@ def test_issue_example_has_a_smooth_pair_not_polynomial(ex17, ex17_12321):
     d = json.loads(json.dumps(F.to_dict()))
     assert d["exists"] is True and d["polynomial"] is False and d["drift"] is None
     assert "smooth" in F.to_text() and "undecided" not in repr(F)
+
+
+def test_bounded_work_refuses_an_elimination_above_the_cost_budget(ex17, monkeypatch):
+    """Bounded work (issue 17, kept by issue 14): with max_unknowns given, an order whose elimination is estimated
+    (elimination_cost of the built matrix) above direct_route.SOLVE_COST is refused up front, before anything is
+    eliminated, and the averages decide; at the estimate itself the solve runs (ex17, 12321, h^2: obstructed)."""
+    import importlib
+
+    from nambu_bch.algebra import elimination
+
+    dr = importlib.import_module("nambu_bch.shadow.direct_route")
+    budget, seen = dr.SOLVE_COST, []
+    monkeypatch.setattr(dr, "elimination_cost", lambda *a: seen.append(elimination.elimination_cost(*a)) or seen[-1])
+    monkeypatch.setattr(dr, "SOLVE_COST", 10**12)
+    assert direct_route(ex17, "12321", 2, max_unknowns=2000).orders[-1].status == "obstructed"
+    cost = seen[-1]
+    assert 10**7 < cost < budget  # 8.4e7 (blocks of the 2808 x 1360 matrix): solved by default
+    eliminated = []
+    original = elimination._rref_block
+    monkeypatch.setattr(elimination, "_rref_block", lambda *a, **k: eliminated.append(a) or original(*a, **k))
+    monkeypatch.setattr(dr, "SOLVE_COST", cost - 1)
+    R = direct_route(ex17, "12321", 2, max_unknowns=2000)
+    assert R.orders[-1].status == "refused" and R.orders[-1].degree == 14 and not eliminated
+    F = shadow_hamiltonians(ex17, "12321", 2, existence=False)
+    assert F.details.orders[-1].status == "refused" and "bounded-work budget" in F.obstruction
+    assert "max_unknowns=" not in F.obstruction  # 1360 unknowns are within the default 2000
+    assert direct_route(ex17, "12321", 2, max_unknowns=None).orders[-1].status == "obstructed"  # no budget
 
 
 def test_issue_example_smooth_corrections_are_conserved(ex17, ex17_12321):

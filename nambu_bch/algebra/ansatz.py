@@ -190,12 +190,12 @@ class Ansatz:
         Columns below ``offset`` (unknowns outside the ansatz) are ignored; column ``offset + k`` is
         ``columns[k]``.
         """
-        out = [sympy.Integer(0)] * self.slots
+        terms: list = [[] for _ in range(self.slots)]
         for col, v in vector.items():
             if col >= offset:
                 a, e = self.columns[col - offset]
-                out[a] += domain.to_sympy(v) * self.monomial(e, coordinates)
-        return tuple(out)
+                terms[a].append(domain.to_sympy(v) * self.monomial(e, coordinates))
+        return tuple(sympy.Add(*t) for t in terms)  # one Add per slot (a running += re-sorts the sum at every term)
 
     def polynomials(self, vector: dict, ring, tail=(), offset: int = 0) -> list:
         """``[dH^0, dH^1, ..]`` as elements of ``ring`` (its first ``n`` generators the coordinates; the exponents

@@ -15,7 +15,11 @@ from .family import ShadowFamily
 from .fi_route import fi_route
 
 ROUTES = ("direct", "fi")
-SOLVE_UNKNOWNS = 800  # default: above this many unknowns per order the exact solve is skipped and existence decided by averages
+#: Default ``max_unknowns``: above this many unknowns per order, or above the elimination cost budget
+#: ``direct_route.SOLVE_COST`` (estimated from the block structure of the matrix), the exact solve is skipped and
+#: existence decided by averages.  2000 admits the N = 4 single split at h^6 (1485 unknowns, 0.5 s of
+#: elimination without python-flint: :mod:`nambu_bch.algebra.modular_rref`); the cost budget refuses what would hang.
+SOLVE_UNKNOWNS = 2000
 
 
 def _system(system):
@@ -53,7 +57,8 @@ def shadow_hamiltonians(system, word, order: int = 2, route: str = "direct", deg
     existence : bool -- when no polynomial pair is found, decide existence in smooth functions by
         orbit averages (:mod:`nambu_bch.shadow.existence`); with False the answer stays undecided
     params : dict, optional -- parameter values for the orbit numerics (default: generic rationals)
-    max_unknowns : int or None -- refuse the exact polynomial solve of an order with more unknowns (bounded work)
+    max_unknowns : int or None -- refuse the exact polynomial solve of an order with more unknowns, or with an
+        elimination estimated above ``direct_route.SOLVE_COST`` (bounded work); None: no such limit
     progress : bool or None -- direct route: a progress bar over the orders; None: automatic
         (a terminal or Jupyter, shown once the run has lasted a second); False: never
 

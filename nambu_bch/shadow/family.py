@@ -158,8 +158,14 @@ class ShadowFamily(Printable):
             certificate, obstruction = bad.certificate, _obstruction_text(bad, len(system.hamiltonians))
         else:
             certificate = None
-            obstruction = (f"at h^{bad.order} the polynomial ansatz of degree <= {bad.degree} has more than "
-                           f"max_unknowns={max_unknowns} unknowns: the exact solve was refused up front")
+            from ..algebra.ansatz import Ansatz
+
+            if max_unknowns is None or Ansatz.size(len(system.coordinates), bad.degree, len(system.hamiltonians)) > max_unknowns:
+                what = f"has more than max_unknowns={max_unknowns} unknowns"
+            else:  # within max_unknowns, above the elimination cost budget (direct_route.SOLVE_COST)
+                what = "needs an elimination above the bounded-work budget"
+            obstruction = (f"at h^{bad.order} the polynomial ansatz of degree <= {bad.degree} {what}: "
+                           "the exact solve was refused up front")
         return cls(system, composition, order, "direct", failed_order=bad.order, polynomial=False, certificate=certificate,
                    obstruction=obstruction, **existence_fields(decision, bad.order), **common)
 
