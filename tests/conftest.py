@@ -37,6 +37,29 @@ LONG = (
 )
 
 
+#: Plugin distributions whose modules pytest marks for assertion rewriting (every module of a distribution with a
+#: ``pytest11`` entry point).  None of them has an ``assert`` the suite relies on (the package has none at all), but
+#: every pytest process re-parsed and rewrote ~150 of their modules as they were imported, ~0.7 s of CPU per process,
+#: since ``PYTHONDONTWRITEBYTECODE`` keeps pytest from caching the result (docs/suite_time.md, session 11).
+NOT_REWRITTEN = ("nambu_bch", "hypothesis", "_hypothesis_pytestplugin", "_hypothesis_globals", "_hypothesis_ftz_detector",
+                 "xdist", "platformdirs")
+
+
+def pytest_configure(config):
+    """Assertion rewriting for the tests only: unmark :data:`NOT_REWRITTEN`.
+
+    The test files (``python_files``) and conftest files are rewritten regardless of the marks, so a failing assert
+    in a test is explained as before.  Uses the rewrite hook's own attributes (pytest 9); if they are not there,
+    nothing changes.
+    """
+    hook = getattr(config.pluginmanager, "rewrite_hook", None)
+    marked = getattr(hook, "_must_rewrite", None)
+    cache = getattr(hook, "_marked_for_rewrite_cache", None)
+    if isinstance(marked, set) and isinstance(cache, dict):
+        marked.difference_update(NOT_REWRITTEN)
+        cache.clear()
+
+
 def pytest_collection_modifyitems(session, config, items):
     def rank(item) -> int:
         for i, (f, n) in enumerate(LONG):

@@ -121,6 +121,28 @@ def test_exponential_flows_use_expm1():
     assert src.count("_np_expm1(") == 2 * len(prog.updates)        # run_numpy and its Kahan form
 
 
+@pytest.mark.parametrize("name,word", [("ho3", "32123"), ("lotka-volterra", "12321")])
+def test_numba_loops_copy_rows_element_by_element(name, word):
+    """The compiled loops move states between arrays only by element loops, never by a slice assignment
+    (``S0[:nb] = X[0, b0:b0 + nb]``): numba compiles a slice assignment's broadcasting error path, which
+    doubled the batch kernels' compile time (docs/suite_time.md, session 11).  The numpy fallback keeps its
+    whole-array statements.  Checked on the parsed source: no subscript-with-slice target outside run_numpy*."""
+    import ast
+
+    tree = ast.parse(python_source(step_program(model(name), word)))
+    compiled = [f for f in tree.body if isinstance(f, ast.FunctionDef) and not f.name.startswith(("run_numpy", "constants"))]
+    assert {f.name for f in compiled} == {"run", "run_kahan", "run_batch", "run_batch_kahan", "scan"}
+    sliced = [ast.unparse(t) for f in compiled for node in ast.walk(f) if isinstance(node, (ast.Assign, ast.AugAssign))
+              for t in (node.targets if isinstance(node, ast.Assign) else [node.target])
+              if isinstance(t, ast.Subscript) and any(isinstance(s, ast.Slice) for s in ast.walk(t.slice))]
+    assert sliced == []
+    # the copies are there: each state row is gathered from X into the chunk and scattered back (per row)
+    batch = ast.unparse(next(f for f in compiled if f.name == "run_batch"))
+    N = model(name).N
+    assert all(f"row = X[{i}, b0:b0 + nb]" in batch and f"S{i}[b] = row[b]" in batch and f"row[b] = S{i}[b]" in batch
+               for i in range(N))
+
+
 def test_shared_exponential_is_accurate_for_both_signs():
     """e = expm1(|u|), f = -e/(1+e) reproduces expm1(u), expm1(-u) to a few ulps for |u| from 1e-300 to 700
     (against mpmath at 50 digits), so sharing the exponential loses nothing."""

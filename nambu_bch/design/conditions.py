@@ -76,7 +76,15 @@ class _Exact:
             K, elems = QQ, [QQ.convert(e) for e in elems]
         self.K = K
         self.factors = list(zip(comp.pieces, elems))
-        self.inv = lambda m: K.convert(sympy.Rational(1, factorial(m)))
+        self._inverse_factorials = {}
+
+    def inv(self, m):
+        """``1/m!`` in ``K`` (memoised: converting a sympy number into an algebraic field is slow, and the
+        defects ask for the same few ``m`` hundreds of thousands of times)."""
+        value = self._inverse_factorials.get(m)
+        if value is None:
+            value = self._inverse_factorials[m] = self.K.convert(sympy.Rational(1, factorial(m)))
+        return value
 
     def defects(self, parts, degree):
         return lyndon_defects(self.factors, parts, degree, self.K.one, self.K.zero, self.inv)

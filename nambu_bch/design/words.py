@@ -89,11 +89,16 @@ def log_coefficients(factors, n_pieces: int, degree: int, one, zero, rational) -
     ``q = 2..p`` exactly when the composition has order ``p``: these are the order conditions.
     ``rational(a, b)`` returns ``a/b`` in the coefficient ring.
     """
-    memo = {}
+    memo, inverse_factorials = {}, {}
+
+    def inv_factorial(m):
+        if m not in inverse_factorials:
+            inverse_factorials[m] = rational(1, factorial(m))
+        return inverse_factorials[m]
 
     def coefficient(u):
         if u not in memo:
-            memo[u] = word_coefficient(u, factors, one, zero, lambda m: rational(1, factorial(m)))
+            memo[u] = word_coefficient(u, factors, one, zero, inv_factorial)
         return memo[u]
 
     out = {}

@@ -58,7 +58,7 @@ from ..integrators.flows import TIME, exact_flow
 STEP = sympy.Symbol("h")
 
 #: Bump when the generated source changes meaning (part of the cache key).
-TEMPLATE_VERSION = "4"
+TEMPLATE_VERSION = "5"
 
 _FUNCTIONS = ("exp", "expm1", "log", "sin", "cos", "tan", "sinh", "cosh", "tanh", "sqrt", "atan", "asin", "acos")
 
@@ -509,6 +509,15 @@ def _indent(lines, n):
     return "\n".join(pad + line for line in lines)
 
 
+def _row_copy(dst, src):
+    """Lines copying the first ``nb`` entries of ``src`` into ``dst`` (chunk arrays; at most one of them a row slice)."""
+    if "[" in src:
+        return [f"row = {src}", "for b in range(nb):", f"    {dst}[b] = row[b]"]
+    if "[" in dst:
+        return [f"row = {dst}", "for b in range(nb):", f"    row[b] = {src}[b]"]
+    return ["for b in range(nb):", f"    {dst}[b] = {src}[b]"]
+
+
 def _sampling_loop(step, sample, checks=()):
     """The loop every kernel shares: ``steps`` steps, a sample into ``out[j]`` after each ``every`` of them.
 
@@ -590,12 +599,14 @@ def {name}({args}):
         alloc = ["W = (chunk + 7) // 8 * 8", f"buf = np.empty({len(rows) + len(spare)} * W + 8)",
                  "off = (8 - (buf.ctypes.data // 8) % 8) % 8"]
         alloc += [f"{r} = buf[off + {q} * W:off + {q} * W + chunk]" for q, r in enumerate(rows + spare)]
-        # whole-row slice copies (numba compiles them to tight vector loops; element loops over the
-        # three rows at once measured 3-4x slower on these memory passes)
-        gather = [f"S{i}[:nb] = X[{i}, b0:b0 + nb]" for i in range(N)] + ([f"Q{i}[:nb] = C[{i}, b0:b0 + nb]" for i in range(N)] if kahan else [])
-        first = [f"out[0, {i}, b0:b0 + nb] = S{i}[:nb]" for i in range(N)]
-        scatter = [f"X[{i}, b0:b0 + nb] = S{i}[:nb]" for i in range(N)]
-        comp_back = [f"C[{i}, b0:b0 + nb] = Q{i}[:nb]" for i in range(N)] if kahan else []
+        # the memory passes as one element loop per row (numba vectorises each; a slice assignment
+        # ``S0[:nb] = X[0, b0:b0 + nb]`` runs as fast but makes numba compile its broadcasting error
+        # path, which doubled the kernel's compile time; one loop over all rows at once measured 3-4x slower)
+        gather = [line for i in range(N) for line in _row_copy(f"S{i}", f"X[{i}, b0:b0 + nb]")]
+        gather += [line for i in range(N) for line in _row_copy(f"Q{i}", f"C[{i}, b0:b0 + nb]")] if kahan else []
+        first = [line for i in range(N) for line in _row_copy(f"out[0, {i}, b0:b0 + nb]", f"S{i}")]
+        scatter = [line for i in range(N) for line in _row_copy(f"X[{i}, b0:b0 + nb]", f"S{i}")]
+        comp_back = [line for i in range(N) for line in _row_copy(f"C[{i}, b0:b0 + nb]", f"Q{i}")] if kahan else []
         inner_load = [f"s{i} = S{i}[b]" for i in range(N)] + ([f"c{i} = Q{i}[b]" for i in range(N)] if kahan else [])
         inner_store = [f"S{i}[b] = s{i}" for i in range(N)] + ([f"Q{i}[b] = c{i}" for i in range(N)] if kahan else [])
         chunk_step = ["for b in range(nb):", *("    " + line for line in inner_load + body + inner_store)]
@@ -604,8 +615,8 @@ def {name}({args}):
             # series range, the chunk's step is undone and redone with the library branch -- the same bits
             # as the branchy loop either way
             fast = body_lines(program, scalar, kahan, select=True)
-            saved = [f"R{q}[:nb] = {r}[:nb]" for q, r in enumerate(rows)]
-            restore = [f"{r}[:nb] = R{q}[:nb]" for q, r in enumerate(rows)]
+            saved = [line for q, r in enumerate(rows) for line in _row_copy(f"R{q}", r)]
+            restore = [line for q, r in enumerate(rows) for line in _row_copy(r, f"R{q}")]
             chunk_step = [*saved, "over = 0", "for b in range(nb):",
                           *("    " + line for line in inner_load + fast + inner_store),
                           "if over:", *("    " + line for line in restore),
