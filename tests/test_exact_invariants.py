@@ -196,3 +196,17 @@ def test_invariant_search_too_large_is_refused_up_front():
 
     with pytest.raises(ResourceLimitError, match="lower the degree"):
         conserved_quantities(model("rigid-body"), "12321", degree=4)
+
+
+def test_rotation_sub_flows_are_refused_before_the_map_is_composed(monkeypatch):
+    """The Lie-Poisson rigid body splits into rotations (cos/sin sub-flows): no polynomial invariant search, and the
+    refusal comes before the trigonometric composed map is built (it took 2-5 s of sympy expand to refuse)."""
+    import nambu_bch.exact.invariants as inv
+    from nambu_bch.errors import NoExactResultError
+
+    def never(*args, **kwargs):
+        raise AssertionError("the composed map was built")
+
+    monkeypatch.setattr(inv, "composed_map", never)
+    with pytest.raises(NoExactResultError, match="trigonometric sub-flows"):
+        conserved_quantities(model("rigid-body-lp"), "12321")

@@ -53,6 +53,7 @@ from ..algebra.zero import is_zero
 from ..algebra.elimination import nullspace, rank, solve_affine
 from ..errors import InvalidOrderError, InvalidSystemError, NoExactResultError, ResourceLimitError
 from ..integrators import composed_map, composition_for
+from ..integrators.flows import exact_flow
 from ..printing import Printable, aligned, series_text, series_tokens
 
 H_STEP = sympy.Symbol("h")
@@ -86,6 +87,13 @@ class _Setup:
         # the package's exact ring, with h among the parameters: K = QQ<ext>(parameters, h)
         algebra = PolynomialAlgebra(self.coords, (*system.parameters, H_STEP), extension=comp.extension)
         self.K, self.R, self.gens = algebra.domain, algebra.ring, algebra.gens
+        if any(e.has(sympy.sin, sympy.cos, sympy.tan)
+               for k, _ in comp.factors() for e in exact_flow(system.splitting[k], self.coords).expressions):
+            # rotations (Lie-Poisson rigid body): powers of the composed cos/sin expressions blow up and the
+            # exponential-generator bookkeeping of _exp_images does not apply; refused before composing (bounded work)
+            raise NoExactResultError(
+                f"the composed map on {system.name} has trigonometric sub-flows (rotations); "
+                "polynomial invariants are not searched for it")
         phi = composed_map(system.splitting, comp)
         self.phi_exprs = tuple(sympy.sympify(e) for e in phi)
         try:
@@ -141,12 +149,6 @@ def _exp_images(setup: _Setup, monos):
     therefore an exact identity (the search is sound); an invariant that needs an identity between
     different exponentials would be missed."""
     coords = setup.coords
-    if any(e.has(sympy.sin, sympy.cos, sympy.tan) for e in setup.phi_exprs):
-        # rotations (Lie-Poisson rigid body): the powers of cos/sin expressions blow up and the
-        # exponential-generator bookkeeping below does not apply; refuse up front (bounded work)
-        raise NoExactResultError(
-            f"the composed map on {setup.system.name} has trigonometric sub-flows (rotations); "
-            "polynomial invariants are not searched for it")
     columns = []
     for mu in monos:
         image = sympy.Integer(1)
