@@ -139,12 +139,14 @@ class DirectResult:
         upto = self.order if upto is None else upto
         out = []
         for a, Ha in enumerate(self.hamiltonians):
-            total = self.algebra.to_sympy(Ha)
-            for j in range(1, upto + 1):
-                c = self.corrections.get((a, j))
-                if c:
-                    total += H_STEP**j * self.algebra.to_sympy(c)
-            out.append(sympy.expand(total))
+            # term by term: the same expression as sympy.expand of the sum (PolynomialAlgebra.expanded_terms),
+            # without expand's walk over the rational-function coefficients
+            parts = [(Ha, ())] + [(self.corrections[(a, j)], (H_STEP**j,)) for j in range(1, upto + 1)
+                                  if self.corrections.get((a, j))]
+            if all(self.algebra.is_polynomial(p) for p, _ in parts):
+                out.append(sympy.Add(*[t for p, f in parts for t in self.algebra.expanded_terms(p, f)]))
+            else:  # non-polynomial pieces (the BCH series of _non_polynomial): sympy expands the sum
+                out.append(sympy.expand(sympy.Add(*[sympy.Mul(self.algebra.to_sympy(p), *f) for p, f in parts])))
         return tuple(out)
 
 

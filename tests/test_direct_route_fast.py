@@ -1,0 +1,118 @@
+"""The fast paths of the direct route over QQ(parameters) and QQ<2^(1/3)>(parameters) against the plain ones.
+
+* ``PolynomialAlgebra.expanded_terms`` (the shadow pair built term by term) against ``sympy.expand`` of
+  ``to_sympy``: random ring elements over ``QQ``, ``QQ(a, b)``, ``QQ<2^(1/3)>`` and ``QQ<2^(1/3)>(a, b)``
+  (hypothesis), compared structurally (``srepr``), not only as values.
+* The rigid body with symbolic moments ``I1, I2, I3`` (Eqs. (SH12321c), (SG12321c) generalised; the family of
+  Eq. (Xeff3)): the shadow pair of ``DirectResult.shadow`` against ``sympy.expand`` of the corrections' sum, and
+  ``X_{H_S, G_S} = X_eff`` through the order (Eq. L2) by backward error analysis (an independent route).
+"""
+
+from __future__ import annotations
+
+import sympy
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from nambu_bch import liouville_field, model
+from nambu_bch.algebra import PolynomialAlgebra
+from nambu_bch.bch.backward import effective_field as backward_field
+from nambu_bch.shadow.direct_route import direct_route
+
+x1, x2, a, b, h = sympy.symbols("x1 x2 a b h")
+THETA = sympy.cbrt(2)
+
+ALGEBRAS = {
+    "QQ": PolynomialAlgebra([x1, x2]),
+    "QQ(a,b)": PolynomialAlgebra([x1, x2], [a, b]),
+    "QQ<2^(1/3)>": PolynomialAlgebra([x1, x2], extension=[THETA]),
+    "QQ<2^(1/3)>(a,b)": PolynomialAlgebra([x1, x2], [a, b], extension=[THETA]),
+}
+
+
+@st.composite
+def ring_elements(draw, name):
+    """A random element of ``ALGEBRAS[name]``: a sum of monomials ``x^m`` times fractions ``p/q`` in the parameters."""
+    alg = ALGEBRAS[name]
+    params = list(alg.parameters)
+    small = st.integers(-3, 3)
+
+    def poly_in(symbols, terms):
+        out = sympy.Integer(0)
+        for _ in range(terms):
+            c = sympy.Rational(draw(small), draw(st.integers(1, 6)))
+            if alg.extension and draw(st.booleans()):
+                c = c + sympy.Rational(draw(small), draw(st.integers(1, 4))) * THETA ** draw(st.integers(1, 2))
+            out += c * sympy.Mul(*(s ** draw(st.integers(0, 2)) for s in symbols))
+        return out
+
+    expr = sympy.Integer(0)
+    for _ in range(draw(st.integers(0, 4))):
+        coeff = poly_in(params, draw(st.integers(1, 3)))
+        if params and draw(st.booleans()):
+            den = poly_in(params, draw(st.integers(1, 2)))
+            if den != 0:
+                coeff = coeff / den
+        expr += coeff * x1 ** draw(st.integers(0, 3)) * x2 ** draw(st.integers(0, 2))
+    return alg.convert(expr)
+
+
+@settings(max_examples=40, deadline=None, derandomize=True)
+@given(st.sampled_from(sorted(ALGEBRAS)).flatmap(lambda name: st.tuples(st.just(name), ring_elements(name))),
+       st.integers(0, 3))
+def test_expanded_terms_equal_sympy_expand(case, j):
+    """``Add(*expanded_terms(p, (h^j,)))`` is the very expression ``sympy.expand(h^j to_sympy(p))`` (same srepr)."""
+    name, p = case
+    alg = ALGEBRAS[name]
+    ours = alg.to_sympy_expanded(p, (h**j,))
+    plain = sympy.expand(h**j * alg.to_sympy(p))
+    assert sympy.srepr(ours) == sympy.srepr(plain)
+    assert sympy.expand(ours - plain) == 0
+
+
+def test_expanded_terms_rational_over_whole_denominator():
+    """A rational coefficient over a non-monomial denominator: ``expand`` writes ``r/(s q)``, and so do we."""
+    alg = ALGEBRAS["QQ<2^(1/3)>(a,b)"]
+    p = alg.convert((sympy.Rational(5, 12) * THETA * a - sympy.Rational(1, 54)) * x1**2 / (a**2 * b - a * b**2))
+    ours = alg.to_sympy_expanded(p)
+    assert sympy.srepr(ours) == sympy.srepr(sympy.expand(alg.to_sympy(p)))
+    assert any(isinstance(t, sympy.Pow) and t.exp == -1 and t.base.is_Add
+               for term in sympy.Add.make_args(ours) for t in sympy.Mul.make_args(term))
+
+
+def _check_shadow(system, word, order):
+    """The shadow pair of the fast conversion: identical to sympy.expand of the sum, and a solution of Eq. (L2)."""
+    R = direct_route(system, word, order)
+    assert R.exists
+    fast = R.shadow()
+    plain = []
+    for a_, Ha in enumerate(R.hamiltonians):
+        total = R.algebra.to_sympy(Ha)
+        for j in range(1, order + 1):
+            c = R.corrections.get((a_, j))
+            if c:
+                total += h**j * R.algebra.to_sympy(c)
+        plain.append(sympy.expand(total))
+    assert [sympy.srepr(s) for s in fast] == [sympy.srepr(s) for s in plain]
+    # X_{H_S, G_S} = X_eff through h^order (Eq. L2), X_eff by backward error analysis
+    eff = backward_field(system.splitting, word, order)
+    alg = eff[0].algebra.with_constants(h, sympy.Symbol("alpha"))
+    X = liouville_field(alg, *(alg.convert(S) for S in fast))
+    ih = alg.n + alg.constants.index(h)
+    for j in range(order + 1):
+        for comp, Z in zip(X.components, eff[j].components):
+            part = {m[:ih] + (0,) + m[ih + 1:]: c for m, c in comp.items() if m[ih] == j}
+            assert alg.ring.from_dict(part) == alg.convert(Z.as_expr())
+    return fast
+
+
+def test_rigid_body_symbolic_shadow_fast_conversion():
+    """Rigid body, symbolic I1, I2, I3, word 12321 through h^4 (Eqs. (SH12321c), (SG12321c) generalised)."""
+    H_S, G_S = _check_shadow(model("rigid-body"), "12321", 4)
+    assert H_S.has(sympy.Symbol("alpha")) and H_S.has(sympy.Symbol("I1"))
+
+
+def test_rigid_body_symbolic_yoshida_fast_conversion():
+    """Rigid body, symbolic I, yoshida:12321 (coefficients in QQ(2^(1/3))) through h^4: 2^(1/3) in the pair."""
+    H_S, _ = _check_shadow(model("rigid-body"), "yoshida:12321", 4)
+    assert H_S.has(THETA)
