@@ -16,6 +16,7 @@ from hypothesis import strategies as st
 
 from nambu_bch import liouville_field, model
 from nambu_bch.algebra import PolynomialAlgebra
+from nambu_bch.algebra.elimination import signed_sums
 from nambu_bch.bch.backward import effective_field as backward_field
 from nambu_bch.shadow.direct_route import direct_route
 
@@ -80,8 +81,9 @@ def test_expanded_terms_rational_over_whole_denominator():
                for term in sympy.Add.make_args(ours) for t in sympy.Mul.make_args(term))
 
 
-def _check_shadow(system, word, order):
-    """The shadow pair of the fast conversion: identical to sympy.expand of the sum, and a solution of Eq. (L2)."""
+def _check_shadow(system, word, order, values=None):
+    """The shadow pair of the fast conversion: identical to sympy.expand of the sum, the family through its
+    members (alpha = 0, 1), and a solution of Eq. (L2) (at the parameter ``values`` when given)."""
     R = direct_route(system, word, order)
     assert R.exists
     fast = R.shadow()
@@ -94,16 +96,26 @@ def _check_shadow(system, word, order):
                 total += h**j * R.algebra.to_sympy(c)
         plain.append(sympy.expand(total))
     assert [sympy.srepr(s) for s in fast] == [sympy.srepr(s) for s in plain]
-    # X_{H_S, G_S} = X_eff through h^order (Eq. L2), X_eff by backward error analysis
+    # the family m0 + alpha (m1 - m0) at alpha = 0, 1 is the two canonical members (Eq. Xeff3)
+    alpha = sympy.Symbol("alpha")
+    for o in R.orders:
+        if o.status == "solved":
+            for k in (0, 1):
+                assert all(sympy.expand(sympy.together(c.subs(alpha, k) - m.subs(alpha, k))) == 0
+                           for c, m in zip(o.corrections, o.members[k]))
+    # X_{H_S, G_S} = X_eff through h^order (Eq. L2), X_eff by backward error analysis (an independent route)
+    if values is not None:
+        system = system.substitute(values)
+        fast = [S.subs({sympy.Symbol(k): v for k, v in values.items()}) for S in fast]
     eff = backward_field(system.splitting, word, order)
-    alg = eff[0].algebra.with_constants(h, sympy.Symbol("alpha"))
+    alg = eff[0].algebra.with_constants(h, alpha)
     X = liouville_field(alg, *(alg.convert(S) for S in fast))
     ih = alg.n + alg.constants.index(h)
     for j in range(order + 1):
         for comp, Z in zip(X.components, eff[j].components):
             part = {m[:ih] + (0,) + m[ih + 1:]: c for m, c in comp.items() if m[ih] == j}
             assert alg.ring.from_dict(part) == alg.convert(Z.as_expr())
-    return fast
+    return R.shadow()
 
 
 def test_rigid_body_symbolic_shadow_fast_conversion():
@@ -112,7 +124,30 @@ def test_rigid_body_symbolic_shadow_fast_conversion():
     assert H_S.has(sympy.Symbol("alpha")) and H_S.has(sympy.Symbol("I1"))
 
 
-def test_rigid_body_symbolic_yoshida_fast_conversion():
-    """Rigid body, symbolic I, yoshida:12321 (coefficients in QQ(2^(1/3))) through h^4: 2^(1/3) in the pair."""
-    H_S, _ = _check_shadow(model("rigid-body"), "yoshida:12321", 4)
-    assert H_S.has(THETA)
+def test_rigid_body_symbolic_yoshida_family_over_base_field():
+    """Rigid body, symbolic I, yoshida:12321 (coefficients in QQ(2^(1/3))) through h^4: the family built over
+    QQ(I1, I2, I3) (signed_sums) and the fast conversion; Eq. (L2) checked at I = 1, 2, 3."""
+    H_S, _ = _check_shadow(model("rigid-body"), "yoshida:12321", 4, values={"I1": 1, "I2": 2, "I3": 3})
+    assert H_S.has(THETA) and H_S.has(sympy.Symbol("I3"))
+
+
+@st.composite
+def split_values(draw):
+    """Random small elements of QQ<2^(1/3)>(a, b) (monomial and linear-factor denominators, as in the rigid body)."""
+    alg = ALGEBRAS["QQ<2^(1/3)>(a,b)"]
+    num = sum((sympy.Rational(draw(st.integers(-4, 4)), draw(st.integers(1, 5))) * THETA ** draw(st.integers(0, 2))
+               * a ** draw(st.integers(0, 2)) * b ** draw(st.integers(0, 2)) for _ in range(draw(st.integers(1, 3)))),
+              sympy.Integer(0))
+    den = draw(st.sampled_from([sympy.Integer(1), a, a * b**2, a - b, a * (a - b), 2 * a + b]))
+    return alg.domain.from_sympy(num / den)
+
+
+@settings(max_examples=30, deadline=None, derandomize=True)
+@given(st.lists(st.tuples(st.sampled_from([1, -1, 2]), split_values()), min_size=1, max_size=4))
+def test_signed_sums_equal_plain_sums(pairs):
+    """signed_sums over the basis 1, 2^(1/3), 2^(2/3) equals the sum in QQ<2^(1/3)>(a, b) (as values)."""
+    K = ALGEBRAS["QQ<2^(1/3)>(a,b)"].domain
+    out = signed_sums({"k": pairs}, K)
+    plain = sum((s * v for s, v in pairs), K.zero)
+    assert out.get("k", K.zero) - plain == K.zero
+    assert signed_sums({"k": pairs}, ALGEBRAS["QQ(a,b)"].domain) is None  # other domains: the caller adds

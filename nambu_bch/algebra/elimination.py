@@ -244,6 +244,45 @@ class _AlgebraicSplit:
         return field.raw_new(field.ring.from_dict(coeffs(v.numer)), field.ring.from_dict(coeffs(v.denom)))
 
 
+def signed_sums(sums: dict, domain) -> dict | None:
+    """``{key: sum(s * v for s, v in pairs)}`` for ``sums = {key: [(s, v), ..]}`` (``s`` integers), computed over the base
+    field when ``domain`` is ``QQ<theta>(params)``; ``None`` for any other domain (the caller adds in ``domain``).
+
+    In ``K = B<theta>`` with ``B = QQ(params)`` every addition cancels a fraction with a polynomial gcd over
+    the number field (sympy's subresultants: seconds for one sum of two rigid-body coefficients).  On the
+    basis ``1, theta, ..`` over ``B`` (:class:`_AlgebraicSplit`) a sum is ``k`` sums in ``B`` (gcds over ``QQ``),
+    joined into ``K`` once per key.  Zero sums are left out.  ``None`` also when a value does not split (a
+    denominator outside ``B``).
+
+    >>> import sympy
+    >>> K = QQ.algebraic_field(sympy.cbrt(2)).frac_field(sympy.Symbol("a"))
+    >>> t, a = K.from_sympy(sympy.cbrt(2)), K.from_sympy(sympy.Symbol("a"))
+    >>> out = signed_sums({0: [(1, t / a), (-1, 1 / a)], 1: [(1, a), (-1, a)]}, K)
+    >>> list(out), out[0] == (t - 1) / a
+    ([0], True)
+    """
+    split = _AlgebraicSplit.of(domain) if FAST_PATHS else None
+    if split is None or not split.params:
+        return None
+    out = {}
+    base = split.base
+    for key, pairs in sums.items():
+        acc = [base.zero] * split.k
+        for sign, v in pairs:
+            if not v:
+                continue
+            parts = split.split(v)
+            if parts is None:
+                return None
+            for i, part in enumerate(parts):
+                if part:
+                    acc[i] = acc[i] + part if sign == 1 else acc[i] + sign * part
+        value = split.join(acc)
+        if value:
+            out[key] = value
+    return out
+
+
 def _rref(rows: dict, nrows: int, ncols: int, domain, lift: bool = True, link: int | None = None):
     """The reduced row echelon form of ``{row: {column: value}}``, block by block: ``(R, pivots)``.
 

@@ -65,7 +65,7 @@ import sympy
 
 from ..algebra import liouville_field
 from ..algebra.ansatz import Ansatz, Rows
-from ..algebra.elimination import rank
+from ..algebra.elimination import rank, signed_sums
 from ..bch.backward import check_order
 from ..bch.concrete import effective_field_by_cost
 from ..errors import InvalidOrderError, NambuBCHError, ResourceLimitError
@@ -330,7 +330,7 @@ class _Solver:
         # of coefficients, each of which would cancel a fraction (slow over QQ<2^(1/3)>(parameters))
         alpha = tuple(int(i == self.alpha_index) for i in range(len(alg.gens)))
         for a in range(self.slots):
-            fam[a] = mem_polys[0][a] + (mem_polys[1][a] - mem_polys[0][a]).mul_monom(alpha)
+            fam[a] = self._family(mem_polys[0][a], mem_polys[1][a], alpha)
         for a in range(self.slots):
             corrections[(a, j)] = fam[a]
         gauge = [ansatz.expressions(v, alg.coordinates, domain) for v in kernel]
@@ -340,6 +340,20 @@ class _Solver:
             members=tuple(tuple(alg.to_sympy(p) for p in polys) for polys in mem_polys),
             gauge=gauge, kernel_dim=len(kernel), psi_dim=psi_dim, rhs=rhs,
         )
+
+    def _family(self, m0, m1, alpha):
+        """``m0 + alpha (m1 - m0)``; over ``QQ<theta>(params)`` coefficient by coefficient over ``QQ(params)``
+        (:func:`~nambu_bch.algebra.elimination.signed_sums`: no gcds over the number field)."""
+        sums: dict = {}
+        for m, c in m0.items():
+            sums.setdefault(m, []).append((1, c))
+            sums.setdefault(tuple(i + j for i, j in zip(m, alpha)), []).append((-1, c))
+        for m, c in m1.items():
+            sums.setdefault(tuple(i + j for i, j in zip(m, alpha)), []).append((1, c))
+        coeffs = signed_sums(sums, self.alg.domain)
+        if coeffs is None:
+            return m0 + (m1 - m0).mul_monom(alpha)
+        return self.alg.ring.from_dict(coeffs) if coeffs else self.alg.zero
 
     def _psi_dim(self, ansatz, D):
         """Rank of ``{(psi_G, -psi_H) : psi = H^p G^q}`` within the ansatz (they lie in the kernel)."""
