@@ -550,7 +550,48 @@ def rank(vectors: list, ncols: int, domain) -> int:
     if not vectors:
         return 0
     rows = {r: {c: v for c, v in vec.items() if v} for r, vec in enumerate(vectors)}
+    full = _full_rank_at_a_point(rows, len(vectors), ncols, domain) if FAST_PATHS else None
+    if full is not None:
+        return full
     return len(_rref(rows, len(vectors), ncols, domain, lift=False)[1])
+
+
+#: The points tried by :func:`_full_rank_at_a_point` (parameter values, one tuple per try).
+_RANK_POINTS = ((3, 5, 7, 11, 13, 17, 19, 23), (29, 31, 37, 41, 43, 47, 53, 59))
+
+
+def _full_rank_at_a_point(rows: dict, nrows: int, ncols: int, domain):
+    """``min(nrows, ncols)`` when the matrix over ``QQ(params)`` has full rank at a rational point, else ``None``.
+
+    Certified, not probabilistic: a non-zero maximal minor at a point where no entry's denominator
+    vanishes is a non-zero maximal minor over ``QQ(params)``, so the rank there, ``<= min(nrows, ncols)``,
+    is that bound.  A smaller rank at the point proves nothing (the caller eliminates over the field).
+    The rank at the point is an elimination over ``QQ`` (no polynomial gcds).
+    """
+    if not (getattr(domain, "is_FractionField", False) and domain.domain.is_QQ) or len(domain.symbols) > 8:
+        return None
+    bound = min(nrows, ncols)
+    for point in _RANK_POINTS:
+        values = point[:len(domain.symbols)]
+        at = {}
+        for i, row in rows.items():
+            new = {}
+            for j, v in row.items():
+                den = v.denom(*values)
+                if not den:
+                    break
+                num = v.numer(*values)
+                if num:
+                    new[j] = QQ.convert(num) / QQ.convert(den)
+            else:
+                at[i] = new
+                continue
+            break  # a denominator vanishes here: the next point
+        else:
+            if len(_rref(at, nrows, ncols, QQ, lift=False)[1]) == bound:
+                return bound
+            return None
+    return None
 
 
 def nullspace(rows: dict, nrows: int, ncols: int, domain) -> list:

@@ -20,6 +20,7 @@ from functools import cached_property
 import sympy
 from sympy.polys.domains import QQ
 from sympy.polys.polyerrors import CoercionFailed, GeneratorsError, PolynomialError
+from sympy.polys.polyutils import expr_from_dict
 from sympy.polys.rings import PolyElement, ring
 
 from ..errors import InvalidSystemError
@@ -98,10 +99,24 @@ class PolynomialAlgebra:
     def is_polynomial(self, value) -> bool:
         return isinstance(value, PolyElement) and value.ring == self.ring
 
-    def to_sympy(self, value) -> sympy.Expr:
-        """A sympy expression (polynomials are expanded, coefficients as rational functions)."""
+    def to_sympy(self, value, memo: dict | None = None) -> sympy.Expr:
+        """A sympy expression (polynomials are expanded, coefficients as rational functions).
+
+        ``memo`` (a dict the caller keeps, e.g. for the polynomials of one solve) remembers the
+        coefficients already converted: the same expression as ``value.as_expr()``, each distinct
+        coefficient converted once.
+        """
         if isinstance(value, PolyElement):
-            return value.as_expr()
+            if memo is None:
+                return value.as_expr()
+            to_sympy = value.ring.domain.to_sympy
+            coefficients = {}
+            for m, c in value.items():
+                e = memo.get(c)
+                if e is None:
+                    e = memo[c] = to_sympy(c)
+                coefficients[m] = e
+            return expr_from_dict(coefficients, *value.ring.symbols)
         return sympy.sympify(value)
 
     def expanded_terms(self, value, factors=()) -> list:

@@ -232,7 +232,54 @@ class _Solver:
 
     # -- fields ------------------------------------------------------------------
     def _field(self, slots):
+        """``X_{slots}`` (Eq. gLiouville); over ``QQ(params)`` fraction-free (:meth:`_field_cleared`)."""
+        domain = self.alg.domain
+        if getattr(domain, "is_FractionField", False) and domain.domain.is_QQ:
+            return self._field_cleared(slots)
         return liouville_field(self.alg, *slots)
+
+    def _field_cleared(self, slots):
+        """``X_{slots}`` over ``QQ(params)`` without fraction arithmetic: the same field, exactly.
+
+        ``X_{P_1 .. P_{N-1}}`` is multilinear in its slots over the constants, so with ``P_a = Q_a / D_a``
+        (``D_a`` the lcm of the coefficient denominators, a polynomial in the parameters, ``Q_a`` a
+        polynomial in the coordinates, ``alpha`` and the parameters) ``X_{P} = X_{Q} / (D_1 .. D_{N-1})``.
+        ``X_Q`` is computed in ``QQ[coordinates, alpha, params]`` (products without gcds; the parameters
+        are never differentiated), and each coefficient is divided by ``D_1 .. D_{N-1}`` once (one
+        cancellation per coefficient instead of one per product term).  Field elements are reduced
+        fractions either way, so the result is the same ring element.
+        """
+        alg = self.alg
+        field = alg.domain.field
+        if getattr(self, "_plain", None) is None:
+            from ..algebra import PolynomialAlgebra
+
+            self._plain = PolynomialAlgebra(alg.coordinates, (), alg.constants + alg.parameters)
+        plain = self._plain
+        width = len(alg.gens)
+        cleared, total = [], field.ring.one
+        for p in slots:
+            D = field.ring.one
+            for c in p.values():
+                D = D.lcm(c.denom)
+            terms: dict = {}
+            for m, c in p.items():
+                num = c.numer * D.exquo(c.denom)
+                for e, q in num.items():
+                    terms[m + e] = q
+            cleared.append(plain.ring.from_dict(terms) if terms else plain.zero)
+            total = total * D
+        X = liouville_field(plain, *cleared)
+        components = []
+        for comp in X.components:
+            groups: dict = {}
+            for m, q in comp.items():
+                groups.setdefault(m[:width], {})[m[width:]] = q
+            components.append(alg.ring.from_dict({m: field.new(field.ring.from_dict(g), total)
+                                                  for m, g in groups.items()}) if groups else alg.zero)
+        from ..algebra import VectorField
+
+        return VectorField(alg, components)
 
     def _cross(self, j, corrections):
         """``sum`` over assignments of lower orders to two or more slots (the cross terms at ``h^j``)."""
@@ -334,10 +381,11 @@ class _Solver:
         for a in range(self.slots):
             corrections[(a, j)] = fam[a]
         gauge = [ansatz.expressions(v, alg.coordinates, domain) for v in kernel]
+        memo: dict = {}  # the members and the family share most coefficients: each converted once
         psi_dim = self._psi_dim(ansatz, D) if self.slots == 2 else None
         return OrderSolution(
-            j, "solved", degree=D, corrections=tuple(alg.to_sympy(f) for f in fam),
-            members=tuple(tuple(alg.to_sympy(p) for p in polys) for polys in mem_polys),
+            j, "solved", degree=D, corrections=tuple(alg.to_sympy(f, memo) for f in fam),
+            members=tuple(tuple(alg.to_sympy(p, memo) for p in polys) for polys in mem_polys),
             gauge=gauge, kernel_dim=len(kernel), psi_dim=psi_dim, rhs=rhs,
         )
 
