@@ -229,6 +229,7 @@ class _Solver:
         self.slots = len(hams)
         self.gdeg = [_total_degree(p, self.n) - 1 for p in hams]
         self._columns: dict = {}
+        self._plain = None  # the polynomial algebra of the fraction-free cross terms (_field_cleared)
 
     # -- fields ------------------------------------------------------------------
     def _field(self, slots):
@@ -251,7 +252,7 @@ class _Solver:
         """
         alg = self.alg
         field = alg.domain.field
-        if getattr(self, "_plain", None) is None:
+        if self._plain is None:  # QQ[coordinates, constants, parameters]: the parameters never differentiated
             from ..algebra import PolynomialAlgebra
 
             self._plain = PolynomialAlgebra(alg.coordinates, (), alg.constants + alg.parameters)
