@@ -2,6 +2,7 @@
 
 Run:  /work/venv/bin/python benchmarks/bench_shadow.py            (the rows below, then the issue-14 rows)
       /work/venv/bin/python benchmarks/bench_shadow.py --issue14  (the issue-14 rows only)
+      /work/venv/bin/python benchmarks/bench_shadow.py --issue14 --rows=ab  (rows a and b only)
 
 Prints, measured in this one run (process CPU time, best of a few repeats):
 * all six ho3 words through the FI route and the direct route at O(h^2);
@@ -169,13 +170,18 @@ ISSUE14 = [  # (row, system, word, order, goal in s)
 ]
 
 
-def issue14(limit: float = 150.0):
-    """The issue-14 rows: ours and the previous elimination, each cold in a child process (CPU s)."""
+def issue14(limit: float = 150.0, only=None):
+    """The issue-14 rows: ours and the previous elimination, each cold in a child process (CPU s).
+
+    ``only``: the row letters to run (e.g. ``"ab"``; ``--rows=ab`` on the command line), default all.
+    """
     import os
 
     print(f"issue 14 rows (cold child process each, CPU s; load average {os.getloadavg()[0]:.1f})")
     rows = []
     for label, name, word, order, goal in ISSUE14:
+        if only and label[0] not in only:
+            continue
         ours = _child(_timed_ours, (name, word, order, True), limit)
         before = _child(_timed_ours, (name, word, order, False), limit)
         t_ours = ours[0] if ours else None
@@ -230,5 +236,6 @@ if __name__ == "__main__":
     ok = True
     if "--issue14" not in sys.argv:
         ok = all(r[3] is not False and r[4] for r in main())
-    ok = all(r[3] is not False for r in issue14()) and ok
+    only = next((a.split("=", 1)[1] for a in sys.argv if a.startswith("--rows=")), None)
+    ok = all(r[3] is not False for r in issue14(only=only)) and ok
     sys.exit(0 if ok else 1)

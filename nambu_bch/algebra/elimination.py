@@ -309,6 +309,45 @@ def elimination_cost(columns: list, nrows: int, domain=QQ) -> int:
     return total if over_qq else total * FIELD_WEIGHT
 
 
+def signed_sums(sums: dict, domain) -> dict | None:
+    """``{key: sum(s * v for s, v in pairs)}`` for ``sums = {key: [(s, v), ..]}`` (``s`` integers), computed over the base
+    field when ``domain`` is ``QQ<theta>(params)``; ``None`` for any other domain (the caller adds in ``domain``).
+
+    In ``K = B<theta>`` with ``B = QQ(params)`` every addition cancels a fraction with a polynomial gcd over
+    the number field (sympy's subresultants: seconds for one sum of two rigid-body coefficients).  On the
+    basis ``1, theta, ..`` over ``B`` (:class:`_AlgebraicSplit`) a sum is ``k`` sums in ``B`` (gcds over ``QQ``),
+    joined into ``K`` once per key.  Zero sums are left out.  ``None`` also when a value does not split (a
+    denominator outside ``B``).
+
+    >>> import sympy
+    >>> K = QQ.algebraic_field(sympy.cbrt(2)).frac_field(sympy.Symbol("a"))
+    >>> t, a = K.from_sympy(sympy.cbrt(2)), K.from_sympy(sympy.Symbol("a"))
+    >>> out = signed_sums({0: [(1, t / a), (-1, 1 / a)], 1: [(1, a), (-1, a)]}, K)
+    >>> list(out), out[0] == (t - 1) / a
+    ([0], True)
+    """
+    split = _AlgebraicSplit.of(domain) if FAST_PATHS else None
+    if split is None or not split.params:
+        return None
+    out = {}
+    base = split.base
+    for key, pairs in sums.items():
+        acc = [base.zero] * split.k
+        for sign, v in pairs:
+            if not v:
+                continue
+            parts = split.split(v)
+            if parts is None:
+                return None
+            for i, part in enumerate(parts):
+                if part:
+                    acc[i] = acc[i] + part if sign == 1 else acc[i] + sign * part
+        value = split.join(acc)
+        if value:
+            out[key] = value
+    return out
+
+
 def _rref(rows: dict, nrows: int, ncols: int, domain, lift: bool = True, link: int | None = None):
     """The reduced row echelon form of ``{row: {column: value}}``, block by block: ``(R, pivots)``.
 
@@ -562,7 +601,48 @@ def rank(vectors: list, ncols: int, domain) -> int:
     if not vectors:
         return 0
     rows = {r: {c: v for c, v in vec.items() if v} for r, vec in enumerate(vectors)}
+    full = _full_rank_at_a_point(rows, len(vectors), ncols, domain) if FAST_PATHS else None
+    if full is not None:
+        return full
     return len(_rref(rows, len(vectors), ncols, domain, lift=False)[1])
+
+
+#: The points tried by :func:`_full_rank_at_a_point` (parameter values, one tuple per try).
+_RANK_POINTS = ((3, 5, 7, 11, 13, 17, 19, 23), (29, 31, 37, 41, 43, 47, 53, 59))
+
+
+def _full_rank_at_a_point(rows: dict, nrows: int, ncols: int, domain):
+    """``min(nrows, ncols)`` when the matrix over ``QQ(params)`` has full rank at a rational point, else ``None``.
+
+    Certified, not probabilistic: a non-zero maximal minor at a point where no entry's denominator
+    vanishes is a non-zero maximal minor over ``QQ(params)``, so the rank there, ``<= min(nrows, ncols)``,
+    is that bound.  A smaller rank at the point proves nothing (the caller eliminates over the field).
+    The rank at the point is an elimination over ``QQ`` (no polynomial gcds).
+    """
+    if not (getattr(domain, "is_FractionField", False) and domain.domain.is_QQ) or len(domain.symbols) > 8:
+        return None
+    bound = min(nrows, ncols)
+    for point in _RANK_POINTS:
+        values = point[:len(domain.symbols)]
+        at = {}
+        for i, row in rows.items():
+            new = {}
+            for j, v in row.items():
+                den = v.denom(*values)
+                if not den:
+                    break
+                num = v.numer(*values)
+                if num:
+                    new[j] = QQ.convert(num) / QQ.convert(den)
+            else:
+                at[i] = new
+                continue
+            break  # a denominator vanishes here: the next point
+        else:
+            if len(_rref(at, nrows, ncols, QQ, lift=False)[1]) == bound:
+                return bound
+            return None
+    return None
 
 
 def nullspace(rows: dict, nrows: int, ncols: int, domain) -> list:

@@ -20,6 +20,7 @@ from functools import cached_property
 import sympy
 from sympy.polys.domains import QQ
 from sympy.polys.polyerrors import CoercionFailed, GeneratorsError, PolynomialError
+from sympy.polys.polyutils import expr_from_dict
 from sympy.polys.rings import PolyElement, ring
 
 from ..errors import InvalidSystemError
@@ -98,11 +99,103 @@ class PolynomialAlgebra:
     def is_polynomial(self, value) -> bool:
         return isinstance(value, PolyElement) and value.ring == self.ring
 
-    def to_sympy(self, value) -> sympy.Expr:
-        """A sympy expression (polynomials are expanded, coefficients as rational functions)."""
+    def to_sympy(self, value, memo: dict | None = None) -> sympy.Expr:
+        """A sympy expression (polynomials are expanded, coefficients as rational functions).
+
+        ``memo`` (a dict the caller keeps, e.g. for the polynomials of one solve) remembers the
+        coefficients already converted: the same expression as ``value.as_expr()``, each distinct
+        coefficient converted once.
+        """
         if isinstance(value, PolyElement):
-            return value.as_expr()
+            if memo is None:
+                return value.as_expr()
+            to_sympy = value.ring.domain.to_sympy
+            coefficients = {}
+            for m, c in value.items():
+                e = memo.get(c)
+                if e is None:
+                    e = memo[c] = to_sympy(c)
+                coefficients[m] = e
+            return expr_from_dict(coefficients, *value.ring.symbols)
         return sympy.sympify(value)
+
+    def expanded_terms(self, value, factors=()) -> list:
+        """The terms of ``sympy.expand(to_sympy(value) * factors[0] * ...)``, built without ``expand``.
+
+        A coefficient ``c = p/q`` of the monomial ``x^m`` (``p, q`` polynomials in the
+        parameters, coprime, as the field keeps them) expands to
+        ``sum_e p_e P^e x^m / q``: one term per term ``p_e P^e`` of the numerator, the
+        denominator ``q`` as sympy writes it (``Pow(q, -1)``; a monomial ``q`` is split
+        into powers; the denominator ``s`` of a rational coefficient ``r/s`` of ``p`` joins a whole
+        ``q`` as ``r/(s q)``).  This is exactly what ``Mul._eval_expand_mul`` produces for
+        ``x^m p/q`` (it distributes the numerator over the other factors and keeps the
+        denominator whole), and ``Mul``'s canonical flattening gives the same objects, so
+        ``sympy.Add(*terms)`` is identical to the expanded expression.  The terms of
+        distinct monomials never combine (their powers of the generators differ), so
+        nothing else is to be collected.  ``factors`` are extra factors of every term
+        (powers of symbols, e.g. ``h**j``).  A sympy expression (not a ring element) is
+        expanded by sympy.
+
+        Parameters
+        ----------
+        value : ring element or sympy expression
+        factors : sequence of sympy expressions -- powers of symbols multiplying every term
+
+        Returns
+        -------
+        list of sympy expressions -- ``sympy.Add(*terms) == sympy.expand(to_sympy(value) * prod(factors))``
+
+        Examples
+        --------
+        >>> import sympy
+        >>> x, m, k = sympy.symbols("x m k")
+        >>> A = PolynomialAlgebra([x], [m, k])
+        >>> p = A.convert(x**2 * (m + 1) / (2 * m * (m - k)))
+        >>> sympy.Add(*A.expanded_terms(p)) == sympy.expand(A.to_sympy(p))
+        True
+        """
+        if not isinstance(value, PolyElement):
+            return list(sympy.Add.make_args(sympy.expand(sympy.Mul(sympy.sympify(value), *factors))))
+        domain = value.ring.domain
+        gens = value.ring.symbols
+        factors = list(factors)
+        fraction = getattr(domain, "is_FractionField", False)
+        if fraction:
+            ground, params = domain.domain, domain.field.ring.symbols
+            inverses: dict = {}
+            wholes: dict = {}
+        terms = []
+        for m, c in value.items():
+            mono = [s**e for s, e in zip(gens, m) if e] + factors
+            if not fraction:
+                terms.extend(sympy.Add.make_args(sympy.expand(sympy.Mul(domain.to_sympy(c), *mono))))
+                continue
+            den = c.denom
+            key = tuple(sorted(den.items()))
+            if key not in wholes:
+                expanded = sympy.expand(den.as_expr())  # e.g. (1 + 2^(1/3)) b + 1 -> b + 2^(1/3) b + 1
+                wholes[key] = expanded.is_Add  # a denominator sympy keeps whole, not split into powers
+                inverses[(key, 1)] = 1 / expanded
+            whole = wholes[key]
+            for e, a in c.numer.items():
+                # an algebraic ground coefficient a + b 2^(1/3) + ... distributes over its terms, as expand does
+                for part in sympy.Add.make_args(ground.to_sympy(a)):
+                    q = 1
+                    if whole:
+                        # expand's fixed point moves the denominator q of a rational coefficient p/q into
+                        # the whole denominator: p/(q d), with q d expanded
+                        r, rest = part.as_coeff_Mul()
+                        if r.q != 1:
+                            q, part = r.q, sympy.Integer(r.p) * rest
+                    inv = inverses.get((key, q))
+                    if inv is None:
+                        inv = inverses[(key, q)] = 1 / sympy.expand(q * den.as_expr())
+                    terms.append(sympy.Mul(part, *[s**k for s, k in zip(params, e) if k], *mono, inv))
+        return terms
+
+    def to_sympy_expanded(self, value, factors=()) -> sympy.Expr:
+        """``sympy.expand(to_sympy(value) * prod(factors))``, identical, from :meth:`expanded_terms` (no ``expand``)."""
+        return sympy.Add(*self.expanded_terms(value, factors))
 
     @cached_property
     def zero(self):

@@ -65,7 +65,7 @@ import sympy
 
 from ..algebra import liouville_field
 from ..algebra.ansatz import Ansatz, Rows
-from ..algebra.elimination import elimination_cost, rank
+from ..algebra.elimination import elimination_cost, rank, signed_sums
 from ..bch.backward import check_order
 from ..bch.concrete import effective_field_by_cost
 from ..errors import InvalidOrderError, NambuBCHError, ResourceLimitError
@@ -140,12 +140,14 @@ class DirectResult:
         upto = self.order if upto is None else upto
         out = []
         for a, Ha in enumerate(self.hamiltonians):
-            total = self.algebra.to_sympy(Ha)
-            for j in range(1, upto + 1):
-                c = self.corrections.get((a, j))
-                if c:
-                    total += H_STEP**j * self.algebra.to_sympy(c)
-            out.append(sympy.expand(total))
+            # term by term: the same expression as sympy.expand of the sum (PolynomialAlgebra.expanded_terms),
+            # without expand's walk over the rational-function coefficients
+            parts = [(Ha, ())] + [(self.corrections[(a, j)], (H_STEP**j,)) for j in range(1, upto + 1)
+                                  if self.corrections.get((a, j))]
+            if all(self.algebra.is_polynomial(p) for p, _ in parts):
+                out.append(sympy.Add(*[t for p, f in parts for t in self.algebra.expanded_terms(p, f)]))
+            else:  # non-polynomial pieces (the BCH series of _non_polynomial): sympy expands the sum
+                out.append(sympy.expand(sympy.Add(*[sympy.Mul(self.algebra.to_sympy(p), *f) for p, f in parts])))
         return tuple(out)
 
 
@@ -233,10 +235,58 @@ class _Solver:
         self.slots = len(hams)
         self.gdeg = [_total_degree(p, self.n) - 1 for p in hams]
         self._columns: dict = {}
+        self._plain = None  # the polynomial algebra of the fraction-free cross terms (_field_cleared)
 
     # -- fields ------------------------------------------------------------------
     def _field(self, slots):
+        """``X_{slots}`` (Eq. gLiouville); over ``QQ(params)`` fraction-free (:meth:`_field_cleared`)."""
+        domain = self.alg.domain
+        if getattr(domain, "is_FractionField", False) and domain.domain.is_QQ:
+            return self._field_cleared(slots)
         return liouville_field(self.alg, *slots)
+
+    def _field_cleared(self, slots):
+        """``X_{slots}`` over ``QQ(params)`` without fraction arithmetic: the same field, exactly.
+
+        ``X_{P_1 .. P_{N-1}}`` is multilinear in its slots over the constants, so with ``P_a = Q_a / D_a``
+        (``D_a`` the lcm of the coefficient denominators, a polynomial in the parameters, ``Q_a`` a
+        polynomial in the coordinates, ``alpha`` and the parameters) ``X_{P} = X_{Q} / (D_1 .. D_{N-1})``.
+        ``X_Q`` is computed in ``QQ[coordinates, alpha, params]`` (products without gcds; the parameters
+        are never differentiated), and each coefficient is divided by ``D_1 .. D_{N-1}`` once (one
+        cancellation per coefficient instead of one per product term).  Field elements are reduced
+        fractions either way, so the result is the same ring element.
+        """
+        alg = self.alg
+        field = alg.domain.field
+        if self._plain is None:  # QQ[coordinates, constants, parameters]: the parameters never differentiated
+            from ..algebra import PolynomialAlgebra
+
+            self._plain = PolynomialAlgebra(alg.coordinates, (), alg.constants + alg.parameters)
+        plain = self._plain
+        width = len(alg.gens)
+        cleared, total = [], field.ring.one
+        for p in slots:
+            D = field.ring.one
+            for c in p.values():
+                D = D.lcm(c.denom)
+            terms: dict = {}
+            for m, c in p.items():
+                num = c.numer * D.exquo(c.denom)
+                for e, q in num.items():
+                    terms[m + e] = q
+            cleared.append(plain.ring.from_dict(terms) if terms else plain.zero)
+            total = total * D
+        X = liouville_field(plain, *cleared)
+        components = []
+        for comp in X.components:
+            groups: dict = {}
+            for m, q in comp.items():
+                groups.setdefault(m[:width], {})[m[width:]] = q
+            components.append(alg.ring.from_dict({m: field.new(field.ring.from_dict(g), total)
+                                                  for m, g in groups.items()}) if groups else alg.zero)
+        from ..algebra import VectorField
+
+        return VectorField(alg, components)
 
     def _cross(self, j, corrections):
         """``sum`` over assignments of lower orders to two or more slots (the cross terms at ``h^j``)."""
@@ -336,16 +386,31 @@ class _Solver:
         # of coefficients, each of which would cancel a fraction (slow over QQ<2^(1/3)>(parameters))
         alpha = tuple(int(i == self.alpha_index) for i in range(len(alg.gens)))
         for a in range(self.slots):
-            fam[a] = mem_polys[0][a] + (mem_polys[1][a] - mem_polys[0][a]).mul_monom(alpha)
+            fam[a] = self._family(mem_polys[0][a], mem_polys[1][a], alpha)
         for a in range(self.slots):
             corrections[(a, j)] = fam[a]
         gauge = [ansatz.expressions(v, alg.coordinates, domain) for v in kernel]
+        memo: dict = {}  # the members and the family share most coefficients: each converted once
         psi_dim = self._psi_dim(ansatz, D) if self.slots == 2 else None
         return OrderSolution(
-            j, "solved", degree=D, corrections=tuple(alg.to_sympy(f) for f in fam),
-            members=tuple(tuple(alg.to_sympy(p) for p in polys) for polys in mem_polys),
+            j, "solved", degree=D, corrections=tuple(alg.to_sympy(f, memo) for f in fam),
+            members=tuple(tuple(alg.to_sympy(p, memo) for p in polys) for polys in mem_polys),
             gauge=gauge, kernel_dim=len(kernel), psi_dim=psi_dim, rhs=rhs,
         )
+
+    def _family(self, m0, m1, alpha):
+        """``m0 + alpha (m1 - m0)``; over ``QQ<theta>(params)`` coefficient by coefficient over ``QQ(params)``
+        (:func:`~nambu_bch.algebra.elimination.signed_sums`: no gcds over the number field)."""
+        sums: dict = {}
+        for m, c in m0.items():
+            sums.setdefault(m, []).append((1, c))
+            sums.setdefault(tuple(i + j for i, j in zip(m, alpha)), []).append((-1, c))
+        for m, c in m1.items():
+            sums.setdefault(tuple(i + j for i, j in zip(m, alpha)), []).append((1, c))
+        coeffs = signed_sums(sums, self.alg.domain)
+        if coeffs is None:
+            return m0 + (m1 - m0).mul_monom(alpha)
+        return self.alg.ring.from_dict(coeffs) if coeffs else self.alg.zero
 
     def _psi_dim(self, ansatz, D):
         """Rank of ``{(psi_G, -psi_H) : psi = H^p G^q}`` within the ansatz (they lie in the kernel)."""
