@@ -68,13 +68,42 @@ class Printable:
 # --------------------------------------------------------------------------------------------
 # series by powers of h
 # --------------------------------------------------------------------------------------------
+def _coefficients(expr, gens):
+    """``[(exponents, coefficient)]`` of the expanded ``expr`` as a polynomial in ``gens``, highest monomial first
+    (lex, as ``Poly.terms()``), zero coefficients left out; ``None`` when ``expr`` is not a polynomial in ``gens``.
+
+    The terms are grouped by their power products and each group is added once: linear in the number of
+    terms.  (``Poly(expr, *gens)`` with symbolic coefficients adds them one by one into a growing sympy
+    ``Add``, quadratic: minutes for the h^6 shadow pair of the rigid body with symbolic moments of inertia.)
+    """
+    index = {g: i for i, g in enumerate(gens)}
+    groups: dict = {}
+    for term in sympy.Add.make_args(expr):
+        exponents, rest = [0] * len(gens), []
+        for factor in sympy.Mul.make_args(term):
+            base, e = factor.as_base_exp()
+            if base in index and e.is_Integer and e >= 0:
+                exponents[index[base]] += int(e)
+            elif factor.has(*gens):  # not a power product: a negative power, or an unexpanded factor
+                if not expr.is_polynomial(*gens):
+                    return None
+                return [(m, c) for m, c in sympy.Poly(expr, *gens).terms() if c != 0]
+            else:
+                rest.append(factor)
+        groups.setdefault(tuple(exponents), []).append(sympy.Mul(*rest))
+    out = ((m, sympy.Add(*cs)) for m, cs in groups.items())
+    return sorted(((m, c) for m, c in out if c != 0), reverse=True)
+
+
 def _by_monomial(expr, coordinates):
-    """``expr`` as a sum over monomials of the coordinates, each coefficient factored (unevaluated Add)."""
-    if coordinates and expr.is_polynomial(*coordinates):
-        poly = sympy.Poly(expr, *coordinates)
-        terms = [sympy.factor(c) * sympy.Mul(*(x**e for x, e in zip(coordinates, m))) for m, c in poly.terms()]
-        return sympy.Add(*terms, evaluate=False) if len(terms) > 1 else terms[0]
-    return sympy.factor(expr)
+    """The expanded ``expr`` as a sum over monomials of the coordinates, each coefficient factored (unevaluated Add)."""
+    coefficients = _coefficients(expr, coordinates) if coordinates else None
+    if coefficients is None:
+        return sympy.factor(expr)
+    terms = [sympy.factor(c) * sympy.Mul(*(x**e for x, e in zip(coordinates, m))) for m, c in coefficients]
+    if not terms:
+        return sympy.Integer(0)
+    return sympy.Add(*terms, evaluate=False) if len(terms) > 1 else terms[0]
 
 
 def h_coefficients(expr, base, coordinates, step=STEP):
@@ -91,11 +120,10 @@ def h_coefficients(expr, base, coordinates, step=STEP):
     diff = sympy.expand(sympy.sympify(expr) - sympy.sympify(base))
     if diff == 0:
         return []
-    if not diff.is_polynomial(step):
+    coefficients = _coefficients(diff, [step])
+    if coefficients is None:
         return None
-    poly = sympy.Poly(diff, step)
-    return sorted(((m[0], _by_monomial(sympy.expand(c), coordinates)) for m, c in poly.terms() if c != 0),
-                  key=lambda item: item[0])
+    return sorted(((m[0], _by_monomial(c, coordinates)) for m, c in coefficients), key=lambda item: item[0])
 
 
 def signed(term, first=False) -> str:

@@ -12,6 +12,8 @@ from pathlib import Path
 
 import pytest
 import sympy
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from nambu_bch import (
     conserved_quantities,
@@ -240,3 +242,24 @@ def test_models_cache_is_not_trusted_in_a_shared_directory(tmp_path, monkeypatch
     assert main(["models", "--format", "text"]) == 0
     assert capsys.readouterr().out == honest
     del planted
+
+
+@settings(max_examples=60, deadline=None, derandomize=True)
+@given(st.lists(st.tuples(st.sampled_from([-3, -1, 1, 2, sympy.Rational(5, 7)]),
+                          st.sampled_from([1, sympy.Symbol("I1"), 1 / sympy.Symbol("I2"),
+                                           1 / (sympy.Symbol("I1") - sympy.Symbol("I3"))]),
+                          st.tuples(st.integers(0, 2), st.integers(0, 2), st.integers(0, 3))),
+                min_size=0, max_size=8))
+def test_coefficients_by_monomial_equal_poly_terms(terms):
+    """The linear-time grouping of printing._coefficients gives Poly(expr, *gens).terms(): same monomials, same
+    order, equal coefficients (the layout of Eqs. (SH12321c), (SG12321c) rests on it)."""
+    from nambu_bch.printing import _coefficients
+
+    x1, x2, h = sympy.symbols("x1 x2 h")
+    expr = sympy.expand(sum((c * k * x1**a * x2**b * h**j for c, k, (a, b, j) in terms), sympy.Integer(0)))
+    gens = (x1, x2, h)
+    ours = _coefficients(expr, gens)
+    plain = [(m, c) for m, c in sympy.Poly(expr, *gens).terms() if c != 0] if expr != 0 else []
+    assert [m for m, _ in ours] == [m for m, _ in plain]
+    assert all(sympy.cancel(a - b) == 0 for (_, a), (_, b) in zip(ours, plain))
+    assert _coefficients(expr + x1 / (1 + x2), gens) is None  # not a polynomial: the caller factors instead
