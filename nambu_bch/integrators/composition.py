@@ -287,21 +287,23 @@ def _jump_base(base: Composition, what: str) -> int:
 
 
 def _jump(base: Composition, gammas, root, name: str, citation: str) -> Composition:
-    """``Phi_{g_1 h} ... Phi_{g_m h}`` of ``base``, adjacent sub-flows of one piece merged, coefficients in QQ(root)."""
+    """``Phi_{g_1 h} ... Phi_{g_m h}`` of ``base``, adjacent sub-flows of one piece merged, coefficients in QQ(root).
+
+    ``gammas(theta)`` gives the ``g_i`` as elements of ``QQ(root)`` from its generator ``theta = root``:
+    the arithmetic stays in the number field (one normal form per number, ``a + b r + c r^2 ...``); converting
+    sympy expressions such as ``1/(2 - 2^(1/3))`` into the field would compute minimal polynomials each time.
+    """
     field = QQ.algebraic_field(root)
-
-    def canonical(c):  # a + b r + c r^2 ... : one normal form per number
-        return field.to_sympy(field.from_sympy(sympy.expand(c)))
-
     pieces, coeffs = [], []
-    for g in gammas:
+    for g in gammas(field.from_sympy(root), field):
         for k, c in base.factors():
+            term = g * field.convert(QQ.from_sympy(c), QQ)
             if pieces and pieces[-1] == k:  # merge adjacent sub-flows of one piece
-                coeffs[-1] = canonical(coeffs[-1] + g * c)
+                coeffs[-1] = coeffs[-1] + term
             else:
                 pieces.append(k)
-                coeffs.append(canonical(g * c))
-    return Composition(tuple(pieces), tuple(coeffs), name, base.order + 2, citation)
+                coeffs.append(term)
+    return Composition(tuple(pieces), tuple(field.to_sympy(c) for c in coeffs), name, base.order + 2, citation)
 
 
 def _triple_jump(base: Composition) -> Composition:
@@ -311,10 +313,12 @@ def _triple_jump(base: Composition) -> Composition:
     (Yoshida 1990, Eq. 5.19).
     """
     p = _jump_base(base, "triple jump")
-    root = sympy.Integer(2) ** sympy.Rational(1, p)
-    g1 = 1 / (2 - root)
-    g0 = -root / (2 - root)
-    return _jump(base, (g1, g0, g1), root, f"triple-jump:{base.name}",
+
+    def gammas(theta, field):
+        g1 = field.one / (field.convert(2) - theta)
+        return g1, -theta * g1, g1
+
+    return _jump(base, gammas, sympy.Integer(2) ** sympy.Rational(1, p), f"triple-jump:{base.name}",
                  "Yoshida, Phys. Lett. A 150 (1990) 262; Forest & Ruth, Physica D 43 (1990) 105")
 
 
@@ -326,9 +330,12 @@ def _five_jump(base: Composition) -> Composition:
     ``g3 = 1 - 4 g1``.  The coefficients lie in ``QQ(2^(2/p))``.
     """
     p = _jump_base(base, "five-jump")
-    root = sympy.Integer(4) ** sympy.Rational(1, p)
-    g = 1 / (4 - root)
-    return _jump(base, (g, g, 1 - 4 * g, g, g), root, f"suzuki:{base.name}",
+
+    def gammas(theta, field):
+        g = field.one / (field.convert(4) - theta)
+        return g, g, field.one - field.convert(4) * g, g, g
+
+    return _jump(base, gammas, sympy.Integer(4) ** sympy.Rational(1, p), f"suzuki:{base.name}",
                  "Suzuki, Phys. Lett. A 146 (1990) 319")
 
 
