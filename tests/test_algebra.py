@@ -669,3 +669,28 @@ class TestParser:
             System("x1 x2", ["__import__('os').system('true')"])
         with pytest.raises(NambuBCHError):
             System("x1 x2", ["x1.__class__"])
+
+
+def test_is_zero_witness_point_decides_nonzero_before_simplify(monkeypatch):
+    """algebra.zero.is_zero: a non-zero value at a rational point (30 digits, clearly above round-off) answers False
+    without the expensive tiers; identities (with cancellation of 30 orders of magnitude, radicals, exp/trig) still
+    reach the exact tiers and answer True."""
+    import nambu_bch.algebra.zero as Z
+
+    x, y = sympy.symbols("x y")
+    c = sympy.cbrt(2)
+    zeros = [10**30 * (sympy.sin(x)**2 + sympy.cos(x)**2) - 10**30, sympy.exp(2 * x) - sympy.exp(x)**2,
+             1 / (2 - c) - (4 + 2 * c + c**2) / 6,  # Yoshida's triple-jump coefficient (Phys. Lett. A 150 (1990), Eq. 5.5)
+             sympy.sin(2 * x) - 2 * sympy.sin(x) * sympy.cos(x),
+             sympy.sin(x + 10**20) - sympy.sin(x) * sympy.cos(10**20) - sympy.cos(x) * sympy.sin(10**20)]
+    for e in zeros:
+        assert not Z._nonzero_at_a_point(sympy.expand(e)) and Z.is_zero(e)
+    # outside the domain at the point, or too small to be told from round-off: no witness, the exact tiers decide
+    assert not Z._nonzero_at_a_point(sympy.sqrt(x - 5)) and not Z._nonzero_at_a_point(sympy.Float(1e-40) * sympy.cos(x))
+
+    def never(*args, **kwargs):
+        raise AssertionError("the expensive tier was reached")
+
+    monkeypatch.setattr(Z.sympy, "simplify", never)
+    for e in [sympy.sin(x) - x + x**3 / 6, sympy.exp(x) * sympy.cos(y) - 1, c * sympy.sin(x) - sympy.sin(x)]:
+        assert Z.is_zero(e) is False

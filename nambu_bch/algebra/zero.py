@@ -24,13 +24,40 @@ def has_radicals(expr) -> bool:
     return any(p.base.is_Number and not p.exp.is_Integer for p in sympy.sympify(expr).atoms(sympy.Pow))
 
 
+#: The witness points' coordinates: distinct, irregular rationals in (0, 1) (inside the domain of log, sqrt, 1/x).
+_POINT = (sympy.Rational(7, 19), sympy.Rational(5, 13), sympy.Rational(11, 23), sympy.Rational(3, 7),
+          sympy.Rational(13, 29), sympy.Rational(9, 17), sympy.Rational(17, 31), sympy.Rational(2, 11))
+
+
+def _nonzero_at_a_point(e) -> bool:
+    """``e`` evaluates, at 30 digits, to a real number clearly away from zero at a rational point (a witness that
+    ``e`` is not identically zero).
+
+    sympy's ``evalf`` tracks the cancellation in sums and raises its working precision until the result has
+    the requested 30 digits; a zero expression therefore evaluates to below ``1e-30`` of its terms' size, and
+    a value above ``1e-12`` of that size is not round-off.  Where the point is outside the domain (a pole,
+    a complex value) or the evaluation does not give a number, no witness is claimed and the exact tiers decide.
+    """
+    symbols = sorted(e.free_symbols, key=str)
+    point = {x: _POINT[i % len(_POINT)] + i // len(_POINT) for i, x in enumerate(symbols)}
+    try:
+        value = e.evalf(30, subs=point)
+        scale = max((abs(t.evalf(30, subs=point)) for t in sympy.Add.make_args(e)), default=sympy.Integer(0))
+    except (TypeError, ValueError, ArithmeticError):  # noqa: BLE001 - outside the domain: no witness
+        return False
+    if not (value.is_Number and value.is_real and scale.is_Number and scale.is_finite) or value.has(sympy.nan):
+        return False
+    return bool(abs(value) > sympy.Float(1e-12, 30) * max(scale, sympy.Integer(1)))
+
+
 def is_zero(expr) -> bool:
     """Exact zero test, cheapest decisive tier first.
 
     1. A rational function of its symbols with rational coefficients is zero exactly when
        ``cancel`` gives ``0`` (decisive both ways: ``QQ(symbols)`` is a field).
-    2. Otherwise the expansion; with algebraic numbers, the expansion after rationalising
-       the denominators (``radsimp``).
+    2. Otherwise the expansion; then a witness of non-zero-ness (a rational point where the value,
+       at 30 digits, is clearly not zero: :func:`_nonzero_at_a_point`) answers ``False`` before the
+       expensive tiers; with algebraic numbers, the expansion after rationalising the denominators (``radsimp``).
     3. With ``exp`` and trigonometric functions, everything rewritten as exponentials and
        combined, which decides identities between polynomials in ``exp(a x)``, ``cos``, ``sin``.
     4. ``simplify`` as the last resort.
@@ -48,6 +75,8 @@ def is_zero(expr) -> bool:
     e = sympy.expand(expr)
     if e == 0:
         return True
+    if _nonzero_at_a_point(e):
+        return False
     if radicals and sympy.expand(sympy.radsimp(sympy.together(e))) == 0:
         return True
     if e.has(sympy.exp, sympy.sin, sympy.cos, sympy.tan, sympy.sinh, sympy.cosh, sympy.tanh):
