@@ -18,8 +18,8 @@ from pathlib import Path
 # ``--import-mode=importlib`` pytest does not put it on sys.path itself
 sys.path.insert(0, str(Path(__file__).parent))
 
-# (file, test name prefix) of the tests that take >= 3 s of CPU each on the two-core machine, roughly longest first
-# (a cold ``pytest -n 2`` with per-test CPU, own and of child processes: docs/suite_time.md)
+# (file, test name prefix) of the tests that take >= 2 s each on the two-core machine, roughly longest first
+# (a cold ``pytest -n 2 --durations=0``, session 11: docs/suite_time.md)
 LONG = (
     ("test_notebooks.py", "test_notebook_executes"),                        # 2.4-10.8 s each, in a kernel process
     ("test_bch_modular.py", "test_sparse_engine_equals_dense_engine"),      # 8.5 s at [12-12], cold: numba compile
@@ -29,7 +29,11 @@ LONG = (
     ("test_cli.py", "test_every_subcommand_runs_as_a_subprocess"),
     ("test_shadow.py", "test_shadow_pair_reproduces_effective_field"),
     ("test_shadow.py", "test_eight_representations_for_generic_functions"),
-    ("test_any_system.py", "test_rigid_body_lp_check_runs_and_keeps_the_casimir"),
+    ("test_direct_route_fast.py", "test_rigid_body_symbolic_yoshida_family_over_base_field"),
+    ("test_fi_route.py", "test_hull_members_have_the_brackets_field"),
+    ("test_modular_rref.py", "test_n4_single_split_h4_same_with_modular_and_flint"),
+    ("test_any_system.py", "test_new_system_numerics"),
+    ("test_any_system.py", "test_concrete_equals_generic_substituted_to_h4"),
     ("test_any_system.py", "test_lie_poisson_bch_member_with_casimir_kept"),
     ("test_existence.py", "test_issue_example_non_symmetric_word_drifts"),
     ("test_shadow.py", "test_n4_full_split_is_obstructed"),
