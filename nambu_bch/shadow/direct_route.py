@@ -63,7 +63,7 @@ from itertools import product
 
 import sympy
 
-from ..algebra import liouville_field
+from ..algebra import PolynomialAlgebra, VectorField, liouville_field
 from ..algebra.ansatz import Ansatz, Rows
 from ..algebra.elimination import elimination_cost, rank, signed_sums
 from ..bch.backward import check_order
@@ -259,8 +259,6 @@ class _Solver:
         alg = self.alg
         field = alg.domain.field
         if self._plain is None:  # QQ[coordinates, constants, parameters]: the parameters never differentiated
-            from ..algebra import PolynomialAlgebra
-
             self._plain = PolynomialAlgebra(alg.coordinates, (), alg.constants + alg.parameters)
         plain = self._plain
         width = len(alg.gens)
@@ -284,8 +282,6 @@ class _Solver:
                 groups.setdefault(m[:width], {})[m[width:]] = q
             components.append(alg.ring.from_dict({m: field.new(field.ring.from_dict(g), total)
                                                   for m, g in groups.items()}) if groups else alg.zero)
-        from ..algebra import VectorField
-
         return VectorField(alg, components)
 
     def _cross(self, j, corrections):
@@ -320,8 +316,6 @@ class _Solver:
         cross = self._cross(j, corrections)
         if cross is not None:
             comps = [c - x for c, x in zip(comps, cross.components)]
-        from ..algebra import VectorField
-
         rhs = VectorField(alg, comps)
         if all(not c for c in comps):
             return OrderSolution(j, "vanishes", corrections=(sympy.Integer(0),) * self.slots, rhs=rhs)

@@ -17,6 +17,7 @@ from dataclasses import dataclass, field
 
 import sympy
 
+from ..algebra.ansatz import Ansatz
 from ..printing import Printable, aligned, h_coefficients, latex_text, series_text, series_tokens
 from ..symbols import ALPHA, STEP
 
@@ -158,8 +159,6 @@ class ShadowFamily(Printable):
             certificate, obstruction = bad.certificate, _obstruction_text(bad, len(system.hamiltonians))
         else:
             certificate = None
-            from ..algebra.ansatz import Ansatz
-
             if max_unknowns is None or Ansatz.size(len(system.coordinates), bad.degree, len(system.hamiltonians)) > max_unknowns:
                 what = f"has more than max_unknowns={max_unknowns} unknowns"
             else:  # within max_unknowns, above the elimination cost budget (direct_route.SOLVE_COST)
