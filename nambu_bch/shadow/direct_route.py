@@ -94,6 +94,10 @@ class OrderSolution:
     certificate : dict ``{(component, monomial): coefficient}`` or None
     obstruction_value : sympy expression -- the certificate applied to the right-hand side
     rhs : VectorField or None -- the right-hand side of Eq. (*)
+
+    A solved order converts ``corrections`` and ``members`` to sympy on first access (``convert``, a callable
+    returning both; the same expressions, cached): the route itself works on the ring elements, and a
+    caller that only reads ``H_S, G_S`` never pays for the per-order sympy forms.
     """
 
     order: int
@@ -107,11 +111,37 @@ class OrderSolution:
     certificate: dict | None = None
     obstruction_value: object = None
     rhs: object = None
+    convert: object = field(default=None, repr=False, compare=False)
+
+    def _converted(self, name):
+        value = self.__dict__.get("_" + name)
+        if value is None and self.convert is not None:
+            self.__dict__["_corrections"], self.__dict__["_members"] = self.convert()
+            self.convert = None
+            value = self.__dict__["_" + name]
+        return value
 
     @property
     def extra_gauge_dim(self):
         """Kernel directions not of the form ``(psi_G, -psi_H)`` (system-specific gauge)."""
         return None if self.psi_dim is None else self.kernel_dim - self.psi_dim
+
+
+def _lazy(name):
+    """A property of :class:`OrderSolution` whose value may be converted on first access (``convert``)."""
+
+    def get(self):
+        return self._converted(name)
+
+    def put(self, value):
+        self.__dict__["_" + name] = value
+
+    return property(get, put, doc=f"``{name}`` as sympy expressions (converted on first access)")
+
+
+# after @dataclass: the generated __init__ assigns through the properties (defaults () stay the fields' own)
+OrderSolution.corrections = _lazy("corrections")
+OrderSolution.members = _lazy("members")
 
 
 @dataclass
@@ -208,6 +238,25 @@ def _lift(alg, value):
     return alg.ring.from_dict({m + pad: alg.domain.convert(c) for m, c in value.items()})
 
 
+def _divided(numerators: dict, denominator, domain) -> dict:
+    """``{key: n / denominator}`` in ``domain = QQ(params)`` (``n``, ``denominator`` polynomials in the parameters),
+    zero quotients left out: each a reduced fraction, cancelled by flint's gcd when python-flint is available
+    (:mod:`nambu_bch.algebra.frac_rref`, the same normal form), else by sympy's field."""
+    from ..algebra import frac_rref
+    from ..algebra.elimination import FAST_PATHS, flint_available
+
+    ctx = frac_rref.context(domain) if FAST_PATHS and flint_available() else None
+    field = domain.field
+    if ctx is None:
+        out = {k: field.new(n, denominator) for k, n in numerators.items()}
+        return {k: v for k, v in out.items() if v}
+    out = {}
+    for k, n in numerators.items():
+        if n:
+            out[k] = frac_rref.to_field(frac_rref.quotient(n, denominator, ctx), domain)
+    return out
+
+
 def _total_degree(p, n):
     return max((sum(m[:n]) for m in p.keys()), default=-1)
 
@@ -238,23 +287,27 @@ class _Solver:
         self._plain = None  # the polynomial algebra of the fraction-free cross terms (_field_cleared)
 
     # -- fields ------------------------------------------------------------------
-    def _field(self, slots):
-        """``X_{slots}`` (Eq. gLiouville); over ``QQ(params)`` fraction-free (:meth:`_field_cleared`)."""
+    def _cleared_ok(self):
         domain = self.alg.domain
-        if getattr(domain, "is_FractionField", False) and domain.domain.is_QQ:
-            return self._field_cleared(slots)
+        return getattr(domain, "is_FractionField", False) and domain.domain.is_QQ
+
+    def _field(self, slots):
+        """``X_{slots}`` (Eq. gLiouville); over ``QQ(params)`` fraction-free (:meth:`_fields_cleared`)."""
+        if self._cleared_ok():
+            return self._fields_cleared([slots])
         return liouville_field(self.alg, *slots)
 
-    def _field_cleared(self, slots):
-        """``X_{slots}`` over ``QQ(params)`` without fraction arithmetic: the same field, exactly.
+    def _fields_cleared(self, assignments):
+        """``sum_k X_{slots_k}`` over ``QQ(params)`` without fraction arithmetic: the same field, exactly.
 
         ``X_{P_1 .. P_{N-1}}`` is multilinear in its slots over the constants, so with ``P_a = Q_a / D_a``
         (``D_a`` the lcm of the coefficient denominators, a polynomial in the parameters, ``Q_a`` a
         polynomial in the coordinates, ``alpha`` and the parameters) ``X_{P} = X_{Q} / (D_1 .. D_{N-1})``.
         ``X_Q`` is computed in ``QQ[coordinates, alpha, params]`` (products without gcds; the parameters
-        are never differentiated), and each coefficient is divided by ``D_1 .. D_{N-1}`` once (one
-        cancellation per coefficient instead of one per product term).  Field elements are reduced
-        fractions either way, so the result is the same ring element.
+        are never differentiated); the fields of all ``assignments`` are summed there over the lcm ``T`` of
+        their denominators, and each coefficient of the sum is divided by ``T`` once (one cancellation per
+        coefficient instead of one per product term and per sum: :func:`_divided`).  Field elements are
+        reduced fractions either way, so the result is the same ring element.
         """
         alg = self.alg
         field = alg.domain.field
@@ -262,31 +315,46 @@ class _Solver:
             self._plain = PolynomialAlgebra(alg.coordinates, (), alg.constants + alg.parameters)
         plain = self._plain
         width = len(alg.gens)
-        cleared, total = [], field.ring.one
-        for p in slots:
-            D = field.ring.one
-            for c in p.values():
-                D = D.lcm(c.denom)
-            terms: dict = {}
-            for m, c in p.items():
-                num = c.numer * D.exquo(c.denom)
-                for e, q in num.items():
-                    terms[m + e] = q
-            cleared.append(plain.ring.from_dict(terms) if terms else plain.zero)
-            total = total * D
-        X = liouville_field(plain, *cleared)
+        pad = (0,) * width
+
+        def lift(d):  # a polynomial in the parameters as an element of the plain ring
+            return plain.ring.from_dict({pad + m: c for m, c in d.items()})
+
+        parts = []
+        for slots in assignments:
+            cleared, total = [], field.ring.one
+            for p in slots:
+                D = field.ring.one
+                for c in p.values():
+                    D = D.lcm(c.denom)
+                terms: dict = {}
+                for m, c in p.items():
+                    num = c.numer * D.exquo(c.denom)
+                    for e, q in num.items():
+                        terms[m + e] = q
+                cleared.append(plain.ring.from_dict(terms) if terms else plain.zero)
+                total = total * D
+            parts.append((liouville_field(plain, *cleared), total))
+        T = parts[0][1]
+        for _, total in parts[1:]:
+            T = T.lcm(total)
+        sums = None
+        for X, total in parts:
+            scale = T.exquo(total)
+            comps = X.components if scale == 1 else [c * lift(scale) for c in X.components]
+            sums = comps if sums is None else [a + b for a, b in zip(sums, comps)]
         components = []
-        for comp in X.components:
+        for comp in sums:
             groups: dict = {}
             for m, q in comp.items():
                 groups.setdefault(m[:width], {})[m[width:]] = q
-            components.append(alg.ring.from_dict({m: field.new(field.ring.from_dict(g), total)
-                                                  for m, g in groups.items()}) if groups else alg.zero)
+            components.append(alg.ring.from_dict(_divided({m: field.ring.from_dict(g) for m, g in groups.items()}, T,
+                                                          alg.domain)) if groups else alg.zero)
         return VectorField(alg, components)
 
     def _cross(self, j, corrections):
         """``sum`` over assignments of lower orders to two or more slots (the cross terms at ``h^j``)."""
-        total = None
+        assignments = []
         for orders in product(range(j), repeat=self.slots):
             if sum(orders) != j or sum(1 for o in orders if o) < 2:
                 continue
@@ -300,8 +368,15 @@ class _Solver:
                         break
                     slots.append(c)
             else:
-                X = self._field(slots)
-                total = X if total is None else total + X
+                assignments.append(slots)
+        if not assignments:
+            return None
+        if self._cleared_ok():
+            return self._fields_cleared(assignments)
+        total = None
+        for slots in assignments:
+            X = liouville_field(self.alg, *slots)
+            total = X if total is None else total + X
         return total
 
     def _needed_degree(self, rhs_deg):
@@ -384,13 +459,15 @@ class _Solver:
         for a in range(self.slots):
             corrections[(a, j)] = fam[a]
         gauge = [ansatz.expressions(v, alg.coordinates, domain) for v in kernel]
-        memo: dict = {}  # the members and the family share most coefficients: each converted once
         psi_dim = self._psi_dim(ansatz, D) if self.slots == 2 else None
-        return OrderSolution(
-            j, "solved", degree=D, corrections=tuple(alg.to_sympy(f, memo) for f in fam),
-            members=tuple(tuple(alg.to_sympy(p, memo) for p in polys) for polys in mem_polys),
-            gauge=gauge, kernel_dim=len(kernel), psi_dim=psi_dim, rhs=rhs,
-        )
+
+        def convert():  # on first access (OrderSolution): the sympy forms of the family and the members
+            memo: dict = {}  # the members and the family share most coefficients: each converted once
+            return (tuple(alg.to_sympy(f, memo) for f in fam),
+                    tuple(tuple(alg.to_sympy(p, memo) for p in polys) for polys in mem_polys))
+
+        return OrderSolution(j, "solved", degree=D, corrections=None, members=None, gauge=gauge,
+                             kernel_dim=len(kernel), psi_dim=psi_dim, rhs=rhs, convert=convert)
 
     def _family(self, m0, m1, alpha):
         """``m0 + alpha (m1 - m0)``; over ``QQ<theta>(params)`` coefficient by coefficient over ``QQ(params)``
