@@ -50,17 +50,36 @@ def context(domain):
 
 
 def _integer_poly(p, ctx):
-    """``(P, c)`` with ``p = P / c``, ``P`` in ``ZZ[params]`` (flint), ``c`` a positive integer."""
-    from sympy.polys.domains import QQ
+    """``(P, c)`` with ``p = P / c``, ``P`` in ``ZZ[params]`` (flint), ``c`` a positive integer (``p`` a sympy polynomial)."""
+    return _integer_terms(p.items(), ctx)
 
+
+def _integer_terms(items, ctx):
+    """``(P, c)`` of ``{exponent: rational}`` items (sympy's ``QQ`` elements or flint ``fmpq``: both have
+    ``numerator``/``denominator``)."""
+    items = [(m, int(q.numerator), int(q.denominator)) for m, q in items]
     c = 1
-    for q in p.values():
-        den = int(QQ.denom(q))
+    for _, _, den in items:
         if den != 1:
             c = c * den // _gcd(c, den)
-    if c == 1:
-        return ctx.from_dict({m: int(QQ.numer(q)) for m, q in p.items()}), 1
-    return ctx.from_dict({m: int(QQ.numer(q * c)) for m, q in p.items()}), c
+    return ctx.from_dict({m: num * (c // den) for m, num, den in items}), c
+
+
+def integer_poly(p, ctx):
+    """A sympy polynomial over ``QQ`` in the parameters as ``(P, c)``: ``p = P / c``, ``P`` a flint ``fmpz_mpoly``."""
+    return _integer_poly(p, ctx)
+
+
+def quotient_terms(terms: dict, denominator, ctx):
+    """``sum_e t_e P^e / denominator`` as a normalised pair; ``None`` when it is zero.
+
+    ``terms``: ``{exponent tuple: rational}`` (sympy ``QQ`` or flint ``fmpq``); ``denominator``: ``(P, c)``
+    from :func:`integer_poly` (the polynomial ``P / c``, non-zero)."""
+    n, cn = _integer_terms(terms.items(), ctx)
+    if n.is_zero():
+        return None
+    d, cd = denominator
+    return normalize(n * cd, d * cn)
 
 
 def _gcd(a, b):
@@ -87,13 +106,6 @@ def from_field(v, ctx):
     d, cd = _integer_poly(v.denom, ctx)
     if cn == 1 and cd == 1 and d.leading_coefficient() > 0:
         return n, d  # sympy's own normal form: nothing to cancel
-    return normalize(n * cd, d * cn)
-
-
-def quotient(numer, denom, ctx):
-    """``numer / denom`` (sympy polynomials over ``QQ`` in the parameters, ``denom`` non-zero) as a normalised pair."""
-    n, cn = _integer_poly(numer, ctx)
-    d, cd = _integer_poly(denom, ctx)
     return normalize(n * cd, d * cn)
 
 

@@ -65,6 +65,7 @@ import sympy
 
 from ..algebra import PolynomialAlgebra, VectorField, liouville_field
 from ..algebra.ansatz import Ansatz, Rows
+from ..algebra import elimination, frac_rref
 from ..algebra.elimination import elimination_cost, rank, signed_sums
 from ..bch.backward import check_order
 from ..bch.concrete import effective_field_by_cost
@@ -238,22 +239,33 @@ def _lift(alg, value):
     return alg.ring.from_dict({m + pad: alg.domain.convert(c) for m, c in value.items()})
 
 
-def _divided(numerators: dict, denominator, domain) -> dict:
-    """``{key: n / denominator}`` in ``domain = QQ(params)`` (``n``, ``denominator`` polynomials in the parameters),
-    zero quotients left out: each a reduced fraction, cancelled by flint's gcd when python-flint is available
-    (:mod:`nambu_bch.algebra.frac_rref`, the same normal form), else by sympy's field."""
-    from ..algebra import frac_rref
-    from ..algebra.elimination import FAST_PATHS, flint_available
+def FAST_PATHS_FLINT() -> bool:  # noqa: N802 -- read at every call, like the switches it combines
+    """The elimination's fast paths are on and python-flint is available (``NAMBU_BCH_DISABLE_FLINT`` unset)."""
+    return elimination.FAST_PATHS and elimination.flint_available()
 
-    ctx = frac_rref.context(domain) if FAST_PATHS and flint_available() else None
+
+def _divided(numerators: dict, denominator, domain) -> dict:
+    """``{key: n / denominator}`` in ``domain = QQ(params)``, zero quotients left out.
+
+    ``numerators``: ``{key: {exponent tuple: rational}}`` (polynomials in the parameters), ``denominator``
+    a non-zero polynomial of the field's ring.  Each quotient is a reduced fraction, cancelled by flint's
+    gcd when python-flint is available (:mod:`nambu_bch.algebra.frac_rref`, the same normal form), else by
+    sympy's field.
+    """
+    ctx = frac_rref.context(domain) if FAST_PATHS_FLINT() else None
     field = domain.field
-    if ctx is None:
-        out = {k: field.new(n, denominator) for k, n in numerators.items()}
-        return {k: v for k, v in out.items() if v}
     out = {}
+    if ctx is None:
+        for k, n in numerators.items():
+            v = field.new(field.ring.from_dict(n), denominator)
+            if v:
+                out[k] = v
+        return out
+    D = frac_rref.integer_poly(denominator, ctx)
     for k, n in numerators.items():
-        if n:
-            out[k] = frac_rref.to_field(frac_rref.quotient(n, denominator, ctx), domain)
+        pair = frac_rref.quotient_terms(n, D, ctx)
+        if pair is not None:
+            out[k] = frac_rref.to_field(pair, domain)
     return out
 
 
@@ -304,22 +316,20 @@ class _Solver:
         (``D_a`` the lcm of the coefficient denominators, a polynomial in the parameters, ``Q_a`` a
         polynomial in the coordinates, ``alpha`` and the parameters) ``X_{P} = X_{Q} / (D_1 .. D_{N-1})``.
         ``X_Q`` is computed in ``QQ[coordinates, alpha, params]`` (products without gcds; the parameters
-        are never differentiated); the fields of all ``assignments`` are summed there over the lcm ``T`` of
-        their denominators, and each coefficient of the sum is divided by ``T`` once (one cancellation per
-        coefficient instead of one per product term and per sum: :func:`_divided`).  Field elements are
-        reduced fractions either way, so the result is the same ring element.
+        are never differentiated) -- on flint's ``fmpq_mpoly`` when python-flint is available
+        (:class:`~nambu_bch.algebra.flint_ring.FlintRing`), else on sympy's ring; the fields of all
+        ``assignments`` are summed there over the lcm ``T`` of their denominators, and each coefficient of
+        the sum is divided by ``T`` once (one cancellation per coefficient instead of one per product term
+        and per sum: :func:`_divided`).  Field elements are reduced fractions either way, so the result is
+        the same ring element.
         """
         alg = self.alg
         field = alg.domain.field
-        if self._plain is None:  # QQ[coordinates, constants, parameters]: the parameters never differentiated
-            self._plain = PolynomialAlgebra(alg.coordinates, (), alg.constants + alg.parameters)
-        plain = self._plain
         width = len(alg.gens)
         pad = (0,) * width
-
-        def lift(d):  # a polynomial in the parameters as an element of the plain ring
-            return plain.ring.from_dict({pad + m: c for m, c in d.items()})
-
+        plain = self._plain_ring()
+        flint = not isinstance(plain, PolynomialAlgebra)
+        make = plain.from_terms if flint else (lambda t: plain.ring.from_dict(t) if t else plain.zero)
         parts = []
         for slots in assignments:
             cleared, total = [], field.ring.one
@@ -332,25 +342,38 @@ class _Solver:
                     num = c.numer * D.exquo(c.denom)
                     for e, q in num.items():
                         terms[m + e] = q
-                cleared.append(plain.ring.from_dict(terms) if terms else plain.zero)
+                cleared.append(make(terms))
                 total = total * D
-            parts.append((liouville_field(plain, *cleared), total))
+            parts.append((liouville_field(plain, *cleared).components, total))
         T = parts[0][1]
         for _, total in parts[1:]:
             T = T.lcm(total)
         sums = None
-        for X, total in parts:
+        for comps, total in parts:
             scale = T.exquo(total)
-            comps = X.components if scale == 1 else [c * lift(scale) for c in X.components]
-            sums = comps if sums is None else [a + b for a, b in zip(sums, comps)]
+            if scale != 1:
+                factor = make({pad + m: c for m, c in scale.items()})
+                comps = [c * factor for c in comps]
+            sums = list(comps) if sums is None else [a + b for a, b in zip(sums, comps)]
         components = []
         for comp in sums:
             groups: dict = {}
-            for m, q in comp.items():
+            for m, q in (plain.terms(comp) if flint else comp).items():
                 groups.setdefault(m[:width], {})[m[width:]] = q
-            components.append(alg.ring.from_dict(_divided({m: field.ring.from_dict(g) for m, g in groups.items()}, T,
-                                                          alg.domain)) if groups else alg.zero)
+            components.append(alg.ring.from_dict(_divided(groups, T, alg.domain)) if groups else alg.zero)
         return VectorField(alg, components)
+
+    def _plain_ring(self):
+        """``QQ[coordinates, constants, parameters]`` of :meth:`_fields_cleared`: flint's when available, else sympy's."""
+        if self._plain is None:
+            alg = self.alg
+            if FAST_PATHS_FLINT():
+                from ..algebra.flint_ring import FlintRing
+
+                self._plain = FlintRing([str(s) for s in alg.coordinates + alg.constants + alg.parameters], alg.n)
+            else:
+                self._plain = PolynomialAlgebra(alg.coordinates, (), alg.constants + alg.parameters)
+        return self._plain
 
     def _cross(self, j, corrections):
         """``sum`` over assignments of lower orders to two or more slots (the cross terms at ``h^j``)."""
