@@ -28,6 +28,7 @@ from __future__ import annotations
 import importlib
 
 _CONTEXTS: dict = {}
+_FLINT_QQ: dict = {}  # QQ's element type -> is it flint's fmpq
 
 
 def _flint():
@@ -113,10 +114,13 @@ def to_field(pair, domain):
     """The pair ``(n, d)`` (normal form) as the element of ``domain`` sympy's arithmetic would give (no cancellation)."""
     n, d = pair
     field = domain.field
-    ring = field.ring
+    make, coeff = field.ring.dtype, domain.domain.dtype  # PolyElement from (monomial, coefficient) pairs; QQ's type
+    if _FLINT_QQ.get(coeff) is None:
+        _FLINT_QQ[coeff] = coeff is _flint().fmpq  # flint ground types: fmpz coefficients convert directly
 
     def poly(p):
-        return ring.from_dict({tuple(m): int(c) for m, c in zip(p.monoms(), p.coeffs())})
+        cs = p.coeffs() if _FLINT_QQ[coeff] else [int(c) for c in p.coeffs()]
+        return make(zip(map(tuple, p.monoms()), map(coeff, cs)))
 
     return field.raw_new(poly(n), poly(d))
 

@@ -202,7 +202,7 @@ def _check_ansatz_size(slots, n, degree):
         )
 
 
-def operator_columns(alg, hams, ansatz, rows, memo=None) -> list:
+def operator_columns(alg, hams, ansatz, rows, memo=None, field=None) -> list:
     """The columns of ``L`` in Eq. (*): ``X_{H^1, .., x^mu, .., H^{N-1}}`` (``x^mu`` in slot ``a``) per ansatz column.
 
     Parameters
@@ -212,6 +212,8 @@ def operator_columns(alg, hams, ansatz, rows, memo=None) -> list:
     ansatz : Ansatz -- the unknown corrections (its slots are the Hamiltonians')
     rows : Rows -- interns ``(component, exponent tuple[:n])``
     memo : dict, optional -- ``(slot, mu) -> components``, shared by the orders of one solve
+    field : callable, optional -- ``slots -> VectorField``, the Liouville field of the slots (default
+        :func:`~nambu_bch.algebra.brackets.liouville_field` on ``alg``; the direct route passes its fraction-free one)
 
     Returns
     -------
@@ -224,7 +226,7 @@ def operator_columns(alg, hams, ansatz, rows, memo=None) -> list:
         if comps is None:
             slots = list(hams)
             slots[a] = alg.ring.from_dict({e + pad: alg.domain.one})
-            comps = liouville_field(alg, *slots).components
+            comps = (liouville_field(alg, *slots) if field is None else field(slots)).components
             if memo is not None:
                 memo[(a, e)] = comps
         out.append(rows.field(comps, alg.n))
@@ -296,7 +298,8 @@ class _Solver:
         self.slots = len(hams)
         self.gdeg = [_total_degree(p, self.n) - 1 for p in hams]
         self._columns: dict = {}
-        self._plain = None  # the polynomial algebra of the fraction-free cross terms (_field_cleared)
+        self._plain = None  # the polynomial ring of the fraction-free fields (_fields_cleared)
+        self._cleared: dict = {}  # id of a Hamiltonian -> (its cleared polynomial, its denominator)
 
     # -- fields ------------------------------------------------------------------
     def _cleared_ok(self):
@@ -334,16 +337,21 @@ class _Solver:
         for slots in assignments:
             cleared, total = [], field.ring.one
             for p in slots:
-                D = field.ring.one
-                for c in p.values():
-                    D = D.lcm(c.denom)
-                terms: dict = {}
-                for m, c in p.items():
-                    num = c.numer * D.exquo(c.denom)
-                    for e, q in num.items():
-                        terms[m + e] = q
-                cleared.append(make(terms))
-                total = total * D
+                hit = self._cleared.get(id(p)) if any(p is q for q in self.hams) else None
+                if hit is None:
+                    D = field.ring.one
+                    for c in p.values():
+                        D = D.lcm(c.denom)
+                    terms: dict = {}
+                    for m, c in p.items():
+                        num = c.numer * D.exquo(c.denom)
+                        for e, q in num.items():
+                            terms[m + e] = q
+                    hit = (make(terms), D)
+                    if any(p is q for q in self.hams):  # the Hamiltonians: cleared once per solve
+                        self._cleared[id(p)] = hit
+                cleared.append(hit[0])
+                total = total * hit[1]
             parts.append((liouville_field(plain, *cleared).components, total))
         T = parts[0][1]
         for _, total in parts[1:]:
@@ -431,7 +439,7 @@ class _Solver:
         _check_ansatz_size(self.slots, self.n, D)
         ansatz = Ansatz(self.n, D, self.slots)
         rows = Rows()
-        col_vectors = operator_columns(alg, self.hams, ansatz, rows, self._columns)
+        col_vectors = operator_columns(alg, self.hams, ansatz, rows, self._columns, self._field)
         if self.max_unknowns is not None and elimination_cost(col_vectors, len(rows), alg.domain) > SOLVE_COST:
             return OrderSolution(j, "refused", degree=D, rhs=rhs)  # bounded work: the elimination would be too long
         by_power: dict = {}
