@@ -521,13 +521,22 @@ class _Solver:
         index = ansatz.index
         vecs = []
         dh, dg = (max(_total_degree(Hp, self.n), 1), max(_total_degree(Gp, self.n), 1))
+        powers: dict = {}  # (k, l) -> H^k G^l, each product formed once
+
+        def power(k, l):
+            value = powers.get((k, l))
+            if value is None:
+                value = alg.ring.one if k == l == 0 else (power(k - 1, l) * Hp if k else power(k, l - 1) * Gp)
+                powers[(k, l)] = value
+            return value
+
         for p in range(D + 2):
             for q in range(D + 2):
                 # psi_G and psi_H must fit the ansatz degree: skip the products that cannot
                 if p + q == 0 or dh * p + dg * (q - 1) > D and dh * (p - 1) + dg * q > D:
                     continue
-                dG = q * Hp**p * Gp ** (q - 1) if q else alg.zero  # d psi / dG
-                dH = p * Hp ** (p - 1) * Gp**q if p else alg.zero  # d psi / dH
+                dG = q * power(p, q - 1) if q else alg.zero  # d psi / dG
+                dH = p * power(p - 1, q) if p else alg.zero  # d psi / dH
                 pair = (dG, -dH)
                 vec, ok = {}, True
                 for a, poly in enumerate(pair):
