@@ -20,6 +20,12 @@ import importlib
 from types import SimpleNamespace
 
 
+def exponents(p) -> list:
+    """The exponent tuples of a flint polynomial's terms as Python ints (flint returns ``fmpz`` exponents, which
+    must not leak into sympy's rings), in the order of ``p.coeffs()``."""
+    return [tuple(map(int, m)) for m in p.monoms()]
+
+
 class FlintRing:
     """``QQ[names]`` on flint ``fmpq_mpoly`` (lexicographic), the first ``n`` generators the coordinates.
 
@@ -48,7 +54,7 @@ class FlintRing:
     @staticmethod
     def terms(p) -> dict:
         """``{exponent tuple: fmpq}`` of a polynomial (no zero coefficients)."""
-        return dict(zip(map(tuple, p.monoms()), p.coeffs()))
+        return dict(zip(exponents(p), p.coeffs()))
 
     # -- the interface of the brackets ------------------------------------------------
     def diff(self, value, index: int):

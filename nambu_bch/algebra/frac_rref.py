@@ -27,6 +27,8 @@ from __future__ import annotations
 
 import importlib
 
+from .flint_ring import exponents
+
 _CONTEXTS: dict = {}
 _FLINT_QQ: dict = {}  # QQ's element type -> is it flint's fmpq
 
@@ -120,7 +122,7 @@ def to_field(pair, domain):
 
     def poly(p):
         cs = p.coeffs() if _FLINT_QQ[coeff] else [int(c) for c in p.coeffs()]
-        return make(zip(map(tuple, p.monoms()), map(coeff, cs)))
+        return make(zip(exponents(p), map(coeff, cs)))
 
     return field.raw_new(poly(n), poly(d))
 
