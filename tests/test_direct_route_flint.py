@@ -6,6 +6,8 @@
   ``DomainMatrix.rref`` over ``QQ(a, b)`` (hypothesis; the reduced echelon form is unique).
 * :class:`nambu_bch.algebra.flint_ring.FlintRing`: ``liouville_field`` (Eq. gLiouville) on flint polynomials
   against the same on sympy's ring, for N = 2 (canonical), N = 3 and N = 4.
+* The effective field's brackets (integral Laurent backend) on flint against sympy's ring and against
+  ``VectorField.bracket`` (Eq. CL1).
 * The direct route's fraction-free fields (cross terms and operator columns, summed over their assignments) against
   ``liouville_field`` over the field, with and without python-flint (``NAMBU_BCH_DISABLE_FLINT=1``).
 * Whole solves with flint, without flint and on the reference elimination (``FAST_PATHS = False``) give the same
@@ -30,6 +32,7 @@ from sympy.polys.matrices.sdm import SDM
 from nambu_bch import System, liouville_field, model
 from nambu_bch.algebra import PolynomialAlgebra, elimination, frac_rref
 from nambu_bch.algebra.flint_ring import FlintRing
+from nambu_bch.caches import clear_caches
 from nambu_bch.shadow import shadow_hamiltonians
 from nambu_bch.shadow.direct_route import direct_route
 
@@ -182,13 +185,50 @@ SYSTEMS = {
 def test_solves_identical_with_and_without_flint(name, word, order, reference, monkeypatch):
     """Flint paths, pure sympy (NAMBU_BCH_DISABLE_FLINT=1) and the reference elimination (FAST_PATHS = False)
     give the same objects: shadow pair, members alpha = 0, 1 (Eq. Xeff3), every order's corrections and gauge."""
+    clear_caches()  # the effective field's backends are cached per splitting: built afresh for each path
     fast = _digest(shadow_hamiltonians(SYSTEMS[name](), word, order))
     monkeypatch.setenv("NAMBU_BCH_DISABLE_FLINT", "1")
+    clear_caches()
     assert _digest(shadow_hamiltonians(SYSTEMS[name](), word, order)) == fast
     if reference:
         monkeypatch.setattr(elimination, "FAST_PATHS", False)
+        clear_caches()
         assert _digest(shadow_hamiltonians(SYSTEMS[name](), word, order)) == fast
+    clear_caches()
     assert sum(o[1] == "solved" for o in fast[3]) >= 2
+
+
+@pytest.mark.parametrize("name", sorted(SYSTEMS))
+def test_flint_brackets_equal_sympy_ring(name, monkeypatch):
+    """The integral Laurent backend's brackets on flint (algebra/backend.py) equal those on sympy's ring and the
+    vector fields' own Lie bracket (Eq. CL1, an independent route): all brackets of the pieces to depth 3,
+    combined with integer and rational weights."""
+    from nambu_bch.algebra.backend import PolynomialBackend
+
+    splitting = SYSTEMS[name]().splitting
+    alg = splitting.system.algebra
+    fields = {p.number: p.field for p in splitting.pieces}
+
+    def brackets(F):
+        keys = sorted(F.fields)
+        one = {k: F.fields[k] for k in keys}
+        two = {(i, j): F.bracket(one[i], one[j]) for i in keys for j in keys if i < j}
+        three = {(k, ij): F.bracket(one[k], X) for k in keys for ij, X in two.items()}
+        out = [F.combine([(1, X)]) for X in list(two.values()) + list(three.values())]
+        out.append(F.scaled_combine(6, [(n, X) for n, X in zip(range(-3, 9), list(three.values()))]))
+        out.append(F.combine([(sympy.Rational(2, 7), X) for X in two.values()]))
+        return out, two
+
+    fast = PolynomialBackend.build(alg, fields)
+    assert fast.laurent and fast.flint is not None
+    ours, two = brackets(fast)
+    monkeypatch.setenv("NAMBU_BCH_DISABLE_FLINT", "1")
+    slow = PolynomialBackend.build(alg, fields)
+    assert slow.flint is None
+    assert [X.components for X in ours] == [X.components for X in brackets(slow)[0]]
+    assert any(any(X.components) for X in ours)
+    for (i, j), X in two.items():   # [X_i, X_j] as the vector fields compute it
+        assert fast.combine([(1, X)]) == fields[i].bracket(fields[j])
 
 
 def test_lazy_sympy_forms():
