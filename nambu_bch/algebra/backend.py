@@ -298,9 +298,9 @@ class PolynomialBackend:
         from .elimination import FAST_PATHS, flint_available
 
         if self._integral and FAST_PATHS and flint_available():
-            import flint
+            from .frac_rref import generic_context
 
-            self.flint = flint.fmpz_mpoly_ctx.get(tuple(str(g) for g in self.bracket_ring.symbols), "lex")
+            self.flint = generic_context(len(self.bracket_ring.symbols))  # the bracket ring's generators, in order
 
     def to_flint(self, X: _Field) -> tuple:
         """The components of ``X`` as ``fmpz_mpoly`` (kept with ``X``)."""

@@ -27,7 +27,8 @@ def exponents(p) -> list:
 
 
 class FlintRing:
-    """``QQ[names]`` on flint ``fmpq_mpoly`` (lexicographic), the first ``n`` generators the coordinates.
+    """``QQ[names]`` on flint ``fmpq_mpoly`` (lexicographic, generators in the order of ``names``), the first ``n``
+    generators the coordinates.
 
     >>> R = FlintRing(("x", "y", "a"), 2)
     >>> x, y, a = R.gens
@@ -38,7 +39,8 @@ class FlintRing:
 
     def __init__(self, names, n: int):
         flint = importlib.import_module("flint")
-        self.ctx = flint.fmpq_mpoly_ctx.get(tuple(names), "lex")
+        # flint names are cosmetic and ASCII-only (a generator may be called ``ω``): v0, v1, .. in the given order
+        self.ctx = flint.fmpq_mpoly_ctx.get(tuple(f"v{i}" for i in range(len(tuple(names)))), "lex")
         self._fmpq = flint.fmpq
         self.n = n
         self.gens = tuple(self.ctx.gens())

@@ -45,10 +45,15 @@ def context(domain):
     ring = domain.field.ring
     if str(ring.order) != "lex":
         return None
-    names = tuple(str(s) for s in ring.symbols)
-    ctx = _CONTEXTS.get(names)
+    return generic_context(len(ring.symbols))
+
+
+def generic_context(nvars: int):
+    """flint's ``fmpz_mpoly_ctx`` in ``nvars`` variables (lexicographic); the variables are named ``v0, v1, ..``:
+    only their order matters, and flint accepts ASCII names only (a parameter may be called ``ω``)."""
+    ctx = _CONTEXTS.get(nvars)
     if ctx is None:
-        ctx = _CONTEXTS[names] = _flint().fmpz_mpoly_ctx.get(names, "lex")
+        ctx = _CONTEXTS[nvars] = _flint().fmpz_mpoly_ctx.get(tuple(f"v{i}" for i in range(nvars)), "lex")
     return ctx
 
 
