@@ -87,6 +87,9 @@ def test_normal_form_of_a_non_canonical_fraction():
     denom = R.from_dict({(2, 0): QQ(-6), (0, 1): QQ(12)})                 # -6a^2 + 12b
     raw = K.field.raw_new(numer, denom)
     assert identical(frac_rref.to_field(frac_rref.from_field(raw, CTX), K), K.field.new(numer, denom))
+    common = R.from_dict({(1, 1): QQ(3), (0, 0): QQ(-1)})                # an unreduced fraction with integer parts
+    raw = K.field.raw_new(common * R.from_dict({(0, 2): QQ(2)}), common * R.from_dict({(1, 0): QQ(-4)}))
+    assert identical(frac_rref.to_field(frac_rref.from_field(raw, CTX), K), K.field.new(raw.numer, raw.denom))
 
 
 @st.composite

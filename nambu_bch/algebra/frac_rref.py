@@ -112,8 +112,8 @@ def from_field(v, ctx):
     """A field element (sympy ``FracElement`` of ``QQ(params)``) as a normalised pair ``(n, d)`` of ``fmpz_mpoly``."""
     n, cn = _integer_poly(v.numer, ctx)
     d, cd = _integer_poly(v.denom, ctx)
-    if cn == 1 and cd == 1 and d.leading_coefficient() > 0:
-        return n, d  # sympy's own normal form: nothing to cancel
+    if cn == 1 and cd == 1:
+        return normalize(n, d)  # sympy's own normal form (a gcd of one, unless built with raw_new unreduced)
     return normalize(n * cd, d * cn)
 
 
@@ -167,7 +167,10 @@ def sub(a, b):
     g2 = n.gcd(g)
     if not g2.is_one():
         n, bd = n / g2, bd / g2  # g2 divides g, hence bd
-    return n, a1 * bd
+    d = a1 * bd
+    if d.leading_coefficient() < 0:  # flint's gcds have positive leading coefficients: never, kept as a guard
+        n, d = -n, -d
+    return n, d
 
 
 def inverse(a):
