@@ -241,7 +241,7 @@ def _lift(alg, value):
     return alg.ring.from_dict({m + pad: alg.domain.convert(c) for m, c in value.items()})
 
 
-def FAST_PATHS_FLINT() -> bool:  # noqa: N802 -- read at every call, like the switches it combines
+def _flint_on() -> bool:
     """The elimination's fast paths are on and python-flint is available (``NAMBU_BCH_DISABLE_FLINT`` unset)."""
     return elimination.FAST_PATHS and elimination.flint_available()
 
@@ -254,7 +254,7 @@ def _divided(numerators: dict, denominator, domain) -> dict:
     gcd when python-flint is available (:mod:`nambu_bch.algebra.frac_rref`, the same normal form), else by
     sympy's field.
     """
-    ctx = frac_rref.context(domain) if FAST_PATHS_FLINT() else None
+    ctx = frac_rref.context(domain) if _flint_on() else None
     field = domain.field
     out = {}
     if ctx is None:
@@ -375,7 +375,7 @@ class _Solver:
         """``QQ[coordinates, constants, parameters]`` of :meth:`_fields_cleared`: flint's when available, else sympy's."""
         if self._plain is None:
             alg = self.alg
-            if FAST_PATHS_FLINT():
+            if _flint_on():
                 from ..algebra.flint_ring import FlintRing
 
                 self._plain = FlintRing([str(s) for s in alg.coordinates + alg.constants + alg.parameters], alg.n)
