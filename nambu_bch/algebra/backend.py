@@ -57,6 +57,7 @@ from sympy.polys.domains import ZZ
 from sympy.polys.rings import PolyElement, ring
 
 from ..errors import NambuBCHError
+from .flint_ring import exponents
 from .vector_field import VectorField
 
 
@@ -108,15 +109,27 @@ class FieldBackend(Protocol):
 
 class _Field:
     """A field of :class:`PolynomialBackend`: ``components / scale`` plus its value-ring components and
-    derivatives, each computed once."""
+    derivatives, each computed once.
 
-    __slots__ = ("components", "scale", "_values", "_derivatives")
+    In the integral Laurent case with python-flint (:attr:`PolynomialBackend.flint`) the components are also kept
+    as flint ``fmpz_mpoly`` (``flint``); a field made by a flint bracket has only those, and its sympy
+    ``components`` are built on first access."""
 
-    def __init__(self, components, scale=1, values=None):
-        self.components = tuple(components)
+    __slots__ = ("_components", "scale", "_values", "_derivatives", "flint", "_backend")
+
+    def __init__(self, components, scale=1, values=None, flint=None, backend=None):
+        self._components = None if components is None else tuple(components)
         self.scale = scale
         self._values = values
         self._derivatives = None
+        self.flint = flint
+        self._backend = backend
+
+    @property
+    def components(self) -> tuple:
+        if self._components is None:
+            self._components = tuple(self._backend.from_flint(c) for c in self.flint)
+        return self._components
 
 
 def _new_derivatives(X: _Field, n: int) -> list:
@@ -158,6 +171,7 @@ class PolynomialBackend:
         self._bracket_coords = bracket_ring.gens[: algebra.n]
         self._value_coords = value_ring.gens[: algebra.n]
         self._monomials: dict = {}  # Laurent monomial -> its canonical QQ(parameters) coefficient
+        self.flint = None  # flint's fmpz_mpoly context of the bracket ring, when brackets run there (_use_flint)
 
     # -- construction -------------------------------------------------------------
     @classmethod
@@ -203,6 +217,7 @@ class PolynomialBackend:
         # no rational normalisation), carrying the product of the scales along
         bracket_ring = ring(names, ZZ)[0] if base.is_QQ else value_ring
         self = cls(algebra, value_ring, bracket_ring, pairs, True)
+        self._use_flint()
         for key, X in fields.items():
             parts = [self._from_algebra(c) for c in X.components]
             if any(p is None for p in parts):
@@ -275,6 +290,66 @@ class PolynomialBackend:
     def function_to_sympy(self, f):
         return self.algebra.to_sympy(self.to_algebra(self.reduce(f)))
 
+    # -- flint ---------------------------------------------------------------------
+    def _use_flint(self):
+        """Brackets over ``ZZ`` (the integral Laurent ring) on flint's ``fmpz_mpoly`` when python-flint is available and
+        the elimination's fast paths are on (``NAMBU_BCH_DISABLE_FLINT=1`` keeps sympy's ring): the same polynomials,
+        products in C."""
+        from .elimination import FAST_PATHS, flint_available
+
+        if self._integral and FAST_PATHS and flint_available():
+            from .frac_rref import generic_context
+
+            self.flint = generic_context(len(self.bracket_ring.symbols))  # the bracket ring's generators, in order
+
+    def to_flint(self, X: _Field) -> tuple:
+        """The components of ``X`` as ``fmpz_mpoly`` (kept with ``X``)."""
+        if X.flint is None:
+            ctx = self.flint
+            X.flint = tuple(ctx.from_dict({m: int(c) for m, c in comp.items()}) for comp in X.components)
+        return X.flint
+
+    def from_flint(self, p):
+        """An ``fmpz_mpoly`` as an element of :attr:`bracket_ring`."""
+        ring = self.bracket_ring
+        ZZ_ = ring.domain
+        return ring.dtype(zip(exponents(p), map(ZZ_.dtype, map(int, p.coeffs())))) if not p.is_zero() else ring.zero
+
+    def _reduce_flint(self, p):
+        """:meth:`reduce` of an ``fmpz_mpoly``: untouched unless some ``p`` and ``p_inv`` both occur (degrees)."""
+        degrees = p.degrees()
+        if not any(degrees[i] > 0 and degrees[j] > 0 for i, j in self._pairs):
+            return p
+        poly = self.reduce(self.from_flint(p))
+        return self.flint.from_dict({m: int(c) for m, c in poly.items()})
+
+    def _bracket_flint(self, X: _Field, Y: _Field) -> _Field:
+        """:meth:`bracket` on flint polynomials (derivatives kept with the fields, as there)."""
+        n = self.algebra.n
+        Xc, Yc = self.to_flint(X), self.to_flint(Y)
+        dX = X._derivatives or _new_derivatives(X, n)
+        dY = Y._derivatives or _new_derivatives(Y, n)
+        zero = self.flint.from_dict({})
+        comps = []
+        for i in range(n):
+            total = zero
+            dXi, dYi = dX[i], dY[i]
+            for j in range(n):
+                if not Xc[j].is_zero():
+                    d = dYi[j]
+                    if d is None:
+                        d = dYi[j] = Yc[i].derivative(j)
+                    if not d.is_zero():
+                        total = total + Xc[j] * d
+                if not Yc[j].is_zero():
+                    d = dXi[j]
+                    if d is None:
+                        d = dXi[j] = Xc[i].derivative(j)
+                    if not d.is_zero():
+                        total = total - Yc[j] * d
+            comps.append(self._reduce_flint(total))
+        return _Field(None, X.scale * Y.scale, flint=tuple(comps), backend=self)
+
     # -- calculus -----------------------------------------------------------------
     def reduce(self, poly):
         """Canonical Laurent form of a ring element: no monomial holds both ``p`` and ``p_inv`` (``p p_inv = 1``)."""
@@ -309,6 +384,8 @@ class PolynomialBackend:
         The derivatives ``D_j X^i`` are computed when first needed (only where the other field's ``j``-th
         component is non-zero) and kept with the field: memoised leaves of a BCH series reuse them.
         """
+        if self.flint is not None:
+            return self._bracket_flint(X, Y)
         n = self.algebra.n
         Xc, Yc = X.components, Y.components
         dX = X._derivatives or _new_derivatives(X, n)
@@ -350,6 +427,8 @@ class PolynomialBackend:
 
     @staticmethod
     def is_zero(X: _Field) -> bool:
+        if X._components is None:
+            return all(c.is_zero() for c in X.flint)
         return not any(X.components)
 
     @staticmethod
@@ -392,11 +471,21 @@ class PolynomialBackend:
         # accumulate monomial by monomial, one sum per scale (integers in the Laurent case over QQ): for the
         # many small fields of a series this beats ring arithmetic, and rationals appear once per monomial
         by_scale: dict = {}
+        sums: dict = {}  # flint: scale -> the components' integer combination (fields made by flint brackets)
         for n, X in pairs:
+            if X.flint is not None and X._components is None and isinstance(n, int):
+                acc = sums.get(X.scale)
+                sums[X.scale] = [c * n for c in X.flint] if acc is None else [a + c * n for a, c in zip(acc, X.flint)]
+                continue
             totals = by_scale.setdefault(X.scale, [{} for _ in range(algebra.n)])
             for acc, comp in zip(totals, X.components):
                 for monom, coeff in comp.items():
                     acc[monom] = acc.get(monom, 0) + coeff * n
+        for scale, comps in sums.items():
+            totals = by_scale.setdefault(scale, [{} for _ in range(algebra.n)])
+            for acc, comp in zip(totals, comps):
+                for monom, coeff in zip(exponents(comp), comp.coeffs()):
+                    acc[monom] = acc.get(monom, 0) + ZZ(int(coeff))
         domain = self.domain
         out = [{} for _ in range(algebra.n)]
         for scale, totals in by_scale.items():

@@ -408,8 +408,32 @@ def _rref_block(rows: dict, nrows: int, ncols: int, domain, lift: bool = True):
             if not lift:  # only the pivots are wanted
                 return R, pivots
             return {i: {j: split.lift(v) for j, v in r.items()} for i, r in R.items()}, pivots
+    if FAST_PATHS and flint_available():
+        out = _rref_flint_frac(rows, ncols, domain)
+        if out is not None:
+            return out
     R, pivots = _sdm(rows, nrows, ncols, domain).rref()
     return R.rep.to_sdm(), tuple(pivots)
+
+
+def _rref_flint_frac(rows: dict, ncols: int, domain):
+    """Over ``QQ(params)``: Gauss-Jordan on flint ``fmpz_mpoly`` fractions (:mod:`nambu_bch.algebra.frac_rref`), the
+    values converted back in sympy's normal form (identical elements); ``None`` for any other domain."""
+    from . import frac_rref
+
+    ctx = frac_rref.context(domain)
+    if ctx is None:
+        return None
+    memo: dict = {}
+
+    def pair(v):
+        p = memo.get(v)
+        if p is None:
+            p = memo[v] = frac_rref.from_field(v, ctx)
+        return p
+
+    R, pivots = frac_rref.rref({i: {j: pair(v) for j, v in r.items()} for i, r in rows.items()}, ncols, ctx)
+    return {k: {j: frac_rref.to_field(v, domain) for j, v in r.items()} for k, r in R.items()}, pivots
 
 
 def _kernel(R, pivots, ncols: int, domain) -> list:

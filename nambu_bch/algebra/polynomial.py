@@ -18,6 +18,7 @@ from __future__ import annotations
 from functools import cached_property
 
 import sympy
+from sympy.core.mul import _mulsort
 from sympy.polys.domains import QQ
 from sympy.polys.polyerrors import CoercionFailed, GeneratorsError, PolynomialError
 from sympy.polys.polyutils import expr_from_dict
@@ -31,6 +32,46 @@ _CONVERSION_ERRORS = (CoercionFailed, GeneratorsError, PolynomialError, ValueErr
 
 def _symbols(names) -> tuple[sympy.Symbol, ...]:
     return tuple(sympy.Symbol(n) if isinstance(n, str) else n for n in names)
+
+
+def _symbol_powers(factors) -> dict | None:
+    """``{symbol: exponent}`` of a product of powers of symbols with integer exponents, else ``None``."""
+    out: dict = {}
+    for f in factors:
+        base, exp = f.as_base_exp() if isinstance(f, sympy.Basic) else (None, None)
+        if not (isinstance(base, sympy.Symbol) and isinstance(exp, sympy.Integer)):
+            return None
+        out[base] = out.get(base, 0) + int(exp)
+    return out
+
+
+def _monomial_denominator_terms(c, gens, m, params, powers) -> list:
+    """The terms of ``expand(c x^m prod(powers))`` for ``c = p / (d P^k)`` in ``QQ(params)``, a monomial denominator.
+
+    Each term of ``p`` gives one product of a rational number and powers of distinct symbols (the
+    parameters' exponents minus ``k``, the generators', ``powers``), which is how ``Mul`` flattens
+    ``r P^e x^m / (d P^k)``: its canonical form is the coefficient (left out when it is one) followed
+    by the powers sorted by ``Basic.compare`` (``sympy.core.mul._mulsort``), so the object is built
+    directly with ``Mul._from_args`` -- the same expression, without ``Mul.flatten``.
+    """
+    [(dexp, d)] = c.denom.items()
+    base = dict(powers)
+    for s, e in zip(gens, m):
+        if e:
+            base[s] = base.get(s, 0) + e
+    out = []
+    for e, a in c.numer.items():
+        exps = dict(base)
+        for s, k, j in zip(params, e, dexp):
+            if k != j:
+                exps[s] = exps.get(s, 0) + k - j
+        args = [s if k == 1 else sympy.Pow(s, k) for s, k in exps.items() if k]
+        _mulsort(args)
+        coeff = QQ.to_sympy(a / d)
+        if coeff != 1:
+            args.insert(0, coeff)
+        out.append(args[0] if len(args) == 1 else sympy.Mul._from_args(args) if args else coeff)
+    return out
 
 
 class PolynomialAlgebra:
@@ -164,8 +205,12 @@ class PolynomialAlgebra:
             ground, params = domain.domain, domain.field.ring.symbols
             inverses: dict = {}
             wholes: dict = {}
+        powers = _symbol_powers(factors) if fraction and ground.is_QQ else None
         terms = []
         for m, c in value.items():
+            if powers is not None and len(c.denom) == 1:
+                terms.extend(_monomial_denominator_terms(c, gens, m, params, powers))
+                continue
             mono = [s**e for s, e in zip(gens, m) if e] + factors
             if not fraction:
                 terms.extend(sympy.Add.make_args(sympy.expand(sympy.Mul(domain.to_sympy(c), *mono))))

@@ -65,6 +65,7 @@ import sympy
 
 from ..algebra import PolynomialAlgebra, VectorField, liouville_field
 from ..algebra.ansatz import Ansatz, Rows
+from ..algebra import elimination, frac_rref
 from ..algebra.elimination import elimination_cost, rank, signed_sums
 from ..bch.backward import check_order
 from ..bch.concrete import effective_field_by_cost
@@ -94,6 +95,10 @@ class OrderSolution:
     certificate : dict ``{(component, monomial): coefficient}`` or None
     obstruction_value : sympy expression -- the certificate applied to the right-hand side
     rhs : VectorField or None -- the right-hand side of Eq. (*)
+
+    A solved order converts ``corrections`` and ``members`` to sympy on first access (``convert``, a callable
+    returning both; the same expressions, cached): the route itself works on the ring elements, and a
+    caller that only reads ``H_S, G_S`` never pays for the per-order sympy forms.
     """
 
     order: int
@@ -107,11 +112,37 @@ class OrderSolution:
     certificate: dict | None = None
     obstruction_value: object = None
     rhs: object = None
+    convert: object = field(default=None, repr=False, compare=False)
+
+    def _converted(self, name):
+        value = self.__dict__.get("_" + name)
+        if value is None and self.convert is not None:
+            self.__dict__["_corrections"], self.__dict__["_members"] = self.convert()
+            self.convert = None
+            value = self.__dict__["_" + name]
+        return value
 
     @property
     def extra_gauge_dim(self):
         """Kernel directions not of the form ``(psi_G, -psi_H)`` (system-specific gauge)."""
         return None if self.psi_dim is None else self.kernel_dim - self.psi_dim
+
+
+def _lazy(name):
+    """A property of :class:`OrderSolution` whose value may be converted on first access (``convert``)."""
+
+    def get(self):
+        return self._converted(name)
+
+    def put(self, value):
+        self.__dict__["_" + name] = value
+
+    return property(get, put, doc=f"``{name}`` as sympy expressions (converted on first access)")
+
+
+# after @dataclass: the generated __init__ assigns through the properties (defaults () stay the fields' own)
+OrderSolution.corrections = _lazy("corrections")
+OrderSolution.members = _lazy("members")
 
 
 @dataclass
@@ -171,7 +202,7 @@ def _check_ansatz_size(slots, n, degree):
         )
 
 
-def operator_columns(alg, hams, ansatz, rows, memo=None) -> list:
+def operator_columns(alg, hams, ansatz, rows, memo=None, field=None) -> list:
     """The columns of ``L`` in Eq. (*): ``X_{H^1, .., x^mu, .., H^{N-1}}`` (``x^mu`` in slot ``a``) per ansatz column.
 
     Parameters
@@ -181,6 +212,8 @@ def operator_columns(alg, hams, ansatz, rows, memo=None) -> list:
     ansatz : Ansatz -- the unknown corrections (its slots are the Hamiltonians')
     rows : Rows -- interns ``(component, exponent tuple[:n])``
     memo : dict, optional -- ``(slot, mu) -> components``, shared by the orders of one solve
+    field : callable, optional -- ``slots -> VectorField``, the Liouville field of the slots (default
+        :func:`~nambu_bch.algebra.brackets.liouville_field` on ``alg``; the direct route passes its fraction-free one)
 
     Returns
     -------
@@ -193,7 +226,7 @@ def operator_columns(alg, hams, ansatz, rows, memo=None) -> list:
         if comps is None:
             slots = list(hams)
             slots[a] = alg.ring.from_dict({e + pad: alg.domain.one})
-            comps = liouville_field(alg, *slots).components
+            comps = (liouville_field(alg, *slots) if field is None else field(slots)).components
             if memo is not None:
                 memo[(a, e)] = comps
         out.append(rows.field(comps, alg.n))
@@ -206,6 +239,36 @@ def _lift(alg, value):
         raise NambuBCHError(f"the direct route needs a polynomial effective field, got the component {value}")
     pad = (0,) * (len(alg.gens) - len(value.ring.gens))
     return alg.ring.from_dict({m + pad: alg.domain.convert(c) for m, c in value.items()})
+
+
+def _flint_on() -> bool:
+    """The elimination's fast paths are on and python-flint is available (``NAMBU_BCH_DISABLE_FLINT`` unset)."""
+    return elimination.FAST_PATHS and elimination.flint_available()
+
+
+def _divided(numerators: dict, denominator, domain) -> dict:
+    """``{key: n / denominator}`` in ``domain = QQ(params)``, zero quotients left out.
+
+    ``numerators``: ``{key: {exponent tuple: rational}}`` (polynomials in the parameters), ``denominator``
+    a non-zero polynomial of the field's ring.  Each quotient is a reduced fraction, cancelled by flint's
+    gcd when python-flint is available (:mod:`nambu_bch.algebra.frac_rref`, the same normal form), else by
+    sympy's field.
+    """
+    ctx = frac_rref.context(domain) if _flint_on() else None
+    field = domain.field
+    out = {}
+    if ctx is None:
+        for k, n in numerators.items():
+            v = field.new(field.ring.from_dict(n), denominator)
+            if v:
+                out[k] = v
+        return out
+    D = frac_rref.integer_poly(denominator, ctx)
+    for k, n in numerators.items():
+        pair = frac_rref.quotient_terms(n, D, ctx)
+        if pair is not None:
+            out[k] = frac_rref.to_field(pair, domain)
+    return out
 
 
 def _total_degree(p, n):
@@ -235,58 +298,94 @@ class _Solver:
         self.slots = len(hams)
         self.gdeg = [_total_degree(p, self.n) - 1 for p in hams]
         self._columns: dict = {}
-        self._plain = None  # the polynomial algebra of the fraction-free cross terms (_field_cleared)
+        self._plain = None  # the polynomial ring of the fraction-free fields (_fields_cleared)
+        self._cleared: dict = {}  # id of a Hamiltonian -> (its cleared polynomial, its denominator)
 
     # -- fields ------------------------------------------------------------------
-    def _field(self, slots):
-        """``X_{slots}`` (Eq. gLiouville); over ``QQ(params)`` fraction-free (:meth:`_field_cleared`)."""
+    def _cleared_ok(self):
         domain = self.alg.domain
-        if getattr(domain, "is_FractionField", False) and domain.domain.is_QQ:
-            return self._field_cleared(slots)
+        return getattr(domain, "is_FractionField", False) and domain.domain.is_QQ
+
+    def _field(self, slots):
+        """``X_{slots}`` (Eq. gLiouville); over ``QQ(params)`` fraction-free (:meth:`_fields_cleared`)."""
+        if self._cleared_ok():
+            return self._fields_cleared([slots])
         return liouville_field(self.alg, *slots)
 
-    def _field_cleared(self, slots):
-        """``X_{slots}`` over ``QQ(params)`` without fraction arithmetic: the same field, exactly.
+    def _fields_cleared(self, assignments):
+        """``sum_k X_{slots_k}`` over ``QQ(params)`` without fraction arithmetic: the same field, exactly.
 
         ``X_{P_1 .. P_{N-1}}`` is multilinear in its slots over the constants, so with ``P_a = Q_a / D_a``
         (``D_a`` the lcm of the coefficient denominators, a polynomial in the parameters, ``Q_a`` a
         polynomial in the coordinates, ``alpha`` and the parameters) ``X_{P} = X_{Q} / (D_1 .. D_{N-1})``.
         ``X_Q`` is computed in ``QQ[coordinates, alpha, params]`` (products without gcds; the parameters
-        are never differentiated), and each coefficient is divided by ``D_1 .. D_{N-1}`` once (one
-        cancellation per coefficient instead of one per product term).  Field elements are reduced
-        fractions either way, so the result is the same ring element.
+        are never differentiated) -- on flint's ``fmpq_mpoly`` when python-flint is available
+        (:class:`~nambu_bch.algebra.flint_ring.FlintRing`), else on sympy's ring; the fields of all
+        ``assignments`` are summed there over the lcm ``T`` of their denominators, and each coefficient of
+        the sum is divided by ``T`` once (one cancellation per coefficient instead of one per product term
+        and per sum: :func:`_divided`).  Field elements are reduced fractions either way, so the result is
+        the same ring element.
         """
         alg = self.alg
         field = alg.domain.field
-        if self._plain is None:  # QQ[coordinates, constants, parameters]: the parameters never differentiated
-            self._plain = PolynomialAlgebra(alg.coordinates, (), alg.constants + alg.parameters)
-        plain = self._plain
         width = len(alg.gens)
-        cleared, total = [], field.ring.one
-        for p in slots:
-            D = field.ring.one
-            for c in p.values():
-                D = D.lcm(c.denom)
-            terms: dict = {}
-            for m, c in p.items():
-                num = c.numer * D.exquo(c.denom)
-                for e, q in num.items():
-                    terms[m + e] = q
-            cleared.append(plain.ring.from_dict(terms) if terms else plain.zero)
-            total = total * D
-        X = liouville_field(plain, *cleared)
+        pad = (0,) * width
+        plain = self._plain_ring()
+        flint = not isinstance(plain, PolynomialAlgebra)
+        make = plain.from_terms if flint else (lambda t: plain.ring.from_dict(t) if t else plain.zero)
+        parts = []
+        for slots in assignments:
+            cleared, total = [], field.ring.one
+            for p in slots:
+                hit = self._cleared.get(id(p)) if any(p is q for q in self.hams) else None
+                if hit is None:
+                    D = field.ring.one
+                    for c in p.values():
+                        D = D.lcm(c.denom)
+                    terms: dict = {}
+                    for m, c in p.items():
+                        num = c.numer * D.exquo(c.denom)
+                        for e, q in num.items():
+                            terms[m + e] = q
+                    hit = (make(terms), D)
+                    if any(p is q for q in self.hams):  # the Hamiltonians: cleared once per solve
+                        self._cleared[id(p)] = hit
+                cleared.append(hit[0])
+                total = total * hit[1]
+            parts.append((liouville_field(plain, *cleared).components, total))
+        T = parts[0][1]
+        for _, total in parts[1:]:
+            T = T.lcm(total)
+        sums = None
+        for comps, total in parts:
+            scale = T.exquo(total)
+            if scale != 1:
+                factor = make({pad + m: c for m, c in scale.items()})
+                comps = [c * factor for c in comps]
+            sums = list(comps) if sums is None else [a + b for a, b in zip(sums, comps)]
         components = []
-        for comp in X.components:
+        for comp in sums:
             groups: dict = {}
-            for m, q in comp.items():
+            for m, q in (plain.terms(comp) if flint else comp).items():
                 groups.setdefault(m[:width], {})[m[width:]] = q
-            components.append(alg.ring.from_dict({m: field.new(field.ring.from_dict(g), total)
-                                                  for m, g in groups.items()}) if groups else alg.zero)
+            components.append(alg.ring.from_dict(_divided(groups, T, alg.domain)) if groups else alg.zero)
         return VectorField(alg, components)
+
+    def _plain_ring(self):
+        """``QQ[coordinates, constants, parameters]`` of :meth:`_fields_cleared`: flint's when available, else sympy's."""
+        if self._plain is None:
+            alg = self.alg
+            if _flint_on():
+                from ..algebra.flint_ring import FlintRing
+
+                self._plain = FlintRing([str(s) for s in alg.coordinates + alg.constants + alg.parameters], alg.n)
+            else:
+                self._plain = PolynomialAlgebra(alg.coordinates, (), alg.constants + alg.parameters)
+        return self._plain
 
     def _cross(self, j, corrections):
         """``sum`` over assignments of lower orders to two or more slots (the cross terms at ``h^j``)."""
-        total = None
+        assignments = []
         for orders in product(range(j), repeat=self.slots):
             if sum(orders) != j or sum(1 for o in orders if o) < 2:
                 continue
@@ -300,8 +399,15 @@ class _Solver:
                         break
                     slots.append(c)
             else:
-                X = self._field(slots)
-                total = X if total is None else total + X
+                assignments.append(slots)
+        if not assignments:
+            return None
+        if self._cleared_ok():
+            return self._fields_cleared(assignments)
+        total = None
+        for slots in assignments:
+            X = liouville_field(self.alg, *slots)
+            total = X if total is None else total + X
         return total
 
     def _needed_degree(self, rhs_deg):
@@ -333,7 +439,7 @@ class _Solver:
         _check_ansatz_size(self.slots, self.n, D)
         ansatz = Ansatz(self.n, D, self.slots)
         rows = Rows()
-        col_vectors = operator_columns(alg, self.hams, ansatz, rows, self._columns)
+        col_vectors = operator_columns(alg, self.hams, ansatz, rows, self._columns, self._field)
         if self.max_unknowns is not None and elimination_cost(col_vectors, len(rows), alg.domain) > SOLVE_COST:
             return OrderSolution(j, "refused", degree=D, rhs=rhs)  # bounded work: the elimination would be too long
         by_power: dict = {}
@@ -384,13 +490,15 @@ class _Solver:
         for a in range(self.slots):
             corrections[(a, j)] = fam[a]
         gauge = [ansatz.expressions(v, alg.coordinates, domain) for v in kernel]
-        memo: dict = {}  # the members and the family share most coefficients: each converted once
         psi_dim = self._psi_dim(ansatz, D) if self.slots == 2 else None
-        return OrderSolution(
-            j, "solved", degree=D, corrections=tuple(alg.to_sympy(f, memo) for f in fam),
-            members=tuple(tuple(alg.to_sympy(p, memo) for p in polys) for polys in mem_polys),
-            gauge=gauge, kernel_dim=len(kernel), psi_dim=psi_dim, rhs=rhs,
-        )
+
+        def convert():  # on first access (OrderSolution): the sympy forms of the family and the members
+            memo: dict = {}  # the members and the family share most coefficients: each converted once
+            return (tuple(alg.to_sympy(f, memo) for f in fam),
+                    tuple(tuple(alg.to_sympy(p, memo) for p in polys) for polys in mem_polys))
+
+        return OrderSolution(j, "solved", degree=D, corrections=None, members=None, gauge=gauge,
+                             kernel_dim=len(kernel), psi_dim=psi_dim, rhs=rhs, convert=convert)
 
     def _family(self, m0, m1, alpha):
         """``m0 + alpha (m1 - m0)``; over ``QQ<theta>(params)`` coefficient by coefficient over ``QQ(params)``
@@ -413,13 +521,22 @@ class _Solver:
         index = ansatz.index
         vecs = []
         dh, dg = (max(_total_degree(Hp, self.n), 1), max(_total_degree(Gp, self.n), 1))
+        powers: dict = {}  # (k, l) -> H^k G^l, each product formed once
+
+        def power(k, l):
+            value = powers.get((k, l))
+            if value is None:
+                value = alg.ring.one if k == l == 0 else (power(k - 1, l) * Hp if k else power(k, l - 1) * Gp)
+                powers[(k, l)] = value
+            return value
+
         for p in range(D + 2):
             for q in range(D + 2):
                 # psi_G and psi_H must fit the ansatz degree: skip the products that cannot
                 if p + q == 0 or dh * p + dg * (q - 1) > D and dh * (p - 1) + dg * q > D:
                     continue
-                dG = q * Hp**p * Gp ** (q - 1) if q else alg.zero  # d psi / dG
-                dH = p * Hp ** (p - 1) * Gp**q if p else alg.zero  # d psi / dH
+                dG = q * power(p, q - 1) if q else alg.zero  # d psi / dG
+                dH = p * power(p - 1, q) if p else alg.zero  # d psi / dH
                 pair = (dG, -dH)
                 vec, ok = {}, True
                 for a, poly in enumerate(pair):

@@ -13,6 +13,7 @@ Horikoshi, Eqs. (L1), (L2), (SH12321c), (SG12321c), (Xeff3).
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 
 import sympy
@@ -75,6 +76,32 @@ def _obstruction_text(sol, n_hams: int = 2) -> str:
     )
 
 
+class Corrections(Mapping):
+    """``order -> (dH_j, dG_j, ..)`` of a direct-route family, read-only, each order's sympy forms converted on first
+    access (:class:`~nambu_bch.shadow.direct_route.OrderSolution`); equal to the dict of the same items.
+
+    >>> from nambu_bch import model, shadow_hamiltonians
+    >>> F = shadow_hamiltonians(model("ho"), "TVT")
+    >>> list(F.corrections), F.corrections == {2: F.details.orders[1].corrections}
+    ([2], True)
+    """
+
+    def __init__(self, solutions: dict):
+        self._solutions = dict(solutions)
+
+    def __getitem__(self, order):
+        return self._solutions[order].corrections
+
+    def __iter__(self):
+        return iter(self._solutions)
+
+    def __len__(self):
+        return len(self._solutions)
+
+    def __repr__(self):
+        return repr(dict(self.items()))
+
+
 def _free_parameters(exists, shadows) -> list:
     """``["alpha"]`` when an existing family's shadows depend on ``alpha`` (Eq. Xeff3), else ``[]``."""
     return ["alpha"] if exists and any(S.has(ALPHA) for S in shadows) else []
@@ -97,7 +124,8 @@ class ShadowFamily(Printable):
     shadows : tuple -- all shadow Hamiltonians ``(H_S, G_S, ...)`` (sympy, in ``h`` and ``alpha``), or ``()``
     free_parameters : list of str -- e.g. ``["alpha"]``
     gauge : dict ``order -> [directions]`` -- kernel bases (one correction per Hamiltonian)
-    corrections : dict ``order -> tuple`` -- the family's ``dH_j, dG_j``
+    corrections : mapping ``order -> tuple`` -- the family's ``dH_j, dG_j`` (direct route: a read-only
+        :class:`Corrections`, converted to sympy on first access)
     degree : dict ``order -> int`` -- ansatz degrees used
     notes : list of str -- e.g. vanishing odd orders
     failed_order, certificate, obstruction -- set when ``exists`` is false
@@ -139,16 +167,17 @@ class ShadowFamily(Printable):
             (:func:`existence_fields`; None: undecided); ignored when a polynomial pair was found
         max_unknowns : int or None -- the bound the route used (named in the obstruction of a refused order)
         """
-        notes, gauge, corrections, degree = [], {}, {}, {}
+        notes, gauge, solved, degree = [], {}, {}, {}
         for o in result.orders:
             if o.status == "vanishes":
                 notes.append(_vanishing_note(composition, o.order))
             elif o.status == "solved":
                 gauge[o.order] = o.gauge
-                corrections[o.order] = o.corrections
+                solved[o.order] = o
                 degree[o.order] = o.degree
             else:
                 degree[o.order] = o.degree
+        corrections = Corrections(solved)
         common = dict(gauge=gauge, corrections=corrections, degree=degree, notes=notes, details=result)
         if result.exists:
             shadows = result.shadow()

@@ -1,0 +1,239 @@
+"""Reduced row echelon form over ``QQ(parameters)`` with python-flint's multivariate polynomials.
+
+sympy's field ``QQ(p_1, .., p_k)`` keeps each element as a reduced fraction and cancels it
+with a polynomial gcd in Python at every addition and multiplication (``heugcd``); the
+Gauss-Jordan elimination of the shadow solve over ``QQ(I1, I2, I3)`` spends nearly all its
+time there.  Here the same elimination runs on pairs ``(n, d)`` of flint ``fmpz_mpoly``
+(integer polynomials, gcds in C), with the same normal form as sympy's field:
+
+    n, d in ZZ[p_1, .., p_k] coprime (content included), the leading coefficient of ``d``
+    (lexicographic order, the parameters in the field's order) positive, ``0 = 0/1``.
+
+A rational function has exactly one such representation, so the elements converted back
+(:func:`to_field`, without a further cancellation) are the ones sympy's own arithmetic gives,
+and the reduced echelon form -- unique -- is identical to ``DomainMatrix.rref`` over the field.
+
+Arithmetic (Knuth, TAOCP vol. 2, Sect. 4.5.1, Henrici's reductions): ``a/b * c/d`` cancels the
+cross gcds ``(a, d)`` and ``(c, b)``; ``a/b - c/d`` with ``g = gcd(b, d)`` is
+``(a d/g - c b/g) / (b d/g)``, whose only common factors with the denominator divide ``g``.
+
+References
+----------
+Knuth, *The Art of Computer Programming*, vol. 2, Sect. 4.5.1 (rational arithmetic); FLINT
+``fmpz_mpoly_gcd``; sympy ``PolyElement.cancel`` (the normal form).
+"""
+
+from __future__ import annotations
+
+import importlib
+
+from .flint_ring import exponents
+
+_CONTEXTS: dict = {}
+_FLINT_QQ: dict = {}  # QQ's element type -> is it flint's fmpq
+
+
+def _flint():
+    return importlib.import_module("flint")
+
+
+def context(domain):
+    """The flint ``fmpz_mpoly_ctx`` of the parameters of ``domain = QQ(params)`` (lexicographic, same order),
+    or ``None`` when ``domain`` is not a fraction field over ``QQ`` with the lexicographic order."""
+    if not (getattr(domain, "is_FractionField", False) and domain.domain.is_QQ):
+        return None
+    ring = domain.field.ring
+    if str(ring.order) != "lex":
+        return None
+    return generic_context(len(ring.symbols))
+
+
+def generic_context(nvars: int):
+    """flint's ``fmpz_mpoly_ctx`` in ``nvars`` variables (lexicographic); the variables are named ``v0, v1, ..``:
+    only their order matters, and flint accepts ASCII names only (a parameter may be called ``ω``)."""
+    ctx = _CONTEXTS.get(nvars)
+    if ctx is None:
+        ctx = _CONTEXTS[nvars] = _flint().fmpz_mpoly_ctx.get(tuple(f"v{i}" for i in range(nvars)), "lex")
+    return ctx
+
+
+def _integer_poly(p, ctx):
+    """``(P, c)`` with ``p = P / c``, ``P`` in ``ZZ[params]`` (flint), ``c`` a positive integer (``p`` a sympy polynomial)."""
+    return _integer_terms(p.items(), ctx)
+
+
+def _integer_terms(items, ctx):
+    """``(P, c)`` of ``{exponent: rational}`` items (sympy's ``QQ`` elements or flint ``fmpq``: both have
+    ``numerator``/``denominator``)."""
+    items = [(m, int(q.numerator), int(q.denominator)) for m, q in items]
+    c = 1
+    for _, _, den in items:
+        if den != 1:
+            c = c * den // _gcd(c, den)
+    return ctx.from_dict({m: num * (c // den) for m, num, den in items}), c
+
+
+def integer_poly(p, ctx):
+    """A sympy polynomial over ``QQ`` in the parameters as ``(P, c)``: ``p = P / c``, ``P`` a flint ``fmpz_mpoly``."""
+    return _integer_poly(p, ctx)
+
+
+def quotient_terms(terms: dict, denominator, ctx):
+    """``sum_e t_e P^e / denominator`` as a normalised pair; ``None`` when it is zero.
+
+    ``terms``: ``{exponent tuple: rational}`` (sympy ``QQ`` or flint ``fmpq``); ``denominator``: ``(P, c)``
+    from :func:`integer_poly` (the polynomial ``P / c``, non-zero)."""
+    n, cn = _integer_terms(terms.items(), ctx)
+    if n.is_zero():
+        return None
+    d, cd = denominator
+    return normalize(n * cd, d * cn)
+
+
+def _gcd(a, b):
+    while b:
+        a, b = b, a % b
+    return a
+
+
+def normalize(n, d):
+    """``n/d`` in the normal form (module docstring): coprime, ``lc(d) > 0``, zero as ``0/1``."""
+    if n.is_zero():
+        return n, d.context().from_dict({(0,) * d.context().nvars(): 1})
+    g = n.gcd(d)
+    if not g.is_one():
+        n, d = n / g, d / g
+    if d.leading_coefficient() < 0:
+        n, d = -n, -d
+    return n, d
+
+
+def from_field(v, ctx):
+    """A field element (sympy ``FracElement`` of ``QQ(params)``) as a normalised pair ``(n, d)`` of ``fmpz_mpoly``."""
+    n, cn = _integer_poly(v.numer, ctx)
+    d, cd = _integer_poly(v.denom, ctx)
+    if cn == 1 and cd == 1:
+        return normalize(n, d)  # sympy's own normal form (a gcd of one, unless built with raw_new unreduced)
+    return normalize(n * cd, d * cn)
+
+
+def to_field(pair, domain):
+    """The pair ``(n, d)`` (normal form) as the element of ``domain`` sympy's arithmetic would give (no cancellation)."""
+    n, d = pair
+    field = domain.field
+    make, coeff = field.ring.dtype, domain.domain.dtype  # PolyElement from (monomial, coefficient) pairs; QQ's type
+    if _FLINT_QQ.get(coeff) is None:
+        _FLINT_QQ[coeff] = coeff is _flint().fmpq  # flint ground types: fmpz coefficients convert directly
+
+    def poly(p):
+        cs = p.coeffs() if _FLINT_QQ[coeff] else [int(c) for c in p.coeffs()]
+        return make(zip(exponents(p), map(coeff, cs)))
+
+    return field.raw_new(poly(n), poly(d))
+
+
+def mul(a, b):
+    """``a * b`` of two normalised pairs (cross cancellation: no gcd of the products)."""
+    an, ad = a
+    bn, bd = b
+    g1 = an.gcd(bd)
+    g2 = bn.gcd(ad)
+    if not g1.is_one():
+        an, bd = an / g1, bd / g1
+    if not g2.is_one():
+        bn, ad = bn / g2, ad / g2
+    n, d = an * bn, ad * bd
+    if d.leading_coefficient() < 0:
+        n, d = -n, -d
+    return n, d
+
+
+def sub(a, b):
+    """``a - b`` of two normalised pairs (Henrici: only ``gcd(b_d, a_d)`` can cancel)."""
+    an, ad = a
+    bn, bd = b
+    if ad == bd:
+        n = an - bn
+        if n.is_zero():
+            return n, ad.context().from_dict({(0,) * ad.context().nvars(): 1})
+        return normalize(n, ad) if not ad.is_one() else (n, ad)
+    g = ad.gcd(bd)
+    if g.is_one():
+        return an * bd - bn * ad, ad * bd  # lc of a product of positive-lc polynomials is positive
+    a1, b1 = ad / g, bd / g
+    n = an * b1 - bn * a1
+    if n.is_zero():
+        return n, ad.context().from_dict({(0,) * ad.context().nvars(): 1})
+    g2 = n.gcd(g)
+    if not g2.is_one():
+        n, bd = n / g2, bd / g2  # g2 divides g, hence bd
+    d = a1 * bd
+    if d.leading_coefficient() < 0:  # flint's gcds have positive leading coefficients: never, kept as a guard
+        n, d = -n, -d
+    return n, d
+
+
+def inverse(a):
+    """``1 / a`` of a non-zero normalised pair."""
+    n, d = a
+    if n.leading_coefficient() < 0:
+        return -d, -n
+    return d, n
+
+
+def rref(rows: dict, ncols: int, ctx):
+    """Reduced row echelon form of ``{row: {column: (n, d)}}`` (non-zero normalised pairs): ``(R, pivots)``.
+
+    Gauss-Jordan by columns; the pivot row of a column is the candidate with the fewest entries
+    (any choice gives the same, unique, reduced form).  ``R`` is ``{k: {column: pair}}`` for the
+    ``rank`` pivot rows in pivot order, pivot entries one.
+    """
+    one = ctx.from_dict({(0,) * ctx.nvars(): 1})
+    work = {i: dict(r) for i, r in rows.items() if r}
+    by_col: dict = {}
+    for i, r in work.items():
+        for j in r:
+            by_col.setdefault(j, set()).add(i)
+    pivot_rows = []
+    done: set = set()
+    for col in range(ncols):
+        holders = by_col.get(col)
+        if not holders:
+            continue
+        candidates = [i for i in holders if i not in done]
+        if not candidates:
+            continue
+        p = min(candidates, key=lambda i: (len(work[i]), i))
+        prow = work[p]
+        inv = inverse(prow[col])
+        if not (inv[0].is_one() and inv[1].is_one()):
+            prow = {j: (mul(v, inv) if j != col else (one, one)) for j, v in prow.items()}
+        else:
+            prow = dict(prow)
+        prow[col] = (one, one)
+        work[p] = prow
+        for i in list(holders):
+            if i == p:
+                continue
+            r = work[i]
+            f = r.pop(col)
+            for j, v in prow.items():
+                if j == col:
+                    continue
+                t = mul(f, v)
+                old = r.get(j)
+                if old is None:
+                    r[j] = (-t[0], t[1])
+                    by_col.setdefault(j, set()).add(i)
+                else:
+                    s = sub(old, t)
+                    if s[0].is_zero():
+                        del r[j]
+                        by_col[j].discard(i)
+                    else:
+                        r[j] = s
+        by_col[col] = {p}
+        done.add(p)
+        pivot_rows.append((col, p))
+    R = {k: work[p] for k, (col, p) in enumerate(pivot_rows)}
+    return R, tuple(col for col, _ in pivot_rows)
