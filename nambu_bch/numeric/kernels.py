@@ -241,6 +241,8 @@ class Kernel:
     path : pathlib.Path -- where it is cached
     module : the imported module (pure-Python functions, the numpy fallback)
     compile_seconds : dict -- wall time of each numba compilation or cache load, by function name
+    interpreted : dict -- steps run on the interpreter because compiling would have cost more
+        (:func:`~nambu_bch.numeric.iterate.iterate` with ``backend="auto"``), by function name
     """
 
     def __init__(self, system, comp):
@@ -256,6 +258,7 @@ class Kernel:
             self._generate()
         self._jitted = {}
         self.compile_seconds = {}
+        self.interpreted = {}
 
     def _load_cached(self) -> bool:
         """Use the cached source if its index is intact and the file matches the recorded digest."""
@@ -346,6 +349,29 @@ class Kernel:
             fn = numba.njit(cache=on_disk, nogil=True, fastmath=False, error_model="numpy")(getattr(self.module, name))
             self._jitted[name] = fn
         return fn
+
+    def ready(self, name: str) -> bool:
+        """Whether the compiled loop ``name`` starts at no real cost: compiled or loaded in this process, or
+        numba already imported and the loop's machine code in numba's cache next to the module
+        (``__pycache__/<module>.<name>-<line>.py<ver>.nbi``; loading it takes milliseconds, compiling it
+        0.1-4 s).  Only a hint for the backend choice: a stale index just costs a compile."""
+        if name in self.compile_seconds:
+            return True
+        if "numba" not in sys.modules:
+            return False
+        try:
+            return any((self.path.parent / "__pycache__").glob(f"{self.path.stem}.{name}-*.nbi"))
+        except OSError:
+            return False
+
+    @property
+    def numpy_matches_compiled(self) -> bool:
+        """Whether the numpy batch loop gives the compiled loop's bits for every input: it calls no numpy
+        function but ``isfinite`` and ``sqrt`` (correctly rounded).  numpy's own ``exp``, ``expm1``,
+        ``log``, ``sinh``, ... differ from the C library's (which the compiled and the interpreted
+        single-state loops call) in the last bit for some arguments."""
+        body = self.source.partition("\ndef run_numpy(")[2].partition("\ndef scan(")[0]
+        return not (set(re.findall(r"\b_np_(\w+)\(", body)) - {"isfinite", "sqrt"})
 
     def scan(self, X):
         """One compiled pass over a batch ``X`` (N, B): ``(non-finite count, subnormal count, columns)``.
