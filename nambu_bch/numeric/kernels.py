@@ -151,7 +151,7 @@ MAX_CACHE_FILE = 4 * 2**20
 _MODULE_NAME = re.compile(r"nambu_bch_kernel_[0-9a-f]{20}")
 _INDEX_FIELDS = {"template": str, "module": str, "sha256": str, "N": int, "n_constants": int,
                  "n_parameters": int, "linear": list}
-_FUNCTIONS = ("constants", "run", "run_kahan", "run_batch", "run_batch_kahan", "run_numpy", "run_numpy_kahan", "scan")
+_FUNCTIONS = ("constants", "run", "run_kahan", "run_batch", "run_batch_kahan", "run_numpy", "run_numpy_kahan")
 
 
 def input_key(system, comp) -> str:
@@ -370,7 +370,7 @@ class Kernel:
         function but ``isfinite`` and ``sqrt`` (correctly rounded).  numpy's own ``exp``, ``expm1``,
         ``log``, ``sinh``, ... differ from the C library's (which the compiled and the interpreted
         single-state loops call) in the last bit for some arguments."""
-        body = self.source.partition("\ndef run_numpy(")[2].partition("\ndef scan(")[0]
+        body = self.source.partition("\ndef run_numpy(")[2]
         return not (set(re.findall(r"\b_np_(\w+)\(", body)) - {"isfinite", "sqrt"})
 
     def scan(self, X):
@@ -378,17 +378,13 @@ class Kernel:
 
         ``columns`` are the extreme states of :func:`~nambu_bch.numeric.guards.extreme_states`
         (largest / smallest max-norm and product of magnitudes, smallest non-zero component).
+        The pass does not depend on the system: :func:`nambu_bch.numeric.scan.scan`, compiled once
+        for all kernels.
         """
-        if "scan" not in self.compile_seconds:
-            self.compile_seconds["scan"] = 0.0
-            fn = self.function("scan")
-            try:
-                fn(np.zeros((1, 1)), np.zeros(7, dtype=np.int64))
-            except Exception:  # noqa: BLE001 - a corrupt numba cache entry: purge and compile again
-                self._purge_numba_cache(fn)
-                self._jitted.pop("scan", None)
+        from .scan import scan
+
         res = np.zeros(7, dtype=np.int64)
-        self.function("scan")(X, res)
+        scan(X, res)
         return int(res[0]), int(res[1]), np.unique(np.concatenate([res[2:], [0, X.shape[1] - 1]]))
 
     def compile(self, kahan: bool = False, batch: bool = False) -> float:
