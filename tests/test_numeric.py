@@ -363,6 +363,82 @@ def test_kernels_are_cached_on_disk(tmp_path, monkeypatch):
     assert again is k
 
 
+@numba_only
+def test_auto_interprets_small_runs_until_compiling_pays(tmp_path, monkeypatch):
+    """backend="auto" (issue 11): while a loop is neither compiled in the process nor in numba's disk
+    cache, runs of INTERPRET_STEPS trajectory-steps in total take the interpreter -- the same statements
+    on Python floats and the C library's functions, so the same bits as the compiled loop (checked here
+    against backend="numba", and for the library functions of every kind of flow in
+    test_numba_and_numpy_agree_bitwise / test_exponential_flows_mix_series_and_library_ranges);
+    the next run beyond the budget compiles."""
+    from nambu_bch.numeric.iterate import INTERPRET_STEPS as budget
+
+    monkeypatch.setenv("NAMBU_BCH_CACHE", str(tmp_path))
+    k = kernel(model("ho3"), "32123")
+    a = iterate("ho3", "32123", 0.1, budget - 10, X0["ho3"], every=1000)
+    assert k.compile_seconds == {} and k.interpreted == {"run": budget - 10}
+    b = iterate("ho3", "32123", 0.1, 20, X0["ho3"])              # beyond the budget: compiled now
+    assert "run" in k.compile_seconds and k.interpreted == {"run": budget - 10}
+    assert np.array_equal(a, iterate("ho3", "32123", 0.1, budget - 10, X0["ho3"], every=1000, backend="numba"))
+    assert np.array_equal(b, iterate("ho3", "32123", 0.1, 20, X0["ho3"], backend="numpy"))
+    # Kahan is another loop with its own budget; the bits again those of the compiled loop
+    c = iterate("ho3", "32123", 0.1, 300, X0["ho3"], kahan=True)
+    assert "run_kahan" not in k.compile_seconds and k.interpreted["run_kahan"] == 300
+    assert np.array_equal(c, iterate("ho3", "32123", 0.1, 300, X0["ho3"], kahan=True, backend="numba"))
+
+
+@numba_only
+def test_auto_loads_a_loop_from_numbas_disk_cache(tmp_path, monkeypatch):
+    """A loop in numba's cache on disk is ready (loading it takes milliseconds): "auto" runs it compiled,
+    also in a new Kernel of the same source (a fresh process sees the same files)."""
+    from nambu_bch.numeric import kernels as K
+
+    monkeypatch.setenv("NAMBU_BCH_CACHE", str(tmp_path))
+    k = kernel(model("ho"), "TVT")
+    assert not k.ready("run")
+    k.compile()
+    assert k.ready("run") and not k.ready("run_kahan")
+    K._kernel.cache_clear()
+    K._kernel_for_word.cache_clear()
+    fresh = kernel(model("ho"), "TVT")
+    assert fresh is not k and fresh.compile_seconds == {} and fresh.ready("run")
+    x = iterate("ho", "TVT", 0.1, 100, X0["ho"])
+    assert "run" in fresh.compile_seconds and fresh.interpreted == {}
+    assert np.array_equal(x, iterate("ho", "TVT", 0.1, 100, X0["ho"], backend="numpy"))
+
+
+@numba_only
+def test_auto_small_batches_take_numpy_only_where_it_gives_the_compiled_bits(tmp_path, monkeypatch):
+    """numpy's expm1 differs from the C library's in the last bit for some arguments (see
+    test_exponential_flows_mix_series_and_library_ranges): a small Lotka-Volterra batch is compiled,
+    a small polynomial (ho3) batch runs on numpy arrays -- with the compiled loop's bits."""
+    monkeypatch.setenv("NAMBU_BCH_CACHE", str(tmp_path))
+    lv, ho3 = kernel(model("lotka-volterra"), "12321"), kernel(model("ho3"), "32123")
+    assert not lv.numpy_matches_compiled and ho3.numpy_matches_compiled
+    X = np.array([[1.0, 1.0, 1.0], [0.2, -0.4, 0.5], [2.0, 0.0, 3.0]]).T
+    a = iterate("ho3", "32123", 0.1, 50, X, every=10)
+    assert ho3.compile_seconds == {} and ho3.interpreted == {"run_batch": 50}
+    assert np.array_equal(a, iterate("ho3", "32123", 0.1, 50, X, every=10, backend="numba"))
+    from nambu_bch.numeric.iterate import _interpret_small
+
+    assert _interpret_small(lv, 50, (3, 3), False) == ("numba", False)
+
+
+def test_interpreter_arithmetic_errors_are_refused_or_compiled():
+    """Lotka-Volterra at h = 0.5 from (1, 2, 3): math.expm1 overflows on the interpreter mid-run, where the
+    compiled loop gives inf.  backend="numpy" refuses the run in one line (NumericalRangeError, not
+    OverflowError); "auto" hands the segment to the compiled loop, so it reports what "numba" reports."""
+    args = ("lotka-volterra", "12321", 0.5, 200, [1.0, 2.0, 3.0])
+    with pytest.raises(NumericalRangeError, match="interpreter"):
+        iterate(*args, check_stable=False, backend="numpy")
+    if numba_available():
+        with pytest.raises(NumericalRangeError) as compiled:
+            iterate(*args, check_stable=False, backend="numba")
+        with pytest.raises(NumericalRangeError) as auto:
+            iterate(*args, check_stable=False)
+        assert str(auto.value) == str(compiled.value) and "interpreter" not in str(auto.value)
+
+
 # -- precision ---------------------------------------------------------------------------------------------------
 
 
