@@ -429,6 +429,22 @@ def pair_lines(u, e, f, value, prefix="_", style="python"):
             f"if {u} < 0: {e}, {f} = {f}, {e}"]
 
 
+#: The generated function ``e, f = _expm1_pair(u)`` (:func:`pair_lines` as a function), called by the batch
+#: loops' redo; the compiled loops call its compiled form (:meth:`~nambu_bch.numeric.kernels.Kernel.function`).
+PAIR_FUNCTION = "_expm1_pair"
+
+
+def pair_function_source() -> str:
+    """``def _expm1_pair(x): ... return e0, f0`` -- the statements of :func:`pair_lines` (style ``"python"``)."""
+    body = pair_lines("u0", "e0", "f0", "x")
+    return f"""
+
+def {PAIR_FUNCTION}(x):
+{_indent(body, 4)}
+    return e0, f0
+"""
+
+
 def expm1_pair(u: float) -> tuple:
     """``(expm1(u), expm1(-u))`` in float64 exactly as the generated kernels compute a shared pair.
 
@@ -444,18 +460,24 @@ def expm1_pair(u: float) -> tuple:
 # -- loop bodies ----------------------------------------------------------------------------------------
 
 
-def body_lines(program: StepProgram, printer, kahan=False, c_syntax=False, vector=False, prefix="_", select=False):
+def body_lines(program: StepProgram, printer, kahan=False, c_syntax=False, vector=False, prefix="_", select=False,
+               pair_call=None):
     """Statements of one step, ``s_i`` / ``k_j`` / ``d_j`` / ``c_i`` named as in the generated kernels.
 
     ``vector``: numpy arrays (the shared-exponential swap is a ``np.where``); ``prefix``: of the
     function names (``_``, ``_np_``, ``_mp_``); ``c_syntax``: C99; ``select``: shared exponentials
-    without branches (:func:`pair_lines` style ``"select"``, for the vectorised batch loop).
+    without branches (:func:`pair_lines` style ``"select"``, for the vectorised batch loop);
+    ``pair_call``: the name of a function computing a shared pair (``e_j, f_j = pair_call(u_j)``,
+    :data:`PAIR_FUNCTION`) instead of its statements inline.
     """
     end = ";" if c_syntax else ""
     decl = "double " if c_syntax else ""
     lines = []
     for u in program.updates:
         for us, es, fs, ue in u.pairs:
+            if pair_call:
+                lines += [f"{us} = {printer(ue)}", f"{es}, {fs} = {pair_call}({us})"]
+                continue
             style = ("cselect" if select else "c") if c_syntax else "numpy" if vector else "select" if select else "python"
             lines += pair_lines(str(us), str(es), str(fs), printer(ue), prefix, style)
         names = []
@@ -569,6 +591,8 @@ def python_source(program: StepProgram) -> str:
     finite = " and ".join(f"_isfinite({v})" for v in s)
     sample = "; ".join(f"out[j, {i}] = {v}" for i, v in enumerate(s))
     src = [_HEADER.format(version=TEMPLATE_VERSION), constants_source(program)]
+    if any(u.pairs for u in program.updates):
+        src.append(pair_function_source())
 
     for kahan in (False, True):
         body = body_lines(program, scalar, kahan)
@@ -613,14 +637,16 @@ def {name}({args}):
         if any(u.pairs for u in program.updates):
             # shared exponentials: one branch-free pass over the chunk (vectorised); if some |u| left the
             # series range, the chunk's step is undone and redone with the library branch -- the same bits
-            # as the branchy loop either way
+            # as the branchy loop either way.  The redo (scalar, rare) calls the pair function instead of
+            # repeating its statements per sub-flow: half the source numba compiles (issue 11)
             fast = body_lines(program, scalar, kahan, select=True)
+            redo = body_lines(program, scalar, kahan, pair_call=PAIR_FUNCTION)
             saved = [line for q, r in enumerate(rows) for line in _row_copy(f"R{q}", r)]
             restore = [line for q, r in enumerate(rows) for line in _row_copy(r, f"R{q}")]
             chunk_step = [*saved, "over = 0", "for b in range(nb):",
                           *("    " + line for line in inner_load + fast + inner_store),
                           "if over:", *("    " + line for line in restore),
-                          *("    " + line for line in chunk_step)]
+                          "    for b in range(nb):", *("        " + line for line in inner_load + redo + inner_store)]
         chunk_sample = []
         for i in range(N):  # the sample, row by row, counting non-finite values as it is written
             chunk_sample += [f"row = out[j, {i}, b0:b0 + nb]", "for b in range(nb):",

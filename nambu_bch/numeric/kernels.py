@@ -64,7 +64,7 @@ from ..errors import InvalidRunError, NumericalRangeError
 from ..private_dirs import cache_root, euid, untrusted
 from ..integrators.composition import composition_for
 from ..integrators.step import parameter_values
-from .codegen import TEMPLATE_VERSION, python_source, source_hash, step_program
+from .codegen import PAIR_FUNCTION, TEMPLATE_VERSION, python_source, source_hash, step_program
 
 BACKENDS = ("auto", "numba", "numpy")
 #: States per chunk of a batch: the chunk's arrays stay in L1/L2 while all steps run.
@@ -345,8 +345,13 @@ class Kernel:
         if fn is None:
             import numba
 
+            if name.startswith("run_batch") and hasattr(self.module, PAIR_FUNCTION):
+                # the batch loops' redo calls the shared-exponential function: compiled, it is a global of theirs
+                self.module.__dict__[PAIR_FUNCTION] = self.function(PAIR_FUNCTION)
             on_disk = self.path.is_file()  # numba caches next to a source file; without one, compile in memory
-            fn = numba.njit(cache=on_disk, nogil=True, fastmath=False, error_model="numpy")(getattr(self.module, name))
+            py = getattr(self.module, name)
+            py = getattr(py, "py_func", py)  # the compiled pair function stands in the module once bound
+            fn = numba.njit(cache=on_disk, nogil=True, fastmath=False, error_model="numpy")(py)
             self._jitted[name] = fn
         return fn
 
