@@ -68,7 +68,8 @@ def iterate(system, word, h, steps, x0, params=None, every=1, *, kahan=False, dp
     every : int >= 1 -- keep every ``every``-th state (long runs need not fill memory)
     kahan : bool -- compensated summation of the increments (float64 only)
     dps : int, optional -- decimal digits of an mpmath run (a reference; ~10^3x slower)
-    backend : ``"auto"`` | ``"numba"`` | ``"numpy"``
+    backend : ``"auto"`` | ``"numba"`` | ``"numpy"`` -- ``"auto"``: compiled, except runs too small to pay for
+        compiling their loop (:data:`INTERPRET_STEPS`), which take the interpreter (the same bits)
     progress : bool or None -- a progress line on stderr; None: only on a terminal and for long runs
     chunk : int, optional -- states per cache block of a batch (tuning only)
     check_stable : bool -- refuse steps outside the stability interval (:func:`~nambu_bch.numeric.guards.check_stability`)
