@@ -400,8 +400,9 @@ def _word_coefficients(letters, cpow, logk, primes, g, n, count, top):
     k = primes.shape[0]
     inv = 1.0 / primes.astype(np.float64)
     out = _zeros2(count, k, np.int64)
-    F = np.zeros((n + 1) * (n + 1) * (s + 1) * k, dtype=np.int64).reshape((n + 1, n + 1, s + 1, k))  # F[m, j, t] = <E_1..E_t, w[j:m]>
-    A = np.zeros((n + 1) * (n + 1) * k, dtype=np.int64).reshape((n + 1, n + 1, k))  # A[m, kk] = <(Phi - 1)^kk, w[:m]>
+    # F[m, j, t] = <E_1..E_t, w[j:m]>, A[m, kk] = <(Phi - 1)^kk, w[:m]>
+    F = np.zeros((n + 1) * (n + 1) * (s + 1) * k, dtype=np.int64).reshape((n + 1, n + 1, s + 1, k))
+    A = np.zeros((n + 1) * (n + 1) * k, dtype=np.int64).reshape((n + 1, n + 1, k))
     for m in range(n + 1):
         F[m, m, :, :] = 1
     A[0, 0, :] = 1

@@ -22,8 +22,6 @@ Horikoshi, Sect. 5.5: ``x^{32123}(t) = (Phi^{32123}_h)^n x(0)``, ``t = n h``.
 
 from __future__ import annotations
 
-import sys
-
 import numpy as np
 
 from ..errors import InvalidRunError, InvalidSystemError, NumericalRangeError
@@ -170,8 +168,9 @@ def _run_single(kern, state, K, steps, every, out, kahan, comp, be, fallback, wh
             raise
         if fallback:
             return kern.run(state, K, steps, every, out, kahan=kahan, comp=comp, backend="numba"), "numba"
-        raise NumericalRangeError(f"{what}: float64 arithmetic failed on the interpreter ({exc}); the state left "
-                                  "the range of the step's functions; take a smaller h, or use dps=... (mpmath)") from None
+        raise NumericalRangeError(f"{what}: float64 arithmetic failed on the interpreter ({exc}); the state "
+                                  "left the range of the step's functions; take a smaller h, or use dps=... (mpmath)"
+                                  ) from None
 
 
 def _run_batch(kern, X, K, steps, every, out, kahan, be, chunk, segment, reporter, what):
