@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import io
 import os
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -115,9 +116,13 @@ def test_exponential_flows_use_expm1():
     assert all("expm1" in str(d) for u in prog.updates for _, d in u.expanded())
     # one expm1 per sub-flow: each Lotka-Volterra piece scales one coordinate by e^u, another by e^-u
     assert all(len(u.pairs) == 1 and len(u.increments) == 2 for u in prog.updates)
-    # run, run_batch and their Kahan forms: one library call per sub-flow, only above the series range
+    # run and run_kahan: one library call per sub-flow, only above the series range; the batch loops'
+    # redo (and only it) calls the one generated pair function, which holds the last library call
+    from nambu_bch.numeric.codegen import PAIR_FUNCTION
+
     src = python_source(prog)
-    assert src.count("    e0 = _expm1(_au0)") == 4 and src.count("= _expm1(") == 4 * len(prog.updates)
+    assert src.count("    e0 = _expm1(_au0)") == 3 and src.count("= _expm1(") == 2 * len(prog.updates) + 1
+    assert src.count(f"def {PAIR_FUNCTION}(") == 1 and src.count(f" = {PAIR_FUNCTION}(") == 2 * len(prog.updates)
     assert src.count("_np_expm1(") == 2 * len(prog.updates)        # run_numpy and its Kahan form
 
 
@@ -129,9 +134,14 @@ def test_numba_loops_copy_rows_element_by_element(name, word):
     whole-array statements.  Checked on the parsed source: no subscript-with-slice target outside run_numpy*."""
     import ast
 
+    import nambu_bch.numeric.scan as scan_module  # the batch scan, compiled once for every kernel (not generated)
+
     tree = ast.parse(python_source(step_program(model(name), word)))
     compiled = [f for f in tree.body if isinstance(f, ast.FunctionDef) and not f.name.startswith(("run_numpy", "constants"))]
-    assert {f.name for f in compiled} == {"run", "run_kahan", "run_batch", "run_batch_kahan", "scan"}
+    pairs = {"_expm1_pair"} if name == "lotka-volterra" else set()  # the shared-exponential function (compiled too)
+    assert {f.name for f in compiled} == {"run", "run_kahan", "run_batch", "run_batch_kahan"} | pairs
+    compiled += [f for f in ast.parse(Path(scan_module.__file__).read_text()).body if isinstance(f, ast.FunctionDef)]
+    assert [f.name for f in compiled][-1:] == ["scan"]
     sliced = [ast.unparse(t) for f in compiled for node in ast.walk(f) if isinstance(node, (ast.Assign, ast.AugAssign))
               for t in (node.targets if isinstance(node, ast.Assign) else [node.target])
               if isinstance(t, ast.Subscript) and any(isinstance(s, ast.Slice) for s in ast.walk(t.slice))]
@@ -356,6 +366,85 @@ def test_kernels_are_cached_on_disk(tmp_path, monkeypatch):
     assert cached, "numba wrote no cache index next to the generated module"
     again = kernel(model("ho"), "VTV")
     assert again is k
+
+
+@numba_only
+def test_auto_interprets_small_runs_until_compiling_pays(tmp_path, monkeypatch):
+    """backend="auto" (issue 11): while a loop is neither compiled in the process nor in numba's disk
+    cache, runs of INTERPRET_STEPS trajectory-steps in total take the interpreter -- the same statements
+    on Python floats and the C library's functions, so the same bits as the compiled loop (checked here
+    against backend="numba", and for the library functions of every kind of flow in
+    test_numba_and_numpy_agree_bitwise / test_exponential_flows_mix_series_and_library_ranges);
+    the next run beyond the budget compiles."""
+    from nambu_bch.numeric.iterate import INTERPRET_STEPS as budget
+
+    monkeypatch.setenv("NAMBU_BCH_CACHE", str(tmp_path))
+    k = kernel(model("ho3"), "32123")
+    a = iterate("ho3", "32123", 0.1, budget - 10, X0["ho3"], every=1000)
+    assert k.compile_seconds == {} and k.interpreted == {"run": budget - 10}
+    b = iterate("ho3", "32123", 0.1, 20, X0["ho3"])              # beyond the budget: compiled now
+    assert "run" in k.compile_seconds and k.interpreted == {"run": budget - 10}
+    assert np.array_equal(a, iterate("ho3", "32123", 0.1, budget - 10, X0["ho3"], every=1000, backend="numba"))
+    assert np.array_equal(b, iterate("ho3", "32123", 0.1, 20, X0["ho3"], backend="numpy"))
+    # Kahan is another loop with its own budget (its bits: test_numba_and_numpy_agree_bitwise[True-ho3-32123])
+    c = iterate("ho3", "32123", 0.1, 300, X0["ho3"], kahan=True)
+    assert "run_kahan" not in k.compile_seconds and k.interpreted["run_kahan"] == 300
+    assert np.array_equal(c, iterate("ho3", "32123", 0.1, 300, X0["ho3"], kahan=True, backend="numpy"))
+
+
+@numba_only
+def test_auto_loads_a_loop_from_numbas_disk_cache(tmp_path, monkeypatch):
+    """A loop in numba's cache on disk is ready (loading it takes milliseconds): "auto" runs it compiled,
+    also in a new Kernel of the same source (a fresh process sees the same files)."""
+    from nambu_bch.numeric import kernels as K
+
+    monkeypatch.setenv("NAMBU_BCH_CACHE", str(tmp_path))
+    k = kernel(model("ho"), "TVT")
+    assert not k.ready("run")
+    k.compile()
+    assert k.ready("run") and not k.ready("run_kahan")
+    K._kernel.cache_clear()
+    K._kernel_for_word.cache_clear()
+    fresh = kernel(model("ho"), "TVT")
+    assert fresh is not k and fresh.compile_seconds == {} and fresh.ready("run")
+    x = iterate("ho", "TVT", 0.1, 100, X0["ho"])
+    assert "run" in fresh.compile_seconds and fresh.interpreted == {}
+    assert np.array_equal(x, iterate("ho", "TVT", 0.1, 100, X0["ho"], backend="numpy"))
+
+
+@numba_only
+def test_auto_small_batches_take_numpy_only_where_it_gives_the_compiled_bits(tmp_path, monkeypatch):
+    """numpy's expm1 differs from the C library's in the last bit for some arguments (see
+    test_exponential_flows_mix_series_and_library_ranges): a small Lotka-Volterra batch is compiled,
+    a small polynomial (ho3) batch runs on numpy arrays -- with the compiled loop's bits."""
+    monkeypatch.setenv("NAMBU_BCH_CACHE", str(tmp_path))
+    lv, ho3 = kernel(model("lotka-volterra"), "12321"), kernel(model("ho3"), "32123")
+    assert not lv.numpy_matches_compiled and ho3.numpy_matches_compiled
+    X = np.array([[1.0, 1.0, 1.0], [0.2, -0.4, 0.5], [2.0, 0.0, 3.0]]).T
+    a = iterate("ho3", "32123", 0.1, 50, X, every=10)
+    assert ho3.compile_seconds == {} and ho3.interpreted == {"run_batch": 50}
+    # each column is the single run (interpreted too), whose bits are the compiled loop's
+    # (test_batch_numba_numpy_and_single_agree_bitwise compares the compiled batch loop itself)
+    assert all(np.array_equal(a[:, :, i], iterate("ho3", "32123", 0.1, 50, X[:, i], every=10)) for i in range(3))
+    assert ho3.compile_seconds == {} and ho3.interpreted == {"run_batch": 50, "run": 150}
+    from nambu_bch.numeric.iterate import _interpret_small
+
+    assert _interpret_small(lv, 50, (3, 3), False) == ("numba", False)
+
+
+def test_interpreter_arithmetic_errors_are_refused_or_compiled():
+    """Lotka-Volterra at h = 0.5 from (1, 2, 3): math.expm1 overflows on the interpreter mid-run, where the
+    compiled loop gives inf.  backend="numpy" refuses the run in one line (NumericalRangeError, not
+    OverflowError); "auto" hands the segment to the compiled loop, so it reports what "numba" reports."""
+    args = ("lotka-volterra", "12321", 0.5, 200, [1.0, 2.0, 3.0])
+    with pytest.raises(NumericalRangeError, match="interpreter"):
+        iterate(*args, check_stable=False, backend="numpy")
+    if numba_available():
+        with pytest.raises(NumericalRangeError) as compiled:
+            iterate(*args, check_stable=False, backend="numba")
+        with pytest.raises(NumericalRangeError) as auto:
+            iterate(*args, check_stable=False)
+        assert str(auto.value) == str(compiled.value) and "interpreter" not in str(auto.value)
 
 
 # -- precision ---------------------------------------------------------------------------------------------------

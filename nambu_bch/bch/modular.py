@@ -100,6 +100,27 @@ def _reduce(x, p, inv):
     return r
 
 
+# -- allocation ----------------------------------------------------------------------------------------------------
+# numba compiles np.zeros / np.full / np.empty / np.arange once per (function, number of dimensions, dtype):
+# 0.1-0.17 s each on a cold start, 13 of them in this module.  Every array here is allocated as a zeroed
+# one-dimensional int64, int32 or int8 array (three compilations), filled by a loop and reshaped (a view:
+# no compilation).  The helpers are inlined into their callers (no compilation of their own either).
+
+@numba.njit(cache=True, inline="always")
+def _zeros2(rows, cols, dtype):
+    """A zeroed C-contiguous ``(rows, cols)`` array of ``dtype``."""
+    return np.zeros(rows * cols, dtype=dtype).reshape((rows, cols))
+
+
+@numba.njit(cache=True, inline="always")
+def _filled(size, value):
+    """An int64 array of ``size`` entries equal to ``value``."""
+    a = np.zeros(size, dtype=np.int64)
+    for i in range(size):
+        a[i] = value
+    return a
+
+
 # -- Lyndon table -------------------------------------------------------------------------------------------------
 
 @numba.njit(cache=True)
@@ -117,8 +138,8 @@ def _duval_next(w, length, n, g):
 
 @numba.njit(cache=True)
 def _duval_count(g, n):
-    w = np.full(n + 1, -1, dtype=np.int64)
-    length, count = 1, 0
+    w = _filled(n + 1, -1)
+    length, count = np.int64(1), 0  # np.int64: a literal 1 would compile _duval_next once more for Literal[int](1)
     while length > 0:
         w[length - 1] += 1
         count += 1
@@ -146,13 +167,13 @@ def _find(codes, by_length, start, L, code):
 def _lyndon_table_kernel(g, n):
     """Lyndon words of length <= n in Duval (lexicographic) order, lengths, and standard factors."""
     count = _duval_count(g, n)
-    words = np.zeros((count, n), dtype=np.int8)
+    words = _zeros2(count, n, np.int8)
     lengths = np.zeros(count, dtype=np.int64)
     code_of = np.zeros(count, dtype=np.int64)
-    left = np.full(count, -1, dtype=np.int64)
-    right = np.full(count, -1, dtype=np.int64)
-    w = np.full(n + 1, -1, dtype=np.int64)
-    length, k = 1, 0
+    left = _filled(count, -1)
+    right = _filled(count, -1)
+    w = _filled(n + 1, -1)
+    length, k = np.int64(1), 0
     while length > 0:
         w[length - 1] += 1
         code = 0
@@ -178,13 +199,13 @@ def _lyndon_table_kernel(g, n):
     for k in range(count):  # the longest proper Lyndon suffix
         L = lengths[k]
         for first in range(1, L):
-            code = 0
+            code = np.int64(0)  # not a literal 0: one compiled _find, not two
             for i in range(first, L):
                 code = code * g + words[k, i]
             j = _find(codes, by_length, start, L - first, code)
             if j >= 0:
                 right[k] = j
-                code = 0
+                code = np.int64(0)
                 for i in range(first):
                     code = code * g + words[k, i]
                 left[k] = _find(codes, by_length, start, first, code)
@@ -212,7 +233,9 @@ def _chains(words, lengths, left, right):
     count = lengths.shape[0]
     span = np.zeros(count, dtype=np.int64)
     K = np.zeros(count, dtype=np.int64)
-    core = np.arange(count)
+    core = np.zeros(count, dtype=np.int64)
+    for i in range(count):
+        core[i] = i
     lead = np.zeros(count, dtype=np.int64)
     for i in range(count):
         a = words[i, 0]
@@ -233,8 +256,9 @@ _LANES = 8  # words evaluated together by one program sweep (8 x int32: one AVX2
 
 
 @numba.njit(cache=True)
-def _solve(z, primes, words, lengths, left, right, members, class_start, K, core, lead, span, g, d):
-    """Eq. (1) in place, all primes at once, for every degree ``<= d`` through the content classes of degree ``d``.
+def _solve(z, primes, beta, words, lengths, left, right, members, class_start, g, n, d):
+    """Eq. (1) in place, all primes at once, for every degree ``<= d`` through the content classes of degree ``d``;
+    then, if ``d < n``, the even degree ``n`` by Eq. (3) (:func:`_even_top`, with ``beta``).
 
     Chains.  Let ``a`` be the smallest letter of a class (every member starts with it) and
     ``v = a^k u`` with ``P_v = ad_a^k P_u`` (``k <= K_v``).  A Lyndon word ``w`` of length ``>= 2``
@@ -257,14 +281,18 @@ def _solve(z, primes, words, lengths, left, right, members, class_start, K, core
     2^(|u|-1)``, exact for ``|u| <= 31``); the matrix is never stored, a class whose word
     coefficients all vanish is skipped, and ``c`` is used only when a suffix of ``v`` has
     ``z != 0``.  Returns the number of program nodes run (times lanes)."""
+    K, core, lead, span = _chains(words, lengths, left, right)
     k = primes.shape[0]
     inv = 1.0 / primes.astype(np.float64)
     m = members.shape[0]
-    live = np.zeros(m, dtype=np.bool_)
-    x = np.zeros((_LANES, 64), dtype=np.int64)
-    acc = np.zeros((_LANES, d, k), dtype=np.int64)
+    live = np.zeros(m, dtype=np.int8)  # 0 / 1
+    x = _zeros2(_LANES, 64, np.int64)
+    acc = np.zeros(_LANES * d * k, dtype=np.int64).reshape((_LANES, d, k))
     lane_span = np.zeros(_LANES, dtype=np.int64)
-    memo = np.full((lengths.shape[0], d), -1, dtype=np.int32)  # node numbers of _class_program
+    memo = np.zeros(lengths.shape[0] * d, dtype=np.int32)  # node numbers of _class_program
+    for i in range(memo.shape[0]):
+        memo[i] = -1
+    memo = memo.reshape((lengths.shape[0], d))
     lane_lead = np.zeros(_LANES, dtype=np.int64)
     block = 1 << max(0, 35 - d)
     work = 0
@@ -274,7 +302,7 @@ def _solve(z, primes, words, lengths, left, right, members, class_start, K, core
         while r1 < m and class_start[r1] == r0:
             r1 += 1
         size = r1 - r0
-        chain = np.full((size, d), -1, dtype=np.int64)  # chain[r, j]: index of members[r0 + r][j:]
+        chain = _filled(size * d, -1).reshape((size, d))  # chain[r, j]: index of members[r0 + r][j:]
         any_nonzero = False
         for r in range(size):
             c = members[r0 + r]
@@ -287,12 +315,12 @@ def _solve(z, primes, words, lengths, left, right, members, class_start, K, core
                         any_nonzero = True
         if any_nonzero and size > 1:
             kids, roots = _class_program(members[r0:r1], core, K, words, lengths, left, right, g, d, memo)
-            X = np.zeros((g * d + kids.shape[0], _LANES), dtype=np.int32)
+            X = _zeros2(g * d + kids.shape[0], _LANES, np.int32)
             for b0 in range(r0, r1, _LANES):
                 b1 = min(b0 + _LANES, r1)
-                stop = -1  # every member before the group's last word that is (or may still become) non-zero
+                stop = np.int64(-1)  # (not a literal: one compiled _run_program) every member before the group's last word that is (or may still become) non-zero
                 for q in range(r0, b1 - 1):
-                    if (live[q] or q >= b0) and roots[q - r0] > stop:
+                    if (live[q] != 0 or q >= b0) and roots[q - r0] > stop:
                         stop = roots[q - r0]
                 if stop >= 0:
                     for r in range(b0, b1):
@@ -309,7 +337,7 @@ def _solve(z, primes, words, lengths, left, right, members, class_start, K, core
                     acc[:nb] = 0
                     terms = 0
                     for q in range(r0, b0):  # members before the group (final): one row of X for all lanes
-                        if live[q]:
+                        if live[q] != 0:
                             kv, sv, root = K[members[q]], span[members[q]], roots[q - r0]
                             hit = False
                             for lane in range(nb):
@@ -334,7 +362,7 @@ def _solve(z, primes, words, lengths, left, right, members, class_start, K, core
                     kw, la = lane_span[lane], lane_lead[lane]
                     if stop >= 0:
                         for q in range(b0, r):  # members of the group before w (final by now)
-                            if live[q] and K[members[q]] <= la:
+                            if live[q] != 0 and K[members[q]] <= la:
                                 c = np.int64(X[roots[q - r0], lane])
                                 if c != 0:
                                     for j in range(min(span[members[q]], kw) + 1):
@@ -348,14 +376,16 @@ def _solve(z, primes, words, lengths, left, right, members, class_start, K, core
                     for j in range(kw + 1):
                         for i in range(k):
                             if z[chain[r - r0, j], i] != 0:
-                                live[r] = True
+                                live[r] = 1
         else:
             for r in range(size):
                 for j in range(span[members[r0 + r]] + 1):
                     for i in range(k):
                         if z[chain[r, j], i] != 0:
-                            live[r0 + r] = True
+                            live[r0 + r] = 1
         r0 = r1
+    if d < n:
+        _even_top(z, primes, lengths, right, K, beta, n)
     return work
 
 
@@ -369,14 +399,14 @@ def _word_coefficients(letters, cpow, logk, primes, g, n, count, top):
     s = letters.shape[0]
     k = primes.shape[0]
     inv = 1.0 / primes.astype(np.float64)
-    out = np.zeros((count, k), dtype=np.int64)
-    F = np.zeros((n + 1, n + 1, s + 1, k), dtype=np.int64)  # F[m, j, t] = <E_1..E_t, w[j:m]>
-    A = np.zeros((n + 1, n + 1, k), dtype=np.int64)  # A[m, kk] = <(Phi - 1)^kk, w[:m]>
-    F[:, :, :, :] = 0
+    out = _zeros2(count, k, np.int64)
+    # F[m, j, t] = <E_1..E_t, w[j:m]>, A[m, kk] = <(Phi - 1)^kk, w[:m]>
+    F = np.zeros((n + 1) * (n + 1) * (s + 1) * k, dtype=np.int64).reshape((n + 1, n + 1, s + 1, k))
+    A = np.zeros((n + 1) * (n + 1) * k, dtype=np.int64).reshape((n + 1, n + 1, k))
     for m in range(n + 1):
         F[m, m, :, :] = 1
     A[0, 0, :] = 1
-    w = np.full(n + 1, -1, dtype=np.int64)
+    w = _filled(n + 1, -1)
     run = np.zeros(n + 1, dtype=np.int64)  # run[m]: length of the trailing run of equal letters of w[:m]
     acc = np.zeros(k, dtype=np.int64)
     length, idx, period = 1, 0, 1
@@ -584,15 +614,15 @@ def _even_top(z, primes, lengths, right, K, beta, n):
             z[w, i] = acc[i]
 
 
-@numba.njit(cache=True)
 def _engine(letters, cpow, logk, primes, beta, g, n, top, words, lengths, left, right, members, class_start):
-    """Word coefficients, the chained solve of degree ``top``, and Eq. (3) when ``top < n``: one compiled entry
-    point (each entry point costs a cache load in a fresh process)."""
+    """Word coefficients, then the chained solve of degree ``top`` and Eq. (3) when ``top < n``.
+
+    Two compiled entry points called from Python, not one compiled driver calling them: numba links a
+    callee's code into its caller and optimises the linked module again, so a driver would cost the
+    optimisation of both twice on a cold start (1.2 s of 6.5 s measured); an entry point costs a
+    cache load (a few ms) in a fresh process."""
     z = _word_coefficients(letters, cpow, logk, primes, g, n, lengths.shape[0], top)
-    K, core, lead, span = _chains(words, lengths, left, right)
-    work = _solve(z, primes, words, lengths, left, right, members, class_start, K, core, lead, span, g, top)
-    if top < n:
-        _even_top(z, primes, lengths, right, K, beta, n)
+    work = _solve(z, primes, beta, words, lengths, left, right, members, class_start, g, n, top)
     return z, work
 
 
@@ -653,12 +683,12 @@ def _class_program(members, core, K, words, lengths, left, right, g, d, memo):
     evaluating up to the root of a member evaluates all it needs; a core that is a letter has a
     leaf as its root.  ``memo[u, l]`` (all ``-1`` on entry and again on return) numbers the nodes."""
     cap = 64
-    kids = np.empty((cap, 4), dtype=np.int64)
-    keys = np.empty((cap, 2), dtype=np.int64)
+    kids = _zeros2(cap, 4, np.int64)
+    keys = _zeros2(cap, 2, np.int64)
     count = g * d
-    roots = np.empty(members.shape[0], dtype=np.int64)
-    stack = np.empty((4 * d * d + 8, 2), dtype=np.int64)
-    ks = np.empty(4, dtype=np.int64)
+    roots = np.zeros(members.shape[0], dtype=np.int64)
+    stack = _zeros2(4 * d * d + 8, 2, np.int64)
+    ks = np.zeros(4, dtype=np.int64)
     for r in range(members.shape[0]):
         u0, l0 = core[members[r]], K[members[r]]
         if lengths[u0] == 1:
@@ -697,8 +727,8 @@ def _class_program(members, core, K, words, lengths, left, right, g, d, memo):
                 cap *= 2
                 # element loops, not slice assignments: a slice assignment makes numba compile its
                 # broadcasting error path with the unicode machinery (seconds of cold compile time)
-                grown = np.empty((cap, 4), dtype=np.int64)
-                grown_keys = np.empty((cap, 2), dtype=np.int64)
+                grown = _zeros2(cap, 4, np.int64)
+                grown_keys = _zeros2(cap, 2, np.int64)
                 for i in range(inner):
                     for c in range(4):
                         grown[i, c] = kids[i, c]

@@ -58,7 +58,7 @@ from ..integrators.flows import TIME, exact_flow
 STEP = sympy.Symbol("h")
 
 #: Bump when the generated source changes meaning (part of the cache key).
-TEMPLATE_VERSION = "5"
+TEMPLATE_VERSION = "6"
 
 _FUNCTIONS = ("exp", "expm1", "log", "sin", "cos", "tan", "sinh", "cosh", "tanh", "sqrt", "atan", "asin", "acos")
 
@@ -429,6 +429,22 @@ def pair_lines(u, e, f, value, prefix="_", style="python"):
             f"if {u} < 0: {e}, {f} = {f}, {e}"]
 
 
+#: The generated function ``e, f = _expm1_pair(u)`` (:func:`pair_lines` as a function), called by the batch
+#: loops' redo; the compiled loops call its compiled form (:meth:`~nambu_bch.numeric.kernels.Kernel.function`).
+PAIR_FUNCTION = "_expm1_pair"
+
+
+def pair_function_source() -> str:
+    """``def _expm1_pair(x): ... return e0, f0`` -- the statements of :func:`pair_lines` (style ``"python"``)."""
+    body = pair_lines("u0", "e0", "f0", "x")
+    return f"""
+
+def {PAIR_FUNCTION}(x):
+{_indent(body, 4)}
+    return e0, f0
+"""
+
+
 def expm1_pair(u: float) -> tuple:
     """``(expm1(u), expm1(-u))`` in float64 exactly as the generated kernels compute a shared pair.
 
@@ -444,18 +460,24 @@ def expm1_pair(u: float) -> tuple:
 # -- loop bodies ----------------------------------------------------------------------------------------
 
 
-def body_lines(program: StepProgram, printer, kahan=False, c_syntax=False, vector=False, prefix="_", select=False):
+def body_lines(program: StepProgram, printer, kahan=False, c_syntax=False, vector=False, prefix="_", select=False,
+               pair_call=None):
     """Statements of one step, ``s_i`` / ``k_j`` / ``d_j`` / ``c_i`` named as in the generated kernels.
 
     ``vector``: numpy arrays (the shared-exponential swap is a ``np.where``); ``prefix``: of the
     function names (``_``, ``_np_``, ``_mp_``); ``c_syntax``: C99; ``select``: shared exponentials
-    without branches (:func:`pair_lines` style ``"select"``, for the vectorised batch loop).
+    without branches (:func:`pair_lines` style ``"select"``, for the vectorised batch loop);
+    ``pair_call``: the name of a function computing a shared pair (``e_j, f_j = pair_call(u_j)``,
+    :data:`PAIR_FUNCTION`) instead of its statements inline.
     """
     end = ";" if c_syntax else ""
     decl = "double " if c_syntax else ""
     lines = []
     for u in program.updates:
         for us, es, fs, ue in u.pairs:
+            if pair_call:
+                lines += [f"{us} = {printer(ue)}", f"{es}, {fs} = {pair_call}({us})"]
+                continue
             style = ("cselect" if select else "c") if c_syntax else "numpy" if vector else "select" if select else "python"
             lines += pair_lines(str(us), str(es), str(fs), printer(ue), prefix, style)
         names = []
@@ -569,6 +591,8 @@ def python_source(program: StepProgram) -> str:
     finite = " and ".join(f"_isfinite({v})" for v in s)
     sample = "; ".join(f"out[j, {i}] = {v}" for i, v in enumerate(s))
     src = [_HEADER.format(version=TEMPLATE_VERSION), constants_source(program)]
+    if any(u.pairs for u in program.updates):
+        src.append(pair_function_source())
 
     for kahan in (False, True):
         body = body_lines(program, scalar, kahan)
@@ -613,14 +637,16 @@ def {name}({args}):
         if any(u.pairs for u in program.updates):
             # shared exponentials: one branch-free pass over the chunk (vectorised); if some |u| left the
             # series range, the chunk's step is undone and redone with the library branch -- the same bits
-            # as the branchy loop either way
+            # as the branchy loop either way.  The redo (scalar, rare) calls the pair function instead of
+            # repeating its statements per sub-flow: half the source numba compiles (issue 11)
             fast = body_lines(program, scalar, kahan, select=True)
+            redo = body_lines(program, scalar, kahan, pair_call=PAIR_FUNCTION)
             saved = [line for q, r in enumerate(rows) for line in _row_copy(f"R{q}", r)]
             restore = [line for q, r in enumerate(rows) for line in _row_copy(r, f"R{q}")]
             chunk_step = [*saved, "over = 0", "for b in range(nb):",
                           *("    " + line for line in inner_load + fast + inner_store),
                           "if over:", *("    " + line for line in restore),
-                          *("    " + line for line in chunk_step)]
+                          "    for b in range(nb):", *("        " + line for line in inner_load + redo + inner_store)]
         chunk_sample = []
         for i in range(N):  # the sample, row by row, counting non-finite values as it is written
             chunk_sample += [f"row = out[j, {i}, b0:b0 + nb]", "for b in range(nb):",
@@ -667,88 +693,9 @@ def {name}({args}):
 {_indent(vcomp, 8)}
     return bad
 """)
-    src.append(_SCAN)
     return "\n".join(src)
 
 
-#: One pass over a batch ``X`` (N, B): what the input guards need, compiled with the kernel.  Blocks of
-#: ``W`` states: the per-state max-norm, product and smallest non-zero magnitude (rows combined in
-#: order, as :func:`~nambu_bch.numeric.guards.extreme_states`), then the block's extremes.  Those
-#: are found on the IEEE bit patterns as int64 -- ordered like the values for the non-negative
-#: doubles compared here -- so the reductions vectorise without fast-math; the first state reaching
-#: a new extreme is kept, like ``numpy.argmax``.  (A non-finite input makes the columns meaningless;
-#: the caller then refuses the batch on the counts.)
-_SCAN = """
-def scan(X, res):
-    N = X.shape[0]
-    B = X.shape[1]
-    W = 1024
-    big = np.empty(W)
-    prod = np.empty(W)
-    small = np.empty(W)
-    Ib = big.view(np.int64)
-    Ip = prod.view(np.int64)
-    Is = small.view(np.int64)
-    nonfinite = 0
-    subnormal = 0
-    top = np.int64(9223372036854775807)
-    bmax = np.int64(-1); bmin = top; pmax = np.int64(-1); pmin = top; smin = top
-    ibmax = 0; ibmin = 0; ipmax = 0; ipmin = 0; ismin = 0
-    for b0 in range(0, B, W):
-        nb = min(W, B - b0)
-        row = X[0, b0:b0 + nb]
-        for b in range(nb):
-            a = abs(row[b])
-            big[b] = a
-            prod[b] = a
-            small[b] = a if a > 0.0 else _INF
-        for i in range(1, N):
-            row = X[i, b0:b0 + nb]
-            for b in range(nb):
-                a = abs(row[b])
-                g = big[b]
-                big[b] = a if a > g else g
-                prod[b] *= a
-                m = small[b]
-                small[b] = a if (a < m) & (a > 0.0) else m
-        for i in range(N):
-            row = X[i, b0:b0 + nb]
-            nf = 0
-            sb = 0
-            for b in range(nb):
-                a = abs(row[b])
-                nf += 0 if a <= _MAX else 1
-                sb += 1 if (a < _TINY) & (a > 0.0) else 0
-            nonfinite += nf
-            subnormal += sb
-        m1 = Ib[0]; m2 = Ib[0]; m3 = Ip[0]; m4 = Ip[0]; m5 = Is[0]
-        for b in range(nb):
-            v = Ib[b]
-            m1 = max(m1, v)
-            m2 = min(m2, v)
-            v = Ip[b]
-            m3 = max(m3, v)
-            m4 = min(m4, v)
-            m5 = min(m5, Is[b])
-        if m1 > bmax:
-            bmax = m1; ibmax = b0 + np.argmax(Ib[:nb] == m1)
-        if m2 < bmin:
-            bmin = m2; ibmin = b0 + np.argmax(Ib[:nb] == m2)
-        if m3 > pmax:
-            pmax = m3; ipmax = b0 + np.argmax(Ip[:nb] == m3)
-        if m4 < pmin:
-            pmin = m4; ipmin = b0 + np.argmax(Ip[:nb] == m4)
-        if m5 < smin:
-            smin = m5; ismin = b0 + np.argmax(Is[:nb] == m5)
-    res[0] = nonfinite
-    res[1] = subnormal
-    res[2] = ibmax
-    res[3] = ibmin
-    res[4] = ipmax
-    res[5] = ipmin
-    res[6] = ismin
-    return nonfinite + subnormal
-"""
 
 
 def mpmath_source(program: StepProgram) -> str:

@@ -22,11 +22,9 @@ Horikoshi, Sect. 5.5: ``x^{32123}(t) = (Phi^{32123}_h)^n x(0)``, ``t = n h``.
 
 from __future__ import annotations
 
-import sys
-
 import numpy as np
 
-from ..errors import InvalidRunError, InvalidSystemError
+from ..errors import InvalidRunError, InvalidSystemError, NumericalRangeError
 from ..progress import Progress, progress_wanted
 from ..systems import System, model
 from .guards import check_count, check_inputs, check_range, check_result, check_stability, scan_states
@@ -68,7 +66,8 @@ def iterate(system, word, h, steps, x0, params=None, every=1, *, kahan=False, dp
     every : int >= 1 -- keep every ``every``-th state (long runs need not fill memory)
     kahan : bool -- compensated summation of the increments (float64 only)
     dps : int, optional -- decimal digits of an mpmath run (a reference; ~10^3x slower)
-    backend : ``"auto"`` | ``"numba"`` | ``"numpy"``
+    backend : ``"auto"`` | ``"numba"`` | ``"numpy"`` -- ``"auto"``: compiled, except runs too small to pay for
+        compiling their loop (:data:`INTERPRET_STEPS`), which take the interpreter (the same bits)
     progress : bool or None -- a progress line on stderr; None: only on a terminal and for long runs
     chunk : int, optional -- states per cache block of a batch (tuning only)
     check_stable : bool -- refuse steps outside the stability interval (:func:`~nambu_bch.numeric.guards.check_stability`)
@@ -113,7 +112,7 @@ def iterate(system, word, h, steps, x0, params=None, every=1, *, kahan=False, dp
         with reporter:
             return run_mpmath(kern, X, h, steps, every, params, dps, reporter.update if reporter.enabled else None)
 
-    run = _prepare(system, kern, h, steps, every, x0, params, backend, chunk, check_stable)
+    run = _prepare(system, kern, h, steps, every, x0, params, backend, chunk, check_stable, kahan)
     h, steps, every, X, be, K = run.h, run.steps, run.every, run.X, run.backend, run.K
     chunk = run.chunk
 
@@ -141,7 +140,7 @@ def iterate(system, word, h, steps, x0, params=None, every=1, *, kahan=False, dp
         while done < steps:
             seg = min(segment, steps - done)
             nseg = n_samples(seg, every)
-            n = kern.run(state, K, seg, every, out[j:j + nseg], kahan=kahan, comp=comp, backend=be)
+            n, be = _run_single(kern, state, K, seg, every, out[j:j + nseg], kahan, comp, be, run.fallback, what)
             if n < seg:  # stopped at a non-finite sample: the rest is undefined
                 out[j + n_samples(n, every):] = np.nan
                 break
@@ -151,6 +150,27 @@ def iterate(system, word, h, steps, x0, params=None, every=1, *, kahan=False, dp
     if count > 1:  # sample 0 is x0, checked before the run
         check_result(out[1:], sample_steps(steps, every)[1:], what, start=0)
     return out
+
+
+def _run_single(kern, state, K, steps, every, out, kahan, comp, be, fallback, what):
+    """One segment of a single trajectory: ``(steps done, backend for the next segment)``.
+
+    The interpreter raises where compiled float64 arithmetic gives inf or nan (``math.exp``
+    overflowing, ``log`` of a negative number, division by zero); it leaves ``state`` and ``comp``
+    untouched then.  If it was chosen only for speed (``fallback``) the compiled loop runs the
+    segment instead, so ``backend="auto"`` reports the same result as with ``"numba"``;
+    otherwise (``backend="numpy"``, or numba absent) the run is refused in one line.
+    """
+    try:
+        return kern.run(state, K, steps, every, out, kahan=kahan, comp=comp, backend=be), be
+    except (ArithmeticError, ValueError) as exc:
+        if be != "numpy":
+            raise
+        if fallback:
+            return kern.run(state, K, steps, every, out, kahan=kahan, comp=comp, backend="numba"), "numba"
+        raise NumericalRangeError(f"{what}: float64 arithmetic failed on the interpreter ({exc}); the state "
+                                  "left the range of the step's functions; take a smaller h, or use dps=... (mpmath)"
+                                  ) from None
 
 
 def _run_batch(kern, X, K, steps, every, out, kahan, be, chunk, segment, reporter, what):
@@ -180,34 +200,41 @@ def _run_batch(kern, X, K, steps, every, out, kahan, be, chunk, segment, reporte
             reporter.update(done * X.shape[1])
 
 
-#: Runs at most this long (trajectory-steps of one state) take the interpreter when ``backend="auto"``
-#: and numba has not been loaded yet: loading numba and a cached kernel costs ~0.3-0.5 s, more than
-#: the interpreter needs for a few thousand steps (~1-3 us a step).
-SMALL_RUN_STEPS = 4000
-#: Batches of at most this many steps (and states) likewise run on numpy arrays when numba is not loaded.
+#: ``backend="auto"`` runs a loop on the interpreter while its compiled version is not ready
+#: (:meth:`~nambu_bch.numeric.kernels.Kernel.ready`: neither compiled in this process nor in numba's
+#: cache on disk, or numba not even imported) and compiling would cost more than the run: up to this
+#: many trajectory-steps of one state per loop and process, in total.  Compiling a single-state loop
+#: costs 0.1-0.7 s (importing numba another 0.3 s); the interpreter takes 0.3-2 us a step (ho3 0.4,
+#: Lotka-Volterra 2.1), so this budget costs at most ~0.1 s -- and the loop is compiled once a
+#: process needs more.  The interpreter runs the same statements on Python floats and the C
+#: library's functions: the samples are the compiled loop's, bit for bit.
+INTERPRET_STEPS = 50_000
+#: Kept for compatibility: the per-run limit of the earlier rule (now :data:`INTERPRET_STEPS` in total).
+SMALL_RUN_STEPS = INTERPRET_STEPS
+#: Batches of at most this many steps (and states) likewise run on numpy arrays while the compiled batch
+#: loop is not ready (0.3-4 s to compile) -- only kernels whose numpy loop gives the compiled bits
+#: (:attr:`~nambu_bch.numeric.kernels.Kernel.numpy_matches_compiled`: polynomial and trigonometric flows).
 SMALL_BATCH_STEPS, SMALL_BATCH_STATES = 100, 16384
 
 
 class _Run:
     """The validated inputs of one float64 run."""
 
-    __slots__ = ("h", "steps", "every", "X", "backend", "K", "chunk")
+    __slots__ = ("h", "steps", "every", "X", "backend", "K", "chunk", "fallback")
 
     def __init__(self, **kw):
         for k, v in kw.items():
             setattr(self, k, v)
 
 
-def _prepare(system, kern, h, steps, every, x0, params, backend, chunk, check_stable) -> _Run:
+def _prepare(system, kern, h, steps, every, x0, params, backend, chunk, check_stable, kahan=False) -> _Run:
     """Validate a float64 run, choose the backend, compute the constants, check stability and range."""
     be = resolve_backend(backend)
     steps = check_count(steps, "steps", 0)
     shape = np.shape(x0)
-    if backend == "auto" and be == "numba" and not kern.compile_seconds and "numba" not in sys.modules:
-        small = (steps <= SMALL_RUN_STEPS if len(shape) == 1 else
-                 (steps <= SMALL_BATCH_STEPS and len(shape) == 2 and shape[1] <= SMALL_BATCH_STATES))
-        if small:
-            be = "numpy"
+    fallback = False  # the interpreter chosen for speed: on an arithmetic exception the compiled loop takes over
+    if backend == "auto" and be == "numba":
+        be, fallback = _interpret_small(kern, steps, shape, kahan)
     # a large batch: one pass (compiled on numba, blocked numpy otherwise) finds non-finite, subnormal and
     # extreme states; the batch itself is only read by the run, so it is not copied
     batch = len(shape) == 2
@@ -227,7 +254,29 @@ def _prepare(system, kern, h, steps, every, x0, params, backend, chunk, check_st
     if check_stable:
         check_stability(kern, h, K, params)
     check_range(kern, X, K, columns=scanned["result"][2] if scanned else None)
-    return _Run(h=h, steps=steps, every=every, X=X, backend=be, K=K, chunk=chunk)
+    return _Run(h=h, steps=steps, every=every, X=X, backend=be, K=K, chunk=chunk, fallback=fallback)
+
+
+def _interpret_small(kern, steps, shape, kahan):
+    """``("numpy", True)`` if the run should take the interpreter (or numpy, for a batch), else ``("numba", False)``.
+
+    A single state: the loop is not :meth:`~nambu_bch.numeric.kernels.Kernel.ready` and the steps
+    interpreted so far in this process plus these stay within :data:`INTERPRET_STEPS`.  A batch:
+    the same readiness, at most :data:`SMALL_BATCH_STEPS` steps of :data:`SMALL_BATCH_STATES`
+    states, and a numpy loop with the compiled loop's bits.
+    """
+    batch = len(shape) == 2
+    name = ("run_batch" if batch else "run") + ("_kahan" if kahan else "")
+    if kern.ready(name):
+        return "numba", False
+    if batch:
+        small = steps <= SMALL_BATCH_STEPS and shape[1] <= SMALL_BATCH_STATES and kern.numpy_matches_compiled
+    else:
+        small = len(shape) == 1 and kern.interpreted.get(name, 0) + steps <= INTERPRET_STEPS
+    if not small:
+        return "numba", False
+    kern.interpreted[name] = kern.interpreted.get(name, 0) + steps
+    return "numpy", True
 
 
 #: Batches with more states than this are scanned in one pass (compiled, or numpy blocks) instead of
@@ -256,7 +305,7 @@ def iterate_chunks(system, word, h, steps, x0, params=None, every=1, *, kahan=Fa
     system = as_system(system)
     kern = kernel(system, word)
     chunk_samples = _count(chunk_samples, "chunk_samples", 2)
-    run = _prepare(system, kern, h, steps, every, x0, params, backend, None, check_stable)
+    run = _prepare(system, kern, h, steps, every, x0, params, backend, None, check_stable, kahan)
     if run.X.ndim != 1:
         raise InvalidRunError(f"iterate_chunks takes one initial state of shape ({system.N},), got shape {run.X.shape}")
     steps, every, be = run.steps, run.every, run.backend
@@ -271,7 +320,8 @@ def iterate_chunks(system, word, h, steps, x0, params=None, every=1, *, kahan=Fa
             nseg = n_samples(seg, every)
             out = np.empty((nseg, system.N))
             out[0] = state
-            n = kern.run(state, run.K, seg, every, out, kahan=kahan, comp=comp, backend=be)
+            n, be = _run_single(kern, state, run.K, seg, every, out, kahan, comp, be, run.fallback,
+                                f"{system.name} under {kern.word} with h = {run.h!r}")
             numbers = done + sample_steps(seg, every)
             if n < seg:
                 out[n_samples(n, every):] = np.nan

@@ -64,7 +64,7 @@ from ..errors import InvalidRunError, NumericalRangeError
 from ..private_dirs import cache_root, euid, untrusted
 from ..integrators.composition import composition_for
 from ..integrators.step import parameter_values
-from .codegen import TEMPLATE_VERSION, python_source, source_hash, step_program
+from .codegen import PAIR_FUNCTION, TEMPLATE_VERSION, python_source, source_hash, step_program
 
 BACKENDS = ("auto", "numba", "numpy")
 #: States per chunk of a batch: the chunk's arrays stay in L1/L2 while all steps run.
@@ -151,7 +151,7 @@ MAX_CACHE_FILE = 4 * 2**20
 _MODULE_NAME = re.compile(r"nambu_bch_kernel_[0-9a-f]{20}")
 _INDEX_FIELDS = {"template": str, "module": str, "sha256": str, "N": int, "n_constants": int,
                  "n_parameters": int, "linear": list}
-_FUNCTIONS = ("constants", "run", "run_kahan", "run_batch", "run_batch_kahan", "run_numpy", "run_numpy_kahan", "scan")
+_FUNCTIONS = ("constants", "run", "run_kahan", "run_batch", "run_batch_kahan", "run_numpy", "run_numpy_kahan")
 
 
 def input_key(system, comp) -> str:
@@ -241,6 +241,8 @@ class Kernel:
     path : pathlib.Path -- where it is cached
     module : the imported module (pure-Python functions, the numpy fallback)
     compile_seconds : dict -- wall time of each numba compilation or cache load, by function name
+    interpreted : dict -- steps run on the interpreter because compiling would have cost more
+        (:func:`~nambu_bch.numeric.iterate.iterate` with ``backend="auto"``), by function name
     """
 
     def __init__(self, system, comp):
@@ -256,6 +258,7 @@ class Kernel:
             self._generate()
         self._jitted = {}
         self.compile_seconds = {}
+        self.interpreted = {}
 
     def _load_cached(self) -> bool:
         """Use the cached source if its index is intact and the file matches the recorded digest."""
@@ -342,27 +345,51 @@ class Kernel:
         if fn is None:
             import numba
 
+            if name.startswith("run_batch") and hasattr(self.module, PAIR_FUNCTION):
+                # the batch loops' redo calls the shared-exponential function: compiled, it is a global of theirs
+                self.module.__dict__[PAIR_FUNCTION] = self.function(PAIR_FUNCTION)
             on_disk = self.path.is_file()  # numba caches next to a source file; without one, compile in memory
-            fn = numba.njit(cache=on_disk, nogil=True, fastmath=False, error_model="numpy")(getattr(self.module, name))
+            py = getattr(self.module, name)
+            py = getattr(py, "py_func", py)  # the compiled pair function stands in the module once bound
+            fn = numba.njit(cache=on_disk, nogil=True, fastmath=False, error_model="numpy")(py)
             self._jitted[name] = fn
         return fn
+
+    def ready(self, name: str) -> bool:
+        """Whether the compiled loop ``name`` starts at no real cost: compiled or loaded in this process, or
+        numba already imported and the loop's machine code in numba's cache next to the module
+        (``__pycache__/<module>.<name>-<line>.py<ver>.nbi``; loading it takes milliseconds, compiling it
+        0.1-4 s).  Only a hint for the backend choice: a stale index just costs a compile."""
+        if name in self.compile_seconds:
+            return True
+        if "numba" not in sys.modules:
+            return False
+        try:
+            return any((self.path.parent / "__pycache__").glob(f"{self.path.stem}.{name}-*.nbi"))
+        except OSError:
+            return False
+
+    @property
+    def numpy_matches_compiled(self) -> bool:
+        """Whether the numpy batch loop gives the compiled loop's bits for every input: it calls no numpy
+        function but ``isfinite`` and ``sqrt`` (correctly rounded).  numpy's own ``exp``, ``expm1``,
+        ``log``, ``sinh``, ... differ from the C library's (which the compiled and the interpreted
+        single-state loops call) in the last bit for some arguments."""
+        body = self.source.partition("\ndef run_numpy(")[2]
+        return not (set(re.findall(r"\b_np_(\w+)\(", body)) - {"isfinite", "sqrt"})
 
     def scan(self, X):
         """One compiled pass over a batch ``X`` (N, B): ``(non-finite count, subnormal count, columns)``.
 
         ``columns`` are the extreme states of :func:`~nambu_bch.numeric.guards.extreme_states`
         (largest / smallest max-norm and product of magnitudes, smallest non-zero component).
+        The pass does not depend on the system: :func:`nambu_bch.numeric.scan.scan`, compiled once
+        for all kernels.
         """
-        if "scan" not in self.compile_seconds:
-            self.compile_seconds["scan"] = 0.0
-            fn = self.function("scan")
-            try:
-                fn(np.zeros((1, 1)), np.zeros(7, dtype=np.int64))
-            except Exception:  # noqa: BLE001 - a corrupt numba cache entry: purge and compile again
-                self._purge_numba_cache(fn)
-                self._jitted.pop("scan", None)
+        from .scan import scan
+
         res = np.zeros(7, dtype=np.int64)
-        self.function("scan")(X, res)
+        scan(X, res)
         return int(res[0]), int(res[1]), np.unique(np.concatenate([res[2:], [0, X.shape[1] - 1]]))
 
     def compile(self, kahan: bool = False, batch: bool = False) -> float:
