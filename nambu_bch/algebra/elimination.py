@@ -12,7 +12,7 @@ exponent vectors.  Everything here is an exact reduced row echelon form
 
 The echelon form is unique, so its routes are interchangeable and give identical
 results: the matrix is split into the blocks of its sparsity graph; over ``QQ`` a block
-is eliminated densely by python-flint's ``fmpq_mat`` (optional extra ``fast``;
+is eliminated densely by python-flint's ``fmpq_mat`` (a dependency;
 ``NAMBU_BCH_DISABLE_FLINT=1`` switches it off), without it multi-modularly in numpy with an exact check of the
 result (:mod:`nambu_bch.algebra.modular_rref`, blocks of at least :data:`MODULAR_MIN` rows and columns); over ``QQ<theta>`` or
 ``QQ<theta>(parameters)`` (triple-jump coefficients) a matrix with entries in the base
@@ -101,8 +101,8 @@ _FLINT: list = []
 def flint_available() -> bool:
     """python-flint is installed and not disabled by ``NAMBU_BCH_DISABLE_FLINT=1`` (read at every call).
 
-    python-flint is an optional extra (``pip install nambu_bch[fast]``); without it every
-    elimination runs on sympy's ``DomainMatrix`` alone, with the same results.
+    python-flint is a dependency; when it is missing or switched off every elimination runs on the
+    package's multi-modular RREF or sympy's ``DomainMatrix``, with the same results (both paths are tested).
     """
     if os.environ.get("NAMBU_BCH_DISABLE_FLINT", "").strip().lower() in ("1", "true", "yes", "on"):
         return False
