@@ -61,3 +61,11 @@ def bch(name: str, word: str, order: int, verify: bool = True):
 def nambu_h2(word: str = "12321"):
     """``generic_nambu_h2(word)``: the generic Nambu answer at ``h^2`` (separable ``H_i, G_i``, full split)."""
     return generic_nambu_h2(word)
+
+
+@lru_cache(maxsize=None)
+def brackets(name: str, word: str, order: int):
+    """``fi_brackets(model(name), word, order)``: the BCH brackets at ``h^order`` with their FI hulls (a tuple)."""
+    from nambu_bch.shadow.fi_route import fi_brackets
+
+    return tuple(fi_brackets(nb.model(name), word, order))
