@@ -183,10 +183,10 @@ def test_issue_example_has_a_smooth_pair_not_polynomial(ex17, ex17_12321):
     assert "smooth" in F.to_text() and "undecided" not in repr(F)
 
 
-def test_bounded_work_refuses_an_elimination_above_the_cost_budget(ex17, monkeypatch):
+def test_bounded_work_refuses_an_elimination_above_the_cost_budget(ex17, ex17_12321, monkeypatch):
     """Bounded work (issue 17, kept by issue 14): with max_unknowns given, an order whose elimination is estimated
     (elimination_cost of the built matrix) above direct_route.SOLVE_COST is refused up front, before anything is
-    eliminated, and the averages decide; at the estimate itself the solve runs (ex17, 12321, h^2: obstructed)."""
+    eliminated, and the averages decide; below the budget the solve runs (ex17, 12321, h^2: obstructed)."""
     import importlib
 
     from nambu_bch.algebra import elimination
@@ -194,10 +194,12 @@ def test_bounded_work_refuses_an_elimination_above_the_cost_budget(ex17, monkeyp
     dr = importlib.import_module("nambu_bch.shadow.direct_route")
     budget, seen = dr.SOLVE_COST, []
     monkeypatch.setattr(dr, "elimination_cost", lambda *a: seen.append(elimination.elimination_cost(*a)) or seen[-1])
-    monkeypatch.setattr(dr, "SOLVE_COST", 10**12)
-    assert direct_route(ex17, "12321", 2, max_unknowns=2000).orders[-1].status == "obstructed"
+    monkeypatch.setattr(dr, "SOLVE_COST", 0)   # the estimate of the built matrix, recorded; nothing is eliminated
+    assert direct_route(ex17, "12321", 2, max_unknowns=2000).orders[-1].status == "refused"
     cost = seen[-1]
-    assert 10**7 < cost < budget  # 8.4e7 (blocks of the 2808 x 1360 matrix): solved by default
+    assert 10**7 < cost < budget  # 8.4e7 (blocks of the 2808 x 1360 matrix): solved by default ...
+    # ... as the default run (shadow_hamiltonians, max_unknowns 2000, budget SOLVE_COST) did: obstructed
+    assert ex17_12321.details.orders[-1].status == "obstructed" and ex17_12321.details.orders[-1].degree == 14
     eliminated = []
     original = elimination._rref_block
     monkeypatch.setattr(elimination, "_rref_block", lambda *a, **k: eliminated.append(a) or original(*a, **k))
