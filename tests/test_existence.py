@@ -23,6 +23,8 @@ from nambu_bch.shadow.averaging import orbit_average, orbit_functions, section_i
 from nambu_bch.shadow.direct_route import direct_route
 from nambu_bch.shadow.existence import decide, exact_average, integrands, reversing_involutions
 
+import shared_results as shared
+
 # the issue's example: separable, closed orbits, both Hamiltonians quartic
 EX17 = ["x1**2/2 + x2**2/2 + x2**4/4 + x3**2", "x1**2/2 + x1**4/8 + x2**2/2 + x3**2/2 + x3**4/4"]
 Hs, Gs = sympy.symbols("H G")
@@ -125,7 +127,7 @@ def _check_drift(F, j):
 def test_ho3_lie_trotter_certified_exactly_with_drift():
     """ho3, Phi^{123}: no shadow pair (certified by the exact averages); JSON carries exists false, polynomial false,
     the drift dH'/dt = h omega^2 (m omega^2 G - 2H)/4 and the measured drift at two step sizes."""
-    F = shadow_hamiltonians(model("ho3"), "123", 2)
+    F = shared.family("ho3", "123", 2)   # the same family test_shadow checks the certificate of
     assert F.failed_order == 1 and F.evidence["method"] == "exact"
     assert sympy.simplify(sympy.sympify(F.drift["H"]) - sympy.Symbol("h") * sympy.sympify(F.evidence["averages"]["H"])) == 0
     _check_drift(F, 1)
@@ -259,7 +261,7 @@ def test_section_integral_solves_the_homological_equation(ex17, ex17_12321):
 
 def test_polynomial_results_unchanged():
     """ho3 Phi^{12321} (Eqs. SH12321c, SG12321c): polynomial pair as before; JSON adds polynomial: true only."""
-    F = shadow_hamiltonians(model("ho3"), "12321", 2)
+    F = shared.family("ho3", "12321", 2)
     assert F.exists is True and F.polynomial is True and F.existence is None
     d = F.to_dict()
     assert d["polynomial"] is True and "drift" not in d and "evidence" not in d
