@@ -18,26 +18,35 @@ from pathlib import Path
 # ``--import-mode=importlib`` pytest does not put it on sys.path itself
 sys.path.insert(0, str(Path(__file__).parent))
 
-# (file, test name prefix) of the tests that take >= 2 s each on the two-core machine, roughly longest first
-# (a cold ``pytest -n 2 --durations=0``, session 11: docs/suite_time.md)
+# (file, test name prefix) of the tests that take >= ~2 s each on the idle two-core machine, roughly longest first
+# (a cold ``pytest -n 2 --durations=0`` of session 12's branch ts, load 2-4; docs/suite_time.md).  Tests that reuse
+# a result of a long one (tests/shared_results.py: computed once per worker process) follow it, so that both run
+# early in the same worker instead of each computing it (the rest of their file may be stolen by the other worker).
 LONG = (
-    ("test_notebooks.py", "test_notebook_executes"),                        # 2.4-10.8 s each, in a kernel process
-    ("test_bch_modular.py", "test_sparse_engine_equals_dense_engine"),      # 8.5 s at [12-12], cold: numba compile
-    ("test_numeric.py", "test_exponential_flows_"),                         # 4-6 s each: Lotka-Volterra kernels, a C build
-    ("test_elimination.py", "test_solve_affine_matches_plain_domainmatrix"),
-    ("test_testing.py", "test_example_suite_"),                             # two pytest subprocesses
-    ("test_cli.py", "test_every_subcommand_runs_as_a_subprocess"),
-    ("test_shadow.py", "test_shadow_pair_reproduces_effective_field"),
-    ("test_shadow.py", "test_eight_representations_for_generic_functions"),
+    ("test_cli.py", "test_every_subcommand_runs_as_a_subprocess"),          # 14 s: nine subprocesses, two at a time
+    ("test_elimination.py", "test_solve_affine_matches_plain_domainmatrix"),  # 12 s at QQ<2^(1/3)>(a,b)
     ("test_direct_route_fast.py", "test_rigid_body_symbolic_yoshida_family_over_base_field"),
-    ("test_fi_route.py", "test_hull_members_have_the_brackets_field"),
+    ("test_bch_modular.py", "test_sparse_engine_equals_dense_engine"),      # 9 s at [12-12], cold: numba compile
+    ("test_notebooks.py", "test_notebook_executes"),                        # 3-8 s each, in a kernel process
+    ("test_numeric.py", "test_exponential_flows_"),                         # 3-7 s each: Lotka-Volterra kernels, a C build
+    ("test_testing.py", "test_example_suite_"),                             # two pytest subprocesses
+    ("test_fi_route.py", "test_hull_members_have_the_brackets_field"),      # the rigid body's 992 h^4 hulls ...
+    ("test_fi_route.py", "test_h4_hull_equals_brute_force_enumeration"),    # ... reused here
     ("test_modular_rref.py", "test_n4_single_split_h4_same_with_modular_and_flint"),
-    ("test_any_system.py", "test_new_system_numerics"),
+    ("test_shadow.py", "test_shadow_pair_reproduces_effective_field"),      # families and X_eff ...
+    ("test_shadow.py", "test_rigid_body_full_split_has_polynomial_shadows_through_h4"),  # ... reused here
+    ("test_shadow.py", "test_single_split_models_have_shadows"),            # ... and here
+    ("test_shadow.py", "test_eight_representations_for_generic_functions"),
+    ("test_any_system.py", "test_new_system_numerics"),                     # families of eight systems ...
+    ("test_any_system.py", "test_new_system_shadow_equals_X_eff_two_routes"),  # ... reused here
+    ("test_any_system.py", "test_toda_h2_and_fpu_h2"),                      # ... and here
+    ("test_fi_route.py", "test_cli_bad_input_is_one_line[argv3"),           # counts 22272 brackets at h^6
     ("test_any_system.py", "test_concrete_equals_generic_substituted_to_h4"),
+    ("test_shadow.py", "test_rigid_body_non_symmetric_word_is_obstructed_at_h1"),
+    ("test_design.py", "test_optimize_finds_yoshidas_sixth_order_solution"),
     ("test_any_system.py", "test_lie_poisson_bch_member_with_casimir_kept"),
-    ("test_existence.py", "test_issue_example_non_symmetric_word_drifts"),
     ("test_shadow.py", "test_n4_full_split_is_obstructed"),
-    ("test_fi_route.py", "test_h4_hull_equals_brute_force_enumeration"),
+    ("test_numeric.py", "test_series_pair_is_accurate"),
 )
 
 

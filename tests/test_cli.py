@@ -345,18 +345,14 @@ def test_plot(tmp_path):
 # bad input: a few subprocesses (incl. injection) and every flag in-process
 # --------------------------------------------------------------------------------------------
 def test_bad_input_as_subprocess(tmp_path):
+    """Bad input through the interpreter's entry point (one subprocess: the injection attempt, exit 2, one line, no
+    file created), and the same kind of runs in process (a missing system file, an unknown flag)."""
     target = tmp_path / "pwned"
-    argvs = (
-        ("conserved", "--H", f"__import__('os').system('touch {target}')", "--coords", "x1 x2"),
-        ("models", "--system", tmp_path / "missing.toml"),
-        ("bch", "--frobnicate"),
-    )
-    with ThreadPoolExecutor(max_workers=2) as pool:
-        runs = list(pool.map(lambda argv: subprocess_cli(*argv), argvs))
-    bad(runs[0], "--H", "not accepted")
+    injection = subprocess_cli("conserved", "--H", f"__import__('os').system('touch {target}')", "--coords", "x1 x2")
+    bad(injection, "--H", "not accepted")
     assert not target.exists() and not Path("/tmp/pwned").exists()
-    bad(runs[1], "--system", "missing.toml")
-    bad(runs[2], "--frobnicate")
+    bad(cli("models", "--system", tmp_path / "missing.toml"), "--system", "missing.toml")
+    bad(cli("bch", "--frobnicate"), "--frobnicate")
 
 
 def _toml(tmp_path, name, text):

@@ -34,7 +34,7 @@ from nambu_bch.design import (
 )
 from nambu_bch.design.catalog import CatalogComposition, lookup, methods
 from nambu_bch.design.compare import slope
-from nambu_bch.design.words import log_coefficients, lyndon_defect_words, lyndon_defects, word_coefficient
+from nambu_bch.design.words import log_coefficients, lyndon_defect_words, lyndon_defects, word_coefficient, word_coefficients
 from nambu_bch.errors import InvalidCompositionError, InvalidOrderError, InvalidRunError, NambuBCHError
 
 F1 = Fraction(1)
@@ -110,6 +110,30 @@ def test_word_coefficient_small_cases():
     assert word_coefficient((1, 1), [(1, F1), (1, F1)], F1, F0, _inv) == 2
     d = lyndon_defects([(1, F1), (2, F1)], 2, 2, F1, F0, _inv)
     assert d == {(1, 2): 1}
+
+
+def test_word_coefficients_of_a_prefix_tree_equal_the_block_sums():
+    """The shared-prefix walk (words.word_coefficients) against the definition (module docstring of design/words):
+    [w] = sum over the splittings of w into consecutive blocks, block j empty or k_j^m, of prod c_j^m / m!."""
+    from itertools import product
+
+    fac = [(1, Fraction(1, 3)), (2, Fraction(-2, 5)), (3, Fraction(3, 7)), (2, Fraction(5, 4)), (1, Fraction(2, 3)),
+           (1, Fraction(-1, 2))]
+
+    def block_sum(w, j=0):
+        if j == len(fac):
+            return F1 if not w else F0
+        k, c = fac[j]
+        total, m = block_sum(w, j + 1), 1
+        while m <= len(w) and w[m - 1] == k:
+            total += c**m * _inv(m) * block_sum(w[m:], j + 1)
+            m += 1
+        return total
+
+    words = [w for q in range(6) for w in product((1, 2, 3), repeat=q)]
+    got = word_coefficients(words, fac, F1, F0, _inv)
+    assert len(got) == len(words) and all(got[w] == block_sum(w) for w in words)
+    assert all(word_coefficient(w, fac, F1, F0, _inv) == got[w] for w in words[:40])
 
 
 def test_error_constant_bad_input():

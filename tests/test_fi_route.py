@@ -31,6 +31,8 @@ from nambu_bch.shadow.fi_nested import Echelon, RawOps, nested_hull
 from nambu_bch.shadow.fundamental_identity import commutator_terms
 from nambu_bch.testing import assert_shadow_pair
 
+import shared_results as shared
+
 fi_module = importlib.import_module("nambu_bch.shadow.fi_route")
 fi_nested_module = importlib.import_module("nambu_bch.shadow.fi_nested")
 fi_brackets = fi_module.fi_brackets
@@ -142,7 +144,7 @@ def test_h4_hull_equals_brute_force_enumeration(name, word):
     """h^4: every labelled representation (one way per pair of terms) lies in the hull, and they span it."""
     S = model(name)
     ops = ops_for(S)
-    brackets = fi_brackets(S, word, 4)
+    brackets = list(shared.brackets(name, word, 4))
     if name == "ho3":
         assert len(brackets) == 6
     else:  # 992 brackets: the first three of hull dimension 4 and three of dimension 3
@@ -162,7 +164,7 @@ def test_hull_members_have_the_brackets_field(name, word, order):
     """Eq. (CL2) at every depth: the base evaluates to the bracket's vector field, every direction to zero."""
     S = model(name)
     ev = term_evaluator(S.splitting)
-    brackets = fi_brackets(S, word, order)
+    brackets = list(shared.brackets(name, word, order))
     if name == "rigid-body":
         brackets = brackets[::40]  # 992 brackets at h^4: every 40th (25 of them), the hulls are shared anyway
     assert brackets

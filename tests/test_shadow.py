@@ -33,6 +33,8 @@ from nambu_bch.shadow import (
     shadow_hamiltonians,
 )
 
+import shared_results as shared
+
 x1, x2, x3, x4 = sympy.symbols("x1 x2 x3 x4")
 m, omega, h, alpha = sympy.symbols("m omega h alpha")
 I1, I2, I3 = sympy.symbols("I1 I2 I3")
@@ -127,10 +129,17 @@ def test_eight_representations_for_generic_functions():
     f = J.convert(f)
     XAB, XCD, XEF = (liouville_field(J, P, Q) for P, Q in [(fA, fB), (fC, fD), (fE, fF)])
     inner = XCD.bracket(XEF)
+    applied = {}  # X_{slots} f, evaluated once per slots (the eight representations share 16 of their 36 terms)
+
+    def field_on_f(slots):
+        if slots not in applied:
+            applied[slots] = liouville_field(J, *(J.convert(s) for s in slots)).apply(f)
+        return applied[slots]
+
     for way in "ab":  # Eqs. (CL2a), (CL2b)
         total = J.ring.zero
         for t in commutator_terms(J, (fC, fD), (fE, fF), way):
-            total += liouville_field(J, *(J.convert(s) for s in t.slots)).apply(f) * J.convert(t.coefficient)
+            total += field_on_f(tuple(t.slots)) * J.convert(t.coefficient)
         assert total == inner.apply(f)
     lhs = XAB.bracket(inner).apply(f)
     reps = representations(J, (fA, fB), (fC, fD), (fE, fF))
@@ -138,7 +147,7 @@ def test_eight_representations_for_generic_functions():
     for label, terms in reps.items():
         total = J.ring.zero
         for t in terms:
-            total += liouville_field(J, *(J.convert(s) for s in t.slots)).apply(f) * J.convert(t.coefficient)
+            total += field_on_f(tuple(t.slots)) * J.convert(t.coefficient)
         assert total == lhs, label
 
 
@@ -244,7 +253,7 @@ def test_fi_family_lies_in_direct_solution_space(word):
     o2 = direct.orders[1]
     assert all(zero(a - b) for a, b in zip(fi.corrections, o2.corrections))
     alg = S.algebra.with_constants(alpha)
-    Z2 = effective_field(S.splitting, word, 2)[2].to_sympy()
+    Z2 = shared.backward_field("ho3", word, 2)[2].to_sympy()
     dH, dG = fi.corrections
     field = liouville_field(alg, dH, S.G) + liouville_field(alg, S.H, dG)
     assert all(zero(a - b) for a, b in zip(field.to_sympy(), Z2))
@@ -269,7 +278,7 @@ def test_direct_route_eq_SHPV1():
 def test_direct_route_eqs_SH12321c_and_members():
     """Default route: Eqs. (SH12321c), (SG12321c); alpha = 1 gives (SH12321a)/(SG12321a), alpha = 0 (SH12321b)/(SG12321b)."""
     S = model("ho3")
-    F = shadow_hamiltonians(S, "12321")
+    F = shared.family("ho3", "12321")
     assert F.route == "direct" and F.free_parameters == ["alpha"]
     assert zero(F.H_S - S.H - h**2 * SH_C) and zero(F.G_S - S.G - h**2 * SG_C)
     Ha, Ga = F.member(alpha=1)
@@ -294,9 +303,11 @@ def test_gauge_of_ho3_is_psi_of_H_and_G():
 # ---------------------------------------------------------------------------------------------
 
 
-def _check_shadow(S, word, order, shadows):
-    """X_{H_S,G_S} (built with liouville_field, exact ring arithmetic) against effective_field, h^0..h^order."""
-    eff = effective_field(S.splitting, word, order)  # backward error analysis, independent of the BCH route
+def _check_shadow(S, word, order, shadows, eff=None):
+    """X_{H_S,G_S} (built with liouville_field, exact ring arithmetic) against effective_field, h^0..h^order
+    (``eff``: that field when already computed, :mod:`shared_results`)."""
+    if eff is None:
+        eff = effective_field(S.splitting, word, order)  # backward error analysis, independent of the BCH route
     alg = eff[0].algebra.with_constants(alpha)
     X = liouville_field(alg, *(alg.convert(sympy.expand(H)) for H in shadows))
     ih = alg.n + alg.constants.index(h)
@@ -316,16 +327,16 @@ def _check_shadow(S, word, order, shadows):
 def test_shadow_pair_reproduces_effective_field(name, word, order):
     """Every reported family (alpha symbolic) satisfies X_{H_S,G_S} = X_eff coefficient by coefficient."""
     S = model(name)
-    F = shadow_hamiltonians(S, word, order)
+    F = shared.family(name, word, order)
     assert F.exists
-    _check_shadow(S, word, order, F.shadows)
+    _check_shadow(S, word, order, F.shadows, shared.backward_field(name, word, order))
 
 
 @pytest.mark.parametrize("word", PAPER_WORDS)
 def test_fi_route_family_reproduces_effective_field(word):
     S = model("ho3")
-    F = shadow_hamiltonians(S, word, 2, route="fi")
-    _check_shadow(S, word, 2, F.shadows)
+    F = shared.family("ho3", word, 2, route="fi")
+    _check_shadow(S, word, 2, F.shadows, shared.backward_field("ho3", word, 2))
 
 
 # ---------------------------------------------------------------------------------------------
@@ -359,7 +370,7 @@ def test_rigid_body_full_split_has_polynomial_shadows_through_h4():
     """Free rigid body, full split, Phi^{12321}: the computation FINDS polynomial shadow Hamiltonians at h^2 (ansatz
     degree 4) and h^4 (degree 6), with an alpha-family; the gauge is exactly the psi(H, G) directions (9 and 14
     dimensions).  So the (quartic, sextic) BCH corrections of the symmetric scheme are of the form X_{H_S,G_S} to h^4."""
-    F = shadow_hamiltonians(model("rigid-body"), "12321", 4)
+    F = shared.family("rigid-body", "12321", 4)
     assert F.exists and F.free_parameters == ["alpha"]
     assert F.degree == {2: 4, 4: 6}
     orders = {o.order: o for o in F.details.orders}
@@ -386,7 +397,7 @@ def test_ho3_non_symmetric_words_are_obstructed_at_h1(word):
     """ho3, Phi^{123} / Lie-Trotter / Phi^{132}: odd orders appear, and already the h^1 term admits NO polynomial shadow
     pair (degree 2 tried; the same certificate works at degrees 4 and 6)."""
     S = model("ho3")
-    F = shadow_hamiltonians(S, word, 2)
+    F = shared.family("ho3", word, 2)
     assert not F.exists and F.failed_order == 1
     _verify_certificate(S, word, F)
 
@@ -401,12 +412,12 @@ def test_single_split_models_have_shadows():
     """Single-Hamiltonian split (noncanonical Poisson, the paper's footnote): Lotka-Volterra Phi^{12321} to h^4 and
     Phi^{123} (h and h^2 terms!) to h^2, ho3-composite Phi^{121} to h^4 and Phi^{12} to h^2 all EXIST; the
     Lotka-Volterra Lie-Trotter family has no free parameter (G = x1 x2 x3 is exactly conserved and G_S = G)."""
-    F = shadow_hamiltonians(model("lotka-volterra"), "123", 2)
+    F = shared.family("lotka-volterra", "123", 2)
     assert F.exists and F.free_parameters == [] and zero(F.G_S - x1 * x2 * x3)
     assert F.corrections[1] != (0, 0)
-    assert shadow_hamiltonians(model("lotka-volterra"), "12321", 4).exists
-    assert shadow_hamiltonians(model("ho3-composite"), "121", 4).exists
-    assert shadow_hamiltonians(model("ho3-composite"), "12", 2).exists
+    assert shared.family("lotka-volterra", "12321", 4).exists
+    assert shared.family("ho3-composite", "121", 4).exists
+    assert shared.family("ho3-composite", "12", 2).exists
 
 
 def test_odd_orders_of_symmetric_words_vanish():
@@ -425,7 +436,7 @@ def test_odd_orders_of_symmetric_words_vanish():
 
 def test_to_dict_is_json_and_sympifies_back():
     S = model("ho3")
-    F = shadow_hamiltonians(S, "12321")
+    F = shared.family("ho3", "12321")
     d = json.loads(json.dumps(F.to_dict()))
     assert set(d) >= {"model", "integrator", "order", "coordinates", "H", "G", "exists", "H_S", "G_S", "free_parameters"}
     names = S.symbols()
@@ -436,7 +447,7 @@ def test_to_dict_is_json_and_sympifies_back():
 
 
 def test_latex_output():
-    F = shadow_hamiltonians(model("ho3"), "12321")
+    F = shared.family("ho3", "12321")
     tex = F.to_latex()
     # symmetric word: X_eff has no h^3 term, so the remainder after h^2 is O(h^4) (as in Eqs. SH12321a-c)
     assert tex.startswith("\\begin{aligned}\nH_{S} &= H + h^{2}") and "G_{S} &= G + h^{2}" in tex and r"\alpha" in tex

@@ -103,24 +103,42 @@ class _PolyEval:
         self.cf = np.array([float(c) for _, c in terms])
         self.fractions = [(int(sympy.Rational(c).p), int(sympy.Rational(c).q)) for _, c in terms]
         self.top = int(self.monoms.max()) if self.monoms.size else 0
+        self.monoms_list = [tuple(int(e) for e in m) for m in self.monoms]
 
     def float(self, x):
         return float(np.sum(self.cf * np.prod(np.power(np.asarray(x, float), self.monoms), axis=1)))
 
-    def mp(self, x):
-        powers = [[mpmath.mpf(1)] for _ in x]
-        for i, v in enumerate(x):
-            for _ in range(self.top):
-                powers[i].append(powers[i][-1] * v)
+    def mp(self, x, powers=None):
+        """The value at ``x`` in mpmath (the working precision); ``powers[i][e] = x_i^e`` may be passed in, built
+        by :func:`_mp_powers` (one table for every polynomial of a point: the same products, computed once)."""
+        if powers is None:
+            powers = _mp_powers(x, self.top)
         total = mpmath.mpf(0)
-        for (p, q), mon in zip(self.fractions, self.monoms):
-            if p:
-                term = mpmath.mpf(p) / q
+        for term, mon in zip(self._mp_constants(), self.monoms_list):
+            if term is not None:
                 for i, e in enumerate(mon):
                     if e:
                         term *= powers[i][e]
                 total += term
         return total
+
+    def _mp_constants(self):
+        """``mpf(p) / q`` per term (None for ``p = 0``) at the working precision, computed once per precision."""
+        prec = mpmath.mp.prec
+        cached = self.__dict__.get("_mp_cache")
+        if cached is None or cached[0] != prec:
+            cached = (prec, [mpmath.mpf(p) / q if p else None for p, q in self.fractions])
+            self._mp_cache = cached
+        return cached[1]
+
+
+def _mp_powers(x, top: int) -> list:
+    """``powers[i][e] = x_i^e`` for ``e <= top`` in mpmath, by repeated multiplication from 1."""
+    powers = [[mpmath.mpf(1)] for _ in x]
+    for i, v in enumerate(x):
+        for _ in range(top):
+            powers[i].append(powers[i][-1] * v)
+    return powers
 
 
 class _Problem:
@@ -138,10 +156,17 @@ class _Problem:
         self.H = [[E(g.diff(v)) for v in x] for g in grad]
         self.J = [[E(d) for d in row] for row in jac]
         self.C = [[[E(d.diff(v)) for v in x] for d in row] for row in jac]
+        self.top = max(P.top for P in [self.f, *self.F, *_leaves([self.g, self.H, self.J, self.C])])
 
     def values(self, name, x, lib):
-        def ev(obj):
-            return [ev(o) for o in obj] if isinstance(obj, list) else getattr(obj, lib)(x)
+        if lib == "mp":  # one table of powers for every polynomial of the point
+            powers = _mp_powers(x, self.top)
+
+            def ev(obj):
+                return [ev(o) for o in obj] if isinstance(obj, list) else obj.mp(x, powers)
+        else:
+            def ev(obj):
+                return [ev(o) for o in obj] if isinstance(obj, list) else obj.float(x)
 
         return ev(getattr(self, name))
 
@@ -155,6 +180,11 @@ class _Problem:
               for i in range(n)]
         DG += [[J[k][j] for j in range(n)] + [0] * m for k in range(m)]
         return G, DG
+
+
+def _leaves(nested) -> list:
+    """The polynomials of nested lists."""
+    return [leaf for o in nested for leaf in (_leaves(o) if isinstance(o, list) else [o])]
 
 
 def _newton_float(prob, z, steps=80):

@@ -54,19 +54,64 @@ def word_coefficient(word, factors, one, zero, inv_factorial):
     >>> word_coefficient((2, 1), [(1, Fraction(1)), (2, Fraction(1))], Fraction(1), Fraction(0), f)
     Fraction(0, 1)
     """
-    n = len(word)
-    f = [one] + [zero] * n
-    for k, c in factors:
-        new = list(f)
-        for i in range(1, n + 1):
-            m, power = 1, one
-            while m <= i and word[i - m] == k:
-                power = power * c
-                if f[i - m] != zero:
-                    new[i] = new[i] + f[i - m] * power * inv_factorial(m)
-                m += 1
-        f = new
-    return f[n]
+    word = tuple(word)
+    return word_coefficients([word], factors, one, zero, inv_factorial)[word]
+
+
+def word_coefficients(words, factors, one, zero, inv_factorial) -> dict:
+    """``{w: [w] prod_j exp(c_j X_{k_j})}`` for several words, sharing the work of common prefixes.
+
+    The dynamic programme of the module docstring, column by column: ``T[j][i]`` is the
+    coefficient of the prefix ``w[:i]`` in the product of the first ``j`` factors,
+
+        T[j][0] = 1,   T[0][i] = 0 (i > 0),
+        T[j][i] = T[j-1][i] + sum_{m >= 1, w[i-m:i] = k_j^m} T[j-1][i-m] c_j^m / m!,
+
+    and ``[w] = T[s][len(w)]``.  Column ``i`` depends on ``w[:i]`` only, so the words are
+    visited in lexicographic order (a walk over their prefix tree) and the columns of a
+    shared prefix are computed once; ``c_j^m / m!`` is formed once per factor and ``m``.
+    Exact coefficient rings give the same values as the factor-by-factor programme.
+
+    >>> from fractions import Fraction
+    >>> f = lambda m: Fraction(1, factorial(m))
+    >>> fac = [(1, Fraction(2)), (2, Fraction(3))]            # e^{2A} e^{3B}: [AB] = 6, [AAB] = 4 * 3 / 2
+    >>> word_coefficients([(1, 2), (1, 1, 2), (2, 1)], fac, Fraction(1), Fraction(0), f)
+    {(1, 1, 2): Fraction(6, 1), (1, 2): Fraction(6, 1), (2, 1): Fraction(0, 1)}
+    """
+    words = sorted({tuple(w) for w in words})
+    top = max((len(w) for w in words), default=0)
+    s = len(factors)
+    letters = [k for k, _ in factors]
+    scaled = []  # scaled[j][m] = c_j^m / m!
+    for _, c in factors:
+        row, power = [None], one
+        for m in range(1, top + 1):
+            power = power * c
+            row.append(power * inv_factorial(m))
+        scaled.append(row)
+    out = {}
+    path: tuple = ()
+    columns = [[one] * (s + 1)]  # columns[i][j] = T[j][i] along the current path
+    for w in words:
+        common = 0
+        while common < min(len(path), len(w)) and path[common] == w[common]:
+            common += 1
+        del columns[common + 1:]
+        for i in range(common + 1, len(w) + 1):
+            col = [zero] * (s + 1)
+            for j in range(1, s + 1):
+                k, acc = letters[j - 1], col[j - 1]
+                m = 1
+                while m <= i and w[i - m] == k:
+                    prev = columns[i - m][j - 1]
+                    if prev != zero:
+                        acc = acc + prev * scaled[j - 1][m]
+                    m += 1
+                col[j] = acc
+            columns.append(col)
+        path = w
+        out[w] = columns[len(w)][s]
+    return out
 
 
 def lyndon_defect_words(n_pieces: int, degree: int) -> list:
@@ -84,35 +129,33 @@ def log_coefficients(factors, n_pieces: int, degree: int, one, zero, rational) -
 
     ``[w] log(1 + Q) = sum_k (-1)^(k+1)/k sum_{w = u_1 ... u_k} prod_i [u_i] Phi`` over the
     splittings of ``w`` into ``k`` non-empty consecutive subwords; the coefficients of the
-    subwords are memoised (a word of length ``q`` has ``q(q+1)/2`` of them).  With linear-form
+    subwords are computed once, all together (:func:`word_coefficients`; a word of length ``q`` has ``q(q+1)/2`` of them).  With linear-form
     coefficients the degree-``q`` part is homogeneous of degree ``q``, and it vanishes for
     ``q = 2..p`` exactly when the composition has order ``p``: these are the order conditions.
     ``rational(a, b)`` returns ``a/b`` in the coefficient ring.
     """
-    memo, inverse_factorials = {}, {}
+    inverse_factorials = {}
 
     def inv_factorial(m):
         if m not in inverse_factorials:
             inverse_factorials[m] = rational(1, factorial(m))
         return inverse_factorials[m]
 
-    def coefficient(u):
-        if u not in memo:
-            memo[u] = word_coefficient(u, factors, one, zero, inv_factorial)
-        return memo[u]
-
+    words = lyndon_defect_words(n_pieces, degree)
+    coefficient = word_coefficients({w[j:i] for w in words for i in range(len(w) + 1) for j in range(i)},
+                                    factors, one, zero, inv_factorial)
     out = {}
-    for w in lyndon_defect_words(n_pieces, degree):
+    for w in words:
         q = len(w)
         if q == 1:
-            out[w] = coefficient(w) - one
+            out[w] = coefficient[w] - one
             continue
         # A[i][k]: sum over splittings of w[:i] into k pieces
         A = [[zero] * (q + 1) for _ in range(q + 1)]
         A[0][0] = one
         for i in range(1, q + 1):
             for j in range(i):
-                c = coefficient(w[j:i])
+                c = coefficient[w[j:i]]
                 if c == zero:
                     continue
                 for k in range(1, i + 1):
@@ -129,7 +172,6 @@ def log_coefficients(factors, n_pieces: int, degree: int, one, zero, rational) -
 def lyndon_defects(factors, n_pieces: int, degree: int, one, zero, inv_factorial) -> dict:
     """``{w: q! [w] Phi - 1}`` over the Lyndon words ``w`` of length ``q = degree`` (see module docstring)."""
     q_fact = factorial(degree)
-    return {
-        w: word_coefficient(w, factors, one, zero, inv_factorial) * q_fact - one
-        for w in lyndon_defect_words(n_pieces, degree)
-    }
+    words = lyndon_defect_words(n_pieces, degree)
+    coefficients = word_coefficients(words, factors, one, zero, inv_factorial)
+    return {w: coefficients[w] * q_fact - one for w in words}

@@ -45,6 +45,7 @@ Hairer, Norsett, Wanner, Solving Ordinary Differential Equations I, Sect. II.5 (
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -74,7 +75,9 @@ MAX_STEPS = 200_000  # per orbit and tolerance: the up-front bound of the work
 class OrbitFunctions:
     """``X_{H,G}``, the integrands ``g_a`` and the Hamiltonians, compiled once for numpy.
 
-    ``rhs(x)`` returns ``(X(x), g(x))`` concatenated; ``hamiltonians(x)`` the values ``H_a(x)``.
+    ``rhs(x)`` returns ``(X(x), g(x))`` concatenated; ``hamiltonians(x)`` the values ``H_a(x)``
+    (numpy arrays).  ``values(x)`` and ``levels(x)`` are the same functions on plain lists of floats, what the
+    integrator below steps with.
     """
 
     n: int
@@ -82,6 +85,8 @@ class OrbitFunctions:
     rhs: object
     hamiltonians: object
     integrand_names: tuple
+    values: object = None
+    levels: object = None
 
 
 def orbit_functions(system, integrands, params: dict, names=None) -> OrbitFunctions:
@@ -115,17 +120,86 @@ def orbit_functions(system, integrands, params: dict, names=None) -> OrbitFuncti
         lambda x: np.array(f(x[:n]), dtype=float),
         lambda x: np.array(H(x[:n]), dtype=float),
         tuple(names) if names else tuple(f"g{a}" for a in range(len(ints))),
+        lambda x: [float(v) for v in f(x[:n])],
+        lambda x: [float(v) for v in H(x[:n])],
     )
 
 
+# The integrator steps with plain Python floats: the state has a handful of components, where numpy's per-call
+# overhead was most of the time.  Every sum is formed in the order the numpy version formed it (the stage sums
+# left to right from 0; numpy 2's reductions and BLAS dot products of fewer than 8 resp. 16 terms are sequential,
+# longer ones fall back to numpy), so the orbits, periods and averages are bit for bit those of the numpy version
+# (checked on every orbit of the test suite and the notebooks; tests/test_existence.py pins the step).
+_AN = tuple((tuple(float(a) for a in row if a), tuple(i for i, a in enumerate(row) if a)) for row in _A)
+_EN = (tuple(float(e) for e in _E if e), tuple(i for i, e in enumerate(_E) if e))
+
+
+def _combine(y, dt, coefficients, columns):
+    """``y + dt * (0 + c_1 k_1 + c_2 k_2 + ...)`` componentwise, the sum left to right (as ``sum`` on arrays did)."""
+    c, k = coefficients, columns
+    if len(c) == 1:
+        return [yj + dt * (0 + c[0] * a) for yj, a in zip(y, *k)]
+    if len(c) == 2:
+        return [yj + dt * (0 + c[0] * a + c[1] * b) for yj, a, b in zip(y, *k)]
+    if len(c) == 3:
+        return [yj + dt * (0 + c[0] * a + c[1] * b + c[2] * d) for yj, a, b, d in zip(y, *k)]
+    if len(c) == 4:
+        return [yj + dt * (0 + c[0] * a + c[1] * b + c[2] * d + c[3] * e) for yj, a, b, d, e in zip(y, *k)]
+    if len(c) == 5:
+        return [yj + dt * (0 + c[0] * a + c[1] * b + c[2] * d + c[3] * e + c[4] * f) for yj, a, b, d, e, f in zip(y, *k)]
+    return [dt * (0 + c[0] * a + c[1] * b + c[2] * d + c[3] * e + c[4] * f + c[5] * g)  # the error: no y, six terms
+            for a, b, d, e, f, g in zip(*k)]
+
+
 def _rk_step(F, y, k1, dt):
+    """One Dormand--Prince 5(4) step of ``y' = F(y)`` from ``y`` (``k1 = F(y)``): ``(y_new, error, F(y_new))``.
+
+    ``F`` maps a list of floats to a list of floats (:attr:`OrbitFunctions.values`); ``y`` and ``k1`` are sequences
+    of floats; lists are returned.  The method is FSAL: the last stage is evaluated at ``y_new`` (its
+    coefficients are the fifth-order weights ``_B5``).
+    """
     ks = [k1]
+    y_new = y
     for i in range(1, 7):
-        yi = y + dt * sum(a * k for a, k in zip(_A[i], ks) if a)
-        ks.append(F(yi))
-    y_new = y + dt * sum(b * k for b, k in zip(_B5, ks) if b)
-    err = dt * sum(e * k for e, k in zip(_E, ks) if e)
+        cs, idx = _AN[i]
+        y_new = _combine(y, dt, cs, [ks[j] for j in idx])
+        ks.append(F(y_new))
+    err = _combine(None, dt, _EN[0], [ks[j] for j in _EN[1]])
     return y_new, err, ks[6]
+
+
+def _list_functions(F: OrbitFunctions):
+    """``(values, levels)`` of ``F`` on lists of floats (from ``rhs``, ``hamiltonians`` if built without them)."""
+    if F.values is not None and F.levels is not None:
+        return F.values, F.levels
+    return (lambda x: [float(v) for v in F.rhs(np.asarray(x, float))],
+            lambda x: [float(v) for v in F.hamiltonians(np.asarray(x, float))])
+
+
+def _dot(a, b):
+    """``a . b`` as numpy's ``@`` forms it (sequential below 16 terms)."""
+    if len(a) >= 16:
+        return float(np.asarray(a, float) @ np.asarray(b, float))
+    acc = 0.0
+    for x, y in zip(a, b):
+        acc += x * y
+    return acc
+
+
+def _norm(a) -> float:
+    """``numpy.linalg.norm(a)`` of a vector: ``sqrt(a . a)``."""
+    return math.sqrt(_dot(a, a))
+
+
+def _rms(err, sc):
+    """``sqrt(mean((err / sc)**2))`` as numpy forms it (the reduction is sequential below 8 terms)."""
+    if len(err) >= 8:
+        return float(np.sqrt(np.mean((np.asarray(err) / np.asarray(sc)) ** 2)))
+    q = [(e / s) * (e / s) for e, s in zip(err, sc)]
+    acc = q[0]
+    for v in q[1:]:
+        acc += v
+    return math.sqrt(acc / len(q))
 
 
 @dataclass
@@ -203,55 +277,66 @@ def _crossing(rhs, y, k, dt, f_lo, f_hi, value, f_tol, t_tol):
 
 def _one_orbit(F: OrbitFunctions, x0, rtol, max_steps, radius):
     n, m = F.n, F.m
-    y = np.concatenate([np.asarray(x0, float), np.zeros(m)])
-    k = F.rhs(y)
-    v = k[:n].copy()
-    speed = float(np.linalg.norm(v))
-    if not np.isfinite(speed) or speed < 1e-12:
+    values, levels = _list_functions(F)
+    x0 = [float(v) for v in x0]
+    y = x0 + [0.0] * m
+    k = values(y)
+    speed = _norm(k[:n])
+    if not math.isfinite(speed) or speed < 1e-12:
         return None, "X_{H,G} vanishes (an equilibrium) or is not finite at x0"
-    v /= speed
-    H0 = F.hamiltonians(y)
-    atol = rtol * max(1.0, float(np.abs(y[:n]).max()))
+    v = [c / speed for c in k[:n]]
+    H0 = levels(y)
+    atol = rtol * max(1.0, max(abs(c) for c in x0))
     t, dt = 0.0, 1e-2 / speed
     s_prev = 0.0
     diam = 0.0
-    scale = np.zeros(m)
+    scale = [0.0] * m
     dH = 0.0
-    signs = np.sign(y[:n])
-    crossings = np.zeros(n, dtype=int)
+    signs = [_sign(c) for c in x0]
+    crossings = [0] * n
     accepted = 0
     for _ in range(max_steps):
-        y_new, err, k_new = _rk_step(F.rhs, y, k, dt)
-        sc = atol + rtol * np.maximum(np.abs(y), np.abs(y_new))
-        e = float(np.sqrt(np.mean((err / sc) ** 2)))
-        if not np.isfinite(e):
+        y_new, err, k_new = _rk_step(values, y, k, dt)
+        e = _rms(err, [atol + rtol * max(abs(a), abs(b)) for a, b in zip(y, y_new)])
+        if not math.isfinite(e):
             return None, "the orbit is not finite (escapes)"
         if e > 1.0:
             dt *= max(0.2, 0.9 * e ** -0.2)
             continue
         accepted += 1
         x_new = y_new[:n]
-        if float(np.abs(x_new).max()) > radius:
+        if max(abs(c) for c in x_new) > radius:
             return None, f"the orbit leaves the ball of radius {radius:g} (not periodic)"
-        s_new = float(v @ (x_new - x0))
-        d_new = float(np.linalg.norm(x_new - x0))
+        dx = [a - b for a, b in zip(x_new, x0)]
+        s_new = _dot(v, dx)
+        d_new = _norm(dx)
         diam = max(diam, d_new)
-        scale = np.maximum(scale, np.abs(k_new[n:]))
-        dH = max(dH, float(np.abs(F.hamiltonians(y_new) - H0).max()))
-        sg = np.sign(x_new)
-        crossings += (sg != signs) & (sg != 0)
-        signs = np.where(sg != 0, sg, signs)
+        scale = [max(a, abs(b)) for a, b in zip(scale, k_new[n:])]
+        dH = max(dH, max(abs(a - b) for a, b in zip(levels(y_new), H0)))
+        for i, c in enumerate(x_new):
+            sg = _sign(c)
+            if sg != 0:
+                if sg != signs[i]:
+                    crossings[i] += 1
+                signs[i] = sg
         if accepted > 3 and s_prev < 0.0 <= s_new and d_new < 0.5 * diam:
-            tau, y_tau = _crossing(F.rhs, y, k, dt, s_prev, s_new, lambda z: float(v @ (z[:n] - x0)),
+            tau, y_tau = _crossing(values, y, k, dt, s_prev, s_new,
+                                   lambda z: _dot(v, [a - b for a, b in zip(z[:n], x0)]),
                                    1e-15 * max(1.0, diam), 1e-16 * max(1.0, t))
-            if float(np.linalg.norm(y_tau[:n] - x0)) < 1e-4 * diam:
+            dz = [a - b for a, b in zip(y_tau[:n], x0)]
+            if _norm(dz) < 1e-4 * diam:
                 T = t + tau
-                return dict(period=T, averages=y_tau[n:] / T, scales=scale, H0=H0, dH=dH,
+                return dict(period=T, averages=[g / T for g in y_tau[n:]], scales=scale, H0=H0, dH=dH,
                             crossings=crossings, steps=accepted), ""
         t += dt
         y, k, s_prev = y_new, k_new, s_new
         dt *= min(5.0, max(0.2, 0.9 * max(e, 1e-10) ** -0.2))
     return None, f"no return to the section within {max_steps} steps (period too long, or not periodic)"
+
+
+def _sign(c: float) -> float:
+    """``numpy.sign`` of a finite float: -1.0, 0.0 or 1.0."""
+    return 1.0 if c > 0 else -1.0 if c < 0 else 0.0
 
 
 def orbit_average(F: OrbitFunctions, x0, rtol: float = 1e-10, max_steps: int = MAX_STEPS,
@@ -296,7 +381,7 @@ def orbit_average(F: OrbitFunctions, x0, rtol: float = 1e-10, max_steps: int = M
     fine, why = _one_orbit(F, x0, rtol / 100, max_steps, radius)
     if fine is None:
         return OrbitAverage(tuple(x0), False, reason="finer run: " + why)
-    errors = np.abs(fine["averages"] - coarse["averages"]) + 1e-15 * fine["scales"]
+    errors = np.abs(np.array(fine["averages"]) - np.array(coarse["averages"])) + 1e-15 * np.array(fine["scales"])
     return OrbitAverage(
         tuple(float(v) for v in x0), True, fine["period"], tuple(float(a) for a in fine["averages"]),
         tuple(float(e) for e in errors), tuple(float(s) for s in fine["scales"]),
@@ -338,25 +423,25 @@ def section_integral(F: OrbitFunctions, x, index: int, rtol: float = 1e-11, max_
     n, m = F.n, F.m
     if not (0 <= index < n):
         raise NambuBCHError(f"index must be a coordinate index 0..{n - 1}, got {index!r}")
-    y = np.concatenate([np.asarray(x, float), np.zeros(m)])
-    k = F.rhs(y)
-    speed = float(np.linalg.norm(k[:n]))
-    if not np.isfinite(speed) or speed < 1e-12:
+    values, _ = _list_functions(F)
+    y = [float(v) for v in x] + [0.0] * m
+    k = values(y)
+    speed = _norm(k[:n])
+    if not math.isfinite(speed) or speed < 1e-12:
         raise NambuBCHError(f"X_{{H,G}} vanishes at {list(x)}: no orbit to integrate along")
-    atol = rtol * max(1.0, float(np.abs(y[:n]).max()))
+    atol = rtol * max(1.0, max(abs(c) for c in y[:n]))
     dt = 1e-2 / speed
     for _ in range(max_steps):
-        y_new, err, k_new = _rk_step(F.rhs, y, k, dt)
-        e = float(np.sqrt(np.mean((err / (atol + rtol * np.maximum(np.abs(y), np.abs(y_new)))) ** 2)))
-        if not np.isfinite(e):
+        y_new, err, k_new = _rk_step(values, y, k, dt)
+        e = _rms(err, [atol + rtol * max(abs(a), abs(b)) for a, b in zip(y, y_new)])
+        if not math.isfinite(e):
             break
         if e > 1.0:
             dt *= max(0.2, 0.9 * e ** -0.2)
             continue
         if y[index] < 0.0 <= y_new[index]:
-            _, y_tau = _crossing(F.rhs, y, k, dt, float(y[index]), float(y_new[index]), lambda z: float(z[index]),
-                                 1e-15, 1e-16)
-            return y_tau[n:].copy()
+            _, y_tau = _crossing(values, y, k, dt, y[index], y_new[index], lambda z: z[index], 1e-15, 1e-16)
+            return np.array(y_tau[n:])
         y, k = y_new, k_new
         dt *= min(5.0, max(0.2, 0.9 * max(e, 1e-10) ** -0.2))
     raise NambuBCHError(f"the orbit through {list(x)} does not reach x{index + 1} = 0 within {max_steps} steps")
