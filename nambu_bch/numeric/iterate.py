@@ -209,8 +209,6 @@ def _run_batch(kern, X, K, steps, every, out, kahan, be, chunk, segment, reporte
 #: process needs more.  The interpreter runs the same statements on Python floats and the C
 #: library's functions: the samples are the compiled loop's, bit for bit.
 INTERPRET_STEPS = 50_000
-#: Kept for compatibility: the per-run limit of the earlier rule (now :data:`INTERPRET_STEPS` in total).
-SMALL_RUN_STEPS = INTERPRET_STEPS
 #: Batches of at most this many steps (and states) likewise run on numpy arrays while the compiled batch
 #: loop is not ready (0.3-4 s to compile) -- only kernels whose numpy loop gives the compiled bits
 #: (:attr:`~nambu_bch.numeric.kernels.Kernel.numpy_matches_compiled`: polynomial and trigonometric flows).
