@@ -23,6 +23,8 @@ import sys
 #: ``(module, attribute)``: an ``lru_cache`` function (``cache_clear``), a module's ``clear_cache()``,
 #: or a dict / ``WeakKeyDictionary`` (``clear``).  Modules not imported yet hold nothing and are skipped.
 CACHES = (
+    ("nambu_bch.algebra.frac_rref", "_CONTEXTS"),
+    ("nambu_bch.algebra.frac_rref", "_FLINT_QQ"),
     ("nambu_bch.bch.concrete", "clear_cache"),          # _EVALUATORS
     ("nambu_bch.bch.formal", "clear_cache"),            # _PATTERN_CACHE
     ("nambu_bch.bch.formal", "_fits"),

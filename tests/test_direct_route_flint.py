@@ -38,6 +38,13 @@ from nambu_bch.shadow.direct_route import direct_route
 
 pytest.importorskip("flint")
 
+
+@pytest.fixture(autouse=True)
+def _flint_on(monkeypatch):
+    """Each test starts with python-flint on (even when the suite runs with NAMBU_BCH_DISABLE_FLINT=1) and switches
+    it off itself where it compares with the pure path."""
+    monkeypatch.delenv("NAMBU_BCH_DISABLE_FLINT", raising=False)
+
 dr = importlib.import_module("nambu_bch.shadow.direct_route")
 a, b = sympy.symbols("a b")
 K = QQ.frac_field(a, b)
