@@ -126,6 +126,11 @@ def test_every_symbolic_output_names_the_system(capsys, argv):
     assert code == 0 and data["coordinates"] == ["x1", "x2"] and data["bracket"] == "canonical"
 
 
+def test_models_latex_names_the_bracket_and_coordinates(capsys):
+    code, latex, _ = run(capsys, "models", "--model", "ho", "--format", "latex")
+    assert code == 0 and "&\\text{ho: canonical bracket on}\\ (x_{1}, x_{2}):" in latex, latex[:300]
+
+
 def test_numeric_outputs_name_the_system(capsys):
     code, text, _ = run(capsys, "check", "--H", "x2^2/(2*m) + m*x3/2", "--G", "x3 - x1^2", "--param", "m=2",
                         "--coords", "x1 x2 x3", "--steps", "10")
