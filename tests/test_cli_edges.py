@@ -51,8 +51,8 @@ def _clean(line: str) -> bool:
 # every flag validated when given; a flag the request would ignore is refused
 # --------------------------------------------------------------------------------------------
 LIMIT_JUNK = ["junk", "0", "-1", "1.5", "1e3", "", " ", "nan", "inf", "-inf", "10**6", "0x10", "1_000", "+", "-",
-              "--", "2 3", "1,2", "\u0663", "\uff13", "2\n", "None", "True", "[1]", "1/2", "x1", "99999999999999999999999999999999",
-              "1000001", "\x00", "1;2", "$(id)", "`id`", "__import__('os')", "%d", "\\n", "\x1b[31m1"]
+              "--", "2 3", "1,2", "\u0663", "\uff13", "2\n", "None", "True", "[1]", "1/2", "x1", "9" * 32, "1000001",
+              "\x00", "1;2", "$(id)", "`id`", "__import__('os')", "%d", "\\n", "\x1b[31m1"]
 
 
 def test_fi_limit_is_validated_at_every_order(capsys):

@@ -259,7 +259,9 @@ def system_from_args(args):
         system = load_system(args.system, file_values)
         extra = [n for n in names if n not in {p.name for p in system.parameters}]
         if extra:
-            raise NambuBCHError(f"--param {extra[0]}: the system of {shown(args.system)} has parameters {names_of(system.parameters)}")
+            raise NambuBCHError(
+                f"--param {extra[0]}: the system of {shown(args.system)} has parameters {names_of(system.parameters)}"
+            )
         _refuse_declarations(names, values, f"the system of {shown(args.system)}")
         system = _with_flags(system, args)
         args.file_values = file_values  # numeric defaults for check / plot; not substituted symbolically
