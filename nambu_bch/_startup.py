@@ -9,10 +9,10 @@ handler (``KeyboardInterrupt``) once ``main`` runs and can handle it.  A library
 import (``import nambu_bch`` in a program or notebook) is left untouched.
 """
 
-from __future__ import annotations
-
+# Only modules the interpreter has already loaded when the package starts: ``signal`` (the Python
+# module) would import enum and functools first, a window in which Ctrl-C is still a traceback.
+import _signal as signal
 import os
-import signal
 import sys
 
 _installed = False

@@ -88,12 +88,12 @@ def output_target(path) -> tuple:
         info = os.stat(shown)  # follows links
     except FileNotFoundError:
         if os.path.islink(shown):
-            raise OutputError(f"--output {shown}: a symbolic link to a missing file ({os.readlink(shown)}); refused") from None
+            raise OutputError(f"--output {shown!r}: a symbolic link to a missing file ({os.readlink(shown)!r}); refused") from None
         return "regular", shown
     except OSError as exc:  # ELOOP, EACCES, ENOTDIR ...
-        raise OutputError(f"--output {shown}: cannot use this path ({exc.strerror or exc})") from None
+        raise OutputError(f"--output {shown!r}: cannot use this path ({exc.strerror or exc})") from None
     if stat.S_ISDIR(info.st_mode):
-        raise OutputError(f"--output {shown}: is a directory; give a file name")
+        raise OutputError(f"--output {shown!r}: is a directory; give a file name")
     if stat.S_ISREG(info.st_mode):
         return "regular", os.path.realpath(shown)
     return "stream", shown
@@ -127,4 +127,4 @@ def write_output(path, data) -> None:
         else:
             write_atomic(target, payload)
     except OSError as exc:
-        raise OutputError(f"--output {shown}: cannot write ({exc.strerror or exc})") from None
+        raise OutputError(f"--output {shown!r}: cannot write ({exc.strerror or exc})") from None

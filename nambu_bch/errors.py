@@ -68,3 +68,34 @@ class OutputError(NambuBCHError):
 
 class ResourceLimitError(NambuBCHError):
     """A request whose size, estimated from the input before any work, exceeds what can finish (refused up front)."""
+
+
+def did_you_mean(word, candidates) -> str:
+    """``" (did you mean 'x'?)"`` for the candidate closest to ``word``, or ``""`` when none is close.
+
+    The one suggestion helper of the package (model names, integrator aliases, command-line
+    flags and choices).  A candidate equal to ``word`` up to case and ``-``/``_`` wins, then
+    the only candidate that ``word`` begins (``lotka`` for ``lotka-volterra``), else
+    :func:`difflib.get_close_matches` picks at most one.
+
+    >>> did_you_mean("rigidbody", ["ho3", "rigid-body"]), did_you_mean("zzz", ["ho3"])
+    (" (did you mean 'rigid-body'?)", '')
+    """
+    import difflib
+
+    if not isinstance(word, str) or not word:
+        return ""
+    names = [c for c in candidates if isinstance(c, str)]
+
+    def key(text):
+        return text.lower().replace("_", "-")
+
+    same = [c for c in names if key(c) == key(word) and c != word]
+    if not same and len(word) >= 3:
+        same = [c for c in names if key(c).startswith(key(word))]
+        same = same if len(same) == 1 else []
+    close = same or difflib.get_close_matches(key(word), [key(c) for c in names], n=1, cutoff=0.6)
+    if not close:
+        return ""
+    best = close[0] if same else next(c for c in names if key(c) == close[0])
+    return f" (did you mean {best!r}?)"

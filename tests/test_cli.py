@@ -244,7 +244,8 @@ def test_shadow(tmp_path):
         ("shadow", "--integrator", "123", "--format", "json"),
     )
     latex = ok(runs[0])  # the default: Eqs. (SH12321c), (SG12321c) as LaTeX
-    assert latex.startswith("\\begin{align*}\nH_{S} &= H + h^{2}") and r"\alpha" in latex and "G_{S} &= G + " in latex
+    assert latex.startswith("\\begin{align*}\n&\\text{system ho3: nambu bracket on}\\ (x_{1}, x_{2}, x_{3})")  # what was analysed
+    assert "\\begin{align*}\nH_{S} &= H + h^{2}" in latex and r"\alpha" in latex and "G_{S} &= G + " in latex
     ok(runs[1])
     data = read_json(out.read_text(), "H", "G", "H_S", "G_S")
     assert data["model"] == "ho3" and data["integrator"] == "12321" and data["order"] == 2 and data["exists"] is True
@@ -263,7 +264,8 @@ def test_shadow(tmp_path):
     assert data["G_S"] is None and data["G"] is None and data["order"] == 4
     assert_shadow_pair(model("ho"), "TVT", read(data, "H_S"), order=4)
     text = ok(runs[4])
-    assert text.startswith("12321 on mine, order 2, route direct") and "H_S = " in text
+    assert text.startswith("system mine: nambu bracket on x1, x2, x3 (parameters m)\n12321 on mine, order 2, route direct")
+    assert "H_S = " in text
     data = read_json(ok(runs[5]))  # non-symmetric word: no polynomial shadow pair at h^1
     assert data["exists"] is False and data["H_S"] is None and "h^1" in data["obstruction"]
 

@@ -34,10 +34,19 @@ leaves out a piece of the splitting, a missing file, an invalid flag, a request
 too large to finish) prints one line on stderr naming the input and what is
 accepted, and exits with status 2; user expressions are parsed by
 :func:`nambu_bch.parsing.parse_expression`, never evaluated, and names are
-checked against a LaTeX- and source-safe pattern.  Ctrl-C prints one line and
-exits 130 (also during the imports); a reader that closes stdout early ends the
-run quietly with status 141.  See ``docs/hardening.md``.  Any other exception
-is a bug and propagates with its traceback (exit status 1).
+checked against a LaTeX- and source-safe pattern.  Flags are never abbreviated
+(``--h`` is not ``--help``); an unknown flag is answered with the subcommand it
+belongs to or the closest flag, a flag given twice or one the request would
+ignore (``fi --limit`` without ``--order K > 2``, ``--standalone`` without
+``--format latex``, ``--name`` with ``--model``) is refused.  Text the user gave
+is echoed quoted and escaped (no newline, terminal escape or bidi mark reaches
+the terminal).  An output that cannot be written (``--output`` or stdout: a
+full disk, ``/dev/full``, the ``ulimit -f`` size limit) is one line and exit 2
+as well.  Ctrl-C prints one line and exits 130 (also during the imports); a
+reader that closes stdout early ends the run quietly with status 141; with
+stderr closed the lines are lost, never written to stdout.  See
+``docs/hardening.md``.  Any other exception is a bug and propagates with its
+traceback (exit status 1).
 
 The package: :mod:`._main` (this entry point, error handling and exit codes),
 :mod:`._options` (option groups, flag conversion, the system and integrator from
@@ -56,7 +65,8 @@ import os
 import sys
 
 from ..errors import NambuBCHError
-from ._options import MAX_MESSAGE, PROG, UsageError, _Formatter, _Parser, normalise
+from ._options import PROG, UsageError, _Formatter, _Parser, normalise, one_line, unknown_argument_message
+from ._output import say, stdout_closed
 
 #: The subcommands in the order of ``--help``: each module ``nambu_bch.cli.<name>`` has ``register(sub)``, ``run(args)``.
 SUBCOMMANDS = ("models", "bch", "fi", "shadow", "conserved", "exact", "check", "plot", "compare")
@@ -100,31 +110,34 @@ class _progress_off:
         return False
 
 
-def _stdout_closed() -> None:
-    """After EPIPE: point stdout at /dev/null so that the interpreter's final flush stays quiet."""
-    try:
-        devnull = os.open(os.devnull, os.O_WRONLY)
-        os.dup2(devnull, sys.stdout.fileno())
-        os.close(devnull)
-    except (OSError, ValueError, AttributeError):  # stdout without a file descriptor (captured in tests)
-        pass
+def _reserve_standard_descriptors() -> None:
+    """Put ``/dev/null`` on a standard descriptor (0, 1, 2) that the process was started without.
 
-
-def _say(line: str) -> None:
-    """One line on stderr; a closed stderr is ignored."""
-    try:
-        print(line, file=sys.stderr)
-        sys.stderr.flush()
-    except (OSError, ValueError):
-        pass
+    Started with ``2>&-``, the next file opened (an ``--output`` temporary, a cache file) would get
+    descriptor 2, and anything written to "stderr" would land in it.  ``sys.stderr`` stays ``None``
+    (messages are then lost, never sent to stdout); ``sys.stdout`` ``None`` still ends the run as a
+    closed stdout (exit 141).
+    """
+    for fd in (0, 1, 2):
+        try:
+            os.fstat(fd)
+        except OSError:
+            try:
+                null = os.open(os.devnull, os.O_RDWR)
+                if null != fd:
+                    os.dup2(null, fd)
+                    os.close(null)
+            except OSError:
+                return
 
 
 def main(argv=None) -> int:
     """Run the CLI on ``argv`` (default ``sys.argv[1:]``); returns the exit status.
 
-    0 on success, 2 on bad input (one line on stderr), 130 on Ctrl-C (one line),
-    141 quietly when stdout is closed early (``nambu-bch shadow | head -c1``),
-    1 with one line when memory or the interpreter's recursion limit runs out.
+    0 on success, 2 on bad input or an output that cannot be written (one line on
+    stderr), 130 on Ctrl-C (one line), 141 quietly when stdout is closed early
+    (``nambu-bch shadow | head -c1``), 1 with one line when memory or the
+    interpreter's recursion limit runs out.
     Nothing a user types produces a traceback; any other exception is a bug and
     propagates with its traceback.
     """
@@ -133,8 +146,12 @@ def main(argv=None) -> int:
     _startup.cli_started()  # from here on Ctrl-C is a KeyboardInterrupt handled below
     prog = PROG
     try:
+        _reserve_standard_descriptors()
         parser = build_parser()
-        args = parser.parse_args(argv)
+        args, extras = parser.parse_known_args(argv)
+        if extras:
+            command = getattr(args, "command", None)
+            raise UsageError(f"{PROG} {command}" if command else PROG, unknown_argument_message(parser, command, extras))
         prog = f"{PROG} {args.command}"
         normalise(args)
         if getattr(args, "no_progress", False):
@@ -145,29 +162,22 @@ def main(argv=None) -> int:
     except SystemExit as exc:  # --help, --version
         return exc.code if isinstance(exc.code, int) else 0
     except UsageError as exc:
-        hint = exc.prog if exc.prog != PROG else PROG
-        message = " ".join(str(exc).split())
-        if len(message) > MAX_MESSAGE:
-            message = message[: MAX_MESSAGE - 3] + "..."
-        _say(f"{exc.prog}: error: {message}; see '{hint} --help'")
+        say(f"{exc.prog}: error: {one_line(exc)}; see '{exc.prog} --help'")
         return 2
-    except NambuBCHError as exc:
-        message = " ".join(str(exc).split())
-        if len(message) > MAX_MESSAGE:  # a huge input echoed back: keep the line readable
-            message = message[: MAX_MESSAGE - 3] + "..."
-        _say(f"{prog}: error: {message}")
+    except NambuBCHError as exc:  # includes OutputError: stdout or --output could not be written
+        say(f"{prog}: error: {one_line(exc)}")
         return 2
     except KeyboardInterrupt:
-        _say(f"{prog}: interrupted")
+        say(f"{prog}: interrupted")
         return 130
     except BrokenPipeError:
-        _stdout_closed()
+        stdout_closed()
         return 141  # as a shell reports a process ended by SIGPIPE; nothing printed
     except MemoryError:
-        _say(f"{prog}: error: out of memory; the request is too large for this machine (reduce --order, --degree or --steps)")
+        say(f"{prog}: error: out of memory; the request is too large for this machine (reduce --order, --degree or --steps)")
         return 1
     except RecursionError:
-        _say(f"{prog}: error: the input is nested too deeply to process (recursion limit)")
+        say(f"{prog}: error: the input is nested too deeply to process (recursion limit)")
         return 1
     return 0
 

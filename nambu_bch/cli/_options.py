@@ -9,6 +9,7 @@ errors answer without it.
 from __future__ import annotations
 
 import argparse
+import re
 
 from ..errors import NambuBCHError
 
@@ -16,6 +17,8 @@ PROG = "nambu-bch"
 DEFAULT_MODEL = "ho3"
 MAX_STEPS = 100_000_000
 MAX_CLI_ORDER = 12
+#: Largest ``fi --limit`` (brackets and directions listed).
+MAX_LIMIT = 10**6
 #: Longest error line printed (a huge input echoed back is shortened).
 MAX_MESSAGE = 600
 #: Longest accepted path (--system, --output, --outdir).
@@ -32,12 +35,90 @@ class UsageError(Exception):
 
 
 class _Parser(argparse.ArgumentParser):
+    """``argparse`` with one-line errors and no abbreviations (``--h`` is not ``--help``, ``--out`` not ``--output``)."""
+
+    def __init__(self, *args, **kwargs):
+        kwargs["allow_abbrev"] = False
+        super().__init__(*args, **kwargs)
+        self.register("action", None, _StoreOnce)
+        self.register("action", "store", _StoreOnce)
+
     def error(self, message):  # one line, no usage block
         raise UsageError(self.prog, message)
+
+    def _check_value(self, action, value):
+        # argparse's own message lists the choices; add the closest one (a subcommand, --format, --route ...)
+        if action.choices is not None and value not in action.choices:
+            from ..errors import did_you_mean
+
+            choices = ", ".join(map(repr, action.choices))
+            raise argparse.ArgumentError(
+                action, f"invalid choice: {shown(value)}{did_you_mean(value, list(action.choices))} (choose from {choices})"
+            )
+
+
+def shown(value, limit: int = 80) -> str:
+    """A user string as echoed in a message: quoted, control characters, bidi marks and newlines escaped, shortened.
+
+    The one way the command line echoes text it was given (paths, names, flag values) so that a
+    message cannot carry terminal escapes, right-to-left overrides or line breaks.
+    """
+    text = str(value)
+    if len(text) > limit:
+        text = text[: limit - 3] + "..."
+    return repr(text)
+
+
+def one_line(message: str, limit: int = MAX_MESSAGE) -> str:
+    """``message`` as one printable line: whitespace runs become one space, other unprintable characters are escaped.
+
+    The last filter of every line the command line prints on stderr (messages of the library
+    echo user text with ``repr``, which this leaves as it is).
+    """
+    text = " ".join(str(message).split())
+    text = "".join(ch if ch.isprintable() else ch.encode("unicode_escape").decode("ascii") for ch in text)
+    if len(text) > limit:  # a huge input echoed back: keep the line readable
+        text = text[: limit - 3] + "..."
+    return text
+
+
+def unknown_argument_message(parser, command, extras) -> str:
+    """The one-line answer to arguments ``parse_known_args`` left over: the flag's subcommand or the closest flag."""
+    from ..errors import did_you_mean
+
+    first = next((e for e in extras if e.startswith("-")), extras[0])
+    if not first.startswith("-"):
+        return f"unrecognized argument {shown(first)}"
+    flag = first.split("=", 1)[0]
+    subparsers = next(a for a in parser._actions if isinstance(a, argparse._SubParsersAction)).choices
+    own = subparsers[command]._option_string_actions if command in subparsers else parser._option_string_actions
+    where = f"nambu-bch {command}" if command else "nambu-bch"
+    others = [f"nambu-bch {name}" for name, sub in subparsers.items() if name != command and flag in sub._option_string_actions]
+    message = f"unrecognized argument {shown(flag)}"
+    if others:
+        shown_others = ", ".join(f"`{o}`" for o in others[:3]) + (", ..." if len(others) > 3 else "")
+        message += f": that flag belongs to {shown_others}, not `{where}`"
+    # a flag of another subcommand: suggest only the same name in other case (--h here, --H there)
+    candidates = [o for o in own if o.startswith("--") and (not others or o.lower() == flag.lower())]
+    hint = did_you_mean(flag, candidates)
+    return message + ("; " + hint.strip(" ()") if hint else "")
 
 
 class _Formatter(argparse.RawDescriptionHelpFormatter):
     pass
+
+
+class _StoreOnce(argparse._StoreAction):
+    """A flag with one value given twice is refused (argparse would keep the last one without a word)."""
+
+    def __call__(self, parser, namespace, values, option_string=None):
+        given = namespace.__dict__.setdefault("_given_once", {})
+        if self.dest in given:
+            raise argparse.ArgumentError(
+                self, f"given twice ({shown(given[self.dest], 40)} and {shown(values, 40)}); give it once"
+            )
+        given[self.dest] = values
+        super().__call__(parser, namespace, values, option_string)
 
 
 
@@ -155,6 +236,7 @@ def system_from_args(args):
             coords = args.coords.replace(",", " ").split()
         else:
             coords = [f"x{i}" for i in range(1, (len(hams) + 1 if len(hams) > 1 else 2) + 1)]
+            _check_inferred_coordinates(hams, coords, names, args.bracket)
         if len(coords) > MAX_COORDINATES:
             raise NambuBCHError(f"--coords gives {len(coords)} coordinates; at most {MAX_COORDINATES} are accepted")
         for c in coords:
@@ -177,7 +259,10 @@ def system_from_args(args):
         system = load_system(args.system, file_values)
         extra = [n for n in names if n not in {p.name for p in system.parameters}]
         if extra:
-            raise NambuBCHError(f"--param {extra[0]}: the system of {args.system} has parameters {names_of(system.parameters)}")
+            raise NambuBCHError(
+                f"--param {extra[0]}: the system of {shown(args.system)} has parameters {names_of(system.parameters)}"
+            )
+        _refuse_declarations(names, values, f"the system of {shown(args.system)}")
         system = _with_flags(system, args)
         args.file_values = file_values  # numeric defaults for check / plot; not substituted symbolically
         return system, values
@@ -185,7 +270,53 @@ def system_from_args(args):
     extra = [n for n in names if n not in {p.name for p in system.parameters}]
     if extra:
         raise NambuBCHError(f"--param {extra[0]}: model {system.name} has parameters {names_of(system.parameters)}")
+    _refuse_declarations(names, values, f"model {system.name}")
     return _with_flags(system, args), values
+
+
+def _refuse_declarations(names, values, source) -> None:
+    """``--param NAME`` without a value on a built-in model or a file: it would change nothing."""
+    declared = [n for n in names if n not in values]
+    if declared:
+        raise NambuBCHError(f"--param {declared[0]} without a value declares a parameter of a user system (--H); "
+                            f"{source} has it already: give a value, e.g. --param {declared[0]}=1")
+
+
+_COORDINATE = re.compile(r"(?<![A-Za-z0-9_])x([1-9][0-9]*)(?![A-Za-z0-9_])", re.ASCII)
+
+
+def _check_inferred_coordinates(hams, coords, names, bracket) -> None:
+    """Without ``--coords`` the coordinates are ``x1..xN`` with N from the number of Hamiltonians (2 for one,
+    else one more than their number); refuse when the highest ``x<k>`` the expressions use is not ``xN``.
+
+    ``--H 'x2^2/2 + x1^2/2' --G 'x1^2'`` would otherwise be analysed on ``x1 x2 x3`` (a Nambu system in
+    which x3 appears nowhere), and ``--H`` using ``x3`` would be refused as an undeclared name.
+    """
+    from ..systems import infer_bracket
+
+    found = {f"x{m}" for text in hams for m in _COORDINATE.findall(text)} - set(names)
+    if not found:
+        return  # no coordinate-like name: the parser names whatever is undeclared
+    used = sorted(found, key=lambda name: int(name[1:]))
+    top = int(used[-1][1:])
+    if top == len(coords):
+        return
+    flags = "--H" + (f" and {len(hams) - 1} --G use" if len(hams) > 1 else " uses")
+    try:
+        kind = f", {infer_bracket(len(coords), len(hams), bracket)} bracket"
+    except NambuBCHError:
+        kind = ""
+    count = f"{len(hams)} Hamiltonians mean" if len(hams) > 1 else "one Hamiltonian means"
+    meant = f"{flags} {', '.join(used)}; without --coords, {count} a system on {' '.join(coords)} (N = {len(coords)}{kind})"
+    if top < len(coords):
+        unused = coords[top:]
+        appear = f"{unused[0]} appears" if len(unused) == 1 else f"{', '.join(unused)} appear"
+        raise NambuBCHError(
+            f"{meant}, in which {appear} in no Hamiltonian; pass --coords {' '.join(coords)!r} to analyse that system"
+        )
+    wanted = " ".join(f"x{k}" for k in range(1, top + 1))
+    raise NambuBCHError(f"{meant}; pass --coords {wanted!r} for the coordinates the expressions use "
+                        "(--param NAME declares a parameter)")
 
 
 def _with_flags(system, args):
@@ -301,6 +432,8 @@ def normalise(args):
         args.short_steps = positive_int(args.short_steps, "--short-steps", MAX_STEPS)
     if getattr(args, "dpi", None) is not None:
         args.dpi = positive_int(args.dpi, "--dpi", 1200)
+    if getattr(args, "limit", None) is not None:
+        args.limit = positive_int(args.limit, "--limit", MAX_LIMIT)
     if getattr(args, "every", None) and getattr(args, "steps", None) and args.every > args.steps:
         raise NambuBCHError(f"--every {args.every} is larger than --steps {args.steps}")
     for flag in ("output", "outdir", "system"):
@@ -317,6 +450,21 @@ def normalise(args):
         from ..systems.system import check_name
 
         check_name(args.name, "--name")  # LaTeX- and source-safe, before anything uses it
+    inapplicable(args)
     return args
+
+
+def inapplicable(args) -> None:
+    """Refuse a flag that the request would ignore (each flag either changes the result or is refused).
+
+    Conditions that depend on the integrator (``fi --limit`` needs the nested listing) are
+    checked by the subcommand once the composition is known.
+    """
+    if getattr(args, "standalone", False) and args.format != "latex":
+        raise NambuBCHError(f"--standalone makes a complete LaTeX document; it applies only with --format latex, "
+                            f"not --format {args.format}")
+    if getattr(args, "name", None) is not None and getattr(args, "H", None) is None:
+        chosen = "--system FILE (its 'name' key)" if getattr(args, "system", None) else "a built-in --model"
+        raise NambuBCHError(f"--name {shown(args.name)} names a user system given by --H; {chosen} keeps its own name")
 
 

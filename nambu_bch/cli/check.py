@@ -38,4 +38,4 @@ def run(args):
         out["model"], out["integrator"] = system.name, word
         return out
 
-    emit(args, text=lambda: str(report), data=data)
+    emit(args, text=lambda: str(report), data=data, system=system)

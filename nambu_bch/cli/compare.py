@@ -6,8 +6,8 @@ The work is :func:`nambu_bch.design.compare`.
 from __future__ import annotations
 
 from ..errors import NambuBCHError
-from ._options import (add_subcommand, numeric_inputs, output_options, positive_float, positive_int, system_from_args,
-                       system_options)
+from ._options import (add_subcommand, numeric_inputs, output_options, positive_float, positive_int, shown,
+                       system_from_args, system_options)
 from ._output import emit
 
 HELP = "compare integrators: order, cost, error constant, the system's leading error, measured error vs cost"
@@ -67,7 +67,7 @@ def run(args):
         if not w.strip() or len(w) > 200:
             raise NambuBCHError(f"--integrator {w[:40]!r} must be a non-empty string of at most 200 characters")
     if args.figure is not None and not args.figure.lower().endswith((".png", ".pdf", ".svg")):
-        raise NambuBCHError(f"--figure {args.figure[:80]!r}: give a file name ending in .png, .pdf or .svg")
+        raise NambuBCHError(f"--figure {shown(args.figure)}: give a file name ending in .png, .pdf or .svg")
     t_end = positive_float(args.t_end, "--t-end")
     if t_end > 1e5:
         raise NambuBCHError(f"--t-end {args.t_end!r} must be at most 1e5")
@@ -77,5 +77,11 @@ def run(args):
         try:
             result.figure(args.figure)
         except OSError as exc:
-            raise NambuBCHError(f"--figure {args.figure}: cannot write the file ({exc.strerror or exc})") from None
-    emit(args, text=result.table, data=result.to_dict)
+            raise NambuBCHError(f"--figure {shown(args.figure)}: cannot write the file ({exc.strerror or exc})") from None
+
+    def data():
+        from .. import render
+
+        return {**render.system_dict(system), **result.to_dict()}  # the coordinates and bracket analysed, too
+
+    emit(args, text=result.table, data=data, system=system)

@@ -33,5 +33,5 @@ def run(args):
         out["model"], out["integrator"] = system.name, word
         return out
 
-    emit(args, latex=result.to_latex, text=result.to_text, data=data)
+    emit(args, latex=result.to_latex, text=result.to_text, data=data, system=system)
 

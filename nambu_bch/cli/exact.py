@@ -40,5 +40,5 @@ def run(args):
     def latex():
         return result.to_latex(order=args.order)
 
-    emit(args, latex=latex, text=lambda: result.to_text(order=args.order), data=data)
+    emit(args, latex=latex, text=lambda: result.to_text(order=args.order), data=data, system=system)
 

@@ -3,8 +3,7 @@
 from __future__ import annotations
 
 from ..errors import NambuBCHError
-from ._options import (add_subcommand, integrator_from_args, integrator_options, output_options, positive_int,
-                       symbolic_system, system_options)
+from ._options import add_subcommand, integrator_from_args, integrator_options, output_options, symbolic_system, system_options
 from ._output import base_dict, emit
 
 HELP = "the eight fundamental-identity forms of [X_AB,[X_CD,X_EF]] and their use on a system"
@@ -23,7 +22,8 @@ def register(sub) -> None:
 
 
 def _system_chosen(args) -> bool:
-    return any((args.model, args.system, args.H, args.G, args.coords, args.param, args.split, args.bracket, args.integrator))
+    return any((args.model, args.system, args.H, args.G, args.coords, args.param, args.split, args.bracket, args.integrator,
+                args.order is not None))
 
 
 def run(args):
@@ -32,7 +32,14 @@ def run(args):
 
     system = symbolic_system(args)
     word, comp = integrator_from_args(args, system)
-    if args.order is not None and args.order > (2 if comp.symmetric else 1):
+    if args.order is not None and args.order < 2:
+        raise NambuBCHError(f"--order {args.order}: fi shows the brackets at h^K for K >= 2 (the double commutators "
+                            "start at h^2); give --order 2 or more")
+    nested = args.order is not None and args.order > (2 if comp.symmetric else 1)
+    if args.limit is not None and not nested:
+        raise NambuBCHError(f"--limit {args.limit} applies to the listing of --order K > {2 if comp.symmetric else 1} "
+                            f"for {word}, not to the h^2 brackets (all shown); add e.g. --order 4 or drop --limit")
+    if nested:
         return _nested(args, system, word, comp)
     reps = bch_double_commutators(system, comp) if _system_chosen(args) else None
 
@@ -64,14 +71,14 @@ def run(args):
         blocks += [render.fi_representations_latex(f"{word} on {system.name}", c, abd, forms) for c, abd, forms in reps or ()]
         return blocks
 
-    emit(args, latex=latex, text=text, data=data)
+    emit(args, latex=latex, text=text, data=data, system=system if reps is not None else None)
 
 
 def _nested(args, system, word, comp):
     """``fi --order K``: the brackets at ``h^K`` with the affine hulls of their FI representations (issue 13)."""
     from ..shadow.fi_route import count_brackets, fi_brackets
 
-    limit = positive_int(args.limit, "--limit", 10**6) if args.limit is not None else None
+    limit = args.limit
     total = count_brackets(system, comp, args.order)
     if limit is None and total > 2000:
         raise NambuBCHError(f"--order {args.order}: {total} brackets; pass --limit N to list the first N")
@@ -90,5 +97,5 @@ def _nested(args, system, word, comp):
         title = r"\text{" + f"{word} on {system.name}, {total} brackets at" + "} " + f"h^{{{args.order}}}"
         return " \\\\\n".join([title, *(b.to_latex(limit) for b in shown), *([r"\text{" + more + "}"] if more else [])])
 
-    emit(args, latex=latex, text=text, data=data)
+    emit(args, latex=latex, text=text, data=data, system=system)
 

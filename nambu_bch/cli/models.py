@@ -89,7 +89,8 @@ def run(args):
 
         blocks = []
         for s in systems():
-            rows = [("", "", [latex_text(s.name) + ":"])]
+            coords = ", ".join(sympy.latex(x) for x in s.coordinates)  # the system named as in the text listing
+            rows = [("", "", [latex_text(f"{s.name}: {s.bracket} bracket on") + rf"\ ({coords}):"])]
             labels = ["H", "G"] if len(s.hamiltonians) == 2 else [f"H_{{{k + 1}}}" for k in range(len(s.hamiltonians))]
             rows += [(lab, "=", sum_tokens(H)) for lab, H in zip(labels[: len(s.hamiltonians)] or ["H"], s.hamiltonians)]
             rows += [(f"X_{{{p.number}}}", "=", field_tokens(p)) for p in s.splitting.pieces]

@@ -6,7 +6,7 @@ import os
 
 from ..errors import NambuBCHError
 from ._options import (add_subcommand, integrator_from_args, integrator_options, numeric_inputs, numeric_options,
-                       output_options, progress_option, system_from_args, system_options)
+                       output_options, progress_option, shown, system_from_args, system_options)
 from ._output import emit
 
 HELP = "regenerate the paper's Figs. 1-4 as PNG files"
@@ -33,7 +33,7 @@ def run(args):
         try:
             os.makedirs(outdir, exist_ok=True)
         except (OSError, ValueError) as exc:
-            raise NambuBCHError(f"--outdir {outdir}: cannot create the directory ({exc.strerror or exc})") from None
+            raise NambuBCHError(f"--outdir {shown(outdir)}: cannot create the directory ({exc.strerror or exc})") from None
     system, values = system_from_args(args)
     if args.integrator is None and system.name == "ho3":
         args.integrator = "32123"  # the paper's Figs. 1-4
@@ -53,5 +53,10 @@ def run(args):
     files = paper_figures(outdir, **kwargs)
     files = [os.fspath(f) for f in (files.values() if isinstance(files, dict) else files)]
 
-    emit(args, text=lambda: "\n".join(files), data=lambda: {"outdir": os.fspath(outdir), "files": files})
+    def data():
+        from .. import render
+
+        return {**render.system_dict(system), "outdir": os.fspath(outdir), "files": files}
+
+    emit(args, text=lambda: "\n".join(files), data=data, system=system)
 

@@ -49,5 +49,5 @@ def run(args):
             out += "\n" + family.details.to_text()  # each commutator's representations and weights
         return out
 
-    emit(args, latex=family.to_latex, text=text, data=data)
+    emit(args, latex=family.to_latex, text=text, data=data, system=system)
 

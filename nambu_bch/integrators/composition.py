@@ -56,7 +56,7 @@ from sympy.polys.domains import QQ
 
 from ..algebra.zero import is_zero
 from ..checks import is_int
-from ..errors import InconsistentCoefficientsError, InvalidCompositionError, UnknownPieceError
+from ..errors import InconsistentCoefficientsError, InvalidCompositionError, UnknownPieceError, did_you_mean
 
 #: Names resolved by :mod:`nambu_bch.design.catalog` (literature methods, ``name`` or ``name:WORD``).
 _CATALOG = ("kahan-li", "yoshida6", "blanes-moan")
@@ -435,6 +435,9 @@ def _build(spec, n_pieces):
         from ..design.catalog import lookup  # literature methods with citations (issue 15)
 
         return lookup(text, n_pieces)
+    head = low.partition(":")[0].strip()
+    if ":" in text and not head.isdigit():
+        raise InvalidCompositionError(_named_form_message(text, head))
     if ":" in text:
         pairs = []
         for item in text.split(","):
@@ -445,7 +448,8 @@ def _build(spec, n_pieces):
         return composition(pairs)
     if not text.isdigit() or "0" in text:
         raise InvalidCompositionError(
-            f"unknown composition {text!r}; use a word of piece digits 1-9 such as '12321', "
+            f"unknown composition {text!r}{did_you_mean(text, _NAMES) if not text.isdigit() else ''}; "
+            "use a word of piece digits 1-9 such as '12321', "
             f"an alias ({', '.join(sorted(_ALIASES))}, lie-trotter, strang, forest-ruth, yoshida, yoshida:WORD, "
             "triple-jump:WORD, suzuki[:WORD], kahan-li[:WORD], yoshida6[:WORD], blanes-moan) "
             "or an explicit list 'piece:coefficient,...'"
@@ -456,6 +460,23 @@ def _build(spec, n_pieces):
 
 
 _TEXT_PUNCTUATION = " :,/.+-*()^_"
+#: Names that take a base word after a colon (``yoshida:12321``) and names that stand alone.
+_WITH_WORD = (*_JUMPS[1:], *(c for c in _CATALOG if c != "blanes-moan"))
+_NAMES = (*_ALIASES, "lie-trotter", "strang", *_JUMPS, *_CATALOG)
+
+
+def _named_form_message(text: str, head: str) -> str:
+    """The answer to ``NAME:REST`` where NAME takes no base word (``strang:12321``) or is no method at all."""
+    forms = ", ".join(f"{name}:WORD" for name in _WITH_WORD)
+    if head in _NAMES:
+        return (
+            f"composition {_shown(text)}: {head!r} takes no base word (it expands over the splitting's own pieces); "
+            f"write {head!r} alone or a word such as '12321' itself; the forms with a word are {forms}"
+        )
+    return (
+        f"composition {_shown(text)}: {_shown(head)} is not a method{did_you_mean(head, _NAMES)}; the forms with a "
+        f"word are {forms} (e.g. yoshida:12321), an explicit list is 'piece:coefficient,...' such as '1:1/2,2:1,1:1/2'"
+    )
 
 
 def _digit_pieces(text, n_pieces):

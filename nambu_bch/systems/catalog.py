@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from ..errors import UnknownModelError
+from ..errors import UnknownModelError, did_you_mean
 from .system import System
 
 _PAPER = "Horikoshi, Shadow Hamiltonians of structure-preserving integrators for Nambu mechanics"
@@ -160,7 +160,9 @@ def model(name: str) -> System:
     (m*omega**2*x3/2 + x2**2/(2*m), -x1**2 + x3)
     """
     if not isinstance(name, str) or name not in _MODELS:
-        raise UnknownModelError(f"unknown model {name!r}; built-in models are {', '.join(_MODELS)}")
+        raise UnknownModelError(
+            f"unknown model {name!r}{did_you_mean(name, _MODELS)}; built-in models are {', '.join(_MODELS)}"
+        )
     if name not in _CACHE:
         _CACHE[name] = _MODELS[name]()
     return _CACHE[name]
