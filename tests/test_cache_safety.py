@@ -246,6 +246,61 @@ def test_numba_cache_directory_is_private_or_none(tmp_path, monkeypatch):
     assert compiled.numba_cache_directory(here) is None
 
 
+# -- the models listing cache -----------------------------------------------------------------------------------------
+
+
+def _listing(monkeypatch, capsys, root):
+    from nambu_bch.cli import main
+
+    monkeypatch.setenv("NAMBU_BCH_CACHE", str(root))
+    assert main(["models", "--format", "text"]) == 0
+    return capsys.readouterr().out
+
+
+def _entry(root):
+    (entry,) = (root / "cli").glob("*.txt")
+    return entry
+
+
+def test_truncated_listing_cache_is_recomputed(tmp_path, monkeypatch, capsys):
+    """A listing entry cut to 100 bytes was printed with exit 0: its digest no longer matches, so it is computed."""
+    root = tmp_path / "cache"
+    honest = _listing(monkeypatch, capsys, root)
+    entry = _entry(root)
+    entry.write_bytes(entry.read_bytes()[:100])
+    assert _listing(monkeypatch, capsys, root) == honest
+    assert stat.S_IMODE(entry.stat().st_mode) == 0o600
+    assert _entry(root).read_text().endswith(honest)  # rewritten whole
+    body = entry.read_text().partition("\n")[2]
+    entry.write_text(entry.read_text().partition("\n")[0] + "\n" + body.replace("ho3", "hx3", 1))  # one byte changed
+    assert _listing(monkeypatch, capsys, root) == honest
+
+
+@pytest.mark.parametrize("planted", ["\x1b]0;pwned\x07\x1b[2J", "ok\rplanted", "\u202eplanted", "a\x00b"])
+def test_listing_cache_never_prints_control_characters(tmp_path, monkeypatch, capsys, planted):
+    """A planted entry with terminal escapes (even with a matching digest) is not printed: the listing is computed."""
+    root = tmp_path / "cache"
+    honest = _listing(monkeypatch, capsys, root)
+    from nambu_bch.cli.cache import _HEADER
+
+    text = planted + "\n" + honest
+    _entry(root).write_text(_HEADER + hashlib.sha256(text.encode()).hexdigest() + "\n" + text)
+    shown = _listing(monkeypatch, capsys, root)
+    assert shown == honest and planted not in shown
+
+
+def test_listing_cache_under_a_parent_others_can_write_is_not_used(tmp_path, monkeypatch, capsys):
+    """A cache root whose parent directory anyone can write (no sticky bit) is not private: nothing is cached."""
+    shared = tmp_path / "shared"
+    shared.mkdir()
+    os.chmod(shared, 0o777)
+    honest = _listing(monkeypatch, capsys, shared / "cache")
+    assert not list((shared / "cache").rglob("*.txt"))
+    os.chmod(shared, 0o1777)  # sticky, like /tmp: others cannot rename what is ours
+    assert _listing(monkeypatch, capsys, shared / "cache") == honest
+    assert len(list((shared / "cache").rglob("*.txt"))) == 1
+
+
 # -- non-regular files in place of cache files -------------------------------------------------------------------------
 
 
