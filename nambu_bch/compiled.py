@@ -145,13 +145,14 @@ def _define_cache_class():
     and ``$NUMBA_CACHE_LOCATOR_CLASSES`` first) and ``IndexDataCacheFile``'s reads and writes (``open``
     and ``pickle.load`` on whatever is there).
     """
+    import hashlib
     import inspect
     import io
     import pickle
 
     from numba.core import caching
 
-    from .private_dirs import untrusted
+    from .private_dirs import read_private, untrusted
 
     class PrivateLocator(caching._SourceFileBackedLocatorMixin, caching._CacheLocator):
         def __init__(self, py_func, py_file, directory):
@@ -166,6 +167,9 @@ def _define_cache_class():
 
         def get_cache_path(self):
             return self._cache_path
+
+        def get_source_stamp(self):  # numba's stamp is a digest too, but read with a plain open (a FIFO blocks)
+            return hashlib.sha256(read_private(self._py_file, MAX_NUMBA_FILE, owned=False)).digest()
 
     class PrivateImpl(caching.CompileResultCacheImpl):
         def __init__(self, py_func, directory):  # numba's __init__ without its search for a locator
@@ -184,14 +188,19 @@ def _define_cache_class():
             payload = _verified(self._index_path) if self._private() else None
             if payload is None:  # absent, damaged, planted, or the directory is no longer private
                 return {}
-            stream = io.BytesIO(payload)
-            if pickle.load(stream) != self._version:
+            try:
+                stream = io.BytesIO(payload)
+                if pickle.load(stream) != self._version:
+                    return {}
+                stamp, overloads = pickle.loads(stream.read())
+            except Exception:  # noqa: BLE001 - an index of ours this numba cannot read: start afresh
                 return {}
-            stamp, overloads = pickle.loads(stream.read())
-            return overloads if stamp == self._source_stamp else {}
+            if stamp != self._source_stamp or not isinstance(overloads, dict):
+                return {}
+            return overloads
 
         def _save_index(self, overloads):
-            self._locator_check()
+            self._check_private()
             payload = pickle.dumps(self._version, protocol=-1) + self._dump((self._source_stamp, overloads))
             _write_verified(self._index_path, payload)
 
@@ -204,10 +213,10 @@ def _define_cache_class():
             return pickle.loads(payload)
 
         def _save_data(self, name, data):
-            self._locator_check()
+            self._check_private()
             _write_verified(self._data_path(name), self._dump(data))
 
-        def _locator_check(self):
+        def _check_private(self):
             if not self._private():
                 raise OSError(f"{self._cache_path} is no longer private")
 

@@ -67,7 +67,7 @@ def unsafe_ancestor(path):
     return None
 
 
-def _unsafe_stat(path, st, check_owner: bool, kind: str):
+def _unsafe_stat(path, st, check_owner: bool, kind: str, check_mode: bool = True):
     """The reason why ``st`` (of ``path``) is not a private ``kind``, or None."""
     if stat.S_ISLNK(st.st_mode):
         return f"{path} is a symbolic link"
@@ -75,7 +75,7 @@ def _unsafe_stat(path, st, check_owner: bool, kind: str):
         return f"{path} is not a {kind}" + ("" if kind == "directory" else " (a FIFO, socket, device or directory)")
     if check_owner and euid() is not None and st.st_uid != euid():
         return f"{path} is owned by uid {st.st_uid}, not by this user ({euid()})"
-    if st.st_mode & _WRITABLE_BY_OTHERS:
+    if check_mode and st.st_mode & _WRITABLE_BY_OTHERS:
         return f"{path} is writable by group or others (mode {stat.S_IMODE(st.st_mode):o})"
     return None
 
@@ -95,14 +95,15 @@ def untrusted(path: Path, check_owner: bool = True, kind: str = "directory"):
     return reason
 
 
-def read_private(path, limit: int) -> bytes:
+def read_private(path, limit: int, owned: bool = True) -> bytes:
     """The bytes of the regular file ``path``, ours and writable by nobody else, at most ``limit`` bytes.
 
     The one way a cache file is read.  ``lstat`` first (a symbolic link, FIFO, socket, device or
     directory is refused before it is opened, so opening cannot block or have a device's side
     effects), then ``open`` with ``O_NOFOLLOW | O_NONBLOCK`` and ``fstat`` of the opened descriptor,
     which must be the very file checked (same device and inode), so nothing can be substituted
-    in between.  The directory is the caller's to check (:func:`untrusted`).
+    in between.  The directory is the caller's to check (:func:`untrusted`).  ``owned=False``
+    drops the owner and mode checks (the package's own source files, installed by someone else).
 
     Raises
     ------
@@ -110,14 +111,14 @@ def read_private(path, limit: int) -> bytes:
         Absent, not a private regular file, or larger than ``limit``.
     """
     before = os.lstat(path)
-    reason = _unsafe_stat(path, before, True, "file")
+    reason = _unsafe_stat(path, before, owned, "file", owned)
     if reason:
         raise OSError(reason)
     flags = os.O_RDONLY | getattr(os, "O_NOFOLLOW", 0) | getattr(os, "O_NONBLOCK", 0) | getattr(os, "O_CLOEXEC", 0)
     fd = os.open(path, flags)
     with os.fdopen(fd, "rb") as handle:
         st = os.fstat(fd)
-        reason = _unsafe_stat(path, st, True, "file")
+        reason = _unsafe_stat(path, st, owned, "file", owned)
         if reason is None and (st.st_dev, st.st_ino) != (before.st_dev, before.st_ino):
             reason = f"{path} was replaced while it was opened"
         if reason is None and st.st_size > limit:
@@ -148,10 +149,10 @@ def _prepare(base: Path, parts, fresh: bool = False):
         reason = untrusted(level, check_owner=not fresh)
         if reason:
             return None, reason
-    probe = levels[-1] / f".probe-{os.getpid()}"
-    try:
-        probe.write_text("")
-        probe.unlink()
+    try:  # a fresh name (O_EXCL): nothing planted under a guessable name can be opened
+        fd, probe = tempfile.mkstemp(prefix=".probe-", dir=levels[-1])
+        os.close(fd)
+        os.unlink(probe)
     except OSError as exc:
         return None, f"{levels[-1]} is not writable ({exc.strerror})"
     return levels[-1], None
