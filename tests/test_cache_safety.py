@@ -177,8 +177,8 @@ def _private_index(fn, directory):
 
 @numba_only
 def test_private_numba_cache_unpickles_only_verified_files(tmp_path, warm):
-    """In the package's own numba directories, a file without the digest the package writes (a raw pickle, a
-    truncated or flipped entry) is compiled over, never unpickled; the rewritten entries are loaded next time."""
+    """In the package's own numba directories, a file without the digest the package writes (a raw pickle in
+    numba's format, a truncated entry) is compiled over and rewritten in the verified format, never unpickled."""
     root, env = _copy_warm(warm, tmp_path)
     indexes = sorted(root.rglob("*.nbi"))
     data = sorted(root.rglob("*.nbc"))

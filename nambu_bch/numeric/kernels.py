@@ -4,7 +4,8 @@
 :class:`~nambu_bch.numeric.codegen.StepProgram` is printed as a Python module
 (:func:`~nambu_bch.numeric.codegen.python_source`), written to the cache
 directory under a hash of its source, imported, and its loop functions are
-compiled with ``numba.njit(cache=True)`` on first use -- so a second process
+compiled with numba on first use, their machine code kept in the same private
+cache (:func:`nambu_bch.compiled.enable_private_cache`) -- so a second process
 loads the machine code from disk instead of compiling again.
 
 Cache directory: ``$NAMBU_BCH_CACHE`` if set, else ``~/.cache/nambu_bch``;
