@@ -26,6 +26,7 @@ CACHES = (
     ("nambu_bch.algebra.frac_rref", "_CONTEXTS"),
     ("nambu_bch.algebra.frac_rref", "_FLINT_QQ"),
     ("nambu_bch.bch.concrete", "clear_cache"),          # _EVALUATORS
+    ("nambu_bch.compiled", "_NUMBA_DIRS"),
     ("nambu_bch.bch.formal", "clear_cache"),            # _PATTERN_CACHE
     ("nambu_bch.bch.formal", "_fits"),
     ("nambu_bch.bch.formal", "_lyndon_trees"),

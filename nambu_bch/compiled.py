@@ -1,8 +1,10 @@
-"""Whether compiled (numba) code may be used: one switch for the numeric kernels and the BCH engine.
+"""Whether compiled (numba) code may be used, and where its machine code may be cached: one place for both.
 
 numba is optional at run time: ``NAMBU_BCH_DISABLE_NUMBA=1`` (or numba missing) sends the numeric
 kernels to their numpy fallback and the formal BCH series to the pure-Python dense engine; both
-paths are tested.
+paths are tested.  Every compiled function of the package is made by :func:`njit` (or given
+:func:`enable_private_cache`), never by ``numba.njit(cache=True)``: numba's own cache would read
+pickles from directories the package does not check.
 """
 
 from __future__ import annotations
@@ -23,3 +25,221 @@ def numba_available() -> bool:
         return importlib.util.find_spec("numba") is not None
     except (ImportError, ValueError):
         return False
+
+
+#: Largest numba cache file read back (an index or one compiled overload; the package's are below 1 MB).
+MAX_NUMBA_FILE = 32 * 2**20
+#: First bytes of every numba cache file the package writes; a SHA-256 of the rest follows them.
+_MAGIC = b"nambu_bch numba cache 1\n"
+#: ``{(cache root, directory name): private directory or None}`` of :func:`numba_cache_directory`.
+_NUMBA_DIRS: dict = {}
+
+
+def njit(**options):
+    """``numba.njit(**options)`` whose machine code is kept only in the package's private cache, verified on reading.
+
+    Use it instead of ``numba.njit(cache=True)``: numba's own cache goes to ``$NUMBA_CACHE_DIR``, the
+    source tree's ``__pycache__`` or ``~/.cache/numba`` -- directories the package does not check -- and
+    unpickles whatever it finds there.  See :func:`enable_private_cache`.
+    """
+    def decorate(fn):
+        import numba
+
+        dispatcher = numba.njit(**options)(fn)
+        enable_private_cache(dispatcher)
+        return dispatcher
+
+    return decorate
+
+
+def numba_cache_directory(py_file):
+    """The private directory for the machine code of the functions of ``py_file``, or None (then nothing is cached).
+
+    ``<cache root>/numba/<directory name>_<SHA-1 of the directory>`` (the names numba itself would use
+    under ``$NUMBA_CACHE_DIR``), every level private (:func:`nambu_bch.private_dirs.private_directory`;
+    the per-user temp directory when the cache root is not; never a throw-away one).
+    """
+    import hashlib
+
+    from .private_dirs import cache_root, private_directory
+
+    where = os.path.dirname(os.path.abspath(py_file))
+    name = f"{os.path.basename(where)}_{hashlib.sha1(where.encode()).hexdigest()}"
+    key = (str(cache_root()), name)
+    if key not in _NUMBA_DIRS:  # once per module directory: a dozen functions share it (the caller re-checks it)
+        try:
+            _NUMBA_DIRS[key] = private_directory("numba", name, fresh=False)
+        except OSError:
+            _NUMBA_DIRS[key] = None
+    return _NUMBA_DIRS[key]
+
+
+def enable_private_cache(dispatcher, directory=None) -> bool:
+    """Give a numba dispatcher a disk cache in ``directory`` (default :func:`numba_cache_directory`); whether it got one.
+
+    The cache is used only while the directory is private (:func:`nambu_bch.private_dirs.untrusted`,
+    checked again before every read and write); each file is written atomically with a SHA-256 of its
+    content and read back through :func:`nambu_bch.private_dirs.read_private` (a private regular file,
+    never a link, FIFO or device, size bounded), and numba unpickles it only if the digest matches,
+    so a file planted or damaged there is compiled over, never loaded.  Without a private directory,
+    or if numba's caching internals are not the ones this was written for, the function is compiled
+    in memory in each process (what ``cache=False`` does).
+    """
+    import inspect
+
+    from .private_dirs import untrusted
+
+    try:
+        py_file = inspect.getfile(dispatcher.py_func)
+        if directory is None:
+            directory = numba_cache_directory(py_file)
+        if directory is None or untrusted(directory) is not None or not os.path.exists(py_file):
+            return False
+        dispatcher._cache = _cache_class()(dispatcher.py_func, str(directory))
+    except (ImportError, AttributeError, TypeError, OSError):
+        return False
+    return True
+
+
+def _verified(path):
+    """The payload of a cache file we wrote (digest checked), or None."""
+    import hashlib
+
+    from .private_dirs import read_private
+
+    try:
+        data = read_private(path, MAX_NUMBA_FILE)
+    except OSError:
+        return None
+    head = len(_MAGIC) + 32
+    if not data.startswith(_MAGIC) or len(data) < head:
+        return None
+    payload = data[head:]
+    return payload if hashlib.sha256(payload).digest() == data[len(_MAGIC):head] else None
+
+
+def _write_verified(path, payload: bytes) -> None:
+    """Write ``payload`` with its digest, atomically, mode 0600."""
+    import hashlib
+
+    from .atomic import write_atomic
+
+    write_atomic(path, _MAGIC + hashlib.sha256(payload).digest() + payload, mode=0o600)
+
+
+_CACHE_CLASS = None
+
+
+def _cache_class():
+    """The cache class of :func:`enable_private_cache` (defined on first use: importing numba costs ~0.3 s)."""
+    global _CACHE_CLASS
+    if _CACHE_CLASS is None:
+        _CACHE_CLASS = _define_cache_class()
+    return _CACHE_CLASS
+
+
+def _define_cache_class():
+    """numba's ``FunctionCache`` with the locator and the file format described in :func:`enable_private_cache`.
+
+    It replaces two things of numba's: the choice of directory (``CacheImpl`` tries ``$NUMBA_CACHE_DIR``
+    and ``$NUMBA_CACHE_LOCATOR_CLASSES`` first) and ``IndexDataCacheFile``'s reads and writes (``open``
+    and ``pickle.load`` on whatever is there).
+    """
+    import hashlib
+    import inspect
+    import io
+    import pickle
+
+    from numba.core import caching
+
+    from .private_dirs import read_private, untrusted
+
+    class PrivateLocator(caching._SourceFileBackedLocatorMixin, caching._CacheLocator):
+        def __init__(self, py_func, py_file, directory):
+            self._py_file = py_file
+            self._lineno = py_func.__code__.co_firstlineno
+            self._cache_path = directory
+
+        def ensure_cache_path(self):  # before every save: still private?
+            reason = untrusted(self._cache_path)
+            if reason:
+                raise OSError(reason)
+
+        def get_cache_path(self):
+            return self._cache_path
+
+        def get_source_stamp(self):  # numba's stamp is a digest too, but read with a plain open (a FIFO blocks)
+            return hashlib.sha256(read_private(self._py_file, MAX_NUMBA_FILE, owned=False)).digest()
+
+    class PrivateImpl(caching.CompileResultCacheImpl):
+        def __init__(self, py_func, directory):  # numba's __init__ without its search for a locator
+            self._lineno = py_func.__code__.co_firstlineno
+            qualname = getattr(py_func, "__qualname__", py_func.__name__)
+            filename = inspect.getfile(py_func)
+            self._locator = PrivateLocator(py_func, filename, directory)
+            modname = os.path.splitext(os.path.basename(filename))[0]
+            self._filename_base = self.get_filename_base(f"{modname}.{qualname}", getattr(sys, "abiflags", ""))
+
+    class VerifiedFile(caching.IndexDataCacheFile):
+        def _private(self):
+            return untrusted(self._cache_path) is None
+
+        def _load_index(self):
+            payload = _verified(self._index_path) if self._private() else None
+            if payload is None:  # absent, damaged, planted, or the directory is no longer private
+                return {}
+            try:
+                stream = io.BytesIO(payload)
+                if pickle.load(stream) != self._version:
+                    return {}
+                stamp, overloads = pickle.loads(stream.read())
+            except Exception:  # noqa: BLE001 - an index of ours this numba cannot read: start afresh
+                return {}
+            if stamp != self._source_stamp or not isinstance(overloads, dict):
+                return {}
+            return overloads
+
+        def _save_index(self, overloads):
+            self._check_private()
+            payload = pickle.dumps(self._version, protocol=-1) + self._dump((self._source_stamp, overloads))
+            _write_verified(self._index_path, payload)
+
+        def _load_data(self, name):
+            if os.path.basename(name) != name or not self._private():
+                raise OSError(f"{name}: not a cache file of a private directory")
+            payload = _verified(self._data_path(name))
+            if payload is None:
+                raise OSError(f"{name}: absent or damaged")  # load() then compiles
+            return pickle.loads(payload)
+
+        def _save_data(self, name, data):
+            self._check_private()
+            _write_verified(self._data_path(name), self._dump(data))
+
+        def _check_private(self):
+            if not self._private():
+                raise OSError(f"{self._cache_path} is no longer private")
+
+    class PrivateFunctionCache(caching.FunctionCache):
+        def __init__(self, py_func, directory):  # numba's Cache.__init__ with the classes above
+            self._name = repr(py_func)
+            self._py_func = py_func
+            self._impl = PrivateImpl(py_func, directory)
+            self._cache_path = directory
+            self._cache_file = VerifiedFile(cache_path=directory, filename_base=self._impl.filename_base,
+                                            source_stamp=self._impl.locator.get_source_stamp())
+            self.enable()
+
+        def load_overload(self, sig, target_context):
+            try:
+                return super().load_overload(sig, target_context)
+            except Exception:  # noqa: BLE001 - a verified file this numba cannot rebuild: compile it again
+                return None
+
+        def save_overload(self, sig, data):
+            try:
+                super().save_overload(sig, data)
+            except OSError:  # full disk, read-only, no longer private: the compiled function still runs
+                pass
+
+    return PrivateFunctionCache

@@ -70,9 +70,10 @@ from functools import lru_cache
 from itertools import compress
 from math import factorial
 
-import numba
 import numpy as np
 import sympy
+
+from ..compiled import njit
 
 #: Primes below 2^28: a product of two residues is below 2^56, so up to 128 products (and every inner sum
 #: of the kernels, at most 64 terms for degrees <= 64) add up in int64 with one reduction at the end.
@@ -85,7 +86,7 @@ runs = 0
 
 # -- modular reduction ----------------------------------------------------------------------------------------
 
-@numba.njit(cache=True, inline="always")
+@njit(inline="always")
 def _reduce(x, p, inv):
     """``x mod p`` for ``|x| < 2^62``, ``p < 2^28``, ``inv = 1.0 / p``: a float64 quotient, one correction each way.
 
@@ -106,13 +107,13 @@ def _reduce(x, p, inv):
 # one-dimensional int64, int32 or int8 array (three compilations), filled by a loop and reshaped (a view:
 # no compilation).  The helpers are inlined into their callers (no compilation of their own either).
 
-@numba.njit(cache=True, inline="always")
+@njit(inline="always")
 def _zeros2(rows, cols, dtype):
     """A zeroed C-contiguous ``(rows, cols)`` array of ``dtype``."""
     return np.zeros(rows * cols, dtype=dtype).reshape((rows, cols))
 
 
-@numba.njit(cache=True, inline="always")
+@njit(inline="always")
 def _filled(size, value):
     """An int64 array of ``size`` entries equal to ``value``."""
     a = np.zeros(size, dtype=np.int64)
@@ -123,7 +124,7 @@ def _filled(size, value):
 
 # -- Lyndon table -------------------------------------------------------------------------------------------------
 
-@numba.njit(cache=True)
+@njit()
 def _duval_next(w, length, n, g):
     """Duval's step after the Lyndon word ``w[:length]`` has been used: extend periodically to length ``n``, drop
     trailing maximal letters; returns the new length (0: done).  The caller increments ``w[length - 1]``."""
@@ -136,7 +137,7 @@ def _duval_next(w, length, n, g):
     return length
 
 
-@numba.njit(cache=True)
+@njit()
 def _duval_count(g, n):
     w = _filled(n + 1, -1)
     length, count = np.int64(1), 0  # np.int64: a literal 1 would compile _duval_next once more for Literal[int](1)
@@ -147,7 +148,7 @@ def _duval_count(g, n):
     return count
 
 
-@numba.njit(cache=True)
+@njit()
 def _find(codes, by_length, start, L, code):
     """Duval index of the Lyndon word of length ``L`` with base-``g`` code ``code``, or -1 (binary search:
     within one length Duval order is numeric order of codes)."""
@@ -163,7 +164,7 @@ def _find(codes, by_length, start, L, code):
     return -1
 
 
-@numba.njit(cache=True)
+@njit()
 def _lyndon_table_kernel(g, n):
     """Lyndon words of length <= n in Duval (lexicographic) order, lengths, and standard factors."""
     count = _duval_count(g, n)
@@ -222,7 +223,7 @@ def lyndon_table(g: int, n: int):
 # -- the Lyndon matrix <P_v, w>, through the chains v = a^k u -------------------------------------------------
 
 
-@numba.njit(cache=True)
+@njit()
 def _chains(words, lengths, left, right):
     """Per Lyndon word ``v``: ``K`` (letters peeled as ``P_{a u} = [a, P_u]``, ``a`` the first letter), core, lead, span.
 
@@ -255,7 +256,7 @@ def _chains(words, lengths, left, right):
 _LANES = 8  # words evaluated together by one program sweep (8 x int32: one AVX2 vector)
 
 
-@numba.njit(cache=True)
+@njit()
 def _solve(z, primes, beta, words, lengths, left, right, members, class_start, g, n, d):
     """Eq. (1) in place, all primes at once, for every degree ``<= d`` through the content classes of degree ``d``;
     then, if ``d < n``, the even degree ``n`` by Eq. (3) (:func:`_even_top`, with ``beta``).
@@ -389,7 +390,7 @@ def _solve(z, primes, beta, words, lengths, left, right, members, class_start, g
     return work
 
 
-@numba.njit(cache=True)
+@njit()
 def _word_coefficients(letters, cpow, logk, primes, g, n, count, top):
     """``<log Phi, w> mod p`` for the Lyndon words ``w`` of length ``<= n`` in Duval order, every prime at once.
 
@@ -587,7 +588,7 @@ def _tanh_half_coefficients(n: int) -> dict:
     return {k: t[k] for k in range(1, n + 1, 2)}
 
 
-@numba.njit(cache=True)
+@njit()
 def _even_top(z, primes, lengths, right, K, beta, n):
     """The even top degree ``n`` of ``Z = log(e^{aA} e^{bB})`` from its odd degrees (Eriksen 1968, Sect. III.A).
 
@@ -672,7 +673,7 @@ def _garner(residues, moduli):
     return np.where(total > M // 2, total - M, total)
 
 
-@numba.njit(cache=True)
+@njit()
 def _class_program(members, core, K, words, lengths, left, right, g, d, memo):
     """A straight-line program for ``<P_u, x[K_v:]>``, ``u`` the core of ``v``, every ``v`` in ``members``.
 
@@ -747,7 +748,7 @@ def _class_program(members, core, K, words, lengths, left, right, g, d, memo):
     return kids[: count - g * d].copy(), roots
 
 
-@numba.njit(cache=True)
+@njit()
 def _run_program(kids, x, g, d, stop, X):
     """Evaluate the program of :func:`_class_program` on the words ``x[lane]`` up to node ``stop``."""
     for a in range(g):

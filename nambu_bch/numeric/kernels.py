@@ -4,7 +4,8 @@
 :class:`~nambu_bch.numeric.codegen.StepProgram` is printed as a Python module
 (:func:`~nambu_bch.numeric.codegen.python_source`), written to the cache
 directory under a hash of its source, imported, and its loop functions are
-compiled with ``numba.njit(cache=True)`` on first use -- so a second process
+compiled with numba on first use, their machine code kept in the same private
+cache (:func:`nambu_bch.compiled.enable_private_cache`) -- so a second process
 loads the machine code from disk instead of compiling again.
 
 Cache directory: ``$NAMBU_BCH_CACHE`` if set, else ``~/.cache/nambu_bch``;
@@ -21,8 +22,14 @@ What is cached, and how it is trusted (issue 10 item 6, issue 14):
   its bytes are checked against the recorded SHA-256 (a modified, truncated or
   garbage file is regenerated), and the verified bytes themselves are compiled,
   so the file is never read twice;
-* ``__pycache__/*.nbi, *.nbc`` -- numba's machine code; an entry numba cannot
-  load is deleted and compiled again.
+* ``__pycache__/*.nbi, *.nbc`` -- numba's machine code, kept here whatever
+  ``$NUMBA_CACHE_DIR`` says, each file carrying a SHA-256 of its content that is
+  checked before numba unpickles it (:func:`nambu_bch.compiled.enable_private_cache`);
+  an entry that fails the check, or that numba cannot load, is compiled again.
+
+Every cache file is read through :func:`nambu_bch.private_dirs.read_private` (a
+private regular file: never a symlink, FIFO or device, size bounded) and written
+through :func:`nambu_bch.atomic.write_atomic`.
 
 Every directory of the cache must be a real directory owned by the effective
 user and not writable by group or others (:func:`cache_dir`), otherwise a
@@ -49,9 +56,7 @@ import hashlib
 import json
 import os
 import re
-import stat
 import sys
-import tempfile
 import time
 import types
 from functools import lru_cache
@@ -59,9 +64,11 @@ from pathlib import Path
 
 import numpy as np
 
+from ..compiled import enable_private_cache
 from ..compiled import numba_available  # noqa: F401  (re-exported: nambu_bch.numeric.numba_available)
 from ..errors import InvalidRunError, NumericalRangeError
-from ..private_dirs import cache_root, euid, untrusted
+from ..atomic import write_atomic
+from ..private_dirs import cache_root, private_directory, read_private, untrusted
 from ..integrators.composition import composition_for
 from ..integrators.step import parameter_values
 from .codegen import PAIR_FUNCTION, TEMPLATE_VERSION, python_source, source_hash, step_program
@@ -82,56 +89,26 @@ def cache_dir() -> Path:
 
     Every directory of the cache (the root, ``kernels``, numba's ``kernels/__pycache__``) must be a
     real directory (not a symlink) owned by the effective user and not writable by group or
-    others; one that is not is refused and a private fallback is used instead: the per-user
-    ``$TMPDIR/nambu_bch-<uid>`` if it passes the same checks, else a fresh ``mkdtemp`` directory
-    (mode 0700).  The reason is kept in :data:`CACHE_NOTES`.
+    others, with no directory above it that another user can change
+    (:func:`nambu_bch.private_dirs.untrusted`); one that is not is refused and a private fallback is
+    used instead: the per-user ``$TMPDIR/nambu_bch-<uid>`` if it passes the same checks, else a fresh
+    ``mkdtemp`` directory (mode 0700).  The reason is kept in :data:`CACHE_NOTES`.
     """
     root = str(cache_root())
     known = _CACHE_DIRS.get(root)
     if known is not None and untrusted(known) is None:
         return known
-    _CACHE_DIRS[root] = path = _usable_dir(Path(root))
+    _CACHE_DIRS[root] = path = _usable_dir()
     return path
 
 
-def _prepare(root: Path, fresh=False):
-    """``root/kernels`` with every level created (mode 0700) and checked; the kernels dir or a reason.
-
-    ``fresh``: ``root`` was just made by ``mkdtemp`` (ours by construction), so ownership is not re-checked.
-    """
-    levels = [root, root / "kernels", root / "kernels" / "__pycache__"]
-    for level in levels:
-        try:
-            level.mkdir(mode=0o700, parents=True, exist_ok=True)
-        except OSError as exc:
-            return None, f"cannot create {level} ({exc.strerror})"
-        reason = untrusted(level, check_owner=not fresh)
-        if reason:
-            return None, reason
-    probe = levels[1] / f".probe-{os.getpid()}"
+def _usable_dir() -> Path:
+    """``<cache root>/kernels`` (with ``kernels/__pycache__``) if private, else the per-user temp dir if private,
+    else a fresh private temp dir (:func:`nambu_bch.private_dirs.private_directory`); the reason in :data:`CACHE_NOTES`."""
     try:
-        probe.write_text("")
-        probe.unlink()
-    except OSError as exc:
-        return None, f"{levels[1]} is not writable ({exc.strerror})"
-    return levels[1], None
-
-
-def _usable_dir(root: Path) -> Path:
-    """``root/kernels`` if safe, else the per-user temp dir if safe, else a fresh private temp dir."""
-    path, reason = _prepare(root)
-    if path is not None:
-        return path
-    CACHE_NOTES[str(root)] = reason
-    uid = euid() if euid() is not None else "user"
-    path, reason2 = _prepare(Path(tempfile.gettempdir()) / f"nambu_bch-{uid}")
-    if path is not None:
-        return path
-    CACHE_NOTES[str(root)] = f"{reason}; {reason2}"
-    path, reason3 = _prepare(Path(tempfile.mkdtemp(prefix="nambu_bch-")), fresh=True)
-    if path is None:  # pragma: no cover - a fresh mkdtemp directory is always ours
-        raise InvalidRunError(f"no safe kernel cache directory: {reason}; {reason2}; {reason3}")
-    return path
+        return private_directory("kernels", "__pycache__", notes=CACHE_NOTES).parent
+    except OSError as exc:  # pragma: no cover - a fresh mkdtemp directory is always ours
+        raise InvalidRunError(f"no safe kernel cache directory: {exc}") from None
 
 
 def resolve_backend(backend: str = "auto") -> str:
@@ -189,34 +166,19 @@ def _generator_digest() -> str:
 
 
 def _read_small(path: Path) -> bytes:
-    """The bytes of a regular file we own (no symlink), at most :data:`MAX_CACHE_FILE`; OSError otherwise."""
-    fd = os.open(path, os.O_RDONLY | getattr(os, "O_NOFOLLOW", 0))
-    with os.fdopen(fd, "rb") as fh:
-        st = os.fstat(fh.fileno())
-        if not stat.S_ISREG(st.st_mode) or st.st_mode & (stat.S_IWGRP | stat.S_IWOTH):
-            raise OSError(f"{path} is not a private regular file")
-        data = fh.read(MAX_CACHE_FILE + 1)
-    if len(data) > MAX_CACHE_FILE:
-        raise OSError(f"{path} is too large")
-    return data
+    """The bytes of a private regular file (no symlink, FIFO or device), at most :data:`MAX_CACHE_FILE`; OSError otherwise."""
+    return read_private(path, MAX_CACHE_FILE)
 
 
 def _write_file(path: Path, data: bytes):
     """Make ``path`` hold ``data``: kept untouched if it already does (numba's cache checks its mtime),
-    else replaced atomically (a private temp file, mode 0600, then ``os.replace``)."""
+    else replaced atomically (:func:`nambu_bch.atomic.write_atomic`, mode 0600)."""
     try:
         if _read_small(path) == data:
             return
     except OSError:
         pass
-    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=".tmp-")
-    try:
-        with os.fdopen(fd, "wb") as fh:
-            fh.write(data)
-        os.replace(tmp, path)
-    finally:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
+    write_atomic(path, data, mode=0o600)
 
 
 def _load_module(name: str, path: Path, source: str):
@@ -348,10 +310,11 @@ class Kernel:
             if name.startswith("run_batch") and hasattr(self.module, PAIR_FUNCTION):
                 # the batch loops' redo calls the shared-exponential function: compiled, it is a global of theirs
                 self.module.__dict__[PAIR_FUNCTION] = self.function(PAIR_FUNCTION)
-            on_disk = self.path.is_file()  # numba caches next to a source file; without one, compile in memory
             py = getattr(self.module, name)
             py = getattr(py, "py_func", py)  # the compiled pair function stands in the module once bound
-            fn = numba.njit(cache=on_disk, nogil=True, fastmath=False, error_model="numpy")(py)
+            fn = numba.njit(nogil=True, fastmath=False, error_model="numpy")(py)
+            if self.path.is_file():  # numba caches next to a source file; without one, compile in memory
+                enable_private_cache(fn, self.directory / "__pycache__")
             self._jitted[name] = fn
         return fn
 

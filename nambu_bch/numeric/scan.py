@@ -9,20 +9,21 @@ a new extreme is kept, like ``numpy.argmax``.  (A non-finite input makes the col
 the caller then refuses the batch on the counts.)
 
 It was part of every generated kernel module (compiled once per kernel, 1-1.4 s each cold); it
-depends on nothing but the batch, so it lives here, compiled once and cached by numba next to
-this file (:func:`~nambu_bch.numeric.kernels.Kernel.scan` calls it).  The numpy twin is
-:func:`~nambu_bch.numeric.guards.scan_states`.
+depends on nothing but the batch, so it lives here, compiled once and cached by numba in the
+package's private cache (:func:`nambu_bch.compiled.njit`); :func:`~nambu_bch.numeric.kernels.Kernel.scan`
+calls it.  The numpy twin is :func:`~nambu_bch.numeric.guards.scan_states`.
 """
 
 import math
 
-import numba
 import numpy as np
+
+from ..compiled import njit
 
 _INF, _MAX, _TINY = math.inf, 1.7976931348623157e308, 2.2250738585072014e-308
 
 
-@numba.njit(cache=True, nogil=True, error_model="numpy")
+@njit(nogil=True, error_model="numpy")
 def _first(a, n, v):
     """The first ``i < n`` with ``a[i] == v`` (0 if none, like ``numpy.argmax`` of ``a[:n] == v``): a loop, since
     the array expression and ``argmax`` cost numba ~1.5 s to compile (five of them), the loop ~0.1 s."""
@@ -32,7 +33,7 @@ def _first(a, n, v):
     return 0
 
 
-@numba.njit(cache=True, nogil=True, error_model="numpy")
+@njit(nogil=True, error_model="numpy")
 def scan(X, res):
     """``res[:] = (non-finite count, subnormal count, 5 extreme columns)`` of ``X`` (N, B); returns the two counts' sum."""
     N = X.shape[0]
