@@ -72,10 +72,7 @@ def base_dict(system, word, **extra):
     """The JSON head of a result: the system (:func:`nambu_bch.render.system_dict`), the integrator word, ``extra``."""
     from .. import render
 
-    data = render.system_dict(system)
-    data["integrator"] = word
-    data.update(extra)
-    return data
+    return render.result_head(system, word, **extra)
 
 
 def once(func):

@@ -37,6 +37,11 @@ FI representations (``fi_dim``) and the direct route's kernel at the same
 degree (``direct_dim``): every FI solution is a direct one, and ``whole`` says
 whether the FI span is all of it (docs/fi_route.md: for ho3 it is a proper part).
 
+The family returned at every order is the FI particular solution plus the direct route's
+kernel at the direct route's default degree, with the direct route's canonical members, so
+both routes give the same alpha-family; :class:`FISpan` says whether the FI solutions alone
+held it (for Lotka-Volterra at ``h^4`` they do not: the alpha direction needs ``X_{H,H} = 0``).
+
 References
 ----------
 Horikoshi, Eqs. (BCH2)-(BCH5), (CL5)-(CL8b), (SH12321a)-(SG12321c), (Xeff3).
@@ -51,7 +56,7 @@ from itertools import product
 import sympy
 
 from ..algebra.ansatz import Ansatz, Rows
-from ..algebra.elimination import Echelon, kernel_rref, rank, solve_affine
+from ..algebra.elimination import Echelon, kernel_rref, normal_form, rank, solve_affine
 from ..algebra.zero import is_zero
 from ..bch import expand_terms, formal_bch
 from ..bch.expansion import piece_evaluator, term_evaluator
@@ -60,7 +65,7 @@ from ..checks import is_int
 from ..errors import InvalidOrderError, NambuBCHError
 from ..integrators.composition import composition_for
 from ..symbols import ALPHA, STEP
-from .direct_route import operator_columns
+from .direct_route import needed_degree, operator_columns
 from .fi_nested import RawOps, nested_hull
 from .fundamental_identity import representations, single_representations
 from .liouville_terms import LiouvilleSum
@@ -182,12 +187,13 @@ class FIOrder:
     degree : int or None -- ansatz degree of the corrections
     commutators : list of FINested -- the BCH brackets at ``h^j`` with their hulls
     directions : list of ``(commutator index, label)`` -- the independent directions kept (one weight each)
-    corrections : tuple -- the alpha-family ``(dH_j, dG_j, ...)``
+    corrections : tuple -- the alpha-family ``(dH_j, dG_j, ...)`` (the direct route's: :class:`FISpan`)
     members : (tuple, tuple) -- the ``alpha = 0`` and ``alpha = 1`` members
     kernel : list of tuples -- a basis of the corrections of the homogeneous FI solutions
     fi_dim : int -- dimension of that space (corrections reached through FI representations)
     direct_dim : int -- dimension of the direct route's kernel at the same ansatz degree (computed on first use)
     certificate : dict or None
+    span : FISpan or None -- whether the FI solutions alone held the family (set when solved)
     """
 
     order: int
@@ -200,6 +206,7 @@ class FIOrder:
     kernel: list = field(default_factory=list)
     fi_dim: int = 0
     certificate: dict | None = None
+    span: FISpan | None = None
     _direct: tuple = field(default=(), repr=False)
     _direct_dim: int | None = field(default=None, repr=False)
 
@@ -224,8 +231,10 @@ class FIResult:
     power : int -- the power of ``h`` solved (2 for symmetric words, 1 otherwise)
     commutators : list of FICommutator
     exists : bool
-    members : (FIMember, FIMember) -- the ``alpha = 0`` and ``alpha = 1`` members
-    corrections : tuple -- the alpha-family ``(dH, dG)`` (sympy, in ``alpha``)
+    members : (FIMember, FIMember) -- the ``alpha = 0`` and ``alpha = 1`` FI solutions (weights and corrections)
+    corrections : tuple -- the alpha-family ``(dH, dG)`` (sympy, in ``alpha``): the FI particular solution
+        plus the direct route's kernel, canonical members by the direct route's rule (``span`` says
+        whether the FI members already were them)
     kernel : list -- basis of the homogeneous solutions (weights, corrections)
     degree : int -- ansatz degree of the corrections
     certificate : dict or None
@@ -243,6 +252,7 @@ class FIResult:
     certificate: dict | None = None
     orders: list = field(default_factory=list)  # FIOrder, the powers above ``power``
     failed_order: int | None = None
+    span: FISpan | None = None  # the lowest order's; FIOrder.span for the others
     _ctx: dict = field(default_factory=dict, repr=False)
 
     @property
@@ -294,6 +304,10 @@ class FIResult:
     def check_member(self, weights, corrections) -> bool:
         """Do these representation weights give ``X_{H,dG} + X_{dH,G}`` with these corrections (formally)?"""
         return self.combination(weights) == self.target(corrections)
+
+    def spans(self) -> list:
+        """The :class:`FISpan` of every solved order, lowest first."""
+        return [x for x in (self.span, *(o.span for o in self.orders)) if x is not None]
 
     def kernel_corrections(self) -> list:
         """The ``(dH, dG, ...)`` part of every homogeneous solution (weights dropped), as sympy expressions."""
@@ -539,9 +553,11 @@ def fi_route(system, word, order: int = 2, degree=None, terms=None) -> FIResult:
                 weights[t][r] = alg.domain.to_sympy(v)
         members.append(FIMember(weights, ansatz.expressions(vec, alg.coordinates, alg.domain, offset=nw)))
     result.members = tuple(members)
-    result.corrections = tuple(sympy.expand((1 - ALPHA) * c0 + ALPHA * c1)
-                               for c0, c1 in zip(members[0].corrections, members[1].corrections))
     result.kernel = kernel_rref(sol.kernel, prios[0], alg.domain)
+    fi_dim = rank([{c: v for c, v in vec.items() if c >= nw} for vec in result.kernel], nw + len(ansatz), alg.domain)
+    family, result.span = _whole_family(alg, hams, ansatz, nw, sol.particular, [0], degree if user_degree else None,
+                                        [m.corrections for m in members], fi_dim, power)
+    result.corrections = _family(family)
     if order > power:
         _higher_orders(result, order, degree if user_degree else None)
     return result
@@ -594,6 +610,96 @@ def _direct_kernel_dim(alg, hams, ansatz) -> int:
     rows = Rows()
     vecs = operator_columns(alg, [alg.convert(Hk) for Hk in hams], ansatz, rows)
     return len(vecs) - rank(vecs, len(rows), alg.domain)
+
+
+@dataclass(frozen=True)
+class FISpan:
+    """How much of one order's family the FI representations reach.
+
+    The FI route solves the formal equation, whose solutions are field solutions; its family is then
+    the FI particular solution plus the whole kernel of ``(dH, dG) -> X_{dH,G} + X_{H,dG}`` at the
+    direct route's ansatz degree, with the direct route's canonical members, so both routes return
+    the same alpha-family.  This record says whether the FI solutions alone held that family.
+
+    Attributes
+    ----------
+    order : int -- the power of ``h``
+    degree : int -- ansatz degree of the family (the direct route's default, or the degree given)
+    fi_dim : int -- dimension of the corrections reached through FI representations (at the FI degree)
+    gauge_dim : int -- dimension of the whole kernel at ``degree``
+    reached : bool -- both canonical members are FI solutions (the FI family is the whole family)
+    """
+
+    order: int
+    degree: int
+    fi_dim: int
+    gauge_dim: int
+    reached: bool
+
+    def reason(self) -> str | None:
+        """Why the family needed directions the FI representations miss (None when it did not)."""
+        if self.reached:
+            return None
+        return (f"h^{self.order}: the FI representations reach {self.fi_dim} of the {self.gauge_dim} gauge directions "
+                f"(degree {self.degree}) and not the alpha-family's; its members are completed by the direct route's "
+                "kernel (formal FI sums keep the Hamiltonian pieces whole, so they miss field identities such as "
+                "X_{H,H} = 0)")
+
+    def to_dict(self) -> dict:
+        return {"order": self.order, "degree": self.degree, "fi_dim": self.fi_dim, "gauge_dim": self.gauge_dim,
+                "reached": self.reached, "reason": self.reason()}
+
+
+def _whole_family(alg, hams, ansatz, nw, particulars, powers, degree, fi_members, fi_dim, order):
+    """The canonical members of (FI particular solution) + (the direct route's kernel), and their :class:`FISpan`.
+
+    Parameters
+    ----------
+    alg : the system's algebra; hams : its Hamiltonians (sympy)
+    ansatz : Ansatz -- the FI solve's corrections, columns ``nw + k``
+    particulars : list of sparse vectors -- one FI particular solution per power of alpha in ``powers``
+    degree : int or None -- the ansatz degree asked for (None: the direct route's default, at least the FI one)
+    fi_members : the FI route's own two members (corrections), to tell whether they were already the family's
+    fi_dim, order : for the :class:`FISpan`
+
+    Returns
+    -------
+    (members, span) -- two tuples of corrections (polynomial in alpha), the span record
+    """
+    domain = alg.domain
+    rings = [alg.convert(Hk) for Hk in hams]
+    vecs = [{c - nw: v for c, v in vec.items() if c >= nw} for vec in particulars]
+    if degree is None:  # the degree of the field the particular solution makes, and the direct route's rule
+        rows = Rows()
+        cols = operator_columns(alg, rings, ansatz, rows)
+        field: dict = {}
+        for vec in vecs:
+            for c, v in vec.items():
+                for r, w in cols[c].items():
+                    field[r] = field.get(r, domain.zero) + v * w
+        keys = rows.keys()
+        rhs_deg = max((sum(keys[r][1]) for r, v in field.items() if v), default=0)
+        gdeg = [max((sum(m[: alg.n]) for m in p.keys()), default=0) - 1 for p in rings]
+        degree = max(ansatz.degree, needed_degree(gdeg, rhs_deg)[0])
+    big = ansatz if degree == ansatz.degree else Ansatz(alg.n, degree, ansatz.slots)
+    if big is not ansatz:
+        vecs = [{big.index[ansatz.columns[c]]: v for c, v in vec.items()} for vec in vecs]
+    rows = Rows()
+    kernel = solve_affine(operator_columns(alg, rings, big, rows), [], len(rows), domain).kernel
+    members = []
+    for prio in big.priorities([p.keys() for p in rings]):
+        corr = [sympy.Integer(0)] * big.slots
+        for k, vec in zip(powers, vecs):
+            part = normal_form(vec, kernel, prio, domain)
+            corr = [c + ALPHA**k * d for c, d in zip(corr, big.expressions(part, alg.coordinates, domain))]
+        members.append(tuple(sympy.expand(c) for c in corr))
+    reached = all(is_zero(a - b) for m, f in zip(members, fi_members) for a, b in zip(m, f))
+    return tuple(members), FISpan(order, degree, fi_dim, len(kernel), reached)
+
+
+def _family(members) -> tuple:
+    """``(1 - alpha) m_0 + alpha m_1``, expanded, per slot."""
+    return tuple(sympy.expand((1 - ALPHA) * c0 + ALPHA * c1) for c0, c1 in zip(*members))
 
 
 def _higher_orders(result, order, degree) -> None:
@@ -701,6 +807,7 @@ def _solve_order(system, ctx, ops, memo, series, j, corrections, degree) -> FIOr
     domain = alg.domain
     hams = system.hamiltonians
     slots = len(hams)
+    user_degree = degree
     commutators = _brackets(system, series, j, ops, memo)
     base = LiouvilleSum.zero(alg, atoms)
     ech = Echelon(domain)
@@ -744,12 +851,13 @@ def _solve_order(system, ctx, ops, memo, series, j, corrections, degree) -> FIOr
         for k, part in zip(powers, Ansatz.canonical(sol.particular, sol.kernel, prio, domain)):
             corr = [c + ALPHA**k * d for c, d in zip(corr, ansatz.expressions(part, alg.coordinates, domain, offset=nw))]
         members.append(tuple(sympy.expand(c) for c in corr))
-    out.members = tuple(members)
-    out.corrections = tuple(sympy.expand((1 - ALPHA) * c0 + ALPHA * c1) for c0, c1 in zip(*members))
     projected = [{col: v for col, v in vec.items() if col >= nw} for vec in sol.kernel]
     projected = [p for p in projected if p]
     basis = kernel_rref(projected, prios[0][: len(ansatz)], domain) if projected else []
     out.kernel = [ansatz.expressions(vec, alg.coordinates, domain, offset=nw) for vec in basis]
     out.fi_dim = len(basis)
     out._direct = (alg, hams, ansatz)
+    out.members, out.span = _whole_family(alg, hams, ansatz, nw, sol.particular, powers, user_degree, members,
+                                          out.fi_dim, j)
+    out.corrections = _family(out.members)
     return out
