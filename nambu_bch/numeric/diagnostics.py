@@ -353,8 +353,8 @@ def check(system, word, h, steps, x0, params=None, *, order=2, alpha=0.5, every=
 
     Returns
     -------
-    CheckResult -- ``.to_dict()["max_abs_error"]`` has ``H, G, H_c, G_c, H_S, G_S, H_S_exact,
-    G_S_exact`` and ``x1_o .. xN_s`` where they are defined; ``skipped`` names the quantities
+    CheckResult -- ``.to_dict()["max_abs_error"]`` has ``H, G, H_c, G_c, H_S, G_S``,
+    ``H_S_exact, G_S_exact`` and ``x1_o .. xN_s`` where they are defined; ``skipped`` names the quantities
     that are singular at the given parameters.
 
     Raises

@@ -111,6 +111,8 @@ def _free_parameters(exists, shadows) -> list:
 class ShadowFamily(Printable):
     """Shadow Hamiltonians of a composition on a system, as a family.
 
+    A family is immutable; it is built by :meth:`from_direct`, :meth:`from_fi` or :meth:`unperturbed`.
+
     Attributes
     ----------
     system, composition
@@ -133,8 +135,6 @@ class ShadowFamily(Printable):
     fi_span : list of dict or None -- FI route: per solved order, how much of the family the FI
         representations reach (:class:`~nambu_bch.shadow.fi_route.FISpan`; ``reached`` false: the
         family's members needed the direct route's kernel, the reason is also in ``notes``); None for the direct route
-
-    A family is immutable; it is built by :meth:`from_direct`, :meth:`from_fi` or :meth:`unperturbed`.
     """
 
     system: object
