@@ -1,8 +1,8 @@
 """One JSON shape for the API and the command line: ``--format json`` prints the result's ``to_dict()`` and nothing else.
 
 For every subcommand whose JSON is one result's ``to_dict()`` (shadow on both routes, conserved, exact
-with and without ``--order``, check), the printed document equals that dict after the JSON round
-trip, and the README's read-back recipe works on ``to_dict()`` from Python.
+with and without ``--order``, check, fi --order), the printed document equals that dict after the JSON
+round trip, and the README's read-back recipe works on ``to_dict()`` from Python.
 """
 
 from __future__ import annotations
@@ -69,3 +69,13 @@ def test_check_cli_json_is_to_dict_apart_from_timing(capsys):
     report = nb.check(nb.model("ho3"), "32123", 0.1, 200, (1.0, 1.0, 1.0), params={"m": 1.0, "omega": 1.0})
     assert data == api_json(report)
     assert data["coordinates"] == ["x1", "x2", "x3"] and data["parameters"] == ["m", "omega"]
+
+
+def test_fi_order_cli_json_is_to_dict(capsys):
+    """fi --order K: the brackets' list (FIBrackets) prints its to_dict(), the limit applied to brackets and directions."""
+    from nambu_bch.shadow.fi_route import fi_brackets
+
+    data = cli_json(capsys, "fi", "--model", "ho3", "--integrator", "12321", "--order", "4", "--limit", "2")
+    shown = fi_brackets(nb.model("ho3"), "12321", 4, limit=2)
+    assert data == api_json(shown)
+    assert data["total"] == shown.total == 6 and len(data["brackets"]) == 2 and data["parameters"] == ["m", "omega"]

@@ -76,19 +76,5 @@ def _nested(args, system, word, comp):
     if limit is None and total > 2000:
         raise NambuBCHError(f"--order {args.order}: {total} brackets; pass --limit N to list the first N")
     shown = fi_brackets(system, comp, args.order, limit)
-    more = f"... {total - len(shown)} more brackets (raise --limit)" if len(shown) < total else None
-    head = f"h^{args.order} brackets of {word} on {system.name}: {total}"
-
-    def data():
-        return {**base_dict(system, word, order=args.order), "total": total,
-                "brackets": [b.to_dict(limit) for b in shown]}
-
-    def text():
-        return "\n".join([head, *(b.to_text(limit) for b in shown), *([more] if more else [])])
-
-    def latex():
-        title = r"\text{" + f"{word} on {system.name}, {total} brackets at" + "} " + f"h^{{{args.order}}}"
-        return " \\\\\n".join([title, *(b.to_latex(limit) for b in shown), *([r"\text{" + more + "}"] if more else [])])
-
-    emit(args, latex=latex, text=text, data=data)
+    emit(args, latex=shown.to_latex, text=shown.to_text, data=shown.to_dict)
 

@@ -749,7 +749,45 @@ def _brackets(system, series, j, ops, memo, limit=None) -> list:
     return [FINested(c, tree, nested_hull(ops, tree, memo), ops) for c, tree in trees[:limit]]
 
 
-def fi_brackets(system, word, order: int, limit=None) -> list:
+class FIBrackets(list):
+    """The brackets of ``X_eff`` at one power of ``h`` with their FI hulls: a list of :class:`FINested`.
+
+    Attributes
+    ----------
+    system, composition, order -- what they were computed for
+    total : int -- the number of brackets at ``h^order`` (the list holds the first ``limit`` of them)
+    limit : int or None -- at most this many brackets, and this many directions per bracket, are shown
+    """
+
+    def __init__(self, items, system, composition, order: int, total: int, limit=None):
+        super().__init__(items)
+        self.system, self.composition, self.order, self.total, self.limit = system, composition, order, total, limit
+
+    def _more(self):
+        return f"... {self.total - len(self)} more brackets (raise --limit)" if len(self) < self.total else None
+
+    def to_dict(self) -> dict:
+        """JSON-ready: the system part, ``order``, ``total`` and ``brackets`` (:meth:`FINested.to_dict`);
+        ``nambu-bch fi --order K --format json`` prints exactly this dict."""
+        from ..render import result_head
+
+        return {**result_head(self.system, self.composition.name, order=self.order), "total": self.total,
+                "brackets": [b.to_dict(self.limit) for b in self]}
+
+    def to_text(self) -> str:
+        head = f"h^{self.order} brackets of {self.composition.name} on {self.system.name}: {self.total}"
+        more = self._more()
+        return "\n".join([head, *(b.to_text(self.limit) for b in self), *([more] if more else [])])
+
+    def to_latex(self) -> str:
+        from ..printing import latex_text
+
+        title = latex_text(f"{self.composition.name} on {self.system.name}, {self.total} brackets at") + f" h^{{{self.order}}}"
+        more = self._more()
+        return " \\\\\n".join([title, *(b.to_latex(self.limit) for b in self), *([latex_text(more)] if more else [])])
+
+
+def fi_brackets(system, word, order: int, limit=None) -> FIBrackets:
     """The brackets of ``X_eff`` at ``h^order``, each with the affine hull of its FI representations.
 
     Parameters
@@ -762,7 +800,8 @@ def fi_brackets(system, word, order: int, limit=None) -> list:
 
     Returns
     -------
-    list of FINested -- empty when the order vanishes (odd orders of a symmetric word)
+    FIBrackets -- a list of FINested, empty when the order vanishes (odd orders of a symmetric word), with
+    ``total`` and ``to_dict`` / ``to_text`` / ``to_latex``
 
     Examples
     --------
@@ -775,7 +814,11 @@ def fi_brackets(system, word, order: int, limit=None) -> list:
     if limit is not None and not is_int(limit, 1):
         raise NambuBCHError(f"limit must be a positive integer or None, got {limit!r}")
     atoms, _ = _atoms(system)
-    return _brackets(system, formal_bch(comp, order + 1), order, RawOps(system.algebra, atoms), {}, limit)
+    trees = _merged_trees(system, formal_bch(comp, order + 1), order)
+    ops = RawOps(system.algebra, atoms)
+    memo: dict = {}
+    items = [FINested(c, tree, nested_hull(ops, tree, memo), ops) for c, tree in trees[:limit]]
+    return FIBrackets(items, system, comp, order, len(trees), limit)
 
 
 def count_brackets(system, word, order: int) -> int:
