@@ -335,11 +335,12 @@ _FORMS: dict = {}
 
 
 def clear_cache() -> None:
-    """Forget the memoised FI maps, hulls, labelled forms, formal columns and bracket evaluators."""
+    """Forget the memoised FI maps, hulls, labelled forms, formal columns, bracket evaluators and gauge kernels."""
     _RAW_OPS.clear()
     _FORMS.clear()
     _MONOMIAL_COLUMNS.clear()
     _EVALUATORS.clear()
+    _OPERATOR.clear()
 
 
 def _raw_ops(alg, atoms) -> RawOps:
@@ -669,9 +670,8 @@ def _whole_family(alg, hams, ansatz, nw, particulars, powers, degree, fi_members
     domain = alg.domain
     rings = [alg.convert(Hk) for Hk in hams]
     vecs = [{c - nw: v for c, v in vec.items() if c >= nw} for vec in particulars]
+    rows, cols, _ = _operator(alg, hams, rings, ansatz.degree, kernel=False)
     if degree is None:  # the degree of the field the particular solution makes, and the direct route's rule
-        rows = Rows()
-        cols = operator_columns(alg, rings, ansatz, rows)
         field: dict = {}
         for vec in vecs:
             for c, v in vec.items():
@@ -684,8 +684,7 @@ def _whole_family(alg, hams, ansatz, nw, particulars, powers, degree, fi_members
     big = ansatz if degree == ansatz.degree else Ansatz(alg.n, degree, ansatz.slots)
     if big is not ansatz:
         vecs = [{big.index[ansatz.columns[c]]: v for c, v in vec.items()} for vec in vecs]
-    rows = Rows()
-    kernel = solve_affine(operator_columns(alg, rings, big, rows), [], len(rows), domain).kernel
+    kernel = _operator(alg, hams, rings, degree)[2]
     members = []
     for prio in big.priorities([p.keys() for p in rings]):
         corr = [sympy.Integer(0)] * big.slots
@@ -695,6 +694,24 @@ def _whole_family(alg, hams, ansatz, nw, particulars, powers, degree, fi_members
         members.append(tuple(sympy.expand(c) for c in corr))
     reached = all(is_zero(a - b) for m, f in zip(members, fi_members) for a, b in zip(m, f))
     return tuple(members), FISpan(order, degree, fi_dim, len(kernel), reached)
+
+
+_OPERATOR: dict = {}
+
+
+def _operator(alg, hams, rings, degree, kernel=True) -> tuple:
+    """``(rows, columns, kernel)`` of ``(dH, dG) -> X_{dH,G} + X_{H,dG}`` on the ansatz of ``degree``, memoised
+    (shared by all words and orders of a system; ``kernel`` None until first asked for)."""
+    key = (alg.ring, alg.coordinates, tuple(hams), degree)
+    entry = _OPERATOR.get(key)
+    if entry is None:
+        if len(_OPERATOR) > 256:
+            _OPERATOR.clear()
+        rows = Rows()
+        entry = _OPERATOR[key] = [rows, operator_columns(alg, rings, Ansatz(alg.n, degree, len(rings)), rows), None]
+    if kernel and entry[2] is None:
+        entry[2] = solve_affine(entry[1], [], len(entry[0]), alg.domain).kernel
+    return tuple(entry)
 
 
 def _family(members) -> tuple:
@@ -902,5 +919,7 @@ def _solve_order(system, ctx, ops, memo, series, j, corrections, degree) -> FIOr
     out._direct = (alg, hams, ansatz)
     out.members, out.span = _whole_family(alg, hams, ansatz, nw, sol.particular, powers, user_degree, members,
                                           out.fi_dim, j)
+    if out.span.degree == degree:  # the kernel at the FI degree was just computed
+        out._direct_dim = out.span.gauge_dim
     out.corrections = _family(out.members)
     return out
