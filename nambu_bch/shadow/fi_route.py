@@ -771,7 +771,9 @@ class FIBrackets(list):
 
     Attributes
     ----------
-    system, composition, order -- what they were computed for
+    system : System
+    composition : Composition
+    order : int -- the power of ``h``
     total : int -- the number of brackets at ``h^order`` (the list holds the first ``limit`` of them)
     limit : int or None -- at most this many brackets, and this many directions per bracket, are shown
     """
