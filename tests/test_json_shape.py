@@ -1,8 +1,9 @@
 """One JSON shape for the API and the command line: ``--format json`` prints the result's ``to_dict()`` and nothing else.
 
-For every subcommand whose JSON is one result's ``to_dict()`` (shadow on both routes, conserved, exact
-with and without ``--order``, check, fi --order), the printed document equals that dict after the JSON
-round trip, and the README's read-back recipe works on ``to_dict()`` from Python.
+For every subcommand that prints symbolic or diagnostic results (shadow on both routes, conserved, exact
+with and without ``--order``, check, bch with and without ``--field --terms``, fi with and without a
+system and with ``--order``), the printed document equals the result's ``to_dict()`` after the JSON round
+trip, and the README's read-back recipe works on ``to_dict()`` from Python.
 """
 
 from __future__ import annotations
@@ -79,3 +80,25 @@ def test_fi_order_cli_json_is_to_dict(capsys):
     shown = fi_brackets(nb.model("ho3"), "12321", 4, limit=2)
     assert data == api_json(shown)
     assert data["total"] == shown.total == 6 and len(data["brackets"]) == 2 and data["parameters"] == ["m", "omega"]
+
+
+@pytest.mark.parametrize("flags", [(), ("--field", "--terms")])
+def test_bch_cli_json_is_to_dict(capsys, flags):
+    from nambu_bch.bch.report import bch_report
+
+    data = cli_json(capsys, "bch", "--model", "ho3", "--integrator", "12321", *flags)
+    report = bch_report(nb.model("ho3"), nb.composition("12321"), 2, field=bool(flags), terms=bool(flags))
+    assert data == api_json(report)
+    assert ("X_eff" in data) == ("liouville_terms" in data) == bool(flags) and data["parameters"] == ["m", "omega"]
+
+
+@pytest.mark.parametrize("argv", [(), ("--model", "ho3", "--integrator", "12321")])
+def test_fi_cli_json_is_to_dict(capsys, argv):
+    """fi: the eight forms alone, or with a system each h^2 double commutator in them (FIForms)."""
+    from nambu_bch.shadow.fi_route import FIForms, fi_forms
+
+    data = cli_json(capsys, "fi", *argv)
+    S = nb.model("ho3")
+    result = fi_forms(S, "12321") if argv else FIForms(S, nb.composition("12321"))
+    assert data == api_json(result)
+    assert len(data["forms"]) == 8 and ("representations" in data) == bool(argv)

@@ -5,7 +5,7 @@ from __future__ import annotations
 from ..errors import NambuBCHError
 from ._options import (add_subcommand, integrator_from_args, integrator_options, output_options, positive_int,
                        symbolic_system, system_options)
-from ._output import base_dict, emit
+from ._output import emit
 
 HELP = "the eight fundamental-identity forms of [X_AB,[X_CD,X_EF]] and their use on a system"
 EXAMPLES = ("examples:\n  nambu-bch fi                           # the eight forms 1AX..2BY of [X_AB,[X_CD,X_EF]]\n"
@@ -27,44 +27,14 @@ def _system_chosen(args) -> bool:
 
 
 def run(args):
-    from .. import render
-    from ..shadow.fundamental_identity import FI_LABELS, bch_double_commutators
+    from ..shadow.fi_route import FIForms, fi_forms
 
     system = symbolic_system(args)
     word, comp = integrator_from_args(args, system)
     if args.order is not None and args.order > (2 if comp.symmetric else 1):
         return _nested(args, system, word, comp)
-    reps = bch_double_commutators(system, comp) if _system_chosen(args) else None
-
-    def data():
-        out = {"forms": [{"label": lab, "text": render.fi_form_text(lab), "latex": render.fi_form_latex(lab)} for lab in FI_LABELS]}
-        if reps is not None:
-            out = {**base_dict(system, word), **out}
-            out["representations"] = [
-                {
-                    "coefficient": render.expression(c),
-                    "commutator": [[render.expression(s) for s in t] for t in abd],
-                    "forms": {lab: [{"coefficient": render.expression(t.coefficient), "slots": [render.expression(s) for s in t.expressions]}
-                                    for t in terms] for lab, terms in forms.items()},
-                }
-                for c, abd, forms in reps
-            ]
-        return out
-
-    def text():
-        lines = [f"{lab}: {render.fi_form_text(lab)}" for lab in FI_LABELS]
-        for c, abd, forms in reps or ():
-            a, b, d = ("X_{" + ", ".join(str(s) for s in t) + "}" for t in abd)
-            lines.append(f"{c} [{a}, [{b}, {d}]] (h^2 term of {word} on {system.name}):")
-            lines += [f"  {lab}: " + (" + ".join(str(t) for t in terms) or "0") for lab, terms in forms.items()]
-        return "\n".join(lines)
-
-    def latex():
-        blocks = [render.fi_forms_latex()]
-        blocks += [render.fi_representations_latex(f"{word} on {system.name}", c, abd, forms) for c, abd, forms in reps or ()]
-        return blocks
-
-    emit(args, latex=latex, text=text, data=data)
+    result = fi_forms(system, comp) if _system_chosen(args) else FIForms(system, comp)
+    emit(args, latex=result.to_latex, text=result.to_text, data=result.to_dict)
 
 
 def _nested(args, system, word, comp):

@@ -766,6 +766,79 @@ def _brackets(system, series, j, ops, memo, limit=None) -> list:
     return [FINested(c, tree, nested_hull(ops, tree, memo), ops) for c, tree in trees[:limit]]
 
 
+@dataclass(frozen=True)
+class FIForms:
+    """The eight fundamental-identity forms of ``[X_{A,B},[X_{C,D},X_{E,F}]]`` (Eqs. 1AX-2BY) and, for a system,
+    each ``h^2`` double commutator of the BCH series in them (Eqs. CL5-CL8): what ``nambu-bch fi`` prints.
+
+    Attributes
+    ----------
+    system : System
+    composition : Composition
+    representations : list or None -- :func:`~nambu_bch.shadow.fundamental_identity.bch_double_commutators`
+        of the system, or None for the forms alone
+    """
+
+    system: object
+    composition: object
+    representations: list | None = None
+
+    def to_dict(self) -> dict:
+        """JSON-ready: ``forms`` (label, text, LaTeX); with a system its part first and ``representations``;
+        ``nambu-bch fi --format json`` prints exactly this dict."""
+        from .. import render
+        from .fundamental_identity import FI_LABELS
+
+        out = {"forms": [{"label": lab, "text": render.fi_form_text(lab), "latex": render.fi_form_latex(lab)}
+                         for lab in FI_LABELS]}
+        if self.representations is None:
+            return out
+        out = {**render.result_head(self.system, self.composition.name), **out}
+        out["representations"] = [
+            {
+                "coefficient": render.expression(c),
+                "commutator": [[render.expression(s) for s in t] for t in abd],
+                "forms": {lab: [{"coefficient": render.expression(t.coefficient),
+                                 "slots": [render.expression(s) for s in t.expressions]} for t in terms]
+                          for lab, terms in forms.items()},
+            }
+            for c, abd, forms in self.representations
+        ]
+        return out
+
+    def to_text(self) -> str:
+        from .. import render
+        from .fundamental_identity import FI_LABELS
+
+        lines = [f"{lab}: {render.fi_form_text(lab)}" for lab in FI_LABELS]
+        for c, abd, forms in self.representations or ():
+            a, b, d = ("X_{" + ", ".join(str(s) for s in t) + "}" for t in abd)
+            lines.append(f"{c} [{a}, [{b}, {d}]] (h^2 term of {self.composition.name} on {self.system.name}):")
+            lines += [f"  {lab}: " + (" + ".join(str(t) for t in terms) or "0") for lab, terms in forms.items()]
+        return "\n".join(lines)
+
+    def to_latex(self) -> list:
+        from .. import render
+
+        title = f"{self.composition.name} on {self.system.name}"
+        return [render.fi_forms_latex()] + [render.fi_representations_latex(title, c, abd, forms)
+                                            for c, abd, forms in self.representations or ()]
+
+
+def fi_forms(system, word) -> FIForms:
+    """The eight FI forms and each ``h^2`` double commutator of ``word`` on ``system`` in them (Eqs. CL5-CL8).
+
+    >>> from nambu_bch import model
+    >>> F = fi_forms(model("ho3"), "12321")
+    >>> len(F.to_dict()["forms"]), F.to_dict()["representations"][0]["coefficient"]
+    (8, '-1/24')
+    """
+    from .fundamental_identity import bch_double_commutators
+
+    comp = composition_for(word, system.splitting)
+    return FIForms(system, comp, bch_double_commutators(system, comp))
+
+
 class FIBrackets(list):
     """The brackets of ``X_eff`` at one power of ``h`` with their FI hulls: a list of :class:`FINested`.
 
