@@ -14,12 +14,12 @@ Prints, measured in this one run (process CPU time, best of a few repeats):
 The baseline reproduces the same member (it solves for all unknowns and sets the
 free ones to zero), and its result is checked against ours.
 
-The issue-14 rows (docs/performance.md, Sect. 3) time the whole ``shadow_hamiltonians`` call
+The issue-14 rows (docs/history/performance.md, Sect. 3) time the whole ``shadow_hamiltonians`` call
 in a fresh child process each (cold, CPU seconds), ours against the package's previous
 elimination (``nambu_bch.algebra.elimination.FAST_PATHS = False``: sympy's sparse
 ``DomainMatrix.rref`` over the full coefficient field; since session 12 this also switches off
 the python-flint arithmetic over ``QQ(params)``: the elimination, the fraction-free fields and the
-effective field's brackets, docs/performance.md Sect. 5), and for row c also against the
+effective field's brackets, docs/history/performance.md Sect. 5), and for row c also against the
 plain-sympy baseline; the two results are compared (members alpha = 0 and 1).
 """
 

@@ -47,7 +47,7 @@ class ExpressionParseError(NambuBCHError):
 
 
 class UnstableStepError(NambuBCHError):
-    """A step size outside the stability interval of the integrator (e.g. |omega h| >= 2)."""
+    """A step size outside the stability interval of the integrator (e.g. ``|omega h| >= 2``)."""
 
 
 class NumericalRangeError(NambuBCHError):

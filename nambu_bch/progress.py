@@ -1,5 +1,8 @@
 """Progress bars for long runs, drawn by tqdm (``tqdm.auto``: a text bar on a terminal, a widget in Jupyter).
 
+The widget needs ipywidgets (``pip install nambu_bch[jupyter]``); without it the bar is tqdm's
+plain text bar on stderr in Jupyter too, so a plain install prints no ``IProgress not found`` warning.
+
 Reporting is on when ``enabled=True``, or when ``enabled=None`` (automatic) and
 :func:`progress_wanted` says so: ``NAMBU_BCH_PROGRESS`` is not ``0`` and stderr is
 a terminal or the code runs in a Jupyter kernel; it is off in pipes, files, CI
@@ -48,9 +51,17 @@ def progress_wanted(stream=None) -> bool:
     return stream is sys.stderr and _in_jupyter()
 
 
+def widgets_available() -> bool:
+    """Is ipywidgets importable?  tqdm's Jupyter widget needs it; without it tqdm warns ``IProgress not found``."""
+    from importlib.util import find_spec
+
+    return find_spec("ipywidgets") is not None
+
+
 def _bar(total, label, stream, delay, interval, unit):
-    """A tqdm bar: ``tqdm.auto`` on the default stream (a widget in Jupyter), plain tqdm on a given file."""
-    if stream is None:
+    """A tqdm bar: ``tqdm.auto`` on the default stream when ipywidgets is installed (a widget in Jupyter), else
+    plain tqdm (a text bar on stderr, also in Jupyter: the ``jupyter`` extra installs ipywidgets)."""
+    if stream is None and widgets_available():
         from tqdm.auto import tqdm
     else:
         from tqdm import tqdm

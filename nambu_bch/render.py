@@ -26,7 +26,7 @@ import numpy as np
 import sympy
 
 __all__ = ["expression", "jsonable", "to_json", "to_text", "system_dict", "write_output", "latex_document",
-           "bracket_text", "bracket_tree"]
+           "bracket_text", "bracket_tree", "result_head"]
 
 
 def expression(value):
@@ -103,6 +103,14 @@ def system_dict(system) -> dict:
     }
     if len(hams) > 2:
         data["hamiltonians"] = [expression(H) for H in hams]
+    return data
+
+
+def result_head(system, integrator, **extra) -> dict:
+    """The head of every result's JSON (its ``to_dict()``): :func:`system_dict`, the integrator's name, ``extra``."""
+    data = system_dict(system)
+    data["integrator"] = integrator
+    data.update(extra)
     return data
 
 

@@ -1,8 +1,9 @@
-"""The notebooks in notebooks/ execute without error (nbclient, kernel python3, per-cell timeout).
+"""The notebooks in notebooks/ execute without error or warning (nbclient, kernel python3, per-cell timeout).
 
 The notebooks are committed without outputs; this runs them top to bottom in a
 fresh kernel whose working directory is the repository root, and checks that
-results render as LaTeX (``text/latex`` outputs from ``_repr_latex_``).
+results render as LaTeX (``text/latex`` outputs from ``_repr_latex_``) and that no
+output cell shows a warning (tqdm's ``IProgress not found`` when ipywidgets is missing).
 """
 
 from __future__ import annotations
@@ -47,6 +48,55 @@ def test_notebook_executes(path, monkeypatch):
     assert not errors, errors
     latex = [o for c in book.cells if c.cell_type == "code" for o in c.outputs if "text/latex" in o.get("data", {})]
     assert latex, f"{path.name}: no result rendered as LaTeX"
+    warned = [text for text in _output_texts(book) if any(w in text for w in WARNING_TEXT)]
+    assert not warned, f"{path.name}: warnings in the output cells: {warned}"
+
+
+#: Text that no output cell may contain (tqdm's ``IProgress not found`` without ipywidgets, any Python warning).
+WARNING_TEXT = ("Warning", "IProgress", "warn(")
+
+
+def _output_texts(book) -> list:
+    """Every text an executed notebook shows: streams (stdout, stderr) and the plain-text form of results."""
+    out = []
+    for cell in book.cells:
+        for o in cell.get("outputs", []) if cell.cell_type == "code" else []:
+            if o.get("output_type") == "stream":
+                out.append(o.get("text", ""))
+            else:
+                text = o.get("data", {}).get("text/plain", "")
+                out.append("".join(text) if isinstance(text, list) else text)
+    return out
+
+
+def test_warning_scan_sees_tqdm_s_message():
+    """The scan of the test above finds tqdm's warning where a kernel prints it (stderr stream)."""
+    book = nbformat.v4.new_notebook(cells=[nbformat.v4.new_code_cell("x")])
+    book.cells[0].outputs = [nbformat.v4.new_output("stream", name="stderr",
+                                                    text="TqdmWarning: IProgress not found. Please update jupyter and ipywidgets.")]
+    assert any(w in t for t in _output_texts(book) for w in WARNING_TEXT)
+
+
+def test_progress_bar_is_plain_without_ipywidgets(monkeypatch):
+    """Without ipywidgets the default stream gets tqdm's text bar (tqdm.auto is not imported, so it cannot warn)."""
+    import sys
+    import warnings
+
+    from tqdm.std import tqdm as plain
+
+    from nambu_bch import progress
+
+    monkeypatch.setattr(progress, "widgets_available", lambda: False)
+    monkeypatch.setattr(progress, "_in_jupyter", lambda: True)
+    monkeypatch.delitem(sys.modules, "tqdm.auto", raising=False)
+    monkeypatch.delitem(sys.modules, "tqdm.autonotebook", raising=False)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        bar = progress._bar(10, "run", None, 0.0, 0.0, "step")
+    try:
+        assert type(bar) is plain and "tqdm.auto" not in sys.modules
+    finally:
+        bar.close()
 
 
 def test_notebooks_present():

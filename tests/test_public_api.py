@@ -131,7 +131,8 @@ VIA_CLEAR_CACHE = {
     ("nambu_bch.bch.concrete", "_EVALUATORS"), ("nambu_bch.bch.formal", "_PATTERN_CACHE"),
     ("nambu_bch.numeric.precision", "_MPMATH"), ("nambu_bch.shadow.fi_route", "_RAW_OPS"),
     ("nambu_bch.shadow.fi_route", "_FORMS"), ("nambu_bch.shadow.fi_route", "_MONOMIAL_COLUMNS"),
-    ("nambu_bch.shadow.fi_route", "_EVALUATORS"), ("nambu_bch.shadow.liouville_terms", "_CONTEXTS"),
+    ("nambu_bch.shadow.fi_route", "_EVALUATORS"), ("nambu_bch.shadow.fi_route", "_OPERATOR"),
+    ("nambu_bch.shadow.liouville_terms", "_CONTEXTS"),
     ("nambu_bch.shadow.liouville_terms", "canonical_key"), ("nambu_bch.shadow.liouville_terms", "_dependent"),
 }
 

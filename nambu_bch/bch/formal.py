@@ -136,7 +136,7 @@ def estimate_size(n_generators: int, max_degree: int) -> dict:
 #: Rational series use the sparse modular engine from this degree on, when the dense engine would walk more than
 #: :data:`DENSE_COLD_WORDS` top-degree words, or once the compiled engine has run in this process.  Below that a
 #: fresh process answers faster with the dense engine: the sparse one first imports numba (about 0.2 s) and starts
-#: it (about 0.1 s).  Once numba is up the sparse engine is faster at every size (docs/performance.md, Sect. 1:
+#: it (about 0.1 s).  Once numba is up the sparse engine is faster at every size (docs/history/performance.md, Sect. 1:
 #: fresh process, ``12`` degree 14: dense 0.19 s, sparse 0.28 s; ``12321`` degree 9: 0.15 s against 0.27 s;
 #: numba started: 0.005 s and 0.007 s sparse).
 SPARSE_FROM_DEGREE = 32

@@ -143,16 +143,6 @@ def _formatted(args, latex, text, data) -> str:
     return out
 
 
-def base_dict(system, word, **extra):
-    """The JSON head of a result: the system (:func:`nambu_bch.render.system_dict`), the integrator word, ``extra``."""
-    from .. import render
-
-    data = render.system_dict(system)
-    data["integrator"] = word
-    data.update(extra)
-    return data
-
-
 def once(func):
     """``func()`` computed on the first call only (a result shared by the text, LaTeX and JSON printers)."""
     memo = []

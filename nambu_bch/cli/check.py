@@ -22,7 +22,6 @@ def register(sub) -> None:
 
 
 def run(args):
-    from .. import render
     from ..numeric.diagnostics import check
 
     system, values = system_from_args(args)
@@ -32,10 +31,4 @@ def run(args):
     alpha = float(number(args.alpha, "--alpha")) if args.alpha is not None else 0.5
     report = check(system, word, args.h, args.steps, x0, params=params, every=args.every, order=order, alpha=alpha)
 
-    def data():
-        out = render.system_dict(system)
-        out.update(report.to_dict())
-        out["model"], out["integrator"] = system.name, word
-        return out
-
-    emit(args, text=lambda: str(report), data=data, system=system)
+    emit(args, text=lambda: str(report), data=report.to_dict, system=system)

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from ._options import (add_subcommand, integrator_from_args, integrator_options, output_options, progress_option,
                        symbolic_system, system_options)
-from ._output import base_dict, emit
+from ._output import emit
 
 HELP = "exact conserved quantities H_c, G_c of the integrator (Table (table))"
 EXAMPLES = "examples:\n  nambu-bch conserved --integrator 31213   # a row of Table (table)\n  nambu-bch conserved --format json"
@@ -27,11 +27,5 @@ def run(args):
     word, comp = integrator_from_args(args, system)
     result = conserved_quantities(system, comp, **({"degree": args.degree} if args.degree is not None else {}))
 
-    def data():
-        out = base_dict(system, word)
-        out.update(result.to_dict())
-        out["model"], out["integrator"] = system.name, word
-        return out
-
-    emit(args, latex=result.to_latex, text=result.to_text, data=data, system=system)
+    emit(args, latex=result.to_latex, text=result.to_text, data=result.to_dict, system=system)
 

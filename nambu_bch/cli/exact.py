@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from ._options import add_subcommand, integrator_from_args, integrator_options, output_options, symbolic_system, system_options
-from ._output import base_dict, emit
+from ._output import emit
 
 HELP = "exact shadow Hamiltonians F^alpha H_c, F^(1-alpha) G_c (Eq. Xeff2)"
 EXAMPLES = ("examples:\n  nambu-bch exact                        # F(omega h)^alpha H_c, F^(1-alpha) G_c (Eqs. ESH12321, ESG12321)\n"
@@ -20,22 +20,14 @@ def register(sub) -> None:
 
 
 def run(args):
-    from .. import render
     from ..exact import exact_shadow_hamiltonians
 
     system = symbolic_system(args)
     word, comp = integrator_from_args(args, system)
     result = exact_shadow_hamiltonians(system, comp)
-    series = result.series(args.order) if args.order is not None else None
 
     def data():
-        out = base_dict(system, word)
-        out.update(result.to_dict())
-        out["model"], out["integrator"] = system.name, word
-        if series is not None:
-            out.update(order=args.order, H_S_series=render.expression(series[0]), G_S_series=render.expression(series[1]))
-            out.update({k: v for k, v in result.to_dict(order=args.order).items() if k in ("series", "remainder_power")})
-        return out
+        return result.to_dict(order=args.order)
 
     def latex():
         return result.to_latex(order=args.order)

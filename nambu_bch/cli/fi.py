@@ -3,8 +3,9 @@
 from __future__ import annotations
 
 from ..errors import NambuBCHError
-from ._options import add_subcommand, integrator_from_args, integrator_options, output_options, symbolic_system, system_options
-from ._output import base_dict, emit
+from ._options import (add_subcommand, integrator_from_args, integrator_options, output_options, positive_int,
+                       symbolic_system, system_options)
+from ._output import emit
 
 HELP = "the eight fundamental-identity forms of [X_AB,[X_CD,X_EF]] and their use on a system"
 EXAMPLES = ("examples:\n  nambu-bch fi                           # the eight forms 1AX..2BY of [X_AB,[X_CD,X_EF]]\n"
@@ -27,8 +28,7 @@ def _system_chosen(args) -> bool:
 
 
 def run(args):
-    from .. import render
-    from ..shadow.fundamental_identity import FI_LABELS, bch_double_commutators
+    from ..shadow.fi_route import FIForms, fi_forms
 
     system = symbolic_system(args)
     word, comp = integrator_from_args(args, system)
@@ -41,61 +41,18 @@ def run(args):
                             f"for {word}, not to the h^2 brackets (all shown); add e.g. --order 4 or drop --limit")
     if nested:
         return _nested(args, system, word, comp)
-    reps = bch_double_commutators(system, comp) if _system_chosen(args) else None
-
-    def data():
-        out = {"forms": [{"label": lab, "text": render.fi_form_text(lab), "latex": render.fi_form_latex(lab)} for lab in FI_LABELS]}
-        if reps is not None:
-            out = {**base_dict(system, word), **out}
-            out["representations"] = [
-                {
-                    "coefficient": render.expression(c),
-                    "commutator": [[render.expression(s) for s in t] for t in abd],
-                    "forms": {lab: [{"coefficient": render.expression(t.coefficient), "slots": [render.expression(s) for s in t.expressions]}
-                                    for t in terms] for lab, terms in forms.items()},
-                }
-                for c, abd, forms in reps
-            ]
-        return out
-
-    def text():
-        lines = [f"{lab}: {render.fi_form_text(lab)}" for lab in FI_LABELS]
-        for c, abd, forms in reps or ():
-            a, b, d = ("X_{" + ", ".join(str(s) for s in t) + "}" for t in abd)
-            lines.append(f"{c} [{a}, [{b}, {d}]] (h^2 term of {word} on {system.name}):")
-            lines += [f"  {lab}: " + (" + ".join(str(t) for t in terms) or "0") for lab, terms in forms.items()]
-        return "\n".join(lines)
-
-    def latex():
-        blocks = [render.fi_forms_latex()]
-        blocks += [render.fi_representations_latex(f"{word} on {system.name}", c, abd, forms) for c, abd, forms in reps or ()]
-        return blocks
-
-    emit(args, latex=latex, text=text, data=data, system=system if reps is not None else None)
+    result = fi_forms(system, comp) if _system_chosen(args) else FIForms(system, comp)
+    emit(args, latex=result.to_latex, text=result.to_text, data=result.to_dict, system=system if _system_chosen(args) else None)
 
 
 def _nested(args, system, word, comp):
     """``fi --order K``: the brackets at ``h^K`` with the affine hulls of their FI representations (issue 13)."""
     from ..shadow.fi_route import count_brackets, fi_brackets
 
-    limit = args.limit
+    limit = positive_int(args.limit, "--limit", 10**6) if args.limit is not None else None
     total = count_brackets(system, comp, args.order)
     if limit is None and total > 2000:
         raise NambuBCHError(f"--order {args.order}: {total} brackets; pass --limit N to list the first N")
     shown = fi_brackets(system, comp, args.order, limit)
-    more = f"... {total - len(shown)} more brackets (raise --limit)" if len(shown) < total else None
-    head = f"h^{args.order} brackets of {word} on {system.name}: {total}"
-
-    def data():
-        return {**base_dict(system, word, order=args.order), "total": total,
-                "brackets": [b.to_dict(limit) for b in shown]}
-
-    def text():
-        return "\n".join([head, *(b.to_text(limit) for b in shown), *([more] if more else [])])
-
-    def latex():
-        title = r"\text{" + f"{word} on {system.name}, {total} brackets at" + "} " + f"h^{{{args.order}}}"
-        return " \\\\\n".join([title, *(b.to_latex(limit) for b in shown), *([r"\text{" + more + "}"] if more else [])])
-
-    emit(args, latex=latex, text=text, data=data, system=system)
+    emit(args, latex=shown.to_latex, text=shown.to_text, data=shown.to_dict, system=system)
 

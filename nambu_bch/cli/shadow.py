@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from ._options import (add_subcommand, integrator_from_args, integrator_options, output_options, progress_option,
                        symbolic_system, system_options)
-from ._output import base_dict, emit
+from ._output import emit
 
 HELP = "the shadow-Hamiltonian family of a word at an order, or the obstruction"
 EXAMPLES = ("examples:\n  nambu-bch shadow                       # alpha-family of Phi^{12321}, ho3, order 2 (Eqs. SH12321c, SG12321c)\n"
@@ -37,17 +37,11 @@ def run(args):
         kwargs["degree"] = args.degree
     family = shadow_hamiltonians(system, comp, **kwargs)
 
-    def data():
-        out = base_dict(system, word, order=order, route=args.route)
-        out.update(family.to_dict())
-        out["model"], out["integrator"] = system.name, word
-        return out
-
     def text():
         out = f"{word} on {system.name}, order {order}, route {args.route}\n" + family.to_text()
         if args.route == "fi" and hasattr(family.details, "to_text"):
             out += "\n" + family.details.to_text()  # each commutator's representations and weights
         return out
 
-    emit(args, latex=family.to_latex, text=text, data=data, system=system)
+    emit(args, latex=family.to_latex, text=text, data=family.to_dict, system=system)
 

@@ -166,14 +166,25 @@ class ExactShadow(Printable):
         return "\n".join(lines)
 
     def to_dict(self, order=None) -> dict:
-        """JSON-ready dict; with ``order`` also ``series`` ``{"H_S": {"0": ..., "2": ...}, ...}`` through ``h^order``."""
-        out = {"H_S": str(self.H_S), "G_S": None if self.G_S is None else str(self.G_S),
-               "H_c": str(self.H_c), "G_c": None if self.G_c is None else str(self.G_c),
-               "free_parameters": [] if self.G_S is None else ["alpha"]}
+        """JSON-ready dict; with ``order`` also the truncated series (``H_S_series``, ``G_S_series``) and ``series``
+        ``{"H_S": {"0": ..., "2": ...}, ...}`` through ``h^order``.
+
+        The system's part comes first (:func:`nambu_bch.render.result_head`); ``nambu-bch exact --format json``
+        prints exactly this dict.
+        """
+        from ..render import expression, result_head
+
+        cq = self.conserved
+        out = result_head(cq.system, cq.word)
+        out.update({"H_S": str(self.H_S), "G_S": None if self.G_S is None else str(self.G_S),
+                    "H_c": str(self.H_c), "G_c": None if self.G_c is None else str(self.G_c),
+                    "free_parameters": [] if self.G_S is None else ["alpha"]})
         if order is not None:
+            series = self.series(order)
+            out.update(order=order, H_S_series=expression(series[0]), G_S_series=expression(series[1]))
             names = [f"{tx}_S" for _, tx, *_ in self._rows()]
             out["series"] = {name: {str(k): str(S.coeff(STEP, k)) for k in range(order + 1) if S.coeff(STEP, k) != 0}
-                             for name, S in zip(names, (sympy.expand(S) for S in self.series(order) if S is not None))}
+                             for name, S in zip(names, (sympy.expand(S) for S in series if S is not None))}
             out["remainder_power"] = self.remainder_power(order)
         return out
 

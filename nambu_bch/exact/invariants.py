@@ -299,8 +299,12 @@ class ConservedQuantities(Printable):
 
     def to_dict(self) -> dict:
         """``{"H_c": str, "G_c": str, "series": {"H_c": {"0": str, "2": str}, ...}}`` (``sympy.sympify`` reads them back;
-        ``None`` where absent; a series is ``None`` when the invariant is not polynomial in ``h``)."""
-        out = {"H_c": None if self.H_c is None else str(self.H_c), "G_c": None if self.G_c is None else str(self.G_c)}
+        ``None`` where absent; a series is ``None`` when the invariant is not polynomial in ``h``), after the system's
+        part (:func:`nambu_bch.render.result_head`): ``nambu-bch conserved --format json`` prints exactly this dict."""
+        from ..render import result_head
+
+        out = result_head(self.system, self.word)
+        out.update(H_c=None if self.H_c is None else str(self.H_c), G_c=None if self.G_c is None else str(self.G_c))
         out["series"] = {name: None if coefficients is None else {str(k): str(c) for k, c in coefficients.items()}
                          for name, coefficients in self.series().items()}
         return out
@@ -396,7 +400,8 @@ def conserved_quantities(system, word, degree=None) -> ConservedQuantities:
     >>> from nambu_bch import model
     >>> conserved_quantities(model("ho"), "121").H_c          # Eq. (CQPV)
     -h**2*omega**2*x2**2/(8*m) + m*omega**2*x1**2/2 + x2**2/(2*m)
-    >>> conserved_quantities(model("ho3"), "12321").to_dict()  # Eqs. (CQ12321H), (CQ12321G)
+    >>> d = conserved_quantities(model("ho3"), "12321").to_dict()  # Eqs. (CQ12321H), (CQ12321G)
+    >>> {k: d[k] for k in ("H_c", "G_c", "series")}
     {'H_c': 'm*omega**2*x3/2 + x2**2/(2*m)', 'G_c': 'h**2*x2**2/(4*m**2) - x1**2 + x3',
      'series': {'H_c': {'0': 'm*omega**2*x3/2 + x2**2/(2*m)'}, 'G_c': {'0': '-x1**2 + x3', '2': 'x2**2/(4*m**2)'}}}
     >>> print(conserved_quantities(model("ho3"), "12321"))        # as Table (table) writes it

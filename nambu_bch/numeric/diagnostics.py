@@ -231,10 +231,17 @@ class CheckResult:
     drift_rate: dict = field(default_factory=dict)
     seconds: float = 0.0
     skipped: dict = field(default_factory=dict)
+    system: object = field(default=None, repr=False, compare=False)  # for the JSON head (coordinates, parameters)
 
     def to_dict(self) -> dict:
-        """JSON-ready: ``{"model", "integrator", "h", "steps", ..., "max_abs_error": {...}, "drift_rate": {...}}``."""
+        """JSON-ready: ``{"model", "integrator", "h", "steps", ..., "max_abs_error": {...}, "drift_rate": {...}}``,
+        after the system's part (:func:`nambu_bch.render.result_head`) when the system is known;
+        ``nambu-bch check --format json`` prints exactly this dict."""
+        from ..render import result_head
+
+        head = result_head(self.system, self.integrator) if self.system is not None else {}
         return {
+            **head,
             "model": self.model, "integrator": self.integrator, "h": float(self.h), "steps": int(self.steps),
             "every": int(self.every), "x0": [float(v) for v in self.x0],
             "params": {k: float(v) for k, v in self.params.items()}, "order": int(self.order),
@@ -346,8 +353,8 @@ def check(system, word, h, steps, x0, params=None, *, order=2, alpha=0.5, every=
 
     Returns
     -------
-    CheckResult -- ``.to_dict()["max_abs_error"]`` has ``H, G, H_c, G_c, H_S, G_S, H_S_exact,
-    G_S_exact`` and ``x1_o .. xN_s`` where they are defined; ``skipped`` names the quantities
+    CheckResult -- ``.to_dict()["max_abs_error"]`` has ``H, G, H_c, G_c, H_S, G_S``,
+    ``H_S_exact, G_S_exact`` and ``x1_o .. xN_s`` where they are defined; ``skipped`` names the quantities
     that are singular at the given parameters.
 
     Raises
@@ -416,7 +423,8 @@ def check(system, word, h, steps, x0, params=None, *, order=2, alpha=0.5, every=
             "rescale the initial state or the parameters"
         )
     result = CheckResult(system.name, name, float(h), int(steps), int(every), [float(v) for v in x0],
-                         {p.name: v for p, v in parameter_values(system, params).items()}, int(order), float(alpha))
+                         {p.name: v for p, v in parameter_values(system, params).items()}, int(order), float(alpha),
+                         system=system)
     for key, acc in stats.items():
         result.max_abs_error[key] = acc.max_abs
     for q in fns:

@@ -275,6 +275,17 @@ def _total_degree(p, n):
     return max((sum(m[:n]) for m in p.keys()), default=-1)
 
 
+def needed_degree(gdeg, rhs_deg: int) -> tuple:
+    """``(D, reach)``: the default ansatz degree of an order whose field has degree ``rhs_deg``.
+
+    ``gdeg[a]`` is the degree of the gradient of ``H^a``; a correction of degree ``D`` in slot ``a`` gives a
+    field of degree ``<= D - 1 + reach_a`` (``reach_a`` the sum of the other slots' gradient degrees), so ``D``
+    is the least degree reaching ``rhs_deg`` in every slot, and ``reach`` the largest ``reach_a``.
+    """
+    sums = [sum(g for b, g in enumerate(gdeg) if b != a) for a in range(len(gdeg))]
+    return max(1, max(rhs_deg + 1 - s for s in sums)), max(sums)
+
+
 class _Solver:
     def __init__(self, system, comp, order, degree, max_unknowns=None):
         self.max_unknowns = max_unknowns
@@ -411,8 +422,7 @@ class _Solver:
         return total
 
     def _needed_degree(self, rhs_deg):
-        sums = [sum(g for b, g in enumerate(self.gdeg) if b != a) for a in range(self.slots)]
-        return max(1, max(rhs_deg + 1 - s for s in sums)), max(sums)
+        return needed_degree(self.gdeg, rhs_deg)
 
     # -- one order -----------------------------------------------------------------
     def solve_order(self, j, corrections) -> OrderSolution:

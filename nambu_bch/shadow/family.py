@@ -111,6 +111,8 @@ def _free_parameters(exists, shadows) -> list:
 class ShadowFamily(Printable):
     """Shadow Hamiltonians of a composition on a system, as a family.
 
+    A family is immutable; it is built by :meth:`from_direct`, :meth:`from_fi` or :meth:`unperturbed`.
+
     Attributes
     ----------
     system, composition
@@ -130,8 +132,9 @@ class ShadowFamily(Printable):
     notes : list of str -- e.g. vanishing odd orders
     failed_order, certificate, obstruction -- set when ``exists`` is false
     details : the route's own result (``DirectResult`` or ``FIResult``)
-
-    A family is immutable; it is built by :meth:`from_direct`, :meth:`from_fi` or :meth:`unperturbed`.
+    fi_span : list of dict or None -- FI route: per solved order, how much of the family the FI
+        representations reach (:class:`~nambu_bch.shadow.fi_route.FISpan`; ``reached`` false: the
+        family's members needed the direct route's kernel, the reason is also in ``notes``); None for the direct route
     """
 
     system: object
@@ -153,6 +156,7 @@ class ShadowFamily(Printable):
     drift: dict | None = None
     evidence: dict | None = None
     existence: object = None
+    fi_span: list | None = None
 
     # -- named constructors ------------------------------------------------------------
     @classmethod
@@ -227,6 +231,8 @@ class ShadowFamily(Printable):
                     failed_order, certificate = o.order, o.certificate
                     obstruction = (f"at h^{o.order} no affine combination of the FI representations equals "
                                    f"X_{{H,dG}} + X_{{dH,G}} + (cross terms) with corrections of degree <= {o.degree}")
+        spans = result.spans()
+        notes += [span.reason() for span in spans if not span.reached]
         if result.exists:
             outcome = dict(exists=True, polynomial=True, shadows=result.shadow())
         elif direct is not None and direct.exists:
@@ -236,7 +242,8 @@ class ShadowFamily(Printable):
             outcome = dict(polynomial=False, **existence_fields(decision, failed_order))
         return cls(system, composition, order, "fi", gauge=gauge, corrections=corrections, degree=degree, notes=notes,
                    failed_order=failed_order, certificate=certificate, obstruction=obstruction, details=result,
-                   free_parameters=_free_parameters(outcome["exists"], outcome.get("shadows", ())), **outcome)
+                   free_parameters=_free_parameters(outcome["exists"], outcome.get("shadows", ())),
+                   fi_span=[span.to_dict() for span in spans], **outcome)
 
     @classmethod
     def unperturbed(cls, system, composition, order: int, route: str = "fi") -> "ShadowFamily":
@@ -244,7 +251,8 @@ class ShadowFamily(Printable):
         shadows = tuple(sympy.expand(Hk) for Hk in system.hamiltonians)
         polynomial = all(system.algebra.is_polynomial(system.algebra.convert(Hk)) for Hk in system.hamiltonians)
         return cls(system, composition, order, route, True, shadows=shadows, free_parameters=_free_parameters(True, shadows),
-                   notes=["h^1: the correction vanishes (symmetric word)"], polynomial=polynomial)
+                   notes=["h^1: the correction vanishes (symmetric word)"], polynomial=polynomial,
+                   fi_span=[] if route == "fi" else None)
 
     def _outcome_headline(self) -> str:
         """The existence outcome of a family without a polynomial pair (the three outcomes of issue 17)."""
@@ -372,22 +380,20 @@ class ShadowFamily(Printable):
         return out
 
     def to_dict(self) -> dict:
-        """JSON-ready dict (docs/json.md): expressions as strings ``sympy.sympify`` reads back."""
-        sys_ = self.system
-        out = {
-            "model": sys_.name,
-            "integrator": self.composition.name,
-            "order": self.order,
-            "coordinates": [str(x) for x in sys_.coordinates],
-            "H": str(sys_.H),
-            "G": None if sys_.G is None else str(sys_.G),
-            "bracket": getattr(sys_, "bracket", None),
+        """JSON-ready dict (docs/json.md): expressions as strings ``sympy.sympify`` reads back.
+
+        The system's part (model, coordinates, parameters, Hamiltonians) comes first
+        (:func:`nambu_bch.render.result_head`); ``nambu-bch shadow --format json`` prints exactly this dict.
+        """
+        from ..render import result_head
+
+        out = result_head(self.system, self.composition.name, order=self.order, route=self.route)
+        out.update({
             "exists": self.exists,
             "H_S": None if self.H_S is None else str(self.H_S),
             "G_S": None if self.G_S is None else str(self.G_S),
             "free_parameters": list(self.free_parameters),
-            "route": self.route,
-        }
+        })
         if len(self.shadows) > 2:
             out["shadows"] = [str(S) for S in self.shadows]
         out["polynomial"] = self.polynomial
@@ -405,6 +411,7 @@ class ShadowFamily(Printable):
                                  if any(sympy.sympify(c) != 0 for c in direction)]  # weight-only FI directions dropped
                         for k, directions in sorted(self.gauge.items())}
         out["certificate"] = self._certificate_data()
+        out["fi_span"] = self.fi_span
         return out
 
     def _certificate_data(self):

@@ -37,6 +37,11 @@ FI representations (``fi_dim``) and the direct route's kernel at the same
 degree (``direct_dim``): every FI solution is a direct one, and ``whole`` says
 whether the FI span is all of it (docs/fi_route.md: for ho3 it is a proper part).
 
+The family returned at every order is the FI particular solution plus the direct route's
+kernel at the direct route's default degree, with the direct route's canonical members, so
+both routes give the same alpha-family; :class:`FISpan` says whether the FI solutions alone
+held it (for Lotka-Volterra at ``h^4`` they do not: the alpha direction needs ``X_{H,H} = 0``).
+
 References
 ----------
 Horikoshi, Eqs. (BCH2)-(BCH5), (CL5)-(CL8b), (SH12321a)-(SG12321c), (Xeff3).
@@ -51,7 +56,7 @@ from itertools import product
 import sympy
 
 from ..algebra.ansatz import Ansatz, Rows
-from ..algebra.elimination import Echelon, kernel_rref, rank, solve_affine
+from ..algebra.elimination import Echelon, kernel_rref, normal_form, rank, solve_affine
 from ..algebra.zero import is_zero
 from ..bch import expand_terms, formal_bch
 from ..bch.expansion import piece_evaluator, term_evaluator
@@ -60,7 +65,7 @@ from ..checks import is_int
 from ..errors import InvalidOrderError, NambuBCHError
 from ..integrators.composition import composition_for
 from ..symbols import ALPHA, STEP
-from .direct_route import operator_columns
+from .direct_route import needed_degree, operator_columns
 from .fi_nested import RawOps, nested_hull
 from .fundamental_identity import representations, single_representations
 from .liouville_terms import LiouvilleSum
@@ -182,12 +187,13 @@ class FIOrder:
     degree : int or None -- ansatz degree of the corrections
     commutators : list of FINested -- the BCH brackets at ``h^j`` with their hulls
     directions : list of ``(commutator index, label)`` -- the independent directions kept (one weight each)
-    corrections : tuple -- the alpha-family ``(dH_j, dG_j, ...)``
+    corrections : tuple -- the alpha-family ``(dH_j, dG_j, ...)`` (the direct route's: :class:`FISpan`)
     members : (tuple, tuple) -- the ``alpha = 0`` and ``alpha = 1`` members
     kernel : list of tuples -- a basis of the corrections of the homogeneous FI solutions
     fi_dim : int -- dimension of that space (corrections reached through FI representations)
     direct_dim : int -- dimension of the direct route's kernel at the same ansatz degree (computed on first use)
     certificate : dict or None
+    span : FISpan or None -- whether the FI solutions alone held the family (set when solved)
     """
 
     order: int
@@ -200,6 +206,7 @@ class FIOrder:
     kernel: list = field(default_factory=list)
     fi_dim: int = 0
     certificate: dict | None = None
+    span: FISpan | None = None
     _direct: tuple = field(default=(), repr=False)
     _direct_dim: int | None = field(default=None, repr=False)
 
@@ -224,8 +231,10 @@ class FIResult:
     power : int -- the power of ``h`` solved (2 for symmetric words, 1 otherwise)
     commutators : list of FICommutator
     exists : bool
-    members : (FIMember, FIMember) -- the ``alpha = 0`` and ``alpha = 1`` members
-    corrections : tuple -- the alpha-family ``(dH, dG)`` (sympy, in ``alpha``)
+    members : (FIMember, FIMember) -- the ``alpha = 0`` and ``alpha = 1`` FI solutions (weights and corrections)
+    corrections : tuple -- the alpha-family ``(dH, dG)`` (sympy, in ``alpha``): the FI particular solution
+        plus the direct route's kernel, canonical members by the direct route's rule (``span`` says
+        whether the FI members already were them)
     kernel : list -- basis of the homogeneous solutions (weights, corrections)
     degree : int -- ansatz degree of the corrections
     certificate : dict or None
@@ -243,6 +252,7 @@ class FIResult:
     certificate: dict | None = None
     orders: list = field(default_factory=list)  # FIOrder, the powers above ``power``
     failed_order: int | None = None
+    span: FISpan | None = None  # the lowest order's; FIOrder.span for the others
     _ctx: dict = field(default_factory=dict, repr=False)
 
     @property
@@ -295,6 +305,10 @@ class FIResult:
         """Do these representation weights give ``X_{H,dG} + X_{dH,G}`` with these corrections (formally)?"""
         return self.combination(weights) == self.target(corrections)
 
+    def spans(self) -> list:
+        """The :class:`FISpan` of every solved order, lowest first."""
+        return [x for x in (self.span, *(o.span for o in self.orders)) if x is not None]
+
     def kernel_corrections(self) -> list:
         """The ``(dH, dG, ...)`` part of every homogeneous solution (weights dropped), as sympy expressions."""
         alg, nw, ansatz = self._ctx["algebra"], self._ctx["nw"], self._ctx["ansatz"]
@@ -321,11 +335,12 @@ _FORMS: dict = {}
 
 
 def clear_cache() -> None:
-    """Forget the memoised FI maps, hulls, labelled forms, formal columns and bracket evaluators."""
+    """Forget the memoised FI maps, hulls, labelled forms, formal columns, bracket evaluators and gauge kernels."""
     _RAW_OPS.clear()
     _FORMS.clear()
     _MONOMIAL_COLUMNS.clear()
     _EVALUATORS.clear()
+    _OPERATOR.clear()
 
 
 def _raw_ops(alg, atoms) -> RawOps:
@@ -539,9 +554,11 @@ def fi_route(system, word, order: int = 2, degree=None, terms=None) -> FIResult:
                 weights[t][r] = alg.domain.to_sympy(v)
         members.append(FIMember(weights, ansatz.expressions(vec, alg.coordinates, alg.domain, offset=nw)))
     result.members = tuple(members)
-    result.corrections = tuple(sympy.expand((1 - ALPHA) * c0 + ALPHA * c1)
-                               for c0, c1 in zip(members[0].corrections, members[1].corrections))
     result.kernel = kernel_rref(sol.kernel, prios[0], alg.domain)
+    fi_dim = rank([{c: v for c, v in vec.items() if c >= nw} for vec in result.kernel], nw + len(ansatz), alg.domain)
+    family, result.span = _whole_family(alg, hams, ansatz, nw, sol.particular, [0], degree if user_degree else None,
+                                        [m.corrections for m in members], fi_dim, power)
+    result.corrections = _family(family)
     if order > power:
         _higher_orders(result, order, degree if user_degree else None)
     return result
@@ -596,6 +613,112 @@ def _direct_kernel_dim(alg, hams, ansatz) -> int:
     return len(vecs) - rank(vecs, len(rows), alg.domain)
 
 
+@dataclass(frozen=True)
+class FISpan:
+    """How much of one order's family the FI representations reach.
+
+    The FI route solves the formal equation, whose solutions are field solutions; its family is then
+    the FI particular solution plus the whole kernel of ``(dH, dG) -> X_{dH,G} + X_{H,dG}`` at the
+    direct route's ansatz degree, with the direct route's canonical members, so both routes return
+    the same alpha-family.  This record says whether the FI solutions alone held that family.
+
+    Attributes
+    ----------
+    order : int -- the power of ``h``
+    degree : int -- ansatz degree of the family (the direct route's default, or the degree given)
+    fi_dim : int -- dimension of the corrections reached through FI representations (at the FI degree)
+    gauge_dim : int -- dimension of the whole kernel at ``degree``
+    reached : bool -- both canonical members are FI solutions (the FI family is the whole family)
+    """
+
+    order: int
+    degree: int
+    fi_dim: int
+    gauge_dim: int
+    reached: bool
+
+    def reason(self) -> str | None:
+        """Why the family needed directions the FI representations miss (None when it did not)."""
+        if self.reached:
+            return None
+        return (f"h^{self.order}: the FI representations reach {self.fi_dim} of the {self.gauge_dim} gauge directions "
+                f"(degree {self.degree}) and not the alpha-family's; its members are completed by the direct route's "
+                "kernel (formal FI sums keep the Hamiltonian pieces whole, so they miss field identities such as "
+                "X_{H,H} = 0)")
+
+    def to_dict(self) -> dict:
+        return {"order": self.order, "degree": self.degree, "fi_dim": self.fi_dim, "gauge_dim": self.gauge_dim,
+                "reached": self.reached, "reason": self.reason()}
+
+
+def _whole_family(alg, hams, ansatz, nw, particulars, powers, degree, fi_members, fi_dim, order):
+    """The canonical members of (FI particular solution) + (the direct route's kernel), and their :class:`FISpan`.
+
+    Parameters
+    ----------
+    alg : the system's algebra; hams : its Hamiltonians (sympy)
+    ansatz : Ansatz -- the FI solve's corrections, columns ``nw + k``
+    particulars : list of sparse vectors -- one FI particular solution per power of alpha in ``powers``
+    degree : int or None -- the ansatz degree asked for (None: the direct route's default, at least the FI one)
+    fi_members : the FI route's own two members (corrections), to tell whether they were already the family's
+    fi_dim, order : for the :class:`FISpan`
+
+    Returns
+    -------
+    (members, span) -- two tuples of corrections (polynomial in alpha), the span record
+    """
+    domain = alg.domain
+    rings = [alg.convert(Hk) for Hk in hams]
+    vecs = [{c - nw: v for c, v in vec.items() if c >= nw} for vec in particulars]
+    rows, cols, _ = _operator(alg, hams, rings, ansatz.degree, kernel=False)
+    if degree is None:  # the degree of the field the particular solution makes, and the direct route's rule
+        field: dict = {}
+        for vec in vecs:
+            for c, v in vec.items():
+                for r, w in cols[c].items():
+                    field[r] = field.get(r, domain.zero) + v * w
+        keys = rows.keys()
+        rhs_deg = max((sum(keys[r][1]) for r, v in field.items() if v), default=0)
+        gdeg = [max((sum(m[: alg.n]) for m in p.keys()), default=0) - 1 for p in rings]
+        degree = max(ansatz.degree, needed_degree(gdeg, rhs_deg)[0])
+    big = ansatz if degree == ansatz.degree else Ansatz(alg.n, degree, ansatz.slots)
+    if big is not ansatz:
+        vecs = [{big.index[ansatz.columns[c]]: v for c, v in vec.items()} for vec in vecs]
+    kernel = _operator(alg, hams, rings, degree)[2]
+    members = []
+    for prio in big.priorities([p.keys() for p in rings]):
+        corr = [sympy.Integer(0)] * big.slots
+        for k, vec in zip(powers, vecs):
+            part = normal_form(vec, kernel, prio, domain)
+            corr = [c + ALPHA**k * d for c, d in zip(corr, big.expressions(part, alg.coordinates, domain))]
+        members.append(tuple(sympy.expand(c) for c in corr))
+    reached = all(is_zero(a - b) for m, f in zip(members, fi_members) for a, b in zip(m, f))
+    return tuple(members), FISpan(order, degree, fi_dim, len(kernel), reached)
+
+
+_OPERATOR: dict = {}
+
+
+def _operator(alg, hams, rings, degree, kernel=True) -> tuple:
+    """``(rows, columns, kernel)`` of ``(dH, dG) -> X_{dH,G} + X_{H,dG}`` on the ansatz of ``degree``, memoised
+    (shared by all words and orders of a system; ``kernel`` None until first asked for)."""
+    key = (alg.ring, alg.coordinates, tuple(hams), degree)
+    entry = _OPERATOR.get(key)
+    if entry is None:
+        if len(_OPERATOR) > 256:
+            _OPERATOR.clear()
+        rows = Rows()
+        entry = _OPERATOR[key] = [rows, operator_columns(alg, rings, Ansatz(alg.n, degree, len(rings)), rows), None]
+    if kernel and entry[2] is None:
+        entry[2] = solve_affine(entry[1], [], len(entry[0]), alg.domain).kernel
+    return tuple(entry)
+
+
+def _family(members) -> tuple:
+    """``(1 - alpha) m_0 + alpha m_1``, expanded, per slot."""
+    return tuple(sympy.expand((1 - ALPHA) * c0 + ALPHA * c1) for c0, c1 in zip(*members))
+
+
 def _higher_orders(result, order, degree) -> None:
     """Solve ``h^{power+1} .. h^order`` by the recursive hulls (fi_nested), the lower family fed into the cross terms."""
     system, comp, ctx = result.system, result.composition, result._ctx
@@ -643,7 +766,120 @@ def _brackets(system, series, j, ops, memo, limit=None) -> list:
     return [FINested(c, tree, nested_hull(ops, tree, memo), ops) for c, tree in trees[:limit]]
 
 
-def fi_brackets(system, word, order: int, limit=None) -> list:
+@dataclass(frozen=True)
+class FIForms:
+    """The eight fundamental-identity forms of ``[X_{A,B},[X_{C,D},X_{E,F}]]`` (Eqs. 1AX-2BY) and, for a system,
+    each ``h^2`` double commutator of the BCH series in them (Eqs. CL5-CL8): what ``nambu-bch fi`` prints.
+
+    Attributes
+    ----------
+    system : System
+    composition : Composition
+    representations : list or None -- :func:`~nambu_bch.shadow.fundamental_identity.bch_double_commutators`
+        of the system, or None for the forms alone
+    """
+
+    system: object
+    composition: object
+    representations: list | None = None
+
+    def to_dict(self) -> dict:
+        """JSON-ready: ``forms`` (label, text, LaTeX); with a system its part first and ``representations``;
+        ``nambu-bch fi --format json`` prints exactly this dict."""
+        from .. import render
+        from .fundamental_identity import FI_LABELS
+
+        out = {"forms": [{"label": lab, "text": render.fi_form_text(lab), "latex": render.fi_form_latex(lab)}
+                         for lab in FI_LABELS]}
+        if self.representations is None:
+            return out
+        out = {**render.result_head(self.system, self.composition.name), **out}
+        out["representations"] = [
+            {
+                "coefficient": render.expression(c),
+                "commutator": [[render.expression(s) for s in t] for t in abd],
+                "forms": {lab: [{"coefficient": render.expression(t.coefficient),
+                                 "slots": [render.expression(s) for s in t.expressions]} for t in terms]
+                          for lab, terms in forms.items()},
+            }
+            for c, abd, forms in self.representations
+        ]
+        return out
+
+    def to_text(self) -> str:
+        from .. import render
+        from .fundamental_identity import FI_LABELS
+
+        lines = [f"{lab}: {render.fi_form_text(lab)}" for lab in FI_LABELS]
+        for c, abd, forms in self.representations or ():
+            a, b, d = ("X_{" + ", ".join(str(s) for s in t) + "}" for t in abd)
+            lines.append(f"{c} [{a}, [{b}, {d}]] (h^2 term of {self.composition.name} on {self.system.name}):")
+            lines += [f"  {lab}: " + (" + ".join(str(t) for t in terms) or "0") for lab, terms in forms.items()]
+        return "\n".join(lines)
+
+    def to_latex(self) -> list:
+        from .. import render
+
+        title = f"{self.composition.name} on {self.system.name}"
+        return [render.fi_forms_latex()] + [render.fi_representations_latex(title, c, abd, forms)
+                                            for c, abd, forms in self.representations or ()]
+
+
+def fi_forms(system, word) -> FIForms:
+    """The eight FI forms and each ``h^2`` double commutator of ``word`` on ``system`` in them (Eqs. CL5-CL8).
+
+    >>> from nambu_bch import model
+    >>> F = fi_forms(model("ho3"), "12321")
+    >>> len(F.to_dict()["forms"]), F.to_dict()["representations"][0]["coefficient"]
+    (8, '-1/24')
+    """
+    from .fundamental_identity import bch_double_commutators
+
+    comp = composition_for(word, system.splitting)
+    return FIForms(system, comp, bch_double_commutators(system, comp))
+
+
+class FIBrackets(list):
+    """The brackets of ``X_eff`` at one power of ``h`` with their FI hulls: a list of :class:`FINested`.
+
+    Attributes
+    ----------
+    system : System
+    composition : Composition
+    order : int -- the power of ``h``
+    total : int -- the number of brackets at ``h^order`` (the list holds the first ``limit`` of them)
+    limit : int or None -- at most this many brackets, and this many directions per bracket, are shown
+    """
+
+    def __init__(self, items, system, composition, order: int, total: int, limit=None):
+        super().__init__(items)
+        self.system, self.composition, self.order, self.total, self.limit = system, composition, order, total, limit
+
+    def _more(self):
+        return f"... {self.total - len(self)} more brackets (raise --limit)" if len(self) < self.total else None
+
+    def to_dict(self) -> dict:
+        """JSON-ready: the system part, ``order``, ``total`` and ``brackets`` (:meth:`FINested.to_dict`);
+        ``nambu-bch fi --order K --format json`` prints exactly this dict."""
+        from ..render import result_head
+
+        return {**result_head(self.system, self.composition.name, order=self.order), "total": self.total,
+                "brackets": [b.to_dict(self.limit) for b in self]}
+
+    def to_text(self) -> str:
+        head = f"h^{self.order} brackets of {self.composition.name} on {self.system.name}: {self.total}"
+        more = self._more()
+        return "\n".join([head, *(b.to_text(self.limit) for b in self), *([more] if more else [])])
+
+    def to_latex(self) -> str:
+        from ..printing import latex_text
+
+        title = latex_text(f"{self.composition.name} on {self.system.name}, {self.total} brackets at") + f" h^{{{self.order}}}"
+        more = self._more()
+        return " \\\\\n".join([title, *(b.to_latex(self.limit) for b in self), *([latex_text(more)] if more else [])])
+
+
+def fi_brackets(system, word, order: int, limit=None) -> FIBrackets:
     """The brackets of ``X_eff`` at ``h^order``, each with the affine hull of its FI representations.
 
     Parameters
@@ -656,7 +892,8 @@ def fi_brackets(system, word, order: int, limit=None) -> list:
 
     Returns
     -------
-    list of FINested -- empty when the order vanishes (odd orders of a symmetric word)
+    FIBrackets -- a list of FINested, empty when the order vanishes (odd orders of a symmetric word), with
+    ``total`` and ``to_dict`` / ``to_text`` / ``to_latex``
 
     Examples
     --------
@@ -669,7 +906,11 @@ def fi_brackets(system, word, order: int, limit=None) -> list:
     if limit is not None and not is_int(limit, 1):
         raise NambuBCHError(f"limit must be a positive integer or None, got {limit!r}")
     atoms, _ = _atoms(system)
-    return _brackets(system, formal_bch(comp, order + 1), order, RawOps(system.algebra, atoms), {}, limit)
+    trees = _merged_trees(system, formal_bch(comp, order + 1), order)
+    ops = RawOps(system.algebra, atoms)
+    memo: dict = {}
+    items = [FINested(c, tree, nested_hull(ops, tree, memo), ops) for c, tree in trees[:limit]]
+    return FIBrackets(items, system, comp, order, len(trees), limit)
 
 
 def count_brackets(system, word, order: int) -> int:
@@ -701,6 +942,7 @@ def _solve_order(system, ctx, ops, memo, series, j, corrections, degree) -> FIOr
     domain = alg.domain
     hams = system.hamiltonians
     slots = len(hams)
+    user_degree = degree
     commutators = _brackets(system, series, j, ops, memo)
     base = LiouvilleSum.zero(alg, atoms)
     ech = Echelon(domain)
@@ -744,12 +986,15 @@ def _solve_order(system, ctx, ops, memo, series, j, corrections, degree) -> FIOr
         for k, part in zip(powers, Ansatz.canonical(sol.particular, sol.kernel, prio, domain)):
             corr = [c + ALPHA**k * d for c, d in zip(corr, ansatz.expressions(part, alg.coordinates, domain, offset=nw))]
         members.append(tuple(sympy.expand(c) for c in corr))
-    out.members = tuple(members)
-    out.corrections = tuple(sympy.expand((1 - ALPHA) * c0 + ALPHA * c1) for c0, c1 in zip(*members))
     projected = [{col: v for col, v in vec.items() if col >= nw} for vec in sol.kernel]
     projected = [p for p in projected if p]
     basis = kernel_rref(projected, prios[0][: len(ansatz)], domain) if projected else []
     out.kernel = [ansatz.expressions(vec, alg.coordinates, domain, offset=nw) for vec in basis]
     out.fi_dim = len(basis)
     out._direct = (alg, hams, ansatz)
+    out.members, out.span = _whole_family(alg, hams, ansatz, nw, sol.particular, powers, user_degree, members,
+                                          out.fi_dim, j)
+    if out.span.degree == degree:  # the kernel at the FI degree was just computed
+        out._direct_dim = out.span.gauge_dim
+    out.corrections = _family(out.members)
     return out

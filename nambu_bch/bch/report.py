@@ -1,0 +1,120 @@
+"""``BCHReport``: the formal BCH series of a word on a system, optionally evaluated and expanded, as one result.
+
+What ``nambu-bch bch`` prints (text, LaTeX, or exactly :meth:`BCHReport.to_dict` as JSON): the series
+term by term in the Lyndon basis (Eq. BCH2), with ``field`` the effective field ``X_eff = Z_0 + h Z_1 + ...``
+on the system, with ``terms`` its expansion into Liouville terms, vanishing brackets pruned (Eq. BCH4).
+
+References
+----------
+Horikoshi, Eqs. (BCH1), (BCH2), (BCH4).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from .backward import effective_field
+from .expansion import expand_terms
+from .formal import formal_bch
+
+
+@dataclass(frozen=True)
+class BCHReport:
+    """The BCH series of ``composition`` through ``h^order`` on ``system``.
+
+    Attributes
+    ----------
+    system : System
+    composition : Composition
+    order : int -- the highest power of ``h``
+    series : FormalBCH -- through degree ``order + 1``
+    field : EffectiveField or None -- ``X_eff`` on the system (when asked for)
+    expanded : dict or None -- degree to ``[(coefficient, tree of Liouville terms)]`` (when asked for)
+    """
+
+    system: object
+    composition: object
+    order: int
+    series: object
+    field: object = None
+    expanded: dict | None = None
+
+    def to_dict(self) -> dict:
+        """JSON-ready: the system part, the word's coefficients and pieces, the terms (and ``X_eff``,
+        ``liouville_terms`` when computed); ``nambu-bch bch --format json`` prints exactly this dict."""
+        from .. import render
+        from .lyndon import tree_to_latex
+
+        series, comp = self.series, self.composition
+        terms = [
+            {"degree": d, "power_of_h": d - 1, "coefficient": render.expression(c), "bracket": render.bracket_text(t),
+             "tree": render.bracket_tree(t)}
+            for d in range(1, series.max_degree + 1) for c, t in series.terms(d)
+        ]
+        out = render.result_head(self.system, comp.name, order=self.order, max_degree=series.max_degree,
+                                 coefficients=[render.expression(c) for c in comp.coefficients],
+                                 pieces=list(comp.pieces), terms=terms)
+        if self.field is not None:
+            out["X_eff"] = [[render.expression(c) for c in Z.to_sympy()] for Z in self.field.coefficients]
+        if self.expanded is not None:
+            out["liouville_terms"] = [
+                {"degree": d, "coefficient": render.expression(c), "bracket": render.bracket_text(t),
+                 "tree": render.bracket_tree(t), "latex": tree_to_latex(t)}
+                for d, items in self.expanded.items() for c, t in items
+            ]
+        return out
+
+    def to_text(self) -> str:
+        """The word as a product of exponentials, then ``h^k  coefficient  bracket`` per term."""
+        from ..render import bracket_text
+
+        comp, series = self.composition, self.series
+        lines = [f"{comp.name}: Phi_h = " + " ".join(f"exp({'' if c == 1 else f'({c})*'}h*X{k})" for k, c in comp.factors())]
+        lines.append(f"X_eff through h^{self.order} (formal BCH in the Lyndon basis):")
+        for d in range(1, series.max_degree + 1):
+            for c, t in series.terms(d):
+                lines.append(f"  h^{d - 1}  {c}  {bracket_text(t)}")
+        if self.field is not None:
+            for j, Z in enumerate(self.field.coefficients):
+                comps = ", ".join(str(c) for c in Z.to_sympy())
+                lines.append(f"Z_{j} = ({comps})")
+        if self.expanded is not None:
+            lines.append("Liouville terms (zero brackets pruned):")
+            for d, items in self.expanded.items():
+                for c, t in items:
+                    lines.append(f"  h^{d - 1}  {c}  {bracket_text(t)}")
+        return "\n".join(lines)
+
+    def to_latex(self) -> list:
+        """``aligned`` blocks: the word, the series (Eq. BCH2), ``X_eff`` and the Liouville terms when computed."""
+        from ..printing import aligned, bracket_sum
+
+        lhs, _, rhs = self.composition.to_latex().partition(" = ")
+        blocks = [aligned([(lhs, "=", rhs.split(" "))]), self.series.to_latex()]
+        if self.field is not None:
+            blocks.append(self.field.to_latex())
+        if self.expanded is not None:
+            blocks += [bracket_sum(rf"X_{{\rm eff}}\big|_{{h^{{{d - 1}}}}}", [(c, t, d - 1) for c, t in items])
+                       for d, items in self.expanded.items()]
+        return blocks
+
+
+def bch_report(system, comp, order: int = 2, field: bool = False, terms: bool = False) -> BCHReport:
+    """The formal BCH series of ``comp`` through ``h^order``, with ``X_eff`` on ``system`` and its Liouville terms.
+
+    Parameters
+    ----------
+    system : System
+    comp : Composition (checked against the system's splitting)
+    order : int -- the highest power of ``h``
+    field : bool -- also evaluate ``X_eff`` on the system
+    terms : bool -- also expand into Liouville terms, zero brackets pruned (Eq. BCH4)
+
+    Returns
+    -------
+    BCHReport
+    """
+    series = formal_bch(comp, order + 1)
+    X = effective_field(system.splitting, comp, order) if field else None
+    expanded = {d: expand_terms(series.terms(d), system.splitting) for d in series.degrees} if terms else None
+    return BCHReport(system, comp, order, series, X, expanded)
