@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from ..errors import NambuBCHError
-from ._options import (add_subcommand, integrator_from_args, integrator_options, output_options, positive_int,
+from ._options import (add_subcommand, integrator_from_args, integrator_options, output_options,
                        symbolic_system, system_options)
 from ._output import emit
 
@@ -49,7 +49,7 @@ def _nested(args, system, word, comp):
     """``fi --order K``: the brackets at ``h^K`` with the affine hulls of their FI representations (issue 13)."""
     from ..shadow.fi_route import count_brackets, fi_brackets
 
-    limit = positive_int(args.limit, "--limit", 10**6) if args.limit is not None else None
+    limit = args.limit  # converted and bounded with every other flag (_options.MAX_LIMIT)
     total = count_brackets(system, comp, args.order)
     if limit is None and total > 2000:
         raise NambuBCHError(f"--order {args.order}: {total} brackets; pass --limit N to list the first N")
