@@ -601,7 +601,7 @@ def direct_route(system, word, order: int = 2, degree=None, max_unknowns=None, p
         orders.append(sol)
         if sol.status in ("obstructed", "refused"):
             break
-    if orders[-1].status == "refused":
+    if orders and orders[-1].status == "refused":  # order 0 solves nothing: H_S = H, G_S = G
         from .generic import poisson_structure
 
         if poisson_structure(system) is not None:
