@@ -39,6 +39,15 @@ def is_int(value, low=None, high=None, numpy: bool = False) -> bool:
     return (low is None or value >= low) and (high is None or value <= high)
 
 
+def check_flag(value, what, none=False):
+    """``value`` as a bool: ``True``/``False`` (numpy's too), or ``None`` where ``none`` allows it (automatic)."""
+    if value is None and none:
+        return None
+    if not (isinstance(value, bool) or (type(value).__module__ == "numpy" and type(value).__name__ in ("bool_", "bool"))):
+        raise InvalidRunError(f"{what} must be True or False{' or None' if none else ''}, got {show(value)}")
+    return bool(value)
+
+
 def show(value) -> str:
     """``repr(value)``, shortened to one readable piece (a 400-digit integer is not echoed whole)."""
     text = repr(value)

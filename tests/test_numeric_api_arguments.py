@@ -41,6 +41,18 @@ def _figure(path="wp.png", dpi=20):
     return design.compare("ho", ["121"], t_end=1.0, steps=(10, 20), samples=20).figure(path, dpi)
 
 
+def _direct_route(**kw):
+    from nambu_bch.shadow.direct_route import direct_route
+
+    return direct_route(**kw)
+
+
+def _effective_field(**kw):
+    from nambu_bch.bch.backward import effective_field
+
+    return effective_field(**kw)
+
+
 def _chunks(**kw):
     return list(numeric.iterate_chunks(**kw))
 
@@ -81,7 +93,12 @@ ENTRIES = {
     "ModifiedSolution.numeric": (_solution_numeric, dict(params=None, h=0.1)),
     "ModifiedSolution.numeric()(t, x0)": (_solution_call, dict(t=[0.0, 1.0], x0=[1.0, 1.0, 1.0])),
     "F": (exact.F, dict(x=0.5)),
-    "shadow_hamiltonians": (nb.shadow_hamiltonians, dict(system=S, word="12321", order=2)),
+    "shadow_hamiltonians": (nb.shadow_hamiltonians, dict(system=S, word="12321", order=2, route="direct", degree=None,
+                                                         existence=True, params=None, max_unknowns=2000,
+                                                         progress=False)),
+    "direct_route": (_direct_route, dict(system=S, word="12321", order=2, degree=None, max_unknowns=None,
+                                         progress=False)),
+    "effective_field": (_effective_field, dict(splitting=nb.model(S).splitting, comp="12321", order=2, fast=True)),
 }
 
 #: Public functions of the numeric subpackage that take no numeric argument a user chooses (kernels and

@@ -25,7 +25,7 @@ import sympy
 
 from ..algebra import VectorField
 from ..algebra.backend import field_backend
-from ..checks import MAX_ORDER
+from ..checks import MAX_ORDER, check_flag
 from ..errors import InvalidOrderError
 from ..integrators.composition import composition_for
 from ..printing import Printable, aligned
@@ -141,6 +141,7 @@ def effective_field(splitting, comp, order: int = 2, fast: bool = True) -> Effec
     (-omega**2*x2/(12*m), -m*omega**4*x1/6)
     """
     order = check_order(order)
+    fast = check_flag(fast, "fast")
     comp = composition_for(comp, splitting)
     algebra = splitting.system.algebra.with_constants(H, extension=comp.extension)
     fields = [VectorField(algebra, p.field.to_sympy()) if comp.extension else p.field for p in splitting.pieces]

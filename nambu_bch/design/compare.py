@@ -37,12 +37,13 @@ from ..atomic import write_atomic
 from ..checks import finite_float, is_int, show
 from ..errors import InvalidCompositionError, InvalidRunError, NambuBCHError
 from ..integrators.composition import composition as make_composition, composition_for
+from ..integrators.step import parameter_values
 from ..numeric import iterate
 from ..numeric.figures import MAX_DPI
 from ..numeric.guards import check_count, initial_state
 from ..numeric.iterate import as_system
 from .conditions import error_analysis
-from .system_error import leading_error
+from .system_error import MAX_SAMPLES, _box, leading_error
 
 #: Errors below this are round-off and are not used in the slope fits.
 FLOOR = 1e-11
@@ -50,8 +51,6 @@ FLOOR = 1e-11
 MAX_STEPS = 10**7
 #: Most integrators of one comparison (each costs its runs and an exact error analysis).
 MAX_WORDS = 50
-#: Most sample points of the leading-error size (:func:`~nambu_bch.design.leading_error`).
-MAX_SAMPLES = 100_000
 
 
 def cost(comp) -> tuple:
@@ -224,13 +223,11 @@ def compare(system, words, t_end: float = 10.0, steps=(20, 40, 80, 160, 320, 640
         raise InvalidRunError(f"x0 must be {system.N} real numbers (the coordinates "
                               f"{', '.join(str(c) for c in system.coordinates)} of {system.name}), got {show(x0)}")
     x0 = tuple(finite_float(v, "x0") for v in items)
-    if params is not None and not isinstance(params, dict):
-        raise InvalidRunError(f"params must be a dict such as {{'omega': 1.0}}, got {show(params)}")
+    parameter_values(system, params)  # a dict of known names and finite values, before any run
     params = dict(params or {})
-    samples = check_count(samples, "samples", 1)
-    if samples > MAX_SAMPLES:
-        raise InvalidRunError(f"samples = {samples} is more than the {MAX_SAMPLES} points the leading-error size is "
-                              "estimated on")
+    _box(system, box)  # the leading-error arguments too, before the reference runs
+    if not is_int(samples, 1, MAX_SAMPLES):
+        raise InvalidRunError(f"samples must be an integer in 1..{MAX_SAMPLES:.0e}, got {show(samples)}")
     strang = "".join(str(k) for k in range(1, n + 1))
     strang = strang + strang[-2::-1] if n > 1 else "1"
     ref_name = f"kahan-li:{strang}" if n > 1 else strang

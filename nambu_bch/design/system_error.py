@@ -38,6 +38,8 @@ from ..symbols import STEP
 
 #: Highest power of ``h`` searched for the leading term.
 MAX_POWER = 8
+#: Most sample points of :func:`field_size` (one float64 evaluation of the field each).
+MAX_SAMPLES = 10**7
 
 
 @dataclass(frozen=True)
@@ -100,8 +102,8 @@ def field_size(components, system, box=None, samples: int = 2000, params=None, s
     """``max ||F(x)||_2`` of a polynomial field over a seeded uniform sample of ``box`` (default ``[-1, 1]^N``)."""
     system = as_system(system)
     box = _box(system, box)
-    if not is_int(samples, 1, 10**7):
-        raise InvalidRunError(f"samples must be an integer in 1..10^7, got {samples!r}")
+    if not is_int(samples, 1, MAX_SAMPLES):
+        raise InvalidRunError(f"samples must be an integer in 1..{MAX_SAMPLES:.0e}, got {show(samples)}")
     if not is_int(seed, 0, 2**32 - 1, numpy=True):
         raise InvalidRunError(f"seed must be an integer in 0..2^32-1, got {show(seed)}")
     if isinstance(components, (str, bytes)) or not hasattr(components, "__iter__"):

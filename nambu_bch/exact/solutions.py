@@ -186,8 +186,6 @@ class ModifiedSolution:
         from ..checks import finite_float
         from ..numeric.guards import finite_array
 
-        if params is not None and not isinstance(params, dict):
-            raise NambuBCHError(f"params must be a dict such as {{'omega': 1.0}}, got {params!r}")
         values = parameter_values(self.system, params)
         h = finite_float(h, "h")
         if self.kind != "o":

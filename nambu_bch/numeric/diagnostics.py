@@ -34,10 +34,10 @@ import numpy as np
 import sympy
 
 from ..bch.backward import check_order
+from ..checks import finite_float, show
 from ..errors import InvalidRunError, NambuBCHError, NumericalRangeError
 from ..integrators.composition import composition as make_composition
 from ..integrators.step import parameter_values
-from ..checks import finite_float, show
 from .guards import MAX_RUN_STEPS, check_count, finite_array, initial_state
 from .iterate import as_system, iterate
 from .samples import sample_times

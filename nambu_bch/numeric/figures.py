@@ -31,10 +31,10 @@ from pathlib import Path
 import numpy as np
 import sympy
 
+from ..checks import finite_float
 from ..errors import InvalidRunError, NambuBCHError
 from ..integrators.step import parameter_values
 from .diagnostics import _exact, _try, numpy_function, quantities
-from ..checks import finite_float
 from .guards import MAX_RUN_STEPS, check_count, check_inputs, check_work, initial_state
 from .iterate import as_system, iterate_chunks
 from .samples import n_samples

@@ -82,15 +82,6 @@ def check_count(value, what, minimum):
     return int(value)
 
 
-def check_flag(value, what, none=False) -> bool:
-    """``value`` as a bool: ``True``/``False`` (numpy's too), or ``None`` where ``none`` allows it (automatic)."""
-    if value is None and none:
-        return None
-    if not isinstance(value, (bool, np.bool_)):
-        raise InvalidRunError(f"{what} must be True or False{' or None' if none else ''}, got {show(value)}")
-    return bool(value)
-
-
 def check_backend(backend) -> str:
     """``backend`` if it is a string (:func:`~nambu_bch.numeric.kernels.resolve_backend` checks the name)."""
     if not isinstance(backend, str):

@@ -27,8 +27,9 @@ import numpy as np
 from ..errors import InvalidRunError, InvalidSystemError, NumericalRangeError
 from ..progress import Progress, progress_wanted
 from ..systems import System, model
-from .guards import (check_backend, check_count, check_flag, check_inputs, check_range, check_result, check_stability,
-                     check_work, initial_state, run_label, scan_states)
+from ..checks import check_flag
+from .guards import (check_backend, check_count, check_inputs, check_range, check_result, check_stability, check_work,
+                     initial_state, run_label, scan_states)
 from .kernels import kernel, resolve_backend
 from .precision import check_dps, run_mpmath
 from .samples import MAX_SAMPLE_BYTES, n_samples, sample_steps

@@ -30,11 +30,11 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..bch.backward import check_order
+from ..checks import finite_float, show
 from ..errors import InvalidRunError, NambuBCHError, NumericalRangeError, UnstableStepError
 from ..integrators.step import parameter_values
-from ..bch.backward import check_order
 from .diagnostics import QUANTITY_NAMES, _names, drift_rate, errors_along, quantities
-from ..checks import finite_float, show
 from .guards import check_count, check_work, finite_array, initial_state
 from .iterate import as_system, iterate
 from .samples import sample_times

@@ -146,9 +146,10 @@ _CACHE: dict = {}
 
 #: The documented initial state of each model: what ``check``, ``compare``, ``iterate``, ``plot`` (and the CLI)
 #: use when ``x0`` is omitted.  ``(1, ..., 1)`` where that is a bounded, non-trivial orbit (the paper's
-#: ``x(0) = (1, 1, 1)`` for ho3).  Henon-Heiles at (1, 1, 1, 1) has energy 7/3, far above the escape energy
+#: ``x(0) = (1, 1, 1)`` for ho3).  Henon-Heiles at (1, 1, 1, 1) has energy 8/3, far above the escape energy
 #: 1/6, and leaves to infinity, so its default is an orbit of energy 0.13 inside the bounded well.  Toda at
-#: (1, ..., 1) drifts (total momentum 3) until exp(q_i) overflows float64; its default has total momentum 0.
+#: (1, ..., 1) drifts with total momentum 3 until the step's exponentials overflow float64 (q near 700); its
+#: default has total momentum 0.
 DEFAULT_X0 = {
     "ho": (1.0, 1.0),
     "ho3": (1.0, 1.0, 1.0),
