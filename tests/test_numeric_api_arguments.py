@@ -155,6 +155,11 @@ def test_steps_beyond_the_run_bound_are_refused_before_any_work(monkeypatch):
         numeric.iterate("ho", "121", 0.1, 10**6, np.ones((2, 20000)), every=10**6)
 
 
+def test_a_streamed_block_is_bounded_like_a_sample_array():
+    with pytest.raises(InvalidRunError, match="chunk_samples"):
+        numeric.check("ho3", "32123", 0.1, 10, [1.0, 1.0, 1.0], chunk_samples=10**12)
+
+
 def test_every_beyond_steps_samples_like_every_equal_steps():
     a = numeric.iterate("ho3", "32123", 0.1, 7, [1.0, 1.0, 1.0], every=2**70)
     b = numeric.iterate("ho3", "32123", 0.1, 7, [1.0, 1.0, 1.0], every=7)

@@ -317,6 +317,9 @@ def iterate_chunks(system, word, h, steps, x0=None, params=None, every=1, *, kah
     kahan, check_stable = check_flag(kahan, "kahan"), check_flag(check_stable, "check_stable")
     backend = check_backend(backend)
     chunk_samples = _count(chunk_samples, "chunk_samples", 2)
+    if chunk_samples * system.N * 8 > MAX_SAMPLE_BYTES:  # one block is held at a time: the same memory bound
+        raise InvalidRunError(f"chunk_samples = {chunk_samples} blocks of {system.N} coordinates need more than "
+                              f"{MAX_SAMPLE_BYTES / 2**30:.0f} GiB; take fewer samples per block")
     kern = kernel(system, word)
     run = _prepare(system, kern, h, steps, every, x0, params, backend, None, check_stable, kahan)
     if run.X.ndim != 1:
