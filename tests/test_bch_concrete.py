@@ -163,7 +163,7 @@ def test_bad_orders(order):
 
 def test_order_too_high_to_finish_is_refused_up_front():
     with pytest.raises(InvalidOrderError, match="Witt"):
-        effective_field_bch(model("ho3").splitting, "12321", 15)
+        effective_field_bch(model("ho3").splitting, "suzuki:12321", 12)  # within the order range, beyond the estimate
 
 
 @pytest.mark.parametrize("route", [effective_field, effective_field_bch])

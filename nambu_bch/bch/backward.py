@@ -25,16 +25,16 @@ import sympy
 
 from ..algebra import VectorField
 from ..algebra.backend import field_backend
+from ..checks import MAX_ORDER, check_flag
 from ..errors import InvalidOrderError
 from ..integrators.composition import composition_for
 from ..printing import Printable, aligned
 
 H = sympy.Symbol("h")
-MAX_ORDER = 16
 
 
 def check_order(order, limit: int = MAX_ORDER) -> int:
-    """``order`` as an int in ``0..limit``, else :class:`InvalidOrderError`.
+    """``order`` as an int in ``0..limit`` (:data:`nambu_bch.checks.MAX_ORDER`), else :class:`InvalidOrderError`.
 
     Integral numbers (``2``, ``2.0``, ``sympy.Integer(2)``, numpy ints) are accepted;
     booleans, strings, fractions, ``nan`` and ``inf`` are not.
@@ -52,7 +52,7 @@ def check_order(order, limit: int = MAX_ORDER) -> int:
         except (TypeError, ValueError, OverflowError):
             raise InvalidOrderError(f"order must be a non-negative integer, got {order!r}") from None
     if order < 0 or order > limit:
-        raise InvalidOrderError(f"order must be between 0 and {limit}, got {order}")
+        raise InvalidOrderError(f"order must be an integer between 0 and {limit}, got {order}")
     return order
 
 
@@ -141,6 +141,7 @@ def effective_field(splitting, comp, order: int = 2, fast: bool = True) -> Effec
     (-omega**2*x2/(12*m), -m*omega**4*x1/6)
     """
     order = check_order(order)
+    fast = check_flag(fast, "fast")
     comp = composition_for(comp, splitting)
     algebra = splitting.system.algebra.with_constants(H, extension=comp.extension)
     fields = [VectorField(algebra, p.field.to_sympy()) if comp.extension else p.field for p in splitting.pieces]

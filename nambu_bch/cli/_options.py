@@ -11,12 +11,12 @@ from __future__ import annotations
 import argparse
 import re
 
+from ..checks import MAX_ORDER as MAX_CLI_ORDER  # the API's range of orders (light module: no sympy here)
 from ..errors import NambuBCHError
 
 PROG = "nambu-bch"
 DEFAULT_MODEL = "ho3"
 MAX_STEPS = 100_000_000
-MAX_CLI_ORDER = 12
 #: Largest ``fi --limit`` (brackets and directions listed).
 MAX_LIMIT = 10**6
 #: Longest error line printed (a huge input echoed back is shortened).
@@ -132,10 +132,12 @@ def number(text, flag):
 
 
 def positive_float(text, flag="--h"):
+    from ..checks import finite_float
+
     value = number(text, flag)
     if not value.is_positive:
         raise NambuBCHError(f"{flag} {text!r} must be a positive number such as 0.1")
-    out = float(value)
+    out = finite_float(value, f"{flag} {text!r}")
     if not 0.0 < out < float("inf"):
         raise NambuBCHError(f"{flag} {text!r} is out of range; give a positive finite number such as 0.1")
     return out
@@ -195,13 +197,9 @@ def parse_x0(text, n):
     parts = [p for p in text.replace(",", " ").split()]
     if len(parts) != n:
         raise NambuBCHError(f"--x0 {text!r} gives {len(parts)} value(s); the system has {n} coordinates (e.g. --x0 {','.join(['1'] * n)})")
-    out = []
-    for p in parts:
-        value = float(number(p, "--x0"))
-        if value != value or value in (float("inf"), float("-inf")):
-            raise NambuBCHError(f"--x0 {text!r}: {p!r} is not finite")
-        out.append(value)
-    return out
+    from ..checks import finite_float
+
+    return [finite_float(number(p, "--x0"), f"--x0 {p!r}") for p in parts]
 
 
 
@@ -346,12 +344,14 @@ def integrator_from_args(args, system):
 
 
 def numeric_inputs(args, system, values):
-    """``(params, x0)`` as floats for the numeric subcommands: ``--param`` values over the file's, default 1 each."""
+    """``(params, x0)`` as floats for the numeric subcommands: ``--param`` values over the file's, default 1 each;
+    ``x0`` None when ``--x0`` is not given (the API then takes the model's documented default)."""
+    from ..checks import finite_float
     from ..integrators import parameter_values
 
-    params = {k: float(v) for k, v in {**getattr(args, "file_values", {}), **values}.items()}
+    params = {k: finite_float(v, f"parameter {k}") for k, v in {**getattr(args, "file_values", {}), **values}.items()}
     parameter_values(system, params)  # raises naming an unknown parameter
-    x0 = parse_x0(args.x0, system.N) if args.x0 is not None else [1.0] * system.N
+    x0 = parse_x0(args.x0, system.N) if args.x0 is not None else None  # None: the model's default (the API's)
     return params, x0
 
 # --------------------------------------------------------------------------------------------
@@ -404,7 +404,7 @@ def progress_option(parser):
 def numeric_options(parser, defaults):
     parser.add_argument("--h", metavar="H", type=str, help=f"step size, e.g. 0.1 or 1/20 (default {defaults['h']})")
     parser.add_argument("--steps", metavar="N", type=str, help=f"number of steps (default {defaults['steps']})")
-    parser.add_argument("--x0", metavar="X", help="initial state, comma separated, e.g. 1,1,1 (default 1,...,1)")
+    parser.add_argument("--x0", metavar="X", help="initial state, comma separated, e.g. 1,1,1 (default: the model's, else 1,...,1)")
     parser.add_argument("--every", metavar="K", type=str, help=f"sample every K steps (default {defaults['every']})")
 
 def add_subcommand(sub, name: str, help: str, examples: str, run):

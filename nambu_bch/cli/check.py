@@ -22,13 +22,14 @@ def register(sub) -> None:
 
 
 def run(args):
+    from ..checks import finite_float
     from ..numeric.diagnostics import check
 
     system, values = system_from_args(args)
     word, comp = integrator_from_args(args, system)
     params, x0 = numeric_inputs(args, system, values)
     order = args.order if args.order is not None else 2
-    alpha = float(number(args.alpha, "--alpha")) if args.alpha is not None else 0.5
+    alpha = finite_float(number(args.alpha, "--alpha"), "--alpha") if args.alpha is not None else 0.5
     report = check(system, word, args.h, args.steps, x0, params=params, every=args.every, order=order, alpha=alpha)
 
     emit(args, text=lambda: str(report), data=report.to_dict, system=system)

@@ -34,7 +34,7 @@ def register(sub) -> None:
     p.add_argument("--t-end", metavar="T", default="10", help="final time T of the runs (default 10)")
     p.add_argument("--step-counts", metavar="N,N,...", default="20,40,80,160,320,640",
                    help="numbers of steps N (h = T/N), at least two (default 20,40,80,160,320,640)")
-    p.add_argument("--x0", metavar="X", help="initial state, comma separated (default 1,...,1)")
+    p.add_argument("--x0", metavar="X", help="initial state, comma separated (default: the model's, else 1,...,1)")
     p.add_argument("--figure", metavar="FILE", help="write the log-log work-precision plot (.png, .pdf, .svg) atomically")
     output_options(p, "text", choices=("text", "json"))
 

@@ -39,7 +39,7 @@ def run(args):
         args.integrator = "32123"  # the paper's Figs. 1-4
     word, comp = integrator_from_args(args, system)
     params, x0 = numeric_inputs(args, system, values)
-    kwargs = {"word": word, "h": args.h, "x0": tuple(x0), "params": params, "system": system, "fmt": args.fig_format}
+    kwargs = {"word": word, "h": args.h, "x0": x0, "params": params, "system": system, "fmt": args.fig_format}
     if args.steps is not None:
         kwargs["t_long"] = args.steps * args.h
     if args.short_steps is not None:

@@ -28,22 +28,29 @@ Geometric Numerical Integration*, Sect. 3.7.
 from __future__ import annotations
 
 import io
+import os
 from dataclasses import dataclass, field
 
 import numpy as np
 
 from ..atomic import write_atomic
-from ..errors import InvalidRunError, NambuBCHError
+from ..checks import finite_float, is_int, show
+from ..errors import InvalidCompositionError, InvalidRunError, NambuBCHError
 from ..integrators.composition import composition as make_composition, composition_for
+from ..integrators.step import parameter_values
 from ..numeric import iterate
+from ..numeric.figures import MAX_DPI
+from ..numeric.guards import check_count, initial_state
 from ..numeric.iterate import as_system
 from .conditions import error_analysis
-from .system_error import leading_error
+from .system_error import MAX_SAMPLES, _box, leading_error
 
 #: Errors below this are round-off and are not used in the slope fits.
 FLOOR = 1e-11
 #: Largest number of steps of one run.
 MAX_STEPS = 10**7
+#: Most integrators of one comparison (each costs its runs and an exact error analysis).
+MAX_WORDS = 50
 
 
 def cost(comp) -> tuple:
@@ -107,6 +114,11 @@ class Comparison:
 
     def figure(self, path=None, dpi: int = 100):
         """The log-log work-precision plot (error vs sub-flow evaluations); written atomically to ``path`` if given."""
+        if path is not None and not isinstance(path, (str, os.PathLike)):
+            raise InvalidRunError(f"figure path must be a file name (str or path), got {show(path)}")
+        dpi = check_count(dpi, "dpi", 1)
+        if dpi > MAX_DPI:
+            raise InvalidRunError(f"dpi must be between 1 and {MAX_DPI}, got {dpi}")
         import matplotlib
 
         matplotlib.use("Agg")
@@ -138,11 +150,35 @@ class Comparison:
 
 def _steps_list(steps):
     try:
-        out = sorted({int(s) for s in steps})
-    except (TypeError, ValueError):
-        raise InvalidRunError(f"steps must be a list of positive integers, got {steps!r}") from None
+        items = list(steps)
+    except TypeError:
+        items = None
+    if items is None or isinstance(steps, (str, bytes)) or not all(is_int(s, numpy=True) for s in items):
+        raise InvalidRunError(f"steps must be a list of positive integers, got {show(steps)}")
+    out = sorted({int(s) for s in items})
     if len(out) < 2 or out[0] < 1 or out[-1] > MAX_STEPS:
         raise InvalidRunError(f"steps must hold at least two distinct integers in 1..{MAX_STEPS}, got {steps!r}")
+    return out
+
+
+def _words(words) -> list:
+    """The integrators to compare as a non-empty list (a single word or Composition is a list of one)."""
+    from ..integrators.composition import Composition
+
+    if isinstance(words, (str, Composition)):
+        return [words]
+    try:
+        out = list(words)
+    except TypeError:
+        raise InvalidCompositionError(f"words must be a list of integrators such as ['121', 'forest-ruth'], "
+                                      f"got {show(words)}") from None
+    if not out:
+        raise InvalidRunError("compare needs at least one integrator")
+    if len(out) > MAX_WORDS:
+        raise InvalidRunError(f"compare takes at most {MAX_WORDS} integrators, got {len(out)}")
+    for w in out:
+        if not isinstance(w, (str, Composition)):
+            raise InvalidCompositionError(f"each integrator must be a word, alias or Composition, got {show(w)}")
     return out
 
 
@@ -158,10 +194,10 @@ def compare(system, words, t_end: float = 10.0, steps=(20, 40, 80, 160, 320, 640
     Parameters
     ----------
     system : System or model name
-    words : sequence of words, aliases or Compositions
-    t_end : float -- final time ``T``
+    words : sequence of words, aliases or Compositions (one word alone is taken as a list of one)
+    t_end : float -- final time ``T``, ``0 < T < 1e6``
     steps : sequence of step counts ``N`` (``h = T/N``)
-    x0 : initial state (default all ones)
+    x0 : initial state (default: the model's documented x0, :data:`nambu_bch.systems.catalog.DEFAULT_X0`)
     params : parameter values (default 1)
     box, samples : region and sample size of the leading-error size (default ``[-1, 1]^N``, 500 points)
 
@@ -173,17 +209,25 @@ def compare(system, words, t_end: float = 10.0, steps=(20, 40, 80, 160, 320, 640
     """
     system = as_system(system)
     n = len(system.splitting)
-    if not words:
-        raise InvalidRunError("compare needs at least one integrator")
-    try:
-        t_end = float(t_end)
-    except (TypeError, ValueError):
-        raise InvalidRunError(f"t_end must be a positive number, got {t_end!r}") from None
+    words = _words(words)
+    t_end = finite_float(t_end, "t_end")
     if not 0 < t_end < 1e6:
         raise InvalidRunError(f"t_end must be a positive number below 1e6, got {t_end!r}")
     steps = _steps_list(steps)
-    x0 = tuple(float(v) for v in (x0 if x0 is not None else [1.0] * system.N))
+    x0, origin = initial_state(system, x0)
+    try:
+        items = list(np.asarray(x0, dtype=object)) if np.ndim(x0) == 1 else None
+    except (TypeError, ValueError):  # ragged
+        items = None
+    if items is None or len(items) != system.N:
+        raise InvalidRunError(f"x0 must be {system.N} real numbers (the coordinates "
+                              f"{', '.join(str(c) for c in system.coordinates)} of {system.name}), got {show(x0)}")
+    x0 = tuple(finite_float(v, "x0") for v in items)
+    parameter_values(system, params)  # a dict of known names and finite values, before any run
     params = dict(params or {})
+    _box(system, box)  # the leading-error arguments too, before the reference runs
+    if not is_int(samples, 1, MAX_SAMPLES):
+        raise InvalidRunError(f"samples must be an integer in 1..{MAX_SAMPLES:.0e}, got {show(samples)}")
     strang = "".join(str(k) for k in range(1, n + 1))
     strang = strang + strang[-2::-1] if n > 1 else "1"
     ref_name = f"kahan-li:{strang}" if n > 1 else strang
@@ -191,8 +235,13 @@ def compare(system, words, t_end: float = 10.0, steps=(20, 40, 80, 160, 320, 640
     fine = max(8 * steps[-1], 64)
     if fine > MAX_STEPS:
         raise InvalidRunError(f"the reference run would need {fine} steps; use fewer steps (at most {MAX_STEPS // 8})")
-    x_ref = _final(system, ref, t_end / fine, fine, x0, params)
-    x_half = _final(system, ref, t_end / (fine // 2), fine // 2, x0, params)
+    try:
+        x_ref = _final(system, ref, t_end / fine, fine, x0, params)
+        x_half = _final(system, ref, t_end / (fine // 2), fine // 2, x0, params)
+    except NambuBCHError as exc:
+        note = f"x0 = {list(x0)} is {origin.strip(' ()')}" if origin else "x0 as given"
+        raise type(exc)(f"{exc} -- in the reference run of compare; {note}: choose an x0 whose orbit stays "
+                        f"bounded up to t_end = {t_end:g}") from None
     ref_err = float(np.linalg.norm(x_ref - x_half)) / 63.0  # order 6: error(h) ~ (error(2h) - error(h)) / (2^6 - 1)
     rows, curves = [], {}
     for word in words:

@@ -32,9 +32,9 @@ from sympy.polys.constructor import construct_domain
 from sympy.polys.domains import QQ
 from sympy.polys.rings import ring
 
-from ..checks import is_int
+from ..checks import is_int, show
 from ..errors import InvalidCompositionError, InvalidOrderError
-from ..integrators.composition import Composition
+from ..integrators.composition import MAX_FACTORS, Composition
 from ..integrators.composition import composition as make_composition
 from .words import MAX_WORK, log_coefficients, lyndon_defects, work
 
@@ -277,8 +277,9 @@ def template(spec, parts: int | None = None, stages: int | None = None) -> Templ
         if set(pieces) != set(range(1, n + 1)):
             raise InvalidCompositionError(f"template {spec!r} must use every piece 1..{n}")
         return Template(f"{kind}:{word}", n, pieces, coeffs, unknowns, "word")
-    if not is_int(stages, 1):
-        raise InvalidCompositionError(f"template {spec!r} needs stages = a positive integer (number of base steps), got {stages!r}")
+    if not is_int(stages, 1, MAX_FACTORS):  # the composition it builds has at least `stages` factors
+        raise InvalidCompositionError(f"template {spec!r} needs stages = an integer in 1..{MAX_FACTORS} (number of base "
+                                      f"steps), got {show(stages)}")
     if text == "strang":
         if not is_int(parts, 2):
             raise InvalidCompositionError(f"template 'strang' needs parts >= 2 (the number of pieces), got {parts!r}")

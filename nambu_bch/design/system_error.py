@@ -28,7 +28,7 @@ import numpy as np
 import sympy
 
 from ..bch import effective_field
-from ..checks import is_int
+from ..checks import is_int, show
 from ..errors import InvalidOrderError, InvalidRunError
 from ..integrators.composition import composition_for
 from ..integrators.step import parameter_values
@@ -38,6 +38,8 @@ from ..symbols import STEP
 
 #: Highest power of ``h`` searched for the leading term.
 MAX_POWER = 8
+#: Most sample points of :func:`field_size` (one float64 evaluation of the field each).
+MAX_SAMPLES = 10**7
 
 
 @dataclass(frozen=True)
@@ -98,9 +100,14 @@ def _box(system, box):
 
 def field_size(components, system, box=None, samples: int = 2000, params=None, seed: int = 0) -> float:
     """``max ||F(x)||_2`` of a polynomial field over a seeded uniform sample of ``box`` (default ``[-1, 1]^N``)."""
+    system = as_system(system)
     box = _box(system, box)
-    if not is_int(samples, 1, 10**7):
-        raise InvalidRunError(f"samples must be an integer in 1..10^7, got {samples!r}")
+    if not is_int(samples, 1, MAX_SAMPLES):
+        raise InvalidRunError(f"samples must be an integer in 1..{MAX_SAMPLES:.0e}, got {show(samples)}")
+    if not is_int(seed, 0, 2**32 - 1, numpy=True):
+        raise InvalidRunError(f"seed must be an integer in 0..2^32-1, got {show(seed)}")
+    if isinstance(components, (str, bytes)) or not hasattr(components, "__iter__"):
+        raise InvalidRunError(f"components must be a list of {system.N} sympy expressions (a field), got {show(components)}")
     values = parameter_values(system, params)
     exprs = [sympy.sympify(c).subs(values) for c in components]
     f = sympy.lambdify(system.coordinates, exprs, modules="numpy")
@@ -132,6 +139,8 @@ def leading_error(system, word, box=None, samples: int = 2000, params=None, seed
     True
     """
     system = as_system(system)
+    if not isinstance(hamiltonian, bool):
+        raise InvalidRunError(f"hamiltonian must be True or False, got {show(hamiltonian)}")
     comp = composition_for(word, system.splitting)
     parts = len(set(comp.pieces))
     p = error_analysis(comp, max(comp.pieces)).order if parts == max(comp.pieces) else 1

@@ -34,12 +34,16 @@ import mpmath
 import numpy as np
 import sympy
 
-from ..checks import is_int
+from ..checks import finite_float, is_int, show
 from ..errors import NambuBCHError, NumericalRangeError, UnstableStepError
 
 #: Below this |x| the series is used (its 13 terms reach 2^-60 relative accuracy).
 _SERIES_CUTOFF = 0.25
 _SERIES_TERMS = 14
+
+
+#: Highest order of :func:`F_series`: 200 terms, coefficients of about 120 digits (a request, not a limit of F).
+MAX_SERIES_ORDER = 400
 
 
 def _coefficient(n: int) -> Fraction:
@@ -73,14 +77,20 @@ def F_series(x, order: int):
     >>> F_series(x, 8).coeff(x, 8) == sympy.factorial(4)**2 / sympy.factorial(9)
     True
     """
-    if not is_int(order, 0):
+    if not is_int(order, 0, MAX_SERIES_ORDER):
         from ..errors import InvalidOrderError
 
-        raise InvalidOrderError(f"order of F_series must be a non-negative integer, got {order!r}")
+        raise InvalidOrderError(f"order of F_series must be an integer in 0..{MAX_SERIES_ORDER}, got {show(order)}")
     if isinstance(x, (sympy.Basic, str)):
         x = sympy.sympify(x)
         return sympy.Add(*[sympy.Rational(c.numerator, c.denominator) * x ** (2 * n)
                            for n, c in ((n, _coefficient(n)) for n in range(order // 2 + 1))])
+    if isinstance(x, np.ndarray):
+        from ..numeric.guards import finite_array
+
+        x = finite_array(x, "x")
+    elif not isinstance(x, mpmath.mpf):
+        x = finite_float(x, "x")
     total = 0
     for n in range(order // 2, -1, -1):
         c = _coefficient(n)

@@ -51,11 +51,14 @@ KINDS = ("o", "c", "s")
 
 
 def _check_kind(kind):
-    if kind not in KINDS:
+    if not isinstance(kind, str) or kind not in KINDS:
         raise NambuBCHError(f"kind must be one of 'o' (original), 'c' (conserved), 's' (exact shadow), got {kind!r}")
 
 
 def _word(system, word) -> str:
+    from ..systems.system import as_system
+
+    system = as_system(system)
     comp = composition_for(word, system)
     return word if isinstance(word, str) else (comp.name or "".join(map(str, comp.pieces)))
 
@@ -89,7 +92,10 @@ def modified_equations(system, word, kind) -> tuple:
     >>> modified_equations(model("ho3"), "32123", "c")          # Eq. (NambuCQeqs)
     (x2/m, h**2*m*omega**4*x1/4 - m*omega**2*x1, -h**2*omega**2*x1*x2/m + 2*x1*x2/m)
     """
+    from ..systems.system import as_system
+
     _check_kind(kind)
+    system = as_system(system)
     word = _word(system, word)
     if kind == "o":
         return tuple(system.vector_field.to_sympy())
@@ -177,8 +183,11 @@ class ModifiedSolution:
 
         Raises UnstableStepError if ``|omega h| >= 2`` (kinds "c", "s": ``a`` would be imaginary).
         """
+        from ..checks import finite_float
+        from ..numeric.guards import finite_array
+
         values = parameter_values(self.system, params)
-        h = float(h)
+        h = finite_float(h, "h")
         if self.kind != "o":
             x = complex(sympy.sympify(self.step_frequency).subs(values)) * h
             if abs(x.imag) > 0 or abs(x.real) >= 2:
@@ -189,8 +198,7 @@ class ModifiedSolution:
         n = len(self.initial_symbols)
 
         def solution(t, x0):
-            t = np.asarray(t, dtype=float)
-            x0 = np.asarray(x0, dtype=float).reshape(-1)
+            t, x0 = finite_array(t, "t"), finite_array(x0, "x0").reshape(-1)
             if x0.shape != (n,):
                 raise NambuBCHError(f"initial state must have {n} components, got shape {x0.shape}")
             res = fn(t, *x0, *pvals, h)
@@ -235,7 +243,10 @@ def modified_solution(system, word, kind) -> ModifiedSolution:
     >>> modified_solution(model("ho"), "121", "o").expressions[0]
     x1_0*cos(omega*t) + x2_0*sin(omega*t)/(m*omega)
     """
+    from ..systems.system import as_system
+
     _check_kind(kind)
+    system = as_system(system)
     return _solution(system, _word(system, word), kind)
 
 

@@ -18,6 +18,10 @@ from .flows import TIME, exact_flow
 
 def parameter_values(system, params=None) -> dict:
     """``{Symbol: float}`` for every parameter; missing ones default to 1 (``m = omega = 1``)."""
+    from ..checks import finite_float, show
+
+    if params is not None and not isinstance(params, dict):
+        raise InvalidSystemError(f"params must be a dict such as {{'omega': 1.0}}, got {show(params)}")
     params = dict(params or {})
     names = {p.name: p for p in system.parameters}
     unknown = [k for k in params if str(k) not in names]
@@ -26,7 +30,7 @@ def parameter_values(system, params=None) -> dict:
             f"unknown parameter(s) {unknown} for {system.name}; its parameters are {sorted(names) or 'none'}"
         )
     values = {names[str(k)]: v for k, v in params.items()}
-    return {p: float(values.get(p, 1.0)) for p in system.parameters}
+    return {p: finite_float(values.get(p, 1.0), f"parameter {p.name}") for p in system.parameters}
 
 
 def subflow_functions(splitting, comp, params=None):

@@ -33,10 +33,12 @@ from dataclasses import dataclass, field
 import numpy as np
 import sympy
 
-from ..checks import is_int
-from ..errors import InvalidOrderError, InvalidRunError, NambuBCHError, NumericalRangeError
+from ..bch.backward import check_order
+from ..checks import finite_float, show
+from ..errors import InvalidRunError, NambuBCHError, NumericalRangeError
 from ..integrators.composition import composition as make_composition
 from ..integrators.step import parameter_values
+from .guards import MAX_RUN_STEPS, check_count, finite_array, initial_state
 from .iterate import as_system, iterate
 from .samples import sample_times
 from ..symbols import ALPHA, STEP
@@ -68,10 +70,12 @@ def quantities(system, word, h, params=None, order=2, alpha=0.5, which=QUANTITY_
     (['H', 'H_c'], ['x1', 'x2', 'x3'])
     """
     system = as_system(system)
+    h, alpha, order = finite_float(h, "h"), finite_float(alpha, "alpha"), check_order(order)
+    which = _names(which, QUANTITY_NAMES, "which")
     values = parameter_values(system, params)
     # exact binary values (60 digits), so mpmath evaluations see the same h as the run
-    subs = {**{p: sympy.Float(v, 60) for p, v in values.items()}, STEP: sympy.Float(float(h), 60),
-            ALPHA: sympy.Float(float(alpha), 60)}
+    subs = {**{p: sympy.Float(v, 60) for p, v in values.items()}, STEP: sympy.Float(h, 60),
+            ALPHA: sympy.Float(alpha, 60)}
     out = {}
 
     def put(name, expr):
@@ -104,6 +108,19 @@ def quantities(system, word, h, params=None, order=2, alpha=0.5, which=QUANTITY_
             put("H_S_exact", es.H_S)
             put("G_S_exact", es.G_S)
     return out
+
+
+def _names(names, accepted, what) -> tuple:
+    """``names`` (one name or an iterable of them) as a tuple, each one of ``accepted``; else one line."""
+    if isinstance(names, str):
+        names = (names,)
+    try:
+        names = tuple(names)
+    except TypeError:
+        names = None
+    if names is None or not all(isinstance(n, str) and n in accepted for n in names):
+        raise InvalidRunError(f"{what} must name some of {', '.join(accepted)}, got {names!r}")
+    return names
 
 
 def _exact():
@@ -322,15 +339,7 @@ class RunningStats:
         return self.sty / self.stt if self.count > 2 and self.stt > 0 else 0.0
 
 
-def _finite_real(value, what):
-    if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)):
-        raise InvalidRunError(f"{what} must be a real number, got {value!r}")
-    if not math.isfinite(float(value)):
-        raise NumericalRangeError(f"{what} = {value!r} is not finite; give a finite real number")
-    return float(value)
-
-
-def check(system, word, h, steps, x0, params=None, *, order=2, alpha=0.5, every=1, kahan=False,
+def check(system, word, h, steps, x0=None, params=None, *, order=2, alpha=0.5, every=1, kahan=False,
           backend="auto", include=None, chunk_samples=None) -> CheckResult:
     """Run ``word`` on ``system`` and measure every error the package can predict.
 
@@ -341,9 +350,11 @@ def check(system, word, h, steps, x0, params=None, *, order=2, alpha=0.5, every=
     Parameters
     ----------
     system : System or model name; word : str or Composition
-    h : float; steps : int; x0 : array of shape (N,)
+    h : float; steps : int
+    x0 : array of shape (N,); None: the model's documented default (:data:`nambu_bch.systems.catalog.DEFAULT_X0`)
     params : dict, optional
-    order : int -- truncation order ``k`` of the BCH shadow Hamiltonians ``H_S``, ``G_S``
+    order : int -- truncation order ``k`` of the BCH shadow Hamiltonians ``H_S``, ``G_S``, 0 to
+        :data:`nambu_bch.checks.MAX_ORDER` (0: ``H_S = H``, ``G_S = G``)
     alpha : float -- the value of the family parameter(s) of ``H_S``, ``G_S`` and the exact ones
     every : int -- sample (and measure) every ``every`` steps
     kahan, backend : as for :func:`~nambu_bch.numeric.iterate`
@@ -359,6 +370,8 @@ def check(system, word, h, steps, x0, params=None, *, order=2, alpha=0.5, every=
 
     Raises
     ------
+    InvalidOrderError -- ``order`` outside ``0..MAX_ORDER``
+    ResourceLimitError -- more steps than a run accepts (:func:`~nambu_bch.numeric.guards.check_work`)
     NumericalRangeError -- a non-finite ``alpha``, or a quantity that is not finite along the run
     (float64 overflow in evaluating it, e.g. ``x0 = (1e154, 1e154, 1)``).
 
@@ -382,14 +395,20 @@ def check(system, word, h, steps, x0, params=None, *, order=2, alpha=0.5, every=
     system = as_system(system)
     comp = make_composition(word, len(system.splitting))
     name = word if isinstance(word, str) else str(comp)
-    alpha = _finite_real(alpha, "alpha")
-    if not is_int(order, 0, numpy=True):
-        raise InvalidOrderError(f"order must be a non-negative integer, got {order!r}")
-    if np.ndim(x0) != 1:
+    alpha = finite_float(alpha, "alpha")
+    order = check_order(order)
+    given, (x0, _) = x0, initial_state(system, x0)  # the run resolves None itself, and names it as the default
+    try:
+        ndim = np.ndim(x0)
+    except (TypeError, ValueError):  # ragged: iterate_chunks names it
+        ndim = 1
+    if ndim != 1:
         raise InvalidRunError(f"check takes one initial state of shape ({system.N},), got shape {np.shape(x0)}")
-    include = tuple(include) if include is not None else QUANTITY_NAMES + tuple("ocs")
-    blocks = iterate_chunks(system, word, h, steps, x0, params, every, kahan=kahan, backend=backend,
-                            chunk_samples=chunk_samples or CHUNK_SAMPLES)
+    everything = QUANTITY_NAMES + tuple("ocs")
+    include = _names(include, everything, "include") if include is not None else everything
+    chunk_samples = CHUNK_SAMPLES if chunk_samples is None else check_count(chunk_samples, "chunk_samples", 2)
+    blocks = iterate_chunks(system, word, h, steps, given, params, every, kahan=kahan, backend=backend,
+                            chunk_samples=chunk_samples)
     first_numbers, first = next(blocks)  # validates the run before any symbolic work
     skipped = {}
     exprs = quantities(system, word, h, params, order, alpha, which=[q for q in include if q in QUANTITY_NAMES],
@@ -471,8 +490,8 @@ def drift_rate(t, values) -> DriftFit:
     >>> abs(fit.rate - 3e-12) < 2e-5, fit.span
     (True, 10.0)
     """
-    t = np.asarray(t, dtype=np.float64).ravel()
-    y = np.asarray(values, dtype=np.float64).ravel()
+    t = finite_array(t, "t").ravel()
+    y = finite_array(values, "values").ravel()
     if t.shape != y.shape or t.size < 3:
         raise InvalidRunError(f"drift_rate needs matching t and values with at least 3 points, got {t.shape} and {y.shape}")
     y = y - y[0]
@@ -509,15 +528,17 @@ def fit_order(hs, errors, quantity="error") -> OrderFit:
     >>> round(fit_order([0.1, 0.05, 0.025], [2e-2, 5e-3, 1.25e-3]).order, 6)
     2.0
     """
-    hs = np.asarray(hs, dtype=np.float64)
-    errors = np.asarray(errors, dtype=np.float64)
-    if hs.size < 2 or np.any(hs <= 0) or np.any(errors <= 0) or hs.shape != errors.shape:
-        raise InvalidRunError(f"an order fit needs >= 2 positive steps and positive errors, got hs={hs}, errors={errors}")
+    hs = finite_array(hs, "hs")
+    errors = finite_array(errors, "errors")
+    if (hs.ndim != 1 or np.unique(hs).size < 2 or np.any(hs <= 0) or np.any(errors <= 0)
+            or hs.shape != errors.shape):
+        raise InvalidRunError(f"an order fit needs >= 2 distinct positive steps and as many positive errors, got "
+                              f"hs = {show(hs.tolist())}, errors = {show(errors.tolist())}")
     slope, intercept = np.polyfit(np.log(hs), np.log(errors), 1)
     return OrderFit(float(slope), float(intercept), hs, errors, quantity)
 
 
-def observed_order(system, word, hs, T, x0, params=None, quantity="x", backend="auto") -> OrderFit:
+def observed_order(system, word, hs, T, x0=None, params=None, quantity="x", backend="auto") -> OrderFit:
     """The observed order of convergence of ``word`` by a log-log fit over the steps ``hs``.
 
     ``quantity="x"``: the global error ``max_i |x_i(T) - x_i^ref(T)|`` against the exact
@@ -533,8 +554,14 @@ def observed_order(system, word, hs, T, x0, params=None, quantity="x", backend="
     2.0
     """
     system = as_system(system)
-    x0 = np.asarray(x0, dtype=float)
-    steps_list = [max(1, int(round(T / float(h)))) for h in hs]
+    x0, _ = initial_state(system, x0)
+    T = finite_float(T, "T")
+    hs = finite_array(hs, "hs")
+    if hs.ndim != 1 or hs.size < 2 or not np.all(hs > 0) or not T > 0:
+        raise InvalidRunError(f"observed_order needs T > 0 and at least two positive steps hs, got T = {T!r}, hs = {show(hs)}")
+    if not isinstance(quantity, str) or quantity not in ("x",) + QUANTITY_NAMES:
+        raise InvalidRunError(f"quantity must be 'x' or one of {', '.join(QUANTITY_NAMES)}, got {show(quantity)}")
+    steps_list = [max(1, round(T / h)) if T / h < MAX_RUN_STEPS else MAX_RUN_STEPS + 1 for h in hs]
     hs_eff = np.array([T / n for n in steps_list])
     errors = []
     if quantity == "x":

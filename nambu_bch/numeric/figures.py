@@ -31,9 +31,11 @@ from pathlib import Path
 import numpy as np
 import sympy
 
+from ..checks import finite_float
 from ..errors import InvalidRunError, NambuBCHError
 from ..integrators.step import parameter_values
 from .diagnostics import _exact, _try, numpy_function, quantities
+from .guards import MAX_RUN_STEPS, check_count, check_inputs, check_work, initial_state
 from .iterate import as_system, iterate_chunks
 from .samples import n_samples
 
@@ -41,6 +43,8 @@ from .samples import n_samples
 FIGURE_NAMES = ("fig1", "fig2", "fig3", "fig4")
 #: Most points drawn per curve; longer runs are drawn as their min/max envelope per bucket of samples.
 MAX_POINTS = 40_000
+#: Highest resolution of a figure (dots per inch): a 6.4 x 3.84 inch figure at 1200 dpi is already 35 Mpixel.
+MAX_DPI = 1200
 
 
 class FigureSet(dict):
@@ -138,7 +142,7 @@ def _stream(system, word, h, steps, every, x0, params, names=(), kinds=""):
     return env, size
 
 
-def paper_figures(outdir=None, *, word="32123", h=0.1, x0=(1.0, 1.0, 1.0), params=None, t_short=100.0,
+def paper_figures(outdir=None, *, word="32123", h=0.1, x0=None, params=None, t_short=100.0,
                   t_long=20000.0, every_long=100, dpi=100, fmt="png", system="ho3") -> FigureSet:
     """Draw Figs. 1-4 of the paper and write them to ``outdir`` as one set (``fig1.png`` ... ``fig4.png``).
 
@@ -151,11 +155,12 @@ def paper_figures(outdir=None, *, word="32123", h=0.1, x0=(1.0, 1.0, 1.0), param
     Parameters
     ----------
     outdir : str or Path, optional -- created if missing; None: draw only, write nothing
-    word, h, x0, params, system : the run (defaults: the paper's ``32123``, ``h = 0.1``, ``(1, 1, 1)``, ``m = omega = 1``)
+    word, h, x0, params, system : the run (defaults: the paper's ``32123``, ``h = 0.1``, the model's documented
+        x0 -- ``(1, 1, 1)`` for ho3 --, ``m = omega = 1``)
     t_short : float -- time span of Figs. 1-2 (every step plotted)
     t_long : float -- time span of Figs. 3-4 (long enough for the beat)
     every_long : int -- sampling of Figs. 3-4 (the paper plots every 100 steps)
-    dpi : int; fmt : ``"png"``, ``"pdf"`` or ``"svg"``
+    dpi : int, 1 to :data:`MAX_DPI`; fmt : ``"png"``, ``"pdf"`` or ``"svg"``
 
     Returns
     -------
@@ -166,12 +171,26 @@ def paper_figures(outdir=None, *, word="32123", h=0.1, x0=(1.0, 1.0, 1.0), param
     ----------
     Horikoshi, Sect. 5.5, Figs. 1-4.
     """
-    if fmt not in ("png", "pdf", "svg"):
+    if not isinstance(fmt, str) or fmt not in ("png", "pdf", "svg"):
         raise InvalidRunError(f"figure format must be png, pdf or svg, got {fmt!r}")
     system = as_system(system)
-    h = float(h)
+    x0, _ = initial_state(system, x0)
+    h, t_short, t_long = finite_float(h, "h"), finite_float(t_short, "t_short"), finite_float(t_long, "t_long")
+    for what, value in (("h", h), ("t_short", t_short), ("t_long", t_long)):
+        if not value > 0:
+            raise InvalidRunError(f"{what} must be a positive number, got {value!r}")
+    every_long = check_count(every_long, "every_long", 1)
+    dpi = check_count(dpi, "dpi", 1)
+    if dpi > MAX_DPI:
+        raise InvalidRunError(f"dpi must be between 1 and {MAX_DPI}, got {dpi}")
+    # both runs' lengths from the request, before either starts (t / h can be astronomically many steps)
+    for t in (t_short, t_long):
+        check_work(int(min(t / h, 2.0 * MAX_RUN_STEPS)), x0)
     n_short = max(1, int(round(t_short / h)))
     n_long = max(every_long, int(round(t_long / h)) // every_long * every_long)
+    x0 = check_inputs(system, h, max(n_short, n_long), every_long, x0, params)[3]  # before any title uses them
+    if x0.ndim != 1:
+        raise InvalidRunError(f"x0 must be one initial state of shape ({system.N},), got shape {x0.shape}")
     values = parameter_values(system, params)
     name = _plain(system.name)
     setting = ", ".join([f"$h = {h:g}$"] + [f"${_param_tex(p)} = {v:g}$" for p, v in values.items()] +

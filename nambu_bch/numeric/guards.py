@@ -35,7 +35,8 @@ import numbers
 
 import numpy as np
 
-from ..errors import InvalidRunError, NumericalRangeError, UnstableStepError
+from ..checks import finite_float, show
+from ..errors import InvalidRunError, NumericalRangeError, ResourceLimitError, UnstableStepError
 from ..integrators.step import parameter_values
 
 #: Smallest positive normal float64.
@@ -44,21 +45,27 @@ TINY = np.finfo(np.float64).tiny
 RANGE_RTOL = 1e-6
 
 
+def finite_array(values, what) -> np.ndarray:
+    """``values`` (a number or an array of numbers) as a float64 array of finite values, else one line naming ``what``."""
+    try:
+        out = np.asarray(values, dtype=np.float64)
+    except OverflowError:
+        raise NumericalRangeError(f"{what} holds a number beyond the float64 range (|x| <= "
+                                  f"{np.finfo(np.float64).max:.3g}); give finite real numbers") from None
+    except (TypeError, ValueError):
+        raise InvalidRunError(f"{what} must be a real number or an array of real numbers, got {show(values)}") from None
+    if not np.all(np.isfinite(out)):
+        raise NumericalRangeError(f"{what} holds a non-finite value (nan or inf); give finite real numbers")
+    return out
+
+
 def _real(value, what):
-    if isinstance(value, bool) or not isinstance(value, (numbers.Real, np.floating, np.integer, str)):
-        if hasattr(value, "_mpf_"):  # mpmath.mpf
-            return value
-        raise InvalidRunError(f"{what} must be a real number, got {value!r}")
-    if isinstance(value, str):
-        try:
-            float(value)
-        except ValueError:
-            raise InvalidRunError(f"{what} must be a real number, got {value!r}") from None
-        value_f = float(value)
-    else:
-        value_f = float(value)
-    if not math.isfinite(value_f):
-        raise NumericalRangeError(f"{what} = {value!r} is not finite; give a finite real number")
+    """``value`` itself if it is a finite real number (strings and mpf kept for mpmath runs), else one line."""
+    if hasattr(value, "_mpf_"):  # mpmath.mpf: an mpmath run reads it at full precision
+        return value
+    if not isinstance(value, (numbers.Real, np.floating, np.integer, str)):
+        raise InvalidRunError(f"{what} must be a real number, got {show(value)}")
+    finite_float(value, what)
     return value
 
 
@@ -71,8 +78,45 @@ def check_count(value, what, minimum):
             raise InvalidRunError(f"{what} must be an integer >= {minimum}, got {value!r}")
         value = int(value)
     if not isinstance(value, (int, np.integer)) or value < minimum:
-        raise InvalidRunError(f"{what} must be an integer >= {minimum}, got {value!r}")
+        raise InvalidRunError(f"{what} must be an integer >= {minimum}, got {show(value)}")
     return int(value)
+
+
+def check_backend(backend) -> str:
+    """``backend`` if it is a string (:func:`~nambu_bch.numeric.kernels.resolve_backend` checks the name)."""
+    if not isinstance(backend, str):
+        from .kernels import BACKENDS
+
+        raise InvalidRunError(f"backend must be one of {', '.join(BACKENDS)}, got {show(backend)}")
+    return backend
+
+
+#: Most trajectory-steps (steps x states of a batch) of one float64 run.  A compiled step costs about 18 ns
+#: (ho3) to 37 ns (fpu-beta) on one core, so 10^10 is 3-6 minutes -- the longest run that can be meant --
+#: while 10^400 would never end (and 2^63 overflows the kernels' int64 step counters).
+MAX_RUN_STEPS = 10**10
+#: Most trajectory-steps of one mpmath run (``dps=...``): a step at 30 digits costs about 90 us (ho3) to
+#: 560 us (fpu-beta, toda), so 10^6 is 1.5-10 minutes.
+MAX_MPMATH_STEPS = 10**6
+
+
+def check_work(steps: int, x0, mpmath: bool = False) -> None:
+    """Refuse a run of more than :data:`MAX_RUN_STEPS` (mpmath: :data:`MAX_MPMATH_STEPS`) trajectory-steps.
+
+    Decided from the request alone (``steps`` times the batch size of ``x0``), before a kernel is
+    generated or a step taken (:class:`~nambu_bch.errors.ResourceLimitError`).
+    """
+    try:
+        shape = np.shape(x0)
+    except (TypeError, ValueError):  # a ragged x0: check_inputs names it
+        return
+    batch = shape[1] if len(shape) == 2 else 1
+    limit = MAX_MPMATH_STEPS if mpmath else MAX_RUN_STEPS
+    if steps * batch > limit:
+        states = f" x {batch} states" if batch > 1 else ""
+        raise ResourceLimitError(
+            f"steps = {show(steps)}{states} is more than the {limit:.0e} trajectory-steps one "
+            f"{'mpmath' if mpmath else 'float64'} run accepts; split the run or take a larger h")
 
 
 def check_inputs(system, h, steps, every, x0, params=None, exact=False, scan=None, copy=True):
@@ -88,7 +132,9 @@ def check_inputs(system, h, steps, every, x0, params=None, exact=False, scan=Non
     """
     h = _real(h, "step h")
     steps = check_count(steps, "steps", 0)
-    every = check_count(every, "every", 1)
+    check_work(steps, x0, exact)
+    # every > steps samples 0 and steps, as every = steps does: the same grid, and int64 counters stay small
+    every = min(check_count(every, "every", 1), max(steps, 1))
     if params is not None and not isinstance(params, dict):
         raise InvalidRunError(f"params must be a dict such as {{'omega': 1.0}}, got {params!r}")
     for k, v in (params or {}).items():
@@ -99,8 +145,12 @@ def check_inputs(system, h, steps, every, x0, params=None, exact=False, scan=Non
         arr = convert(x0, dtype=object if exact else np.float64, order="C")
         if not (arr.flags.c_contiguous and arr.flags.aligned and arr.flags.writeable):
             arr = np.array(arr, order="C")  # one layout for the compiled kernels (no recompilation)
+    except OverflowError:
+        raise NumericalRangeError(f"x0 = {show(x0)} holds a number beyond the float64 range (|x| <= "
+                                  f"{np.finfo(np.float64).max:.3g}); give finite real numbers") from None
     except (TypeError, ValueError):
-        raise InvalidRunError(f"x0 must be an array of {system.N} real numbers (or shape ({system.N}, batch)), got {x0!r}") from None
+        raise InvalidRunError(f"x0 must be an array of {system.N} real numbers (or shape ({system.N}, batch)), "
+                              f"got {show(x0)}") from None
     if arr.ndim not in (1, 2) or arr.shape[0] != system.N or (arr.ndim == 2 and arr.shape[1] == 0):
         raise InvalidRunError(
             f"x0 has shape {arr.shape}, but {system.name} has {system.N} coordinates "
@@ -110,7 +160,17 @@ def check_inputs(system, h, steps, every, x0, params=None, exact=False, scan=Non
         nonfinite, subnormal, _ = scan(arr)
         if not (nonfinite or subnormal):
             return h, steps, every, arr, values
-    floats = np.array([float(v) for v in arr.ravel()]).reshape(arr.shape) if exact else arr
+    if exact:
+        try:
+            floats = np.array([float(v) for v in arr.ravel()]).reshape(arr.shape)
+        except OverflowError:
+            raise NumericalRangeError(f"x0 = {show(x0)} holds a number beyond the float64 range; give finite "
+                                      "real numbers") from None
+        except (TypeError, ValueError):
+            raise InvalidRunError(f"x0 must hold {system.N} real numbers (floats, strings or mpf with dps), "
+                                  f"got {show(x0)}") from None
+    else:
+        floats = arr
     flat = floats.reshape(-1)
     if not np.isfinite(np.max(flat) - np.min(flat)):  # nan propagates, +-inf gives inf or nan
         bad = floats[~np.isfinite(floats)].ravel()[0]
@@ -124,6 +184,23 @@ def check_inputs(system, h, steps, every, x0, params=None, exact=False, scan=Non
                 "rescale the initial state or use dps=... (mpmath)"
             )
     return h, steps, every, arr, values
+
+
+def initial_state(system, x0):
+    """``(x0, origin)``: ``x0`` as given (origin ``""``), or for ``x0=None`` the system's documented default
+    (:func:`nambu_bch.systems.catalog.default_x0`) with ``origin`` saying so, e.g. ``" (the default x0 of ho3)"``."""
+    if x0 is not None:
+        return x0, ""
+    from ..systems.catalog import default_x0
+
+    x0, where = default_x0(system)
+    return np.array(x0, dtype=np.float64), f" ({where})"
+
+
+def run_label(system, word, h, X, origin="") -> str:
+    """``"<system> under <word> with h = <h> from x0 = [...]"``: the run named in its error messages."""
+    start = f" from x0 = {np.asarray(X, dtype=np.float64).tolist()}" if np.ndim(X) == 1 else ""
+    return f"{system.name} under {word} with h = {h!r}{start}{origin}"
 
 
 # -- stability --------------------------------------------------------------------------------------------
@@ -344,6 +421,7 @@ def check_result(samples, steps_of_samples, what="the state", start=None):
     lo = int(steps_of_samples[first - 1]) if first > 0 else (start or 0)
     hi = int(steps_of_samples[first])
     raise NumericalRangeError(
-        f"{what} overflowed float64 (became inf/nan) between steps {lo} and {hi}; the initial state is too large "
-        "for float64 or the step is unstable for it; rescale, take a smaller h, or use dps=... (mpmath)"
+        f"{what} overflowed float64 (became inf/nan) between steps {lo} and {hi}: the orbit from this x0 escapes to "
+        "infinity, or the initial state is too large for float64, or the step is unstable for it; start from a "
+        "bounded orbit, rescale, take a smaller h, or use dps=... (mpmath)"
     )

@@ -27,13 +27,13 @@ import numpy as np
 from ..errors import InvalidRunError, InvalidSystemError, NumericalRangeError
 from ..progress import Progress, progress_wanted
 from ..systems import System, model
-from .guards import check_count, check_inputs, check_range, check_result, check_stability, scan_states
+from ..checks import check_flag
+from .guards import (check_backend, check_count, check_inputs, check_range, check_result, check_stability, check_work,
+                     initial_state, run_label, scan_states)
 from .kernels import kernel, resolve_backend
 from .precision import check_dps, run_mpmath
-from .samples import n_samples, sample_steps
+from .samples import MAX_SAMPLE_BYTES, n_samples, sample_steps
 
-#: Largest sample array accepted (bytes); beyond it, sample less often (larger ``every``).
-MAX_SAMPLE_BYTES = 16 * 2**30
 #: Trajectory-steps per kernel call when progress is reported (a few tenths of a second compiled).
 _SEGMENT_WORK = 20_000_000
 
@@ -47,7 +47,7 @@ def as_system(system) -> System:
     raise InvalidSystemError(f"system must be a nambu_bch System or a built-in model name, got {system!r}")
 
 
-def iterate(system, word, h, steps, x0, params=None, every=1, *, kahan=False, dps=None,
+def iterate(system, word, h, steps, x0=None, params=None, every=1, *, kahan=False, dps=None,
             backend="auto", progress=None, chunk=None, check_stable=True):
     """Iterate ``Phi_h`` of ``word`` on ``system`` ``steps`` times from ``x0``; the samples every ``every`` steps.
 
@@ -61,7 +61,8 @@ def iterate(system, word, h, steps, x0, params=None, every=1, *, kahan=False, dp
     word : str or Composition -- e.g. ``"32123"``, ``"TVT"``, ``"forest-ruth"``
     h : float -- the step (negative steps run backwards; str or mpf accepted with ``dps``)
     steps : int >= 0
-    x0 : array of shape (N,) -- one trajectory -- or (N, batch) -- a batch of initial states
+    x0 : array of shape (N,) -- one trajectory -- or (N, batch) -- a batch of initial states; None: the
+        model's documented default (:data:`nambu_bch.systems.catalog.DEFAULT_X0`, else ``(1, ..., 1)``)
     params : dict, optional -- e.g. ``{"m": 1, "omega": 1}``; missing parameters are 1
     every : int >= 1 -- keep every ``every``-th state (long runs need not fill memory)
     kahan : bool -- compensated summation of the increments (float64 only)
@@ -83,6 +84,8 @@ def iterate(system, word, h, steps, x0, params=None, every=1, *, kahan=False, dp
     ------
     InvalidRunError, InvalidSystemError, InvalidCompositionError -- bad arguments
     NumericalRangeError -- non-finite input, or float64 overflow/underflow (before or during the run)
+    ResourceLimitError -- more than ``MAX_RUN_STEPS`` (mpmath: ``MAX_MPMATH_STEPS``) trajectory-steps
+        (:func:`~nambu_bch.numeric.guards.check_work`), refused before any work
     UnstableStepError -- ``h`` outside the stability interval (``|omega h| >= 2`` for the oscillators)
 
     Examples
@@ -98,6 +101,10 @@ def iterate(system, word, h, steps, x0, params=None, every=1, *, kahan=False, dp
     (5, 2, 2)
     """
     system = as_system(system)
+    x0, origin = initial_state(system, x0)
+    check_work(check_count(steps, "steps", 0), x0, mpmath=dps is not None)  # from the request, before any work
+    kahan, check_stable = check_flag(kahan, "kahan"), check_flag(check_stable, "check_stable")
+    progress, backend = check_flag(progress, "progress", none=True), check_backend(backend)
     kern = kernel(system, word)
     if dps is not None:
         dps = check_dps(dps)
@@ -124,7 +131,7 @@ def iterate(system, word, h, steps, x0, params=None, every=1, *, kahan=False, dp
         raise InvalidRunError(f"{count} samples of {system.N} x {batch} states need {nbytes / 2**30:.1f} GiB "
                               f"(limit {MAX_SAMPLE_BYTES / 2**30:.0f} GiB); sample less often (larger every)")
     out = np.empty((count, system.N) if single else (count, system.N, batch), dtype=np.float64)
-    what = f"{system.name} under {kern.word} with h = {h!r}"
+    what = run_label(system, kern.word, h, X, origin)
     reporter = Progress(steps * batch, f"iterate {system.name} {kern.word}",
                         enabled=_enabled(progress, steps * batch * (30 if be == "numpy" and single else 1)))
     segment = steps if not reporter.enabled else max(every, (_SEGMENT_WORK // batch) // every * every)
@@ -193,7 +200,11 @@ def _run_batch(kern, X, K, steps, every, out, kahan, be, chunk, segment, reporte
                                  chunk=chunk, start=j == 0, back=False)
             if bad:
                 grid = sample_steps(steps, every)
-                check_result(out[1:j + nseg], grid[1:j + nseg], what, start=0)
+                samples = out[1:j + nseg]
+                broken = ~np.isfinite(samples).all(axis=1)  # (sample, state)
+                first = int(np.argmax(broken.any(axis=1)))
+                state = int(np.argmax(broken[first]))  # the first state to overflow: named as its own run is
+                check_result(samples, grid[1:j + nseg], f"{what} from x0 = {X[:, state].tolist()}", start=0)
             done += seg
             j += nseg - 1
             source = out[j]
@@ -285,7 +296,7 @@ SCAN_BATCH = 4096
 CHUNK_SAMPLES = 1 << 16
 
 
-def iterate_chunks(system, word, h, steps, x0, params=None, every=1, *, kahan=False, backend="auto",
+def iterate_chunks(system, word, h, steps, x0=None, params=None, every=1, *, kahan=False, backend="auto",
                    chunk_samples=CHUNK_SAMPLES, check_stable=True):
     """Iterate like :func:`iterate` (one trajectory) but yield the samples block by block.
 
@@ -301,14 +312,22 @@ def iterate_chunks(system, word, h, steps, x0, params=None, every=1, *, kahan=Fa
     NumericalRangeError -- at the first block with a non-finite sample (the blocks before it were yielded).
     """
     system = as_system(system)
-    kern = kernel(system, word)
+    x0, origin = initial_state(system, x0)
+    check_work(check_count(steps, "steps", 0), x0)  # from the request, before any work
+    kahan, check_stable = check_flag(kahan, "kahan"), check_flag(check_stable, "check_stable")
+    backend = check_backend(backend)
     chunk_samples = _count(chunk_samples, "chunk_samples", 2)
+    if chunk_samples * system.N * 8 > MAX_SAMPLE_BYTES:  # one block is held at a time: the same memory bound
+        raise InvalidRunError(f"chunk_samples = {chunk_samples} blocks of {system.N} coordinates need more than "
+                              f"{MAX_SAMPLE_BYTES / 2**30:.0f} GiB; take fewer samples per block")
+    kern = kernel(system, word)
     run = _prepare(system, kern, h, steps, every, x0, params, backend, None, check_stable, kahan)
     if run.X.ndim != 1:
         raise InvalidRunError(f"iterate_chunks takes one initial state of shape ({system.N},), got shape {run.X.shape}")
     steps, every, be = run.steps, run.every, run.backend
     state = np.array(run.X, dtype=np.float64)
     comp = np.zeros_like(state) if kahan else None
+    what = run_label(system, kern.word, run.h, run.X, origin)
     yield np.zeros(1, dtype=np.int64), state.copy()[None, :]
     block = (chunk_samples - 1) * every  # steps per block
     done = 0
@@ -318,12 +337,11 @@ def iterate_chunks(system, word, h, steps, x0, params=None, every=1, *, kahan=Fa
             nseg = n_samples(seg, every)
             out = np.empty((nseg, system.N))
             out[0] = state
-            n, be = _run_single(kern, state, run.K, seg, every, out, kahan, comp, be, run.fallback,
-                                f"{system.name} under {kern.word} with h = {run.h!r}")
+            n, be = _run_single(kern, state, run.K, seg, every, out, kahan, comp, be, run.fallback, what)
             numbers = done + sample_steps(seg, every)
             if n < seg:
                 out[n_samples(n, every):] = np.nan
-            check_result(out, numbers, f"{system.name} under {kern.word} with h = {run.h!r}")
+            check_result(out, numbers, what)
             done += seg
             yield numbers[1:], out[1:]
 

@@ -30,9 +30,12 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..errors import NambuBCHError, NumericalRangeError, UnstableStepError
+from ..bch.backward import check_order
+from ..checks import finite_float, show
+from ..errors import InvalidRunError, NambuBCHError, NumericalRangeError, UnstableStepError
 from ..integrators.step import parameter_values
-from .diagnostics import QUANTITY_NAMES, drift_rate, errors_along, quantities
+from .diagnostics import QUANTITY_NAMES, _names, drift_rate, errors_along, quantities
+from .guards import check_count, check_work, finite_array, initial_state
 from .iterate import as_system, iterate
 from .samples import sample_times
 from .kernels import kernel, resolve_backend
@@ -103,7 +106,7 @@ def h_scan(system="ho3", word="32123", hs=None, steps=10_000, x0=None, params=No
     system, word : the scheme (default: the paper's ``32123`` on ``ho3``)
     hs : steps; default ``omega h`` from 1e-3 to 1.999 geometrically, then 2.0 and 2.1
     steps : int -- steps per run
-    x0 : initial state (default all ones); params : dict
+    x0 : initial state (default: the model's documented x0, else all ones); params : dict
     names : quantities to measure (see :func:`~nambu_bch.numeric.diagnostics.quantities`)
 
     Returns
@@ -122,8 +125,11 @@ def h_scan(system="ho3", word="32123", hs=None, steps=10_000, x0=None, params=No
     if hs is None:
         scale = omega or 1.0
         hs = np.concatenate([np.geomspace(1e-3, 1.9, 14), [1.99, 1.999, 2.0, 2.1]]) / scale
-    hs = np.asarray(hs, dtype=np.float64)
-    x0 = np.ones(system.N) if x0 is None else np.asarray(x0, dtype=np.float64)
+    hs = finite_array(hs, "hs").reshape(-1)
+    steps = check_count(steps, "steps", 0)
+    check_work(steps * max(hs.size, 1), None)  # the scan's runs together, before the first
+    names = _names(names, QUANTITY_NAMES, "names")
+    x0, _ = initial_state(system, x0)
     errs = {}
     stable = np.zeros(hs.size, dtype=bool)
     messages = []
@@ -196,7 +202,12 @@ def truncation_study(system="ho3", word="32123", orders=(2, 4, 6, 8), h=0.1, ste
     from ..symbols import ALPHA, STEP
 
     system = as_system(system)
-    x0 = np.ones(system.N) if x0 is None else np.asarray(x0, dtype=np.float64)
+    try:
+        orders = [check_order(k) for k in orders]
+    except TypeError:
+        raise InvalidRunError(f"orders must be a list of truncation orders such as (2, 4, 6), got {show(orders)}") from None
+    h, alpha = finite_float(h, "h"), finite_float(alpha, "alpha")
+    x0, _ = initial_state(system, x0)
     samples = iterate(system, word, h, steps, x0, params, every, backend=backend)
     t = sample_times(h, steps, every)
     values = parameter_values(system, params)
@@ -272,7 +283,14 @@ def precision_study(system="ho3", word="32123", h=0.1, steps=10_000_000, x0=None
     ``extrapolated``, ``state_error_at_mp_steps`` and per quantity ``max|dQ|``, ``rate(Q)``, ``drift(Q)``.
     """
     system = as_system(system)
-    x0 = np.ones(system.N) if x0 is None else np.asarray(x0, dtype=np.float64)
+    x0, _ = initial_state(system, x0)
+    h = finite_float(h, "h")
+    steps, mp_steps = check_count(steps, "steps", 1), check_count(mp_steps, "mp_steps", 1)
+    repeats, timing_steps = check_count(repeats, "repeats", 1), check_count(timing_steps, "timing_steps", 1)
+    names = _names(names, QUANTITY_NAMES, "names")
+    # every run of the study, from the request: float64 (two arithmetics, timed repeatedly) and mpmath
+    check_work(2 * (steps + mp_steps + repeats * timing_steps), x0)
+    check_work(mp_steps + min(mp_steps, 2000), x0, mpmath=True)
     be = resolve_backend(backend)
     kern = kernel(system, word)
     if be == "numba":

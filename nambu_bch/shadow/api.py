@@ -8,6 +8,7 @@ Horikoshi, Sects. 4.2 and 5.2; Eqs. (L2), (SH12321c), (SG12321c).
 from __future__ import annotations
 
 from ..bch.backward import check_order
+from ..checks import check_flag
 from ..errors import NambuBCHError
 from ..integrators.composition import composition_for
 from .direct_route import direct_route
@@ -80,9 +81,10 @@ def shadow_hamiltonians(system, word, order: int = 2, route: str = "direct", deg
     system = _system(system)
     if not isinstance(existence, bool):
         raise NambuBCHError(f"existence must be True or False, got {existence!r}")
-    if route not in ROUTES:
+    if not isinstance(route, str) or route not in ROUTES:
         raise NambuBCHError(f"route must be one of {', '.join(ROUTES)}, got {route!r}")
     order = check_order(order)
+    check_flag(progress, "progress", none=True)
     if route == "fi" and getattr(system, "bracket", "nambu") in ("canonical", "triplets") and system.N > 2:
         raise NambuBCHError(
             f"the FI route needs the Nambu bracket (N - 1 Hamiltonians, the fundamental identity); {system.name} has the "

@@ -68,6 +68,7 @@ from ..algebra.ansatz import Ansatz, Rows
 from ..algebra import elimination, frac_rref
 from ..algebra.elimination import elimination_cost, rank, signed_sums
 from ..bch.backward import check_order
+from ..checks import check_flag
 from ..bch.concrete import effective_field_by_cost
 from ..errors import InvalidOrderError, NambuBCHError, ResourceLimitError
 from ..integrators.composition import composition_for
@@ -592,6 +593,7 @@ def direct_route(system, word, order: int = 2, degree=None, max_unknowns=None, p
 
     system = as_system(system)
     order = check_order(order)
+    check_flag(progress, "progress", none=True)
     if degree is not None:
         if isinstance(degree, bool) or not isinstance(degree, int) or degree < 1:
             raise InvalidOrderError(f"degree must be a positive integer (the ansatz degree) or None, got {degree!r}")
@@ -611,7 +613,7 @@ def direct_route(system, word, order: int = 2, degree=None, max_unknowns=None, p
         orders.append(sol)
         if sol.status in ("obstructed", "refused"):
             break
-    if orders[-1].status == "refused":
+    if orders and orders[-1].status == "refused":  # order 0 solves nothing: H_S = H, G_S = G
         from .generic import poisson_structure
 
         if poisson_structure(system) is not None:

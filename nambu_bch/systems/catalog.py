@@ -144,6 +144,45 @@ _MODELS = {
 }
 _CACHE: dict = {}
 
+#: The documented initial state of each model: what ``check``, ``compare``, ``iterate``, ``plot`` (and the CLI)
+#: use when ``x0`` is omitted.  ``(1, ..., 1)`` where that is a bounded, non-trivial orbit (the paper's
+#: ``x(0) = (1, 1, 1)`` for ho3).  Henon-Heiles at (1, 1, 1, 1) has energy 8/3, far above the escape energy
+#: 1/6, and leaves to infinity, so its default is an orbit of energy 0.13 inside the bounded well.  Toda at
+#: (1, ..., 1) drifts with total momentum 3 until the step's exponentials overflow float64 (q near 700); its
+#: default has total momentum 0.
+DEFAULT_X0 = {
+    "ho": (1.0, 1.0),
+    "ho3": (1.0, 1.0, 1.0),
+    "rigid-body": (1.0, 1.0, 1.0),
+    "lotka-volterra": (1.0, 1.0, 1.0),
+    "ho3-composite": (1.0, 1.0, 1.0),
+    "pendulum": (1.0, 1.0),
+    "henon-heiles": (0.0, 0.1, 0.5, 0.0),
+    "fpu-beta": (1.0, 1.0, 1.0, 1.0, 1.0, 1.0),
+    "toda": (1.0, 0.0, -1.0, 0.5, 0.0, -0.5),
+    "exp-well": (1.0, 1.0),
+    "rational": (1.0, 1.0),
+    "rigid-body-lp": (1.0, 1.0, 1.0),
+    "ho3-pair": (1.0, 1.0, 1.0, 1.0, 1.0, 1.0),
+}
+
+
+def default_x0(system) -> tuple:
+    """``(x0, where)``: the initial state used when none is given, and where it comes from.
+
+    A built-in model (the same coordinates and Hamiltonians as :func:`model` of its name) has its
+    documented :data:`DEFAULT_X0`, ``where = "the default x0 of <name>"``; any other system starts
+    at ``(1, ..., 1)``, ``where = "the default x0 (1, ..., 1)"``.  ``where`` goes into the messages
+    of a run that fails from it, so a default that escapes is named as the default.
+    """
+    name = getattr(system, "name", None)
+    if name in _MODELS:
+        builtin = model(name)
+        if builtin is system or (builtin.coordinates == system.coordinates
+                                 and builtin.hamiltonians == system.hamiltonians):
+            return DEFAULT_X0[name], f"the default x0 of {name}"
+    return (1.0,) * system.N, "the default x0 (1, ..., 1)"
+
 
 def model_names() -> tuple:
     return tuple(_MODELS)
