@@ -179,6 +179,7 @@ def run_main(argv_, capsys):
     try:
         status = main(list(argv_))
     except BaseException as exc:  # noqa: BLE001  (the point: nothing may leave main)
+        capsys.readouterr()  # the next call starts with empty buffers
         first = (str(exc).splitlines() or [""])[0][:160]
         pytest.fail(f"main({argv_!r}) raised {type(exc).__name__}: {first}", pytrace=False)
     out, err = capsys.readouterr()
@@ -252,6 +253,7 @@ def test_each_flag_edge_value(command, workdir, capsys, tmp_path):
     before = [listing(p) for p in outside]
     old = os.getcwd()
     os.chdir(workdir)
+    failures = []
     try:
         for flag, values in EDGE.items():
             if flag not in flags()[command]:
@@ -260,7 +262,11 @@ def test_each_flag_edge_value(command, workdir, capsys, tmp_path):
                 args = [command, flag, value] + (["--no-progress"] if "--no-progress" in flags()[command] else [])
                 if command == "check" and flag != "--steps":
                     args += ["--steps", "10"]
-                check_outcome(args, *run_main(args, capsys))
+                try:  # every flag is tried; the failures are listed together
+                    check_outcome(args, *run_main(args, capsys))
+                except (AssertionError, pytest.fail.Exception) as exc:
+                    failures.append(str(exc).splitlines()[0])
     finally:
         os.chdir(old)
     assert [listing(p) for p in outside] == before, f"{command} wrote outside tmp_path"
+    assert not failures, "\n".join(failures)
