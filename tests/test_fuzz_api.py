@@ -380,11 +380,19 @@ def test_public_callable_raises_only_the_family(qualname, tmp_path_factory):
 
 @pytest.mark.parametrize("qualname", sorted(BASE))
 def test_no_string_argument_is_run_as_code(qualname, tmp_path):
-    """Each parameter in turn receives a Python payload (a string, alone or as an element): never evaluated."""
+    """Each parameter in turn receives a Python payload, as the string and as the elements of a list (for the
+    callables in COSTLY only the form that fits: a list where the parameter holds a sequence): never evaluated."""
     obj = public_callables()[qualname]
+    defaults = {p.name: p.default for p in inspect.signature(obj).parameters.values()}
     failures = []
     for name in parameters(obj):
-        for value in (PAYLOADS[0], [PAYLOADS[0]] * 3):
+        usual = BASE[qualname](valid()).get(name, defaults.get(name))
+        as_list = [PAYLOADS[0]] * max(1, len(usual) if isinstance(usual, (list, tuple)) else 3)
+        if qualname not in COSTLY:
+            forms = (PAYLOADS[0], as_list)
+        else:
+            forms = (as_list,) if name == "*" or (isinstance(usual, (list, tuple)) and usual) else (PAYLOADS[0],)
+        for value in forms:
             kwargs = BASE[qualname](valid())
             kwargs[name] = value
             with deep_cwd(tmp_path):
