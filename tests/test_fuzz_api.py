@@ -28,7 +28,6 @@ from hypothesis import HealthCheck, Phase, given, settings
 from hypothesis import strategies as st
 from strategies import CODE_MARKER, PAYLOADS, adversarial_values
 
-import nambu_bch
 from nambu_bch import NambuBCHError
 
 EXAMPLES = int(os.environ.get("NAMBU_BCH_FUZZ_EXAMPLES", "6"))
