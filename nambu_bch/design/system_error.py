@@ -33,6 +33,7 @@ from ..errors import InvalidOrderError, InvalidRunError
 from ..integrators.composition import composition_for
 from ..integrators.step import parameter_values
 from ..numeric.iterate import as_system
+from ..parsing import as_expression
 from .conditions import error_analysis
 from ..symbols import STEP
 
@@ -102,7 +103,7 @@ def field_size(components, system, box=None, samples: int = 2000, params=None, s
     if not is_int(samples, 1, 10**7):
         raise InvalidRunError(f"samples must be an integer in 1..10^7, got {samples!r}")
     values = parameter_values(system, params)
-    exprs = [sympy.sympify(c).subs(values) for c in components]
+    exprs = [as_expression(c, system.symbols(), "component").subs(values) for c in components]
     f = sympy.lambdify(system.coordinates, exprs, modules="numpy")
     rng = np.random.RandomState(seed)
     pts = [rng.uniform(lo, hi, samples) for lo, hi in box]

@@ -176,7 +176,7 @@ def bch_shadow(system, word, order: int = 2, verify: bool = True) -> PoissonShad
         for c, tree in series.terms(j + 1):
             value = evaluator.value(tree)
             if value is not None:
-                total += sympy.sympify(c) * to_sympy(value)
+                total += sympy.sympify(c, strict=True) * to_sympy(value)
         out[j] = _tidy(total)
     result = PoissonShadow(system, comp, order, out, tuple(fixed), brackets=evaluator.brackets_computed)
     if verify:
@@ -201,9 +201,9 @@ class _FractionBackend:
     @classmethod
     def make(cls, system, exprs):
         symbols = (*system.coordinates, *system.parameters)
-        if all(sympy.sympify(e).is_polynomial(*system.coordinates) for e in exprs):
+        if all(sympy.sympify(e, strict=True).is_polynomial(*system.coordinates) for e in exprs):
             return None  # the polynomial ring is faster still
-        if not all(sympy.sympify(e).is_rational_function(*symbols) for e in exprs):
+        if not all(sympy.sympify(e, strict=True).is_rational_function(*symbols) for e in exprs):
             return None
         from sympy.polys.domains import QQ
         from sympy.polys.fields import field
@@ -212,7 +212,7 @@ class _FractionBackend:
         return cls(system, K, gens)
 
     def convert(self, expr):
-        return self.field.from_expr(sympy.sympify(expr))
+        return self.field.from_expr(sympy.sympify(expr, strict=True))
 
     def to_sympy(self, value):
         return value.as_expr()
