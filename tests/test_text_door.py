@@ -29,6 +29,7 @@ from nambu_bch.errors import NambuBCHError
 from nambu_bch.exact.factor import F_series
 from nambu_bch.parsing import as_expression, parse_expression
 from nambu_bch.shadow.averaging import orbit_functions
+from nambu_bch.shadow.existence import _check_params
 from nambu_bch.shadow.fundamental_identity import commutator_terms, double_commutator_terms
 from nambu_bch.systems import separate
 
@@ -106,6 +107,8 @@ CALLS = {
     "field_size": lambda p: field_size([p, 0, 0], HO3),
     "orbit_functions params": lambda p: orbit_functions(HO3, [x1], {m: p, omega: 1}),
     "orbit_functions integrand": lambda p: orbit_functions(HO3, [p], {m: 1, omega: 1}),
+    # the params of shadow_hamiltonians(..., params=) as the existence decision reads them
+    "shadow_hamiltonians params": lambda p: _check_params(HO3, {"m": p}),
     "parse_expression": lambda p: parse_expression(p, [x1]),
     "as_expression": lambda p: as_expression(p, [x1]),
 }
