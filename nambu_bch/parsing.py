@@ -290,9 +290,10 @@ def to_ascii(text: str, what: str = "expression") -> str:
     digits, a run of superscript digits (optionally after ``⁻``) a power, and
     ``· ⋅ × − ÷`` and the no-break space their ASCII operators.  A Greek letter
     touching another letter (``xω``: ``xomega``, or ``x*omega``?) or a superscript
-    followed by a letter or digit (``x²3``) reads two ways and is refused, as is
-    ``⁻`` or ``⁺`` outside such a run; the message gives the mapping.  Characters
-    outside the table are left for the caller's ASCII check to refuse.
+    followed by a letter or digit (``x²3``) reads two ways and is refused, as is a
+    ``⁻`` without digits; the message gives the mapping.  ``λ`` (``lambda`` is a
+    Python keyword) and ``√`` are refused with advice.  Characters outside the
+    table are left for the caller's ASCII check to refuse.
 
     >>> to_ascii("x₂²/(2*m) + m*ω²*x₁²/2")
     'x2^2/(2*m) + m*omega^2*x1^2/2'
