@@ -30,6 +30,26 @@ whose expansion would have more than :data:`MAX_TERMS` terms or total degree
 above :data:`MAX_DEGREE` (``(x1+x2+1)**1000``: estimated from the number of
 terms and the exponent, before anything is expanded).
 
+Constant subexpressions are bounded too, without evaluating them: an upper bound
+on ``log2 |c|`` is carried through the tree (``exp(a) <= e^|a|``,
+``|a*b| = |a| |b|``, ``|sin(a)| <= 1`` for real ``a`` ...) and a constant whose
+bound exceeds ``2^``:data:`MAX_BITS` is refused (``cos(exp(exp(exp(2.5))))``:
+evaluating it, even only to print or compare it, would need tens of thousands
+of digits).  Where no bound follows from the tree (the argument of ``exp`` is
+``1/(pi - 3)``: a difference may cancel), ``exp``, ``sinh``, ``cosh`` and a
+non-integer power refuse it rather than risk such a tower.
+
+Unicode as typed in a notebook is mapped to ASCII by an explicit table, never by
+NFKC normalisation: Greek letters to their names (``ω`` -> ``omega``), subscript
+digits to digits (``x₁`` -> ``x1``), superscript digits to a power (``x²`` ->
+``x^2``), ``·``/``×`` to ``*`` and ``−`` to ``-``.  A mapping that could read two
+ways (``xω`` -> ``xomega``?, ``x²3``) or a character outside the table is refused,
+with the mapping in the message.  After mapping, the ASCII rules above apply.
+
+An undeclared name is refused with how to declare it (``--param m`` on the
+command line, ``parameters=`` in Python) and a "did you mean" when it is close
+to a declared one.
+
 Long sums and products (``x1 + x1**2 + ... + x1**300``) are walked
 iteratively, so they count as one level of nesting however many terms they
 have.
@@ -38,11 +58,15 @@ have.
 from __future__ import annotations
 
 import ast
+import difflib
 import math
+import numbers
 import warnings
 from decimal import Decimal, InvalidOperation
+from fractions import Fraction
 
 import sympy
+from sympy.polys.rings import PolyElement
 
 from .errors import ExpressionParseError
 
@@ -85,6 +109,24 @@ _OPERATOR_NAMES = {
     ast.BitXor: "^", ast.LShift: "<<", ast.RShift: ">>", ast.Invert: "~", ast.Not: "not",
 }
 _NON_FINITE = (sympy.zoo, sympy.nan, sympy.oo, -sympy.oo)
+
+#: Unicode letters typed in notebooks -> their ASCII names.  Only letters that do not look like a
+#: Latin letter: capital Alpha, Beta, ... and omicron are Latin look-alikes and stay refused.
+GREEK_NAMES = {
+    "α": "alpha", "β": "beta", "γ": "gamma", "δ": "delta", "ε": "epsilon", "ϵ": "epsilon",
+    "ζ": "zeta", "η": "eta", "θ": "theta", "ϑ": "theta", "ι": "iota", "κ": "kappa", "μ": "mu",
+    "µ": "mu", "ν": "nu", "ξ": "xi", "π": "pi", "ρ": "rho", "σ": "sigma", "τ": "tau",
+    "υ": "upsilon", "φ": "phi", "ϕ": "phi", "χ": "chi", "ψ": "psi", "ω": "omega",
+    "Γ": "Gamma", "Δ": "Delta", "Θ": "Theta", "Λ": "Lambda", "Ξ": "Xi", "Π": "Pi", "Σ": "Sigma",
+    "Φ": "Phi", "Ψ": "Psi", "Ω": "Omega",
+}
+#: Operators and spaces with one ASCII reading.
+UNICODE_OPERATORS = {"·": "*", "⋅": "*", "×": "*", "−": "-", "÷": "/", "\u00a0": " "}
+_SUBSCRIPTS = {chr(0x2080 + d): str(d) for d in range(10)}
+_SUPERSCRIPTS = {"⁰": "0", "¹": "1", "²": "2", "³": "3", "⁴": "4", "⁵": "5", "⁶": "6", "⁷": "7", "⁸": "8", "⁹": "9"}
+#: Characters with a known reading that is refused, and what to write instead.
+_UNICODE_ADVICE = {"λ": "'lambda' is a Python keyword; name the parameter e.g. lam",
+                   "√": "write sqrt(...)", "ℏ": "write hbar"}
 
 
 def _shown(text: str, limit: int = 60) -> str:
@@ -141,15 +183,21 @@ def parse_expression(text: str, symbols, what: str = "expression") -> sympy.Expr
         )
     if not text.strip():
         raise ExpressionParseError(f"{what} is empty; give an expression such as 'x2^2/2 + x1^2/2'")
+    original = text
+    text = to_ascii(text, what)
+    if len(text) > MAX_LENGTH:
+        raise ExpressionParseError(
+            f"{what} is {len(text)} characters long once written in ASCII; at most {MAX_LENGTH} are accepted"
+        )
     bad = sorted({ch for ch in text if not (ch.isascii() and (ch.isalnum() or ch in ALLOWED_PUNCTUATION))})
     if bad:
         shown = "".join(bad) if all(ch.isprintable() for ch in bad) else ascii("".join(bad))
         raise ExpressionParseError(
-            f"{what} {_shown(text)} contains {shown!r}, not accepted; expressions use ASCII letters, digits, "
-            f"spaces and {ALLOWED_PUNCTUATION.strip()}"
+            f"{what} {_shown(original)} contains {shown!r}, not accepted; expressions use ASCII letters, digits, "
+            f"spaces and {ALLOWED_PUNCTUATION.strip()} (and the Greek letters, sub- and superscript digits "
+            f"that map to them, e.g. ω -> omega, x₁ -> x1, x² -> x^2)"
         )
     names = _symbol_table(symbols, what)
-    original = text
     # '^' means power to physicists; Python would parse it as xor with the wrong precedence
     source = text.replace("^", "**").strip()
     try:
@@ -181,6 +229,122 @@ def parse_expression(text: str, symbols, what: str = "expression") -> sympy.Expr
     return result
 
 
+def as_expression(value, symbols, what: str = "expression") -> sympy.Expr:
+    """The one door from a user's value to a sympy expression: text is parsed, never ``sympify``-ed.
+
+    Every public function that accepts an expression passes it through here, because
+    ``sympy.sympify`` (and every sympy function that sympifies its arguments implicitly:
+    ``expr.subs({x: "..."})``, ``sympy.diff("...", x)``, containers of strings) runs
+    ``eval`` on text.
+
+    * ``str``: :func:`parse_expression` with ``symbols`` (the whitelist parser); ``symbols=None``
+      where there is no symbol table to read text with (text is then refused);
+    * a sympy expression: itself;
+    * ``int`` (and numpy integers), :class:`fractions.Fraction`: the exact number; a sparse
+      polynomial (``PolyElement``): its expression;
+    * anything else that sympy converts without reading text (``sympify(value, strict=True)``:
+      floats, numpy floats, objects with ``_sympy_``) to an expression: that expression;
+    * anything else (``bool``, ``None``, bytes, lists, dicts, arrays, non-``Expr`` sympy objects):
+      :class:`~nambu_bch.errors.ExpressionParseError` naming ``what`` and the type.
+
+    >>> import sympy
+    >>> x1 = sympy.Symbol("x1")
+    >>> as_expression("x1^2/2", [x1]), as_expression(Fraction(1, 3), [x1]), as_expression(x1 + 1, [])
+    (x1**2/2, 1/3, x1 + 1)
+    >>> as_expression(["x1"], [x1], what="quantity")  # doctest: +ELLIPSIS
+    Traceback (most recent call last):
+    ...
+    nambu_bch.errors.ExpressionParseError: quantity must be a sympy expression, a number or a string ..., got list
+    """
+    if isinstance(value, str):
+        if symbols is None:
+            raise ExpressionParseError(
+                f"{what} {_shown(value)}: text is not accepted here (no system to read its names with); "
+                "pass a sympy expression, e.g. sympy.Symbol('x1')**2")
+        return parse_expression(value, symbols, what=what)
+    if isinstance(value, sympy.Expr):
+        return value
+    if isinstance(value, Fraction):
+        return sympy.Rational(value.numerator, value.denominator)
+    if isinstance(value, PolyElement):  # an exact sparse polynomial of the package's algebras
+        return value.as_expr()
+    if not isinstance(value, (bool, bytes, bytearray, list, tuple, dict, set, frozenset, sympy.Basic)) and value is not None:
+        if isinstance(value, numbers.Integral):
+            return sympy.Integer(int(value))
+        try:
+            converted = sympy.sympify(value, strict=True)
+        except (sympy.SympifyError, TypeError, ValueError, ArithmeticError):
+            converted = None
+        if isinstance(converted, sympy.Expr):
+            return converted
+    raise ExpressionParseError(
+        f"{what} must be a sympy expression, a number or a string such as 'x2^2/2 + x1^2/2', "
+        f"got {type(value).__name__}{'' if isinstance(value, (list, tuple, dict, set)) else ' ' + _shown(repr(value), 40)}"
+    )
+
+
+def to_ascii(text: str, what: str = "expression") -> str:
+    """``text`` with the Unicode a notebook user types mapped to ASCII by an explicit table (never NFKC).
+
+    Greek letters become their names (:data:`GREEK_NAMES`), subscript digits
+    digits, a run of superscript digits (optionally after ``⁻``) a power, and
+    ``· ⋅ × − ÷`` and the no-break space their ASCII operators.  A Greek letter
+    touching another letter (``xω``: ``xomega``, or ``x*omega``?) or a superscript
+    followed by a letter or digit (``x²3``) reads two ways and is refused, as is a
+    ``⁻`` without digits; the message gives the mapping.  ``λ`` (``lambda`` is a
+    Python keyword) and ``√`` are refused with advice.  Characters outside the
+    table are left for the caller's ASCII check to refuse.
+
+    >>> to_ascii("x₂²/(2*m) + m*ω²*x₁²/2")
+    'x2^2/(2*m) + m*omega^2*x1^2/2'
+    >>> to_ascii("xω")  # doctest: +ELLIPSIS
+    Traceback (most recent call last):
+    ...
+    nambu_bch.errors.ExpressionParseError: expression 'xω': 'ω' (-> 'omega') touches another letter or digit, ...
+    """
+    if text.isascii():
+        return text
+    out = []
+    i, n = 0, len(text)
+
+    def refuse(why):
+        raise ExpressionParseError(f"{what} {_shown(text)}: {why}; write it in ASCII (e.g. ω -> omega, x₁ -> x1, x² -> x^2)")
+
+    while i < n:
+        ch = text[i]
+        if ch in GREEK_NAMES:
+            name = GREEK_NAMES[ch]
+            before = text[i - 1] if i else ""
+            after = text[i + 1] if i + 1 < n else ""
+            if (before.isalpha() or before in _SUBSCRIPTS or before.isdigit()) or after.isalpha():
+                refuse(f"{ch!r} (-> {name!r}) touches another letter or digit, so the name it makes is ambiguous; "
+                       f"separate it with '*' or write the name")
+            out.append(name)
+        elif ch in _SUBSCRIPTS:
+            out.append(_SUBSCRIPTS[ch])
+        elif ch in _SUPERSCRIPTS or ch == "⁻":
+            j = i + (ch == "⁻")
+            while j < n and text[j] in _SUPERSCRIPTS:
+                j += 1
+            digits = "".join(_SUPERSCRIPTS[c] for c in text[i + (ch == "⁻"):j])
+            if not digits:
+                refuse("'⁻' must be followed by superscript digits (x⁻¹ -> x^(-1))")
+            if j < n and (text[j].isalnum() or text[j] in _SUBSCRIPTS):
+                refuse(f"the superscript {text[i:j]!r} is followed by {text[j]!r}; write the power with ^ "
+                       f"(x{text[i:j]} -> x^{'(-' + digits + ')' if ch == '⁻' else digits})")
+            out.append(f"^(-{digits})" if ch == "⁻" else f"^{digits}")
+            i = j
+            continue
+        elif ch in UNICODE_OPERATORS:
+            out.append(UNICODE_OPERATORS[ch])
+        elif ch in _UNICODE_ADVICE:
+            refuse(f"{ch!r} is not accepted: {_UNICODE_ADVICE[ch]}")
+        else:
+            out.append(ch)
+        i += 1
+    return "".join(out)
+
+
 def _symbol_table(symbols, what):
     if isinstance(symbols, dict):
         table = dict(symbols)
@@ -198,6 +362,11 @@ def _symbol_table(symbols, what):
 
 
 _CAP = 10**18
+
+
+def _magnitude(log2_bound: float) -> str:
+    """``1.2e+05``-style text of a log2 bound (``inf``: beyond the float range)."""
+    return "(beyond 10^308)" if log2_bound == math.inf else f"{log2_bound:.3g}"
 
 
 def expansion_size(expr) -> tuple:
@@ -238,11 +407,141 @@ def expansion_size(expr) -> tuple:
     return (1, 1)
 
 
+def undeclared_hint(name: str, declared, what: str) -> str:
+    """How to declare ``name`` where ``what`` comes from, and a "did you mean" for a close declared name.
+
+    ``--H``/``--G`` (the command line): ``--param NAME``; a model file (``--system ...``): its
+    ``parameters``; other flags take numbers only, so no hint; the Python API: ``parameters=``; where no
+    names are declared at all, a number is expected.
+    """
+    if not declared:
+        return " (a number is expected here)"
+    close = difflib.get_close_matches(name, [n for n in (*declared, *_CONSTANTS) if n not in ("h", "alpha")], n=1, cutoff=0.6)
+    hint = f" (did you mean {close[0]!r}?)" if close else ""
+    if what.startswith("--system"):
+        return f"{hint}; declare it in the file's parameters"
+    if what in ("--H", "--G"):
+        return f"{hint}; declare it with --param {name} (symbolic) or --param {name}=VALUE"
+    if what.startswith("--"):
+        return hint
+    return f"{hint}; declare it with parameters=[{name!r}] (e.g. System(..., parameters=[{name!r}]))"
+
+
+_LOG2E = math.log2(math.e)
+#: Functions whose value grows exponentially with their argument: they refuse an argument with no bound.
+_GROWING = (sympy.exp, sympy.sinh, sympy.cosh)
+
+
+def _exp2(u: float) -> float:
+    """``2**u`` as a float, ``inf`` beyond the float range."""
+    return math.inf if u > 1000 else 2.0**u
+
+
+def constant_bound(expr, memo=None):
+    """``(upper, lower, sign, real)``: bounds on ``log2 |expr|`` of a constant, read from its tree alone.
+
+    Nothing is evaluated: ``|exp(a)| <= e^|a|``, ``|a*b| = |a| |b|``, ``|a + b| <= 2 max(|a|, |b|)``,
+    ``|sin(a)| <= 1`` for real ``a``, ``|sqrt(a)| = |a|^(1/2)`` ...; ``lower`` (for divisions) is known
+    for numbers, products and sums of terms of one sign, else ``-inf``.  ``upper`` is ``None`` where no
+    bound follows from the tree (a division by a difference that may cancel, ``tan``, ``log`` of a
+    value that may be tiny); ``inf`` when the bound overflows a float.  ``sign`` is +1/-1 when known
+    from the tree, else 0; ``real`` is True when the tree shows the value real.
+
+    >>> up = constant_bound(sympy.exp(sympy.exp(sympy.Rational(5, 2))))[0]  # e^(e^2.5) = 1.95e5 = 2^17.57
+    >>> 17.57 < up < 17.58
+    True
+    >>> constant_bound(1 / (sympy.pi - 3))[0] is None
+    True
+    """
+    if memo is None:
+        memo = {}
+    found = memo.get(expr)
+    if found is None:
+        found = memo[expr] = _bound(expr, memo)
+    return found
+
+
+def _bound(e, memo):
+    inf = math.inf
+    unknown = (None, -inf, 0, False)
+    if e.is_Rational:
+        if e == 0:
+            return (-inf, -inf, 0, True)
+        v = math.log2(abs(e.p)) - math.log2(e.q)
+        return (v, v, 1 if e > 0 else -1, True)
+    if e is sympy.pi or e is sympy.E:
+        v = math.log2(float(e))
+        return (v, v, 1, True)
+    if e is sympy.I:
+        return (0.0, 0.0, 0, False)
+    args = [constant_bound(a, memo) for a in e.args]
+    ups = [a[0] for a in args]
+    real = all(a[3] for a in args)
+    if e.is_Add:
+        if None in ups:
+            return unknown
+        signs = {a[2] for a in args}
+        sign = signs.pop() if len(signs) == 1 else 0
+        lower = max(a[1] for a in args) if sign else -inf
+        return (max(ups) + math.log2(len(args)), lower, sign, real)
+    if e.is_Mul:
+        if None in ups:
+            return unknown
+        sign = math.prod(a[2] for a in args)
+        return (sum(ups), sum(a[1] for a in args), sign, real)
+    if e.is_Pow:
+        (ub, lb, sb, rb), (ue, le, se, re) = args
+        k = e.exp
+        if k.is_Integer:
+            k = int(k)
+            up, low = (k * ub, k * lb) if k > 0 else (k * lb if lb > -inf else None, k * ub if ub is not None else -inf)
+            if ub is None:
+                up = None
+            sign = (sb if k % 2 else 1) if sb else (1 if k % 2 == 0 and rb else 0)
+            return (up, low, sign, rb)
+        if ub is None or ue is None:
+            return unknown
+        reach = max(abs(ub), abs(lb))  # |log2 |b|| <= reach
+        if k.is_Rational:
+            up, low = (float(k) * ub, float(k) * lb) if k > 0 else (float(k) * lb, float(k) * ub)
+            if up != up or low != low:  # inf * 0
+                return unknown
+            return (up, low, 1 if sb == 1 and rb else 0, sb == 1 and rb)
+        # b^k = exp(k log b), |k log b| <= 2^ue (|log2 b| + 4.6): the 4.6 covers pi |Im k| / ln 2
+        up = _exp2(ue) * (reach + 4.6)
+        return (up, -up, 1 if sb == 1 and rb and re else 0, sb == 1 and rb and re)
+    func = e.func
+    if len(args) != 1:
+        return unknown
+    ua, la, sa, ra = args[0]
+    if func is sympy.Abs:
+        return (ua, la, 1, True)
+    if ua is None:
+        return unknown
+    if func in _GROWING:
+        up = _exp2(ua) * _LOG2E
+        if func is sympy.exp and ra and sa:  # e^a <= 1 for a < 0, >= 1 for a > 0
+            return (0.0, -up, 1, True) if sa < 0 else (up, 0.0, 1, True)
+        return (up, 0.0 if (func is sympy.cosh and ra) else -up, 1 if ra and func is not sympy.sinh else 0, ra)
+    if func in (sympy.sin, sympy.cos):
+        return (0.0 if ra else _exp2(ua) * _LOG2E, -inf, 0, ra)
+    if func is sympy.tanh and ra:
+        return (0.0, -inf, 0, True)
+    if func is sympy.atan and ra:
+        return (1.0, -inf, 0, True)
+    if func in (sympy.asin, sympy.acos):
+        return (math.log2(math.pi + 1.1 + max(ua, 0.0) * math.log(2)), -inf, 0, False)
+    if func is sympy.log and la > -inf:
+        return (math.log2(max(abs(ua), abs(la)) * math.log(2) + math.pi), -inf, 0, sa == 1 and ra)
+    return unknown
+
+
 class _Builder:
     """Walks a whitelisted ``ast`` tree and builds the sympy expression."""
 
     def __init__(self, names, what, text, source):
         self.names, self.what, self.text, self.source = names, what, text, source
+        self.bounds: dict = {}
 
     def fail(self, why):
         accepted = ", ".join(sorted(self.names)) or "none"
@@ -273,11 +572,32 @@ class _Builder:
         return self.sized(sympy.Rational(mantissa, 10**-exponent))
 
     def sized(self, value):
-        """Reject exact numbers too large to be a physical input."""
+        """Reject exact numbers too large to be a physical input, and constants too large to evaluate."""
         if isinstance(value, sympy.Rational):
             if max(abs(value.p).bit_length(), abs(value.q).bit_length()) > MAX_BITS:
                 self.fail(f"a number in it has more than {MAX_BITS} bits")
+        elif isinstance(value, sympy.Expr) and value.is_number:
+            self.bounded(value)
+        elif isinstance(value, (sympy.Add, sympy.Mul)):
+            # sympy merges constants on its own (exp(700)*x1*exp(700) = x1*exp(1400)): bound the merged parts
+            for part in value.args:
+                if part.is_number and not part.is_Rational:
+                    self.bounded(part)
         return value
+
+    def bounded(self, value):
+        """The tree bound of a constant (:func:`constant_bound`); refuses one that may exceed ``2^MAX_BITS``."""
+        bound = constant_bound(value, self.bounds)
+        if bound[0] is not None and bound[0] > MAX_BITS:
+            self.fail(f"the constant {_shown(str(value), 50)[1:-1]} may be as large as 2^{_magnitude(bound[0])} "
+                      f"(constants are accepted up to 2^{MAX_BITS}, judged from the expression without evaluating it)")
+        return bound
+
+    def growing(self, name, argument):
+        """``exp``/``sinh``/``cosh`` of a constant, or a constant non-integer power: its size must be bounded."""
+        if isinstance(argument, sympy.Expr) and argument.is_number and self.bounded(argument)[0] is None:
+            self.fail(f"the constant {_shown(str(argument), 50)[1:-1]} in {name} cannot be bounded without evaluating it "
+                      "(a difference that may cancel, tan or log); write it as a decimal")
 
     # -- the walk ---------------------------------------------------------------------
     def visit(self, node, depth):
@@ -292,7 +612,7 @@ class _Builder:
                 return _CONSTANTS[node.id]
             if node.id in ALLOWED_FUNCTIONS:
                 self.fail(f"the function {node.id!r} must be called, e.g. {node.id}(x)")
-            self.fail(f"the name {node.id!r} is not declared")
+            self.fail(f"the name {node.id!r} is not declared{undeclared_hint(node.id, self.names, self.what)}")
         if isinstance(node, ast.UnaryOp):
             if not isinstance(node.op, (ast.UAdd, ast.USub)):
                 self.fail(f"the operator {_OPERATOR_NAMES.get(type(node.op), type(node.op).__name__)!r} is not allowed")
@@ -334,6 +654,10 @@ class _Builder:
         base = self.visit(node.left, depth + 1)
         exponent = self.visit(node.right, depth + 1)
         if exponent.is_number:
+            # bound before comparing: the comparisons below evaluate the exponent
+            self.growing("the exponent", exponent)
+            if not exponent.is_Integer:
+                self.growing("the base of a non-integer power", base)
             if exponent.is_real is False:
                 self.fail(f"the exponent {exponent} is not real")
             if exponent.is_real and abs(exponent) > MAX_EXPONENT:
@@ -355,8 +679,11 @@ class _Builder:
         if node.keywords:
             self.fail(f"keyword arguments are not allowed (in {name})")
         args = [self.visit(a, depth + 1) for a in node.args]
+        if ALLOWED_FUNCTIONS[name] in _GROWING and len(args) == 1:
+            self.growing(name, args[0])
         try:
-            return self.sized(ALLOWED_FUNCTIONS[name](*args))
+            value = ALLOWED_FUNCTIONS[name](*args)
         except (TypeError, ValueError, ArithmeticError) as exc:
             shown = ", ".join(map(str, args))
             self.fail(f"{name}({shown}) is invalid ({str(exc).splitlines()[0] if str(exc) else type(exc).__name__})")
+        return self.sized(value)

@@ -117,7 +117,7 @@ def h_coefficients(expr, base, coordinates, step=STEP):
     >>> h_coefficients(x**2/2 + sympy.Symbol("h")**2 * x**2/(4*m), x**2/2, [x])
     [(2, x**2/(4*m))]
     """
-    diff = sympy.expand(sympy.sympify(expr) - sympy.sympify(base))
+    diff = sympy.expand(sympy.sympify(expr, strict=True) - sympy.sympify(base, strict=True))
     if diff == 0:
         return []
     coefficients = _coefficients(diff, [step])
@@ -128,7 +128,7 @@ def h_coefficients(expr, base, coordinates, step=STEP):
 
 def signed(term, first=False) -> str:
     """``+ t`` / ``- t`` LaTeX of one term (``first``: no ``+``), as sympy's Add printer writes signs."""
-    term = sympy.sympify(term)
+    term = sympy.sympify(term, strict=True)
     if term.could_extract_minus_sign():
         return "- " + sympy.latex(-term)
     return ("" if first else "+ ") + sympy.latex(term)
@@ -173,7 +173,7 @@ def _term_tokens(term, first) -> list:
 
 def sum_tokens(expr, first=True) -> list:
     """The terms of ``expr`` in sympy's printed order, each a signed LaTeX token (a line may break between them)."""
-    expr = sympy.sympify(expr)
+    expr = sympy.sympify(expr, strict=True)
     terms = _ordered_terms(expr) if isinstance(expr, sympy.Add) else [expr]
     return [tok for i, t in enumerate(terms) for tok in _term_tokens(t, first and i == 0)]
 
@@ -187,7 +187,7 @@ def series_tokens(base_latex, expr, base, coordinates, remainder=None, step=STEP
     coefficients = h_coefficients(expr, base, coordinates, step)
     tokens = [base_latex]
     if coefficients is None:  # rational in h: by monomials of the coordinates, coefficients factored
-        tokens += sum_tokens(_by_monomial(sympy.expand(sympy.sympify(expr) - sympy.sympify(base)), coordinates), first=False)
+        tokens += sum_tokens(_by_monomial(sympy.expand(sympy.sympify(expr, strict=True) - sympy.sympify(base, strict=True)), coordinates), first=False)
     for k, c in coefficients or ():
         inner = sum_tokens(c, first=(k != 0))
         power = sympy.latex(step**k) if k else ""
@@ -220,12 +220,12 @@ def series_text(base_text, expr, base, coordinates, remainder=None, step=STEP) -
     coefficients = h_coefficients(expr, base, coordinates, step)
     text = base_text
     if coefficients is None:
-        text += f" + ({sympy.expand(sympy.sympify(expr) - sympy.sympify(base))})"
+        text += f" + ({sympy.expand(sympy.sympify(expr, strict=True) - sympy.sympify(base, strict=True))})"
     for k, c in coefficients or ():
         if isinstance(c, sympy.Add) or k == 0:
             text += " + " + (f"{step}**{k}*({c})" if k > 1 else (f"{step}*({c})" if k == 1 else f"({c})"))
         else:
-            term = sympy.sympify(step**k * c)
+            term = sympy.sympify(step**k * c, strict=True)
             text += f" - {-term}" if term.could_extract_minus_sign() else f" + {term}"
     if remainder is not None:
         text += f" + O({step}^{remainder})"
@@ -252,7 +252,7 @@ class HSeries(Printable):
     """
 
     def __init__(self, lhs, expr, base, base_name, coordinates, remainder=None):
-        self.lhs, self.expr, self.base, self.base_name = lhs, sympy.sympify(expr), sympy.sympify(base), base_name
+        self.lhs, self.expr, self.base, self.base_name = lhs, sympy.sympify(expr, strict=True), sympy.sympify(base, strict=True), base_name
         self.coordinates, self.remainder = tuple(coordinates), remainder
 
     def to_latex(self) -> str:

@@ -35,7 +35,7 @@ def expression(value):
         return None
     if not isinstance(value, sympy.Basic) and hasattr(value, "as_expr"):  # a sparse-ring element
         value = value.as_expr()
-    return str(sympy.sympify(value))
+    return str(sympy.sympify(value, strict=True))
 
 
 def jsonable(obj):

@@ -32,6 +32,8 @@ from __future__ import annotations
 import pytest
 import sympy
 
+from .errors import NambuBCHError
+from .parsing import as_expression
 from .symbols import STEP
 from .systems import model
 
@@ -51,31 +53,46 @@ def _as_expr(value, system, what):
     """A sympy expression from a sympy object or a string (parsed safely with the system's symbols)."""
     if value is None:
         return None
-    if isinstance(value, str):
-        from .parsing import parse_expression
-
-        return parse_expression(value, system.symbols(), what=what)
-    return sympy.sympify(value)
+    return as_expression(value, system.symbols(), what)
 
 
-def _components(field):
-    """Components of a VectorField, EffectiveField or sequence, as sympy expressions."""
+def _text_symbols(coordinates, values) -> dict:
+    """Names a text component may use: the coordinates, ``h``, ``alpha`` and the symbols of the sympy values."""
+    names = {s.name: s for v in values if isinstance(v, sympy.Basic) for s in v.free_symbols if isinstance(s, sympy.Symbol)}
+    names.update({n: sympy.Symbol(n) for n in ("h", "alpha")})
+    names.update({s.name: s for s in coordinates if isinstance(s, sympy.Symbol)})
+    return names
+
+
+def _raw_components(field) -> tuple:
     if hasattr(field, "to_sympy"):
-        return tuple(sympy.sympify(c) for c in field.to_sympy())
-    return tuple(sympy.sympify(c) for c in field)
+        return tuple(field.to_sympy())
+    if isinstance(field, (str, bytes)) or not hasattr(field, "__iter__"):
+        raise NambuBCHError(f"a vector field must be a VectorField, an EffectiveField or a sequence of components, "
+                            f"got {type(field).__name__}")
+    return tuple(field)
 
 
-def liouville_components(coordinates, *hamiltonians) -> tuple:
+def liouville_components(coordinates, *hamiltonians, parameters=()) -> tuple:
     """``X_{H_1..H_{N-1}}^i = {x_i, H_1, ..., H_{N-1}}`` as sympy expressions (any ``h``, ``alpha`` allowed).
 
     The Nambu bracket is the Jacobian determinant ``det d(f, H_1..H_{N-1})/d(x_1..x_N)``
     (Eq. NB; Eq. Poisson for N = 2), so ``X_H = (dH/dx2, -dH/dx1)`` for N = 2.
+    A Hamiltonian given as text is read by :func:`~nambu_bch.parsing.parse_expression` in the
+    coordinates, ``h``, ``alpha``, the ``parameters`` (Symbols or names) and the symbols of the
+    other Hamiltonians.
 
     >>> x1, x2 = sympy.symbols("x1 x2")
     >>> liouville_components((x1, x2), (x1**2 + x2**2) / 2)
     (x2, -x1)
+    >>> liouville_components((x1, x2), "x2^2/(2*m) + m*omega^2*x1^2/2", parameters="m omega")
+    (x2/m, -m*omega**2*x1)
     """
     coords = tuple(coordinates)
+    extra = parameters.split() if isinstance(parameters, str) else list(parameters)
+    extra = [sympy.Symbol(p) if isinstance(p, str) else p for p in extra]
+    names = _text_symbols((*coords, *extra), hamiltonians)
+    hamiltonians = [as_expression(Hk, names, f"Hamiltonian {k + 1}") for k, Hk in enumerate(hamiltonians)]
     grads = [[sympy.diff(Hk, x) for x in coords] for Hk in hamiltonians]
     out = []
     for i in range(len(coords)):
@@ -120,19 +137,26 @@ def assert_fields_equal(X, Y, coordinates=None, msg: str = ""):
 
     Parameters
     ----------
-    X, Y : VectorField, EffectiveField or sequence of sympy expressions
+    X, Y : VectorField, EffectiveField or sequence of sympy expressions or strings (text is read by
+        :func:`~nambu_bch.parsing.parse_expression` in the coordinates, ``h``, ``alpha``, the field's
+        algebra and the symbols of the other components)
     coordinates : sequence of Symbols, optional
         Names for the failure message (default: taken from ``X`` or ``x1..xN``).
     msg : str
         Prefix of the failure message.
     """
     __tracebackhide__ = True
-    a, b = _components(X), _components(Y)
+    a, b = _raw_components(X), _raw_components(Y)
     if len(a) != len(b):
         raise AssertionError(f"{msg}fields on {len(a)} and {len(b)} coordinates cannot be equal")
+    algebra = getattr(X, "algebra", None) or getattr(Y, "algebra", None)
     if coordinates is None:
-        algebra = getattr(X, "algebra", None) or getattr(Y, "algebra", None)
         coordinates = algebra.coordinates if algebra is not None else sympy.symbols(f"x1:{len(a) + 1}")
+    names = _text_symbols(coordinates, (*a, *b))
+    if algebra is not None:
+        names.update(algebra.symbol_table)
+    a = tuple(as_expression(c, names, f"component {i + 1} of X") for i, c in enumerate(a))
+    b = tuple(as_expression(c, names, f"component {i + 1} of Y") for i, c in enumerate(b))
     residuals = [_zero_or_simplified(u - v) for u, v in zip(a, b)]
     if any(r != 0 for r in residuals):
         raise AssertionError(_residual_report(coordinates, residuals, f"{msg}fields differ; residual X - Y:"))
@@ -194,7 +218,7 @@ def _shadow_residuals(system, hams, X_eff, order):
     from .algebra import VectorField, liouville_field
 
     allowed = set(system.coordinates) | set(system.parameters) | {STEP}
-    extra = sorted(set().union(*(sympy.sympify(Hk).free_symbols for Hk in hams)) - allowed, key=str)
+    extra = sorted(set().union(*(Hk.free_symbols for Hk in hams)) - allowed, key=str)
     algebra = system.algebra.with_constants(STEP, *extra)
     converted = [algebra.convert(Hk) for Hk in hams]
     if all(algebra.is_polynomial(c) for c in converted):

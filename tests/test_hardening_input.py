@@ -360,6 +360,59 @@ def test_bounded_work_api():
         composition("1" * 201 + "2")
 
 
+SIN8 = "sin(sin(sin(sin(sin(sin(sin(sin(x1))))))))"
+
+
+@pytest.mark.parametrize("argv, fragment", [
+    (["models", "--H", "x2^2/2+x1^2*cos(exp(exp(exp(2.5))))"], "exp(exp(exp(5/2))) may be as large as 2^2.82e+05"),
+    (["check", "--H", "x2^2/2+x1^2*cos(exp(exp(exp(2.5))))"], "2^1400"),
+    (["shadow", "--H", "x2^2/2 + x1*exp(exp(10))"], "exp(exp(10))"),
+    (["shadow", "--H", f"{SIN8}+x2^2/2", "--order", "4"], "differentiates sin(sin(sin(sin(sin(sin(sin(sin(x1)))))))) up to 5"),
+    (["shadow", "--H", "x2^2/2 + sin(sin(sin(sin(x1))))", "--order", "8"], "at most 4000 are accepted"),
+])
+def test_towers_and_nests_refused_up_front_cli(capsys, argv, fragment):
+    """Constant towers (the parser's tree bound) and deep nests at high order (the derivative estimate): one line."""
+    one_line(capsys, main(argv), fragment)
+
+
+def test_nest_refused_before_any_bracket_is_computed(monkeypatch):
+    """The estimate comes first: neither the BCH series nor backward error analysis is touched."""
+    import nambu_bch.shadow.generic as generic
+
+    def touched(*args, **kwargs):
+        raise AssertionError("work started before the estimate refused the request")
+
+    monkeypatch.setattr(generic, "formal_bch", touched)
+    monkeypatch.setattr(generic, "effective_field", touched)
+    system = nb.System("x1 x2", [f"x2**2/2 + {SIN8}"])
+    with pytest.raises(ResourceLimitError, match="at most 4000"):
+        nb.shadow_hamiltonians(system, "121", order=4)
+    with pytest.raises(ResourceLimitError):
+        generic.bch_shadow(system, "121", order=4)
+
+
+def test_derivative_estimate_counts_faa_di_bruno_terms():
+    """The derivative estimate bounds the number of terms sympy produces where that is cheap to count; the
+    work estimate keeps what finishes in about a minute (sin^8 at h^2, sin^2 at h^8, the pendulum at h^6)."""
+    from nambu_bch.shadow.generic import MAX_BCH_WORK, bch_work, check_work, derivative_terms
+
+    x1, x2 = sympy.symbols("x1 x2")
+    for expr, k in ((sympy.sin(sympy.sin(x1)), 4), (sympy.exp(x1**2), 3), (sympy.cos(x1) * sympy.exp(x1), 3)):
+        counted = len(sympy.Add.make_args(sympy.expand(sympy.diff(expr, x1, k))))
+        assert derivative_terms(expr, [x1], k) >= counted
+    nest = x1
+    for _ in range(8):
+        nest = sympy.sin(nest)
+    assert [derivative_terms(nest, [x1], k) for k in (3, 5)] == [36, 1128]
+    # sum over bracket lengths j of (Lyndon words of length j over 2 letters) x (terms of the j-th derivative)
+    assert bch_work(nb.System("x1 x2", [x2**2 / 2 + nest]), 2, [x2**2 / 2, nest], 2) == (2 * 1 + 1 * 8 + 2 * 36, nest)
+    assert check_work(nb.System("x1 x2", [x2**2 / 2 + nest]), 2, [nest], 2) == 82 <= MAX_BCH_WORK
+    assert check_work(nb.model("pendulum"), 2, [x2**2 / 2, -sympy.cos(x1)], 6) == 2 + 1 + 2 + 3 + 6 + 9 + 18
+    sin2 = sympy.sin(sympy.sin(x1))
+    assert check_work(nb.System("x1 x2", [x2**2 / 2 + sin2]), 2, [sin2], 8) == 2776 <= MAX_BCH_WORK
+    assert check_work(nb.model("ho3"), 3, nb.model("ho3").hamiltonians, 8) == 0  # polynomial: not estimated
+
+
 def test_expansion_estimate_two_ways():
     """The parser's size estimate equals sympy's own count where expansion is cheap (exact for sums of distinct
     letters: binomial(n + t - 1, t - 1) monomials), and bounds it otherwise."""

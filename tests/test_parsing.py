@@ -233,3 +233,127 @@ def test_wellformed_expressions_match_sympy(text):
     result = parse_expression(text, SYMBOLS)
     names = {s.name: s for s in SYMBOLS}
     assert sympy.expand(result - sympy.sympify(text.replace("^", "**"), locals=names)) == 0
+
+
+# -------------------------------------------------------------------------------------------
+# Unicode as typed in a notebook: mapped by an explicit table, or refused with the mapping
+# -------------------------------------------------------------------------------------------
+@pytest.mark.parametrize("text, expected", [
+    ("m*ω²*x₁²/2", m * omega**2 * x1**2 / 2),
+    ("x₂²/(2·m) + m×ω²×x₁²/2", x2**2 / (2 * m) + m * omega**2 * x1**2 / 2),  # Eq. (HO1)
+    ("x₃ − x₁²", x3 - x1**2),  # Eq. (G), with the minus sign U+2212
+    ("x₁⁻¹ + x₂¹⁰", 1 / x1 + x2**10),
+    ("π*x₁ + ω", sympy.pi * x1 + omega),
+    ("(x₁ + x₂)³", (x1 + x2)**3),
+    ("x1\u00a0+\u00a0x2", x1 + x2),  # no-break spaces
+])
+def test_unicode_mapped_to_ascii(text, expected):
+    assert sympy.expand(parse_expression(text, SYMBOLS) - expected) == 0
+
+
+def test_greek_names_reach_declared_parameters():
+    alpha_, sigma = sympy.symbols("alpha sigma")
+    assert parse_expression("α*x₁ + σ", [x1, alpha_, sigma]) == alpha_ * x1 + sigma
+
+
+@pytest.mark.parametrize("text, fragment", [
+    ("xω", "'ω' (-> 'omega') touches another letter"),  # xomega or x*omega?
+    ("ωx1", "touches another letter"),
+    ("2ω", "touches another letter"),
+    ("x1²3", "the superscript '²' is followed by '3'"),  # x^23 or x^2*3?
+    ("x²y", "followed by 'y'"),
+    ("x1⁻", "'⁻' must be followed by superscript digits"),
+    ("λ*x1", "'lambda' is a Python keyword"),
+    ("√x1", "write sqrt(...)"),
+    ("Αx1", "contains 'Α'"),  # capital alpha looks like A: not in the table
+    ("ｘ1", "contains 'ｘ'"),  # fullwidth: never NFKC-normalised
+    ("x1\u2028", "not accepted"),  # a line separator stays refused
+])
+def test_unicode_ambiguous_or_unknown_refused_with_the_mapping(text, fragment):
+    with pytest.raises(ExpressionParseError) as info:
+        parse_expression(text, SYMBOLS, what="--H")
+    message = str(info.value)
+    assert "\n" not in message and message.startswith("--H") and fragment in message, message
+
+
+def test_mapping_result_is_printable_ascii():
+    """Round one's guarantee holds after mapping: whatever is parsed is printable ASCII."""
+    from nambu_bch.parsing import ALLOWED_PUNCTUATION, GREEK_NAMES, to_ascii
+
+    text = "".join(GREEK_NAMES) + "₀₁₂₃₄₅₆₇₈₉·×−÷"
+    spaced = to_ascii(" ".join(text))
+    assert spaced.isascii() and spaced.isprintable()
+    assert all(ch.isalnum() or ch in ALLOWED_PUNCTUATION for ch in spaced)
+
+
+# -------------------------------------------------------------------------------------------
+# undeclared names: how to declare them, and "did you mean"
+# -------------------------------------------------------------------------------------------
+@pytest.mark.parametrize("what, text, fragments", [
+    ("--H", "x2^2/(2*mm)", ["the name 'mm' is not declared", "did you mean 'm'?", "--param mm (symbolic) or --param mm=VALUE"]),
+    ("--G", "x3 - k*x1^2", ["'k' is not declared", "--param k"]),
+    ("--system model.toml: H", "x2^2/(2*mass)", ["'mass' is not declared", "the file's parameters"]),
+    ("expression", "x2^2/(2*omgea)", ["did you mean 'omega'?", "parameters=['omgea']"]),
+    ("--h", "x1", ["'x1' is not declared (a number is expected here)"]),
+])
+def test_undeclared_name_says_how_to_declare_it(what, text, fragments):
+    symbols = [] if what == "--h" else SYMBOLS
+    with pytest.raises(ExpressionParseError) as info:
+        parse_expression(text, symbols, what=what)
+    message = str(info.value)
+    assert "\n" not in message
+    for fragment in fragments:
+        assert fragment in message, message
+
+
+def test_no_did_you_mean_for_a_name_far_from_every_declared_one():
+    with pytest.raises(ExpressionParseError) as info:
+        parse_expression("x1 + kappa", SYMBOLS, what="--H")
+    assert "did you mean" not in str(info.value)
+
+
+# -------------------------------------------------------------------------------------------
+# constant towers: bounded from the tree, never evaluated
+# -------------------------------------------------------------------------------------------
+@pytest.mark.parametrize("text, fragment", [
+    ("x2^2/2 + x1^2*cos(exp(exp(exp(2.5))))", "the constant exp(exp(exp(5/2))) may be as large as 2^2.82e+05"),
+    ("x1*exp(1000)", "exp(1000) may be as large as 2^1.44e+03"),
+    ("x1^exp(exp(10))", "exp(exp(10))"),
+    ("x1*pi^pi^pi", "pi**(pi**pi)"),
+    ("x1*sinh(exp(10))", "sinh(exp(10))"),
+    ("x1*sin(sqrt(-1)*1000)", "may be as large as"),  # sin(1000 i) = i sinh(1000)
+    ("x1*exp(700)*exp(700)", "exp(1400)"),
+    ("x1*exp(1/(pi - 3))", "cannot be bounded without evaluating it"),
+    ("x1*2^(1/(E - 2))", "cannot be bounded"),
+])
+def test_constant_towers_refused_from_the_tree(text, fragment):
+    with pytest.raises(ExpressionParseError) as info:
+        parse_expression(text, SYMBOLS, what="--H")
+    message = str(info.value)
+    assert "\n" not in message and message.startswith("--H") and fragment in message, message
+    assert "2^1400" in message or "cannot be bounded" in message, message
+
+
+@pytest.mark.parametrize("text", [
+    "x1*exp(700)", "x1*exp(-exp(10))", "cos(1/(pi - 3))*x1", "x1*exp(1/(1 + sqrt(2)))", "x1*exp(atan(1/2))",
+    "x1*2^(1/2)*3^(1/3)", "x1*E^E^E", "x1*exp(-1/(2*pi))", "x1*cosh(3)*sin(10^300)", "exp(-x1^2/2)*cos(omega*x2)",
+])
+def test_ordinary_constants_still_accepted(text):
+    assert isinstance(parse_expression(text, SYMBOLS, what="--H"), sympy.Expr)
+
+
+@pytest.mark.parametrize("expr", [
+    sympy.exp(sympy.Rational(5, 2)), sympy.exp(sympy.exp(2)), sympy.pi**sympy.pi, sympy.sqrt(7) / 3,
+    sympy.cosh(5), sympy.sinh(-4) * sympy.E, (2 + sympy.sqrt(3))**7, sympy.exp(-sympy.exp(3)),
+    sympy.asin(sympy.Rational(1, 3)), sympy.log(10**50), 1 / (1 + sympy.pi)**3,
+])
+def test_constant_bound_is_an_upper_and_lower_bound(expr):
+    """The tree bound brackets the true log2 |value| (checked numerically here, never in the parser)."""
+    from nambu_bch.parsing import constant_bound
+
+    upper, lower, sign, real = constant_bound(expr)
+    value = sympy.N(abs(expr), 50)
+    true = float(sympy.log(value, 2))
+    assert upper is not None and lower - 1e-9 <= true <= upper + 1e-9, (upper, true, lower)
+    if sign:
+        assert sympy.sign(sympy.N(expr, 30)) == sign

@@ -453,7 +453,7 @@ class PolynomialBackend:
 
     def _constant(self, c):
         if isinstance(c, (int, sympy.Basic)):
-            return self.domain.from_sympy(sympy.sympify(c))
+            return self.domain.from_sympy(sympy.sympify(c, strict=True))
         return c  # already an element of the ring's domain
 
     def combine(self, pairs) -> VectorField:
@@ -543,7 +543,7 @@ class PolynomialBackend:
 
 def _normal(expr):
     """The normal form of a component: ``p/q`` cancelled for a rational function, else the expansion."""
-    expr = sympy.sympify(expr)
+    expr = sympy.sympify(expr, strict=True)
     if expr.is_rational_function() and not expr.is_polynomial():
         return sympy.cancel(expr)
     return sympy.expand(expr)
@@ -624,7 +624,7 @@ class ExpressionBackend:
 
     @staticmethod
     def constants(numbers) -> list:
-        return [sympy.sympify(c) for c in numbers]
+        return [sympy.sympify(c, strict=True) for c in numbers]
 
     @staticmethod
     def rational(q):
@@ -633,11 +633,11 @@ class ExpressionBackend:
     def combine(self, pairs) -> VectorField:
         totals = [sympy.Integer(0)] * self.algebra.n
         for c, X in pairs:
-            totals = [t + sympy.sympify(c) * comp for t, comp in zip(totals, X)]
+            totals = [t + sympy.sympify(c, strict=True) * comp for t, comp in zip(totals, X)]
         return VectorField(self.algebra, [_normal(t) for t in totals])
 
     def scaled_combine(self, denominator: int, pairs) -> VectorField:
-        return self.combine([(sympy.Rational(sympy.sympify(n), denominator), X) for n, X in pairs])
+        return self.combine([(sympy.Rational(sympy.sympify(n, strict=True), denominator), X) for n, X in pairs])
 
     def vector_field(self, values) -> VectorField:
         return VectorField(self.algebra, [_normal(c) for c in values])

@@ -25,6 +25,7 @@ from sympy.polys.polyutils import expr_from_dict
 from sympy.polys.rings import PolyElement, ring
 
 from ..errors import InvalidSystemError
+from ..parsing import as_expression
 from .zero import is_zero
 
 _CONVERSION_ERRORS = (CoercionFailed, GeneratorsError, PolynomialError, ValueError, TypeError)
@@ -101,7 +102,7 @@ class PolynomialAlgebra:
         self.coordinates = _symbols(coordinates)
         self.parameters = _symbols(parameters)
         self.constants = _symbols(constants)
-        self.extension = tuple(sympy.sympify(e) for e in extension)
+        self.extension = tuple(as_expression(e, (), "extension of a PolynomialAlgebra") for e in extension)
         clash = set(self.coordinates) & (set(self.parameters) | set(self.constants))
         if clash:
             raise InvalidSystemError(
@@ -131,11 +132,19 @@ class PolynomialAlgebra:
         """``expr`` as a ring element when it is a polynomial here, else a sympy expression."""
         if isinstance(expr, PolyElement) and expr.ring == self.ring:
             return expr
-        expr = sympy.sympify(expr)
+        if isinstance(expr, PolyElement):  # another ring's element
+            expr = expr.as_expr()
+        elif not isinstance(expr, sympy.Expr):  # text is parsed with this algebra's symbols, never sympified
+            expr = as_expression(expr, self.symbol_table, "expression")
         try:
             return self.ring.from_expr(expr) if expr.free_symbols else self.ring(self.domain.from_sympy(expr))
         except _CONVERSION_ERRORS:
             return expr
+
+    @cached_property
+    def symbol_table(self) -> dict:
+        """Name -> Symbol of the coordinates, parameters and constants (what a text expression may use)."""
+        return {s.name: s for s in (*self.coordinates, *self.parameters, *self.constants)}
 
     def is_polynomial(self, value) -> bool:
         return isinstance(value, PolyElement) and value.ring == self.ring
@@ -158,7 +167,7 @@ class PolynomialAlgebra:
                     e = memo[c] = to_sympy(c)
                 coefficients[m] = e
             return expr_from_dict(coefficients, *value.ring.symbols)
-        return sympy.sympify(value)
+        return as_expression(value, self.symbol_table, "expression")
 
     def expanded_terms(self, value, factors=()) -> list:
         """The terms of ``sympy.expand(to_sympy(value) * factors[0] * ...)``, built without ``expand``.
@@ -196,7 +205,7 @@ class PolynomialAlgebra:
         True
         """
         if not isinstance(value, PolyElement):
-            return list(sympy.Add.make_args(sympy.expand(sympy.Mul(sympy.sympify(value), *factors))))
+            return list(sympy.Add.make_args(sympy.expand(sympy.Mul(sympy.sympify(value, strict=True), *factors))))
         domain = value.ring.domain
         gens = value.ring.symbols
         factors = list(factors)

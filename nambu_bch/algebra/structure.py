@@ -14,7 +14,14 @@ from __future__ import annotations
 import sympy
 
 from ..errors import NambuBCHError
+from ..parsing import as_expression
 from .zero import is_zero
+
+
+def _components(map_components, coordinates) -> list:
+    """The map's components as sympy expressions; text is parsed in the coordinates and the step ``h``."""
+    symbols = (*coordinates, sympy.Symbol("h"))
+    return [as_expression(y, symbols, f"map component {i + 1}") for i, y in enumerate(map_components)]
 
 
 def jacobian(map_components, coordinates) -> sympy.Matrix:
@@ -23,7 +30,7 @@ def jacobian(map_components, coordinates) -> sympy.Matrix:
         raise NambuBCHError(
             f"a map of {len(coordinates)} coordinates needs {len(coordinates)} components, got {len(map_components)}"
         )
-    return sympy.Matrix(map_components).jacobian(sympy.Matrix(coordinates))
+    return sympy.Matrix(_components(map_components, coordinates)).jacobian(sympy.Matrix(coordinates))
 
 
 def _ring_condition(map_components, coordinates):
@@ -36,7 +43,7 @@ def _ring_condition(map_components, coordinates):
     from .brackets import nambu_bracket
     from .polynomial import PolynomialAlgebra
 
-    ys = [sympy.sympify(y) for y in map_components]
+    ys = _components(map_components, coordinates)
     others = sorted(set().union(*(y.free_symbols for y in ys)) - set(coordinates), key=str)
     try:
         fractions = PolynomialAlgebra(coordinates, parameters=others)

@@ -21,7 +21,7 @@ def has_radicals(expr) -> bool:
     >>> has_radicals(sympy.cbrt(2) * sympy.Symbol("x")), has_radicals(sympy.Symbol("x") ** 2 / 3)
     (True, False)
     """
-    return any(p.base.is_Number and not p.exp.is_Integer for p in sympy.sympify(expr).atoms(sympy.Pow))
+    return any(p.base.is_Number and not p.exp.is_Integer for p in sympy.sympify(expr, strict=True).atoms(sympy.Pow))
 
 
 #: The witness points' coordinates: distinct, irregular rationals in (0, 1) (inside the domain of log, sqrt, 1/x).
@@ -68,7 +68,7 @@ def is_zero(expr) -> bool:
     >>> is_zero(1/(1 + x) - 1/(x + 1)**2 * (x + 1)), is_zero(x - 1)
     (True, False)
     """
-    expr = sympy.sympify(expr)
+    expr = sympy.sympify(expr, strict=True)
     radicals = has_radicals(expr)
     if not radicals and expr.is_rational_function(*sorted(expr.free_symbols, key=str)):
         return sympy.cancel(sympy.together(expr)) == 0

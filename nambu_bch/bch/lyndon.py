@@ -289,7 +289,7 @@ def terms_to_latex(terms, names=None) -> str:
     parts = []
     for item in terms:
         c, tree, factor = item if len(item) == 3 else (*item, sympy.Integer(1))
-        c = sympy.sympify(c)
+        c = sympy.sympify(c, strict=True)
         body = tree_to_latex(tree, names)
         if c.is_Rational:
             magnitude = abs(c) * factor

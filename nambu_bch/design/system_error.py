@@ -33,6 +33,7 @@ from ..errors import InvalidOrderError, InvalidRunError
 from ..integrators.composition import composition_for
 from ..integrators.step import parameter_values
 from ..numeric.iterate import as_system
+from ..parsing import as_expression
 from .conditions import error_analysis
 from ..symbols import STEP
 
@@ -109,7 +110,7 @@ def field_size(components, system, box=None, samples: int = 2000, params=None, s
     if isinstance(components, (str, bytes)) or not hasattr(components, "__iter__"):
         raise InvalidRunError(f"components must be a list of {system.N} sympy expressions (a field), got {show(components)}")
     values = parameter_values(system, params)
-    exprs = [sympy.sympify(c).subs(values) for c in components]
+    exprs = [as_expression(c, system.symbols(), "component").subs(values) for c in components]
     f = sympy.lambdify(system.coordinates, exprs, modules="numpy")
     rng = np.random.RandomState(seed)
     pts = [rng.uniform(lo, hi, samples) for lo, hi in box]

@@ -36,6 +36,7 @@ import sympy
 
 from ..checks import finite_float, is_int, show
 from ..errors import NambuBCHError, NumericalRangeError, UnstableStepError
+from ..parsing import as_expression
 
 #: Below this |x| the series is used (its 13 terms reach 2^-60 relative accuracy).
 _SERIES_CUTOFF = 0.25
@@ -62,7 +63,7 @@ def F_series(x, order: int):
 
     Parameters
     ----------
-    x : sympy expression or number
+    x : sympy expression, number, or text in ``x``, ``omega``, ``h`` (read by the safe parser)
     order : int, highest power of ``x`` kept (>= 0)
 
     Returns
@@ -82,7 +83,7 @@ def F_series(x, order: int):
 
         raise InvalidOrderError(f"order of F_series must be an integer in 0..{MAX_SERIES_ORDER}, got {show(order)}")
     if isinstance(x, (sympy.Basic, str)):
-        x = sympy.sympify(x)
+        x = as_expression(x, sympy.symbols("x omega h"), "x of F_series")
         return sympy.Add(*[sympy.Rational(c.numerator, c.denominator) * x ** (2 * n)
                            for n, c in ((n, _coefficient(n)) for n in range(order // 2 + 1))])
     if isinstance(x, np.ndarray):

@@ -54,6 +54,7 @@ from ..algebra.elimination import nullspace, rank, solve_affine
 from ..errors import InvalidOrderError, InvalidSystemError, NoExactResultError, ResourceLimitError
 from ..integrators import composed_map, composition_for
 from ..integrators.flows import exact_flow
+from ..parsing import as_expression
 from ..printing import Printable, aligned, series_text, series_tokens
 
 H_STEP = sympy.Symbol("h")
@@ -95,7 +96,7 @@ class _Setup:
                 f"the composed map on {system.name} has trigonometric sub-flows (rotations); "
                 "polynomial invariants are not searched for it")
         phi = composed_map(system.splitting, comp)
-        self.phi_exprs = tuple(sympy.sympify(e) for e in phi)
+        self.phi_exprs = tuple(sympy.sympify(e, strict=True) for e in phi)
         try:
             self.phi = tuple(self.R.from_expr(e) for e in self.phi_exprs)
         except Exception:  # CoercionFailed & co: exp(...) flows (Lotka-Volterra), see _exp_images
@@ -362,6 +363,9 @@ class ConservedQuantities(Printable):
 def is_invariant(system, word, quantity) -> bool:
     """``I(Phi_h(x)) - I(x) == 0`` exactly, by substituting the composed map.
 
+    ``quantity`` is a sympy expression or a string in the system's symbols and ``h``
+    (read by :func:`~nambu_bch.parsing.parse_expression`, never evaluated).
+
     Examples
     --------
     >>> from nambu_bch import model
@@ -370,8 +374,9 @@ def is_invariant(system, word, quantity) -> bool:
     >>> is_invariant(model("ho"), "121", H - omega**2*h**2*x2**2/(8*m))   # Eq. (CQPV)
     True
     """
+    quantity = as_expression(quantity, system.symbols(), "quantity")
     phi = composed_map(system.splitting, word)
-    image = sympy.sympify(quantity).subs(dict(zip(system.coordinates, phi)), simultaneous=True)
+    image = quantity.subs(dict(zip(system.coordinates, phi)), simultaneous=True)
     return is_zero(image - quantity)
 
 

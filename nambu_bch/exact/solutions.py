@@ -41,6 +41,7 @@ from ..algebra import liouville_field
 from ..errors import NambuBCHError, NoExactResultError, UnstableStepError
 from ..integrators import composition_for
 from ..integrators.step import parameter_values
+from ..parsing import as_expression
 from .exact_shadow import OMEGA, exact_shadow_hamiltonians, frequency
 from .invariants import conserved_quantities
 from .linear_core import linear_core
@@ -189,7 +190,7 @@ class ModifiedSolution:
         values = parameter_values(self.system, params)
         h = finite_float(h, "h")
         if self.kind != "o":
-            x = complex(sympy.sympify(self.step_frequency).subs(values)) * h
+            x = complex(sympy.sympify(self.step_frequency, strict=True).subs(values)) * h
             if abs(x.imag) > 0 or abs(x.real) >= 2:
                 raise UnstableStepError(f"the modified solution {self.kind!r} needs |omega h| < 2, got omega h = {x.real!r}")
         args = (self.time, *self.initial_symbols, *values, STEP)
@@ -208,10 +209,10 @@ class ModifiedSolution:
 
     def at(self, x0=None, t=None):
         """The expressions with the initial values (and optionally ``t``) substituted."""
-        subs = {} if x0 is None else dict(zip(self.initial_symbols, x0))
+        subs = {} if x0 is None else dict(zip(self.initial_symbols, (as_expression(v, (), "x0") for v in x0)))
         if t is not None:
-            subs[self.time] = t
-        return tuple(sympy.sympify(e).subs(subs) for e in self.expressions)
+            subs[self.time] = as_expression(t, (), "t")
+        return tuple(sympy.sympify(e, strict=True).subs(subs) for e in self.expressions)
 
 
 @lru_cache(maxsize=64)

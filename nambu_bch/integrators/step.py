@@ -40,7 +40,7 @@ def subflow_functions(splitting, comp, params=None):
     values = parameter_values(system, params)
     out = []
     for k, c in comp.factors():
-        exprs = [sympy.sympify(e).subs(values) for e in exact_flow(splitting[k], system.coordinates).expressions]
+        exprs = [sympy.sympify(e, strict=True).subs(values) for e in exact_flow(splitting[k], system.coordinates).expressions]
         f = sympy.lambdify((*system.coordinates, TIME), exprs, modules="numpy")
         out.append((f, float(c)))
     return out

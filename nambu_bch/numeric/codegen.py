@@ -162,7 +162,7 @@ def _step_program(system, comp) -> StepProgram:
         flow = exact_flow(system.splitting[k], coords)
         raw = []
         for i, (x, e) in enumerate(zip(coords, flow.expressions)):
-            d = sympy.sympify(e) - x
+            d = sympy.sympify(e, strict=True) - x
             if d == 0:
                 continue
             d = _with_expm1(sympy.factor_terms(d.subs(TIME, c * STEP)))
@@ -798,7 +798,7 @@ def constants_source(program: StepProgram) -> str:
     inner = [sympy.Symbol(f"p{i}", nambu_internal=True) for i in range(len(program.parameters))]
     rename = dict(zip(program.parameters, inner))
     lines = [f"p{i} = P[{i}]" for i in range(len(inner))]
-    lines += [f"{k} = {print_python(sympy.sympify(e).xreplace(rename), '_')}" for k, e in program.constants]
+    lines += [f"{k} = {print_python(sympy.sympify(e, strict=True).xreplace(rename), '_')}" for k, e in program.constants]
     names = ", ".join(str(k) for k, _ in program.constants)
     return f"""
 

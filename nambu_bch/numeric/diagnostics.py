@@ -80,7 +80,7 @@ def quantities(system, word, h, params=None, order=2, alpha=0.5, which=QUANTITY_
 
     def put(name, expr):
         if name in which and expr is not None:
-            value = sympy.sympify(expr).xreplace(subs)
+            value = sympy.sympify(expr, strict=True).xreplace(subs)
             if value.has(sympy.zoo, sympy.nan, sympy.oo, -sympy.oo):
                 if skipped is not None:
                     given = ", ".join(f"{p} = {v:g}" for p, v in values.items())
@@ -100,8 +100,8 @@ def quantities(system, word, h, params=None, order=2, alpha=0.5, which=QUANTITY_
         if fam is not None and fam.exists:
             free = list(fam.free_parameters)
             extra = {sympy.Symbol(str(s)) if not isinstance(s, sympy.Symbol) else s: sympy.Float(float(alpha), 60) for s in free}
-            put("H_S", None if fam.H_S is None else sympy.sympify(fam.H_S).xreplace(extra))
-            put("G_S", None if fam.G_S is None else sympy.sympify(fam.G_S).xreplace(extra))
+            put("H_S", None if fam.H_S is None else sympy.sympify(fam.H_S, strict=True).xreplace(extra))
+            put("G_S", None if fam.G_S is None else sympy.sympify(fam.G_S, strict=True).xreplace(extra))
     if {"H_S_exact", "G_S_exact"} & set(which):
         es = _try(lambda: _exact().exact_shadow_hamiltonians(system, word))
         if es is not None:

@@ -224,7 +224,7 @@ def truncation_study(system="ho3", word="32123", orders=(2, 4, 6, 8), h=0.1, ste
             if fam.exists:
                 free = {sympy.Symbol(str(s)): sympy.Float(float(alpha), 60) for s in fam.free_parameters}
                 exprs = {"H_S": fam.H_S, "G_S": fam.G_S}
-                exprs = {n: sympy.sympify(e).xreplace(free) for n, e in exprs.items() if e is not None}
+                exprs = {n: sympy.sympify(e, strict=True).xreplace(free) for n, e in exprs.items() if e is not None}
         except NambuBCHError:
             exprs = None
         if exprs is None:  # BCH route unavailable (or no shadow Hamiltonian): the exact family's series

@@ -52,6 +52,7 @@ import numpy as np
 import sympy
 
 from ..checks import is_int
+from ..parsing import as_expression
 from ..errors import NambuBCHError
 
 # Dormand--Prince 5(4) (HNW I, Table II.5.2), FSAL
@@ -104,9 +105,9 @@ def orbit_functions(system, integrands, params: dict, names=None) -> OrbitFuncti
     OrbitFunctions
     """
     coords = system.coordinates
-    subs = {p: sympy.nsimplify(params[p]) for p in system.parameters}
-    field_ = [sympy.expand(sympy.sympify(c).subs(subs)) for c in system.equations_of_motion()]
-    ints = [sympy.expand(sympy.sympify(g).subs(subs)) for g in integrands]
+    subs = {p: sympy.nsimplify(as_expression(params[p], (), f"params[{p}]")) for p in system.parameters}
+    field_ = [sympy.expand(sympy.sympify(c, strict=True).subs(subs)) for c in system.equations_of_motion()]
+    ints = [sympy.expand(as_expression(g, system.symbols(), "integrand").subs(subs)) for g in integrands]
     hams = [sympy.expand(H.subs(subs)) for H in system.hamiltonians]
     for e in field_ + ints + hams:
         stray = e.free_symbols - set(coords)

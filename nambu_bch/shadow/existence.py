@@ -74,6 +74,7 @@ from ..algebra.ansatz import Ansatz, Rows
 from ..algebra.elimination import solve_affine
 from ..checks import is_int
 from ..errors import NambuBCHError
+from ..parsing import as_expression
 from .averaging import orbit_average, orbit_functions, sample_points, section_integral
 from ..symbols import ALPHA, STEP
 
@@ -307,7 +308,7 @@ def _check_params(system, params):
         if str(k) not in by_name:
             raise NambuBCHError(f"unknown parameter {k!r}; the system has {sorted(by_name)}")
         try:
-            val = sympy.nsimplify(v)
+            val = sympy.nsimplify(as_expression(v, (), f"parameter {k}"))  # nsimplify would sympify text
         except (sympy.SympifyError, TypeError) as exc:
             raise NambuBCHError(f"parameter {k} must be a number, got {v!r}") from exc
         if not val.is_real or not val.is_number:

@@ -19,6 +19,7 @@ from dataclasses import dataclass, field
 import sympy
 
 from ..algebra.ansatz import Ansatz
+from ..parsing import as_expression
 from ..printing import Printable, aligned, h_coefficients, latex_text, series_text, series_tokens
 from ..symbols import ALPHA, STEP
 
@@ -276,7 +277,7 @@ class ShadowFamily(Printable):
 
     def member(self, **values) -> tuple:
         """The shadow Hamiltonians at given parameter values, e.g. ``member(alpha=1)`` (Eq. SH12321a)."""
-        subs = {sympy.Symbol(k): sympy.sympify(v) for k, v in values.items()}
+        subs = {sympy.Symbol(k): as_expression(v, self.system.symbols(), f"member({k}=...)") for k, v in values.items()}
         return tuple(sympy.expand(S.subs(subs)) for S in self.shadows)
 
     # -- output ------------------------------------------------------------------
@@ -408,7 +409,7 @@ class ShadowFamily(Printable):
         out["series"] = {name: {str(k): str(c) for k, c in coefficients.items()} for name, coefficients in self.series().items()}
         names = [name for _, name in self._names()]
         out["gauge"] = {str(k): [dict(zip((f"d{n}" for n in names), map(str, direction))) for direction in directions
-                                 if any(sympy.sympify(c) != 0 for c in direction)]  # weight-only FI directions dropped
+                                 if any(sympy.sympify(c, strict=True) != 0 for c in direction)]  # weight-only FI directions dropped
                         for k, directions in sorted(self.gauge.items())}
         out["certificate"] = self._certificate_data()
         out["fi_span"] = self.fi_span

@@ -92,7 +92,7 @@ class RawOps:
         self._coefficients: dict = {}
         self._exprs: dict = {}
         self.hulls: dict = {}  # tree -> NestedHull, for callers that share hulls between words
-        self._ring_atoms = {algebra.convert(a): _atom_id(sympy.sympify(a)) for a in self.atoms}
+        self._ring_atoms = {algebra.convert(a): _atom_id(sympy.sympify(a, strict=True)) for a in self.atoms}
 
     def poly(self, entry):
         if entry not in self._poly:
@@ -136,7 +136,7 @@ class RawOps:
     def coefficient(self, c):
         """A number or sympy constant as an element of the coefficient domain (memoised)."""
         if c not in self._coefficients:
-            self._coefficients[c] = self.domain.from_sympy(sympy.sympify(c))
+            self._coefficients[c] = self.domain.from_sympy(sympy.sympify(c, strict=True))
         return self._coefficients[c]
 
     def from_expanded(self, expanded, coefficient=None) -> dict:
@@ -206,7 +206,7 @@ class RawOps:
     def items(self, raw: dict, coefficient=None) -> list:
         """``[(sympy coefficient, (slot functions...)), ...]`` of a raw sum, in key order."""
         to = self.domain.to_sympy
-        c0 = sympy.Integer(1) if coefficient is None else sympy.sympify(coefficient)
+        c0 = sympy.Integer(1) if coefficient is None else sympy.sympify(coefficient, strict=True)
         out = []
         for k in sorted(raw, key=lambda key: sorted(_content_order(key))):
             order = sorted(range(len(k)), key=lambda i: _content_order((k[i],)))  # slots by content, sign kept

@@ -279,8 +279,8 @@ class FIResult:
             items = w.items() if isinstance(w, dict) else enumerate(w)
             for key, value in items:
                 rep = self._rep(comm, key)
-                total = total + rep.formal.scale(comm.coefficient * sympy.sympify(value))
-            if not is_zero(sum(sympy.sympify(v) for _, v in (w.items() if isinstance(w, dict) else enumerate(w))) - 1):
+                total = total + rep.formal.scale(comm.coefficient * sympy.sympify(value, strict=True))
+            if not is_zero(sum(sympy.sympify(v, strict=True) for _, v in (w.items() if isinstance(w, dict) else enumerate(w))) - 1):
                 raise NambuBCHError(f"the weights of commutator {t} ({comm.label()}) must sum to 1, got {w}")
         return total
 
@@ -501,9 +501,9 @@ def fi_route(system, word, order: int = 2, degree=None, terms=None) -> FIResult:
     entries = []
     for coef, tree in terms:
         if power == 2:
-            entries.append(_as_double(sympy.sympify(coef), tree))
+            entries.append(_as_double(sympy.sympify(coef, strict=True), tree))
         else:
-            entries.append((sympy.sympify(coef), tuple(tree)))
+            entries.append((sympy.sympify(coef, strict=True), tuple(tree)))
     entries = _merge(entries)
     commutators = []
     ops = _raw_ops(alg, atoms)
@@ -756,7 +756,7 @@ def _merged_trees(system, series, j) -> list:
     merged: dict = {}
     for coef, tree in expand_terms(series.terms(j + 1), system.splitting, prune=True,
                                    evaluators=_evaluators(system.splitting)):
-        merged[tree] = merged.get(tree, 0) + sympy.sympify(coef)
+        merged[tree] = merged.get(tree, 0) + sympy.sympify(coef, strict=True)
     return [(c, tree) for tree, c in merged.items() if c != 0]
 
 

@@ -34,6 +34,7 @@ import sympy
 from sympy.polys.rings import PolyElement
 
 from ..algebra import nambu_bracket
+from ..parsing import as_expression
 from .liouville_terms import LiouvilleTerm
 
 #: The paper's labels of the eight representations of a double commutator (N = 3), Eqs. (1AX)-(2BY).
@@ -107,7 +108,7 @@ def commutator_terms(algebra, left, right, way: str, coefficient=1) -> list:
     >>> [str(t) for t in commutator_terms(alg, (x[1], x[2]), (x[0]**2, x[2]), "a")]
     ['X_{2*x1, x3}', 'X_{x1**2, 0}']
     """
-    c = sympy.sympify(coefficient)
+    c = as_expression(coefficient, algebra.symbol_table, "coefficient")
     pairs = _commutator(tuple(left), tuple(right), way, lambda *fs: _bracket(algebra, *fs))
     return [LiouvilleTerm(slots, sign * c) for sign, slots in pairs]
 
@@ -139,7 +140,7 @@ def double_commutator_terms(algebra, a, b, c, label: str, coefficient=1) -> list
     >>> [str(t) for t in double_commutator_terms(alg, AC, AC, BD, "1AX") if not t.vanishes(alg.coordinates)]   # Eq. (CL5)
     ['X_{m*omega**2*x3/2, -2*x2**2/m**2}']
     """
-    c_ = sympy.sympify(coefficient)
+    c_ = as_expression(coefficient, algebra.symbol_table, "coefficient")
     pairs = _double(tuple(a), tuple(b), tuple(c), label, lambda *fs: _bracket(algebra, *fs))
     return [LiouvilleTerm(slots, sign * c_) for sign, slots in pairs]
 

@@ -44,10 +44,167 @@ from ..algebra.zero import is_zero
 from ..bch.backward import check_order, effective_field
 from ..bch.evaluation import BracketEvaluator
 from ..bch.formal import formal_bch
-from ..errors import NambuBCHError, NoExactResultError
+from ..errors import NambuBCHError, NoExactResultError, ResourceLimitError
 from ..integrators.composition import composition_for
 
 H_STEP = sympy.Symbol("h")
+
+#: Largest accepted work estimate of a BCH request on non-polynomial pieces (:func:`bch_work`).  Measured on
+#: ``sin(sin(...(x1)))`` nests under position Verlet through the CLI (docs/hardening.md, round two), the time
+#: was about 7 s + W / 60 s on a shared machine (W = 82: 9 s, 608: 20 s, 2609: 55 s, 2776: 58 s, 7630: > 120 s),
+#: so 4000 is about a minute; W grows 3x-10x per order or nesting level, so the limit is not a fine line.
+MAX_BCH_WORK = 4000
+
+
+def derivative_terms(expr, coordinates, k: int, memo=None) -> int:
+    """An estimate, without differentiating, of the number of terms of a ``k``-th derivative of ``expr``.
+
+    Read from the tree: a sum adds its parts' counts; a product takes one factor's derivative per
+    way of sharing the ``k`` derivatives among its factors (Leibniz); a function of an argument ``g``
+    (``sin(g)``, ``exp(g)``, a non-integer power) has one term per integer partition ``k = k_1 + ...``
+    with the product of ``g``'s ``k_i``-th derivatives (Faa di Bruno; terms with the same block sizes
+    combine).  A factor free of the coordinates has a single term and no derivative.  Capped at
+    ``10**12``.
+
+    >>> x = sympy.Symbol("x1")
+    >>> [derivative_terms(sympy.sin(sympy.sin(x)), [x], k) for k in (1, 2, 3, 4)]   # partitions of k
+    [1, 2, 3, 5]
+    """
+    memo = {} if memo is None else memo
+    coordinates = tuple(coordinates)
+    return _terms(expr, coordinates, k, memo)
+
+
+_CAP_TERMS = 10**12
+
+
+def _partitions(k, largest=None):
+    """The integer partitions of ``k`` (tuples, parts non-increasing)."""
+    largest = k if largest is None else largest
+    if k == 0:
+        yield ()
+        return
+    for part in range(min(k, largest), 0, -1):
+        for rest in _partitions(k - part, part):
+            yield (part, *rest)
+
+
+def _terms(e, coords, k, memo):
+    key = (e, k, coords)
+    found = memo.get(key)
+    if found is not None:
+        return found
+    if k == 0:
+        count = 1
+    elif not e.has(*coords):
+        count = 0
+    elif e.is_Symbol:
+        count = 1 if k == 1 else 0
+    elif e.is_Add:
+        count = sum(_terms(a, coords, k, memo) for a in e.args)
+    elif e.is_Mul:
+        # distribute the k derivatives over the factors: the ways of writing k as an ordered sum
+        counts = [1] + [0] * k  # counts[j]: terms of a j-th derivative of the factors seen so far
+        for a in e.args:
+            new = [0] * (k + 1)
+            for j in range(k + 1):
+                if counts[j]:
+                    for i in range(k - j + 1):
+                        new[j + i] = min(_CAP_TERMS, new[j + i] + counts[j] * _terms(a, coords, i, memo))
+            counts = new
+        count = counts[k]
+    elif e.is_Pow and e.exp.is_Integer and e.exp > 0 and not e.base.is_number:
+        # a polynomial power of g: its derivatives are polynomials in g's derivatives (Faa di Bruno, degree-bounded)
+        count = sum(math_prod(_terms(e.base, coords, part, memo) for part in parts)
+                    for parts in _partitions(k) if len(parts) <= int(e.exp))
+    else:
+        # f(g_1, ...): Faa di Bruno in each argument that moves (a Pow b**g counts its base and exponent)
+        moving = [a for a in e.args if a.has(*coords)]
+        count = 0
+        for g in moving:
+            count += sum(math_prod(_terms(g, coords, part, memo) for part in parts) for parts in _partitions(k))
+    count = min(_CAP_TERMS, count)
+    memo[key] = count
+    return count
+
+
+def math_prod(values):
+    out = 1
+    for v in values:
+        out = min(_CAP_TERMS, out * v)
+    return out
+
+
+def lyndon_words(letters: int, length: int) -> int:
+    """The number of Lyndon words of ``length`` over ``letters`` letters (the necklace polynomial).
+
+    It bounds the number of brackets of that length in the BCH series of a composition of
+    ``letters`` pieces (a basis of the free Lie algebra's degree-``length`` part).
+
+    >>> [lyndon_words(2, j) for j in range(1, 10)]
+    [2, 1, 2, 3, 6, 9, 18, 30, 56]
+    """
+    return sum(_mobius(d) * letters ** (length // d) for d in range(1, length + 1) if length % d == 0) // length
+
+
+def _mobius(n: int) -> int:
+    result, p = 1, 2
+    while p * p <= n:
+        if n % p == 0:
+            n //= p
+            if n % p == 0:
+                return 0
+            result = -result
+        p += 1
+    return -result if n > 1 else result
+
+
+def bch_work(system, pieces, hams, order: int) -> tuple:
+    """``(work, worst piece)``: the size of a BCH request on non-polynomial Hamiltonians, from its input alone.
+
+    ``work = sum_j lyndon_words(pieces, j) * sum_H sum_x derivative_terms(H, x, j)`` over the bracket
+    lengths ``j = 1 .. order + 1``: a bracket of ``j`` letters differentiates the pieces up to ``j`` times,
+    and there are at most ``lyndon_words(pieces, j)`` of them.  Polynomial Hamiltonians are left out (their
+    derivatives only shrink); so the estimate is 0 for polynomial systems.
+    """
+    coords = system.coordinates
+    memo: dict = {}
+    work, worst = 0, (0, None)
+    for H in hams:
+        expr = sympy.sympify(H, strict=True)
+        if expr.is_polynomial(*coords):
+            continue
+        size = 0
+        for j in range(1, order + 2):
+            terms = sum(derivative_terms(expr, [x], j, memo) for x in coords)
+            size = min(_CAP_TERMS, size + lyndon_words(pieces, j) * terms)
+        work = min(_CAP_TERMS, work + size)
+        worst = max(worst, (size, expr), key=lambda pair: pair[0])
+    return work, worst[1]
+
+
+def check_work(system, pieces: int, hams, order: int) -> int:
+    """Refuse, before any work, a BCH request on non-polynomial pieces estimated above :data:`MAX_BCH_WORK`.
+
+    Returns
+    -------
+    int -- the estimate :func:`bch_work`
+
+    Raises
+    ------
+    ResourceLimitError
+        naming the order, the largest piece, the estimate and the limit.
+    """
+    work, worst = bch_work(system, pieces, hams, order)
+    if work > MAX_BCH_WORK:
+        shown = work if work < _CAP_TERMS else "> 10^12"
+        piece = str(worst)
+        piece = piece if len(piece) <= 60 else piece[:57] + "..."
+        raise ResourceLimitError(
+            f"{system.name}: the shadow Hamiltonian through h^{order} differentiates {piece} up to {order + 1} times "
+            f"in every bracket of the BCH series: about {shown} terms (at most {MAX_BCH_WORK} are accepted, about a "
+            "minute; estimated before any work): lower the order or the nesting of functions")
+    return work
 
 
 def poisson_structure(system):
@@ -157,6 +314,7 @@ def bch_shadow(system, word, order: int = 2, verify: bool = True) -> PoissonShad
             "bracket (accepted: canonical T|V splits, or Nambu systems with split='single'); use the direct route")
     hams, fixed = structure
     comp = composition_for(word, system.splitting)
+    check_work(system, len(hams), (*hams, *fixed), order)
     alg = system.algebra
     frac = _FractionBackend.make(system, (*hams, *fixed))
     if frac is not None:  # rational Hamiltonians: exact sparse fractions, no expand/cancel of sympy trees
@@ -176,7 +334,7 @@ def bch_shadow(system, word, order: int = 2, verify: bool = True) -> PoissonShad
         for c, tree in series.terms(j + 1):
             value = evaluator.value(tree)
             if value is not None:
-                total += sympy.sympify(c) * to_sympy(value)
+                total += sympy.sympify(c, strict=True) * to_sympy(value)
         out[j] = _tidy(total)
     result = PoissonShadow(system, comp, order, out, tuple(fixed), brackets=evaluator.brackets_computed)
     if verify:
@@ -201,9 +359,9 @@ class _FractionBackend:
     @classmethod
     def make(cls, system, exprs):
         symbols = (*system.coordinates, *system.parameters)
-        if all(sympy.sympify(e).is_polynomial(*system.coordinates) for e in exprs):
+        if all(sympy.sympify(e, strict=True).is_polynomial(*system.coordinates) for e in exprs):
             return None  # the polynomial ring is faster still
-        if not all(sympy.sympify(e).is_rational_function(*symbols) for e in exprs):
+        if not all(sympy.sympify(e, strict=True).is_rational_function(*symbols) for e in exprs):
             return None
         from sympy.polys.domains import QQ
         from sympy.polys.fields import field
@@ -212,7 +370,7 @@ class _FractionBackend:
         return cls(system, K, gens)
 
     def convert(self, expr):
-        return self.field.from_expr(sympy.sympify(expr))
+        return self.field.from_expr(sympy.sympify(expr, strict=True))
 
     def to_sympy(self, value):
         return value.as_expr()

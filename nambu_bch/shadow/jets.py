@@ -30,6 +30,7 @@ from sympy.polys.rings import PolyElement, ring
 
 from ..algebra import PolynomialAlgebra
 from ..errors import NambuBCHError
+from ..parsing import as_expression
 
 
 class JetAlgebra(PolynomialAlgebra):
@@ -86,7 +87,8 @@ class JetAlgebra(PolynomialAlgebra):
     def convert(self, expr):
         if isinstance(expr, PolyElement) and expr.ring == self.ring:
             return expr
-        expr = sympy.sympify(expr)
+        if not isinstance(expr, sympy.Expr):
+            expr = as_expression(expr, self.symbol_table, "expression")
         reps = {v: sympy.Symbol(f"_jet{k}") for k, v in self._sympy_of.items()}
         derivs = sorted(expr.atoms(sympy.Derivative), key=lambda d: -len(d.variables))
         body = expr.xreplace({d: reps[d] for d in derivs if d in reps})
@@ -101,7 +103,7 @@ class JetAlgebra(PolynomialAlgebra):
         if isinstance(value, PolyElement):
             subs = {self.ring.symbols[k]: v for k, v in self._sympy_of.items()}
             return value.as_expr().xreplace(subs)
-        return sympy.sympify(value)
+        return sympy.sympify(value, strict=True)
 
     def diff(self, value, index: int):
         """The total derivative ``D_index = d/dx_index + sum_alpha F_{alpha + e_index} d/dF_alpha``.

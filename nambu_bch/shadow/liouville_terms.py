@@ -40,6 +40,7 @@ from ..algebra import VectorField, liouville_field
 from ..algebra.brackets import permutation_sign
 from ..algebra.elimination import rank
 from ..errors import NambuBCHError
+from ..parsing import as_expression
 
 
 @dataclass(frozen=True)
@@ -62,8 +63,9 @@ class LiouvilleTerm:
 
     def __post_init__(self):
         # ring elements (exact sparse polynomials) are kept as they are: nested brackets stay fast
-        object.__setattr__(self, "slots", tuple(s if isinstance(s, PolyElement) else sympy.sympify(s) for s in self.slots))
-        object.__setattr__(self, "coefficient", sympy.sympify(self.coefficient))
+        object.__setattr__(self, "slots", tuple(s if isinstance(s, PolyElement) else as_expression(s, None, "a slot of a LiouvilleTerm")
+                                                for s in self.slots))
+        object.__setattr__(self, "coefficient", as_expression(self.coefficient, None, "the coefficient of a LiouvilleTerm"))
 
     @property
     def expressions(self) -> tuple:
@@ -74,7 +76,7 @@ class LiouvilleTerm:
         return LiouvilleTerm(self.slots, -self.coefficient)
 
     def scale(self, c) -> "LiouvilleTerm":
-        return LiouvilleTerm(self.slots, self.coefficient * sympy.sympify(c))
+        return LiouvilleTerm(self.slots, self.coefficient * as_expression(c, None, "a LiouvilleTerm's scale"))
 
     def canonical(self) -> "LiouvilleTerm":
         """Slots in sympy's canonical order, the coefficient times the permutation's sign (antisymmetry)."""
@@ -190,7 +192,7 @@ def clear_cache() -> None:
 def _to_domain(algebra, c):
     """A number / sympy constant / domain element as an element of the algebra's coefficient domain."""
     if isinstance(c, (int, sympy.Basic, Fraction)):
-        return algebra.domain.from_sympy(sympy.sympify(c))
+        return algebra.domain.from_sympy(sympy.sympify(c, strict=True))
     return algebra.domain.convert(c)
 
 
@@ -241,10 +243,10 @@ class LiouvilleSum:
     def from_slots(cls, algebra, slots, coefficient=1, atoms=()) -> "LiouvilleSum":
         """Expand ``coefficient * X_{slots}`` multilinearly into canonical terms (slots equal to an atom stay whole)."""
         n = algebra.n
-        atoms = tuple(sympy.sympify(a) for a in atoms)
+        atoms = tuple(as_expression(a, algebra.symbol_table, "an atom of a LiouvilleSum") for a in atoms)
         polys = []
         for s in slots:
-            s_expr = algebra.to_sympy(s) if algebra.is_polynomial(s) else sympy.sympify(s)
+            s_expr = algebra.to_sympy(s) if algebra.is_polynomial(s) else as_expression(s, algebra.symbol_table, "a slot")
             if atoms and s_expr in atoms:
                 polys.append([((1, _atom_id(s_expr)), algebra.domain.one)])
                 continue

@@ -5,6 +5,7 @@ from __future__ import annotations
 import sympy
 
 from ..errors import NotSeparableError
+from ..parsing import as_expression
 
 
 def separate(expr, coordinates, name: str = "H") -> tuple:
@@ -27,7 +28,7 @@ def separate(expr, coordinates, name: str = "H") -> tuple:
     """
     coords = tuple(coordinates)
     pieces = [sympy.Integer(0)] * len(coords)
-    for term in sympy.Add.make_args(sympy.expand(sympy.sympify(expr))):
+    for term in sympy.Add.make_args(sympy.expand(as_expression(expr, coords, name))):
         used = [i for i, x in enumerate(coords) if term.has(x)]
         if len(used) > 1:
             names = ", ".join(str(coords[i]) for i in used)

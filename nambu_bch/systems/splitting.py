@@ -85,7 +85,7 @@ class Splitting:
 
 
 def _is_constant(expr, coords) -> bool:
-    return not any(sympy.sympify(expr).has(x) for x in coords)
+    return not any(sympy.sympify(expr, strict=True).has(x) for x in coords)
 
 
 def _moving(field: VectorField) -> tuple:
@@ -192,7 +192,7 @@ def canonical_split(system, fine: bool = False) -> Splitting:
 
 def _is_shear(field, moving) -> bool:
     xs = [field.algebra.coordinates[i] for i in moving]
-    return not any(sympy.sympify(field.algebra.to_sympy(field.components[i])).has(*xs) for i in moving)
+    return not any(sympy.sympify(field.algebra.to_sympy(field.components[i]), strict=True).has(*xs) for i in moving)
 
 
 def triplet_split(system, single: bool = False) -> Splitting:

@@ -10,7 +10,8 @@ from functools import cached_property
 import sympy
 
 from ..algebra import PolynomialAlgebra, VectorField, liouville_field
-from ..errors import InvalidSystemError
+from ..errors import InvalidSystemError, NambuBCHError
+from ..parsing import as_expression
 
 #: Symbols reserved by the package: the step and the family parameter.
 RESERVED_SYMBOLS = ("h", "alpha")
@@ -260,15 +261,12 @@ class System:
 
     def _parse(self, H):
         if isinstance(H, str):
-            from ..parsing import parse_expression
-
-            return parse_expression(H, symbols=(*self.coordinates, *self.parameters))
-        try:
-            H = sympy.sympify(H, strict=True)
-        except (sympy.SympifyError, TypeError, ValueError):
-            raise InvalidSystemError(f"Hamiltonian {H!r} is not a sympy expression") from None
+            return as_expression(H, (*self.coordinates, *self.parameters), "expression")
         if not isinstance(H, sympy.Expr):
-            raise InvalidSystemError(f"Hamiltonian {H!r} is not an algebraic expression")
+            try:
+                H = as_expression(H, (), "Hamiltonian")
+            except NambuBCHError:
+                raise InvalidSystemError(f"Hamiltonian {H!r} is not a sympy expression") from None
         # symbolic code never sees floats: read 0.5 as 1/2 (the decimal the user wrote)
         return sympy.nsimplify(H, rational=True) if H.has(sympy.Float) else H
 
@@ -340,9 +338,13 @@ class System:
         """
         if not values:
             return self
+        if not isinstance(values, dict):
+            raise InvalidSystemError(f"substitute takes a dict {{name: exact value}}, got {type(values).__name__}")
+        # text values are parsed (numbers only: a value may not name a symbol), never sympified
+        values = {k: as_expression(v, (), f"the value of {k}") for k, v in values.items()}
         subs = {p: values[p.name] for p in self.parameters if p.name in values}
         rest = tuple(p for p in self.parameters if p.name not in values)
-        hams = tuple(sympy.sympify(H).subs(subs) for H in self.hamiltonians)
+        hams = tuple(H.subs(subs) for H in self.hamiltonians)
         label = ",".join(f"{k}={v}" for k, v in values.items())
         name = f"{self.name}[{label}]"
         if not SYSTEM_NAME.match(name):  # a long or unusual value: keep the name short and safe
