@@ -58,7 +58,6 @@ have.
 from __future__ import annotations
 
 import ast
-import difflib
 import math
 import numbers
 import warnings
@@ -68,7 +67,7 @@ from fractions import Fraction
 import sympy
 from sympy.polys.rings import PolyElement
 
-from .errors import ExpressionParseError
+from .errors import ExpressionParseError, did_you_mean
 
 #: Longest accepted input, in characters.
 MAX_LENGTH = 2000
@@ -416,8 +415,7 @@ def undeclared_hint(name: str, declared, what: str) -> str:
     """
     if not declared:
         return " (a number is expected here)"
-    close = difflib.get_close_matches(name, [n for n in (*declared, *_CONSTANTS) if n not in ("h", "alpha")], n=1, cutoff=0.6)
-    hint = f" (did you mean {close[0]!r}?)" if close else ""
+    hint = did_you_mean(name, [n for n in (*declared, *_CONSTANTS) if n not in ("h", "alpha")])
     if what.startswith("--system"):
         return f"{hint}; declare it in the file's parameters"
     if what in ("--H", "--G"):
