@@ -122,6 +122,11 @@ class OrderSolution:
             value = self.__dict__["_" + name]
         return value
 
+    def __getstate__(self):
+        """The sympy forms are made before pickling: ``convert`` is a closure over this process's solve."""
+        self._converted("corrections")
+        return {**self.__dict__, "convert": None}
+
     @property
     def extra_gauge_dim(self):
         """Kernel directions not of the form ``(psi_G, -psi_H)`` (system-specific gauge)."""
