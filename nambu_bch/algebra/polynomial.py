@@ -85,7 +85,10 @@ def _monomial_denominator_terms(c, gens, m, params, powers) -> list:
 # classes (and a user's own rings) are untouched; every operation is sympy's.
 
 def _symbol_description(s) -> tuple:
-    return (s.name, tuple(sorted(s.assumptions0.items())))
+    # the assumptions as given (what sympy's own pickle of a Symbol keeps): Symbol("x", commutative=True) equals
+    # Symbol("x") but is another object, which sympy's cache would then hand to unrelated expressions
+    (name,), assumptions = s.__getnewargs_ex__()
+    return (name, tuple(sorted(assumptions.items())))
 
 
 def _symbol_from(description) -> sympy.Symbol:
@@ -98,12 +101,12 @@ def _ground(domain):
 
 
 def _ground_description(ground) -> tuple:
-    """``()`` for ``QQ``, the extension numbers as ``srepr`` text for an algebraic field ``QQ<ext>``."""
-    return () if ground.is_QQ else tuple(sympy.srepr(e) for e in ground.orig_ext)
+    """``()`` for ``QQ``, the extension numbers (sympy expressions such as ``2**(1/3)``) for ``QQ<ext>``."""
+    return () if ground.is_QQ else tuple(ground.orig_ext)
 
 
 def _ground_from(description):
-    return QQ.algebraic_field(*(sympy.sympify(e) for e in description)) if description else QQ
+    return QQ.algebraic_field(*description) if description else QQ
 
 
 def _domain_from(extension, parameters):
@@ -112,9 +115,9 @@ def _domain_from(extension, parameters):
     return FractionField(_PicklableField(tuple(parameters), ground)) if parameters else ground
 
 
-def _primitive(ground) -> str | None:
-    """``srepr`` of the primitive element in which algebraic numbers are written (``None`` over ``QQ``)."""
-    return None if ground.is_QQ else sympy.srepr(ground.ext)
+def _primitive(ground):
+    """The primitive element in which algebraic numbers are written, a sympy expression (``None`` over ``QQ``)."""
+    return None if ground.is_QQ else ground.ext.as_expr()
 
 
 def _rational(c) -> tuple:
@@ -128,9 +131,9 @@ def _ground_codec(ground, primitive=None):
     """
     if ground.is_QQ:
         return _rational, lambda d: QQ(*d)
-    if primitive is not None and sympy.sympify(primitive) != ground.ext:
-        a = sympy.sympify(primitive)
-        return None, lambda d: ground.from_sympy(sympy.Add(*(sympy.Rational(*c) * a**k for k, c in enumerate(reversed(d)))))
+    if primitive is not None and primitive != ground.ext.as_expr():
+        return None, lambda d: ground.from_sympy(sympy.Add(*(sympy.Rational(*c) * primitive**k
+                                                             for k, c in enumerate(reversed(d)))))
     return (lambda c: tuple(map(_rational, c.to_list())),
             lambda d: ground.new([QQ(*c) for c in d]))
 
@@ -300,9 +303,9 @@ class PolynomialAlgebra:
         return hash(self._key())
 
     def __reduce__(self):
-        """Pickle as the description: symbol names with assumptions, extension numbers as ``srepr`` text."""
+        """Pickle as the description: symbol names with assumptions, and the extension numbers."""
         symbols = tuple(tuple(map(_symbol_description, group)) for group in self._key()[:3])
-        return _algebra_from, (*symbols, tuple(sympy.srepr(e) for e in self.extension))
+        return _algebra_from, (*symbols, self.extension)
 
     def __repr__(self):
         return f"PolynomialAlgebra(coordinates={self.coordinates}, parameters={self.parameters}, constants={self.constants})"
@@ -472,5 +475,4 @@ class PolynomialAlgebra:
 
 def _algebra_from(coordinates, parameters, constants, extension) -> PolynomialAlgebra:
     """The algebra described by :meth:`PolynomialAlgebra.__reduce__`."""
-    return PolynomialAlgebra(*(map(_symbol_from, group) for group in (coordinates, parameters, constants)),
-                             tuple(sympy.sympify(e) for e in extension))
+    return PolynomialAlgebra(*(map(_symbol_from, group) for group in (coordinates, parameters, constants)), extension)
