@@ -245,6 +245,13 @@ def test_pickle_is_plain_data():
         assert name not in data
 
 
+def test_rings_a_computation_passes_to_pickle():
+    """A ring's ``clone`` keeps the class: polynomials over ZZ (cleared denominators) pickle too."""
+    R = _ho3().algebra.ring.clone(domain=sympy.ZZ)
+    q = R.from_dict({(2, 0, 0, 0): sympy.ZZ(6), (0, 1, 0, 0): sympy.ZZ(1)})
+    assert pickle.loads(pickle.dumps(q)) == q
+
+
 def test_algebraic_numbers_written_in_another_primitive_element():
     """A pickle from a sympy that chose another primitive element for QQ<sqrt(2), i> is read through sympy."""
     from nambu_bch.algebra.polynomial import _polynomial_from
@@ -265,7 +272,7 @@ def test_sympy_rings_are_untouched():
 # -- in worker processes ------------------------------------------------------------------
 
 WORKER_CASES = ("ho3 12321 h^4", "rigid-body 12321 h^4", "ho3 conserved 32123", "ho3 exact 12321",
-                "ho 121 h^4 fi", "ho3 effective field h^4", "rigid-body 123 none")
+                "ho 121 h^4 fi", "ho3 effective field h^4", "rigid-body 123 none", "rigid-body algebra")
 
 
 def _compute(case: str):
@@ -277,6 +284,8 @@ def _compute(case: str):
         return nb.exact_shadow_hamiltonians(S, "12321")
     if what == "effective field h^4":
         return nb.effective_field(S.splitting, "12321", order=4)
+    if what == "algebra":
+        return S.algebra
     if what == "123 none":
         return nb.shadow_hamiltonians(S, "123", order=2)
     word, order, *route = what.split()
@@ -291,3 +300,7 @@ def test_results_come_back_from_spawned_workers():
         local = _compute(case)
         assert type(result) is type(local), case
         assert _views(result) == _views(local), case
+    # an algebra from another process equals, and hashes like, this process's: content-keyed caches hit
+    algebra = remote[WORKER_CASES.index("rigid-body algebra")]
+    assert algebra == nb.model("rigid-body").algebra and hash(algebra) == hash(nb.model("rigid-body").algebra)
+    assert {algebra: 1}.get(nb.model("rigid-body").algebra) == 1

@@ -19,7 +19,7 @@ from functools import cached_property
 
 import sympy
 from sympy.core.mul import _mulsort
-from sympy.polys.domains import QQ, FractionField
+from sympy.polys.domains import QQ, ZZ, FractionField
 from sympy.polys.fields import FracElement, FracField
 from sympy.polys.polyerrors import CoercionFailed, GeneratorsError, PolynomialError
 from sympy.polys.polyutils import expr_from_dict
@@ -100,12 +100,19 @@ def _ground(domain):
     return domain.domain if getattr(domain, "is_FractionField", False) else domain
 
 
-def _ground_description(ground) -> tuple:
-    """``()`` for ``QQ``, the extension numbers (sympy expressions such as ``2**(1/3)``) for ``QQ<ext>``."""
-    return () if ground.is_QQ else tuple(ground.orig_ext)
+def _ground_description(ground):
+    """``()`` for ``QQ``, ``"ZZ"`` for ``ZZ`` (a ring's ``clone`` may pass to it), the extension numbers (sympy
+    expressions such as ``2**(1/3)``) for ``QQ<ext>``."""
+    if ground.is_QQ or ground.is_ZZ:
+        return () if ground.is_QQ else "ZZ"
+    if not ground.is_AlgebraicField:
+        raise TypeError(f"polynomials over {ground} do not pickle (QQ, ZZ and algebraic number fields do)")
+    return tuple(ground.orig_ext)
 
 
 def _ground_from(description):
+    if description == "ZZ":
+        return ZZ
     return QQ.algebraic_field(*description) if description else QQ
 
 
@@ -117,7 +124,7 @@ def _domain_from(extension, parameters):
 
 def _primitive(ground):
     """The primitive element in which algebraic numbers are written, a sympy expression (``None`` over ``QQ``)."""
-    return None if ground.is_QQ else ground.ext.as_expr()
+    return ground.ext.as_expr() if ground.is_AlgebraicField else None
 
 
 def _rational(c) -> tuple:
@@ -125,12 +132,14 @@ def _rational(c) -> tuple:
 
 
 def _ground_codec(ground, primitive=None):
-    """``(describe, rebuild)``: an element of ``QQ`` or ``QQ<a>`` (dense in ``a``) as tuples of ints, and back.
+    """``(describe, rebuild)``: an element of ``QQ``, ``ZZ`` or ``QQ<a>`` (dense in ``a``) as ints, and back.
 
     ``primitive`` is the writer's primitive element; if this sympy chose another one, numbers go through sympy.
     """
     if ground.is_QQ:
         return _rational, lambda d: QQ(*d)
+    if ground.is_ZZ:
+        return int, ZZ
     if primitive is not None and primitive != ground.ext.as_expr():
         return None, lambda d: ground.from_sympy(sympy.Add(*(sympy.Rational(*c) * primitive**k
                                                              for k, c in enumerate(reversed(d)))))
