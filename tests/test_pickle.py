@@ -6,12 +6,12 @@ fields inside them pickle as a plain exact description (:mod:`nambu_bch.algebra.
 
 from __future__ import annotations
 
+import dataclasses
 import importlib
 import inspect
 import json
 import multiprocessing
 import pickle
-import dataclasses
 from concurrent.futures import ProcessPoolExecutor
 
 import numpy as np
@@ -206,6 +206,7 @@ def test_more_results_round_trip(name):
 
 
 def test_exact_data_survive():
+    """The copy's exact polynomials are the original's: same sympy forms, same ring elements, same classes."""
     fam = nb.shadow_hamiltonians(_ho3(), "12321", order=4)
     copy = pickle.loads(pickle.dumps(fam))
     assert sympy.expand(copy.H_S - fam.H_S) == 0 and sympy.expand(copy.G_S - fam.G_S) == 0
@@ -216,6 +217,7 @@ def test_exact_data_survive():
 
 
 def test_algebra_rebuilds_from_its_description():
+    """QQ, QQ(m) with a constant, QQ<2^(1/3)>(m), QQ<sqrt(2), i>: the algebra and its polynomials come back equal."""
     x, y, m = sympy.symbols("x y m", positive=True)
     for algebra in (nb.PolynomialAlgebra([x, y]), nb.PolynomialAlgebra([x, y], [m], [sympy.Symbol("h")]),
                     nb.PolynomialAlgebra([x, y], [m], extension=[sympy.cbrt(2)]),
@@ -223,7 +225,8 @@ def test_algebra_rebuilds_from_its_description():
         copy = pickle.loads(pickle.dumps(algebra))
         assert copy == algebra and hash(copy) == hash(algebra) and copy.ring == algebra.ring
         assert copy.coordinates[0].is_positive
-        p = algebra.convert((1 + algebra.extension[0] if algebra.extension else 1) * x**2 * y / (3 + (m if algebra.parameters else 0)))
+        number = 1 + algebra.extension[0] if algebra.extension else 1
+        p = algebra.convert(number * x**2 * y / (3 + (m if algebra.parameters else 0)))
         q = pickle.loads(pickle.dumps(p))
         assert q == p and copy.is_polynomial(q) and q * q == p * p
 
