@@ -70,6 +70,8 @@ BUILDERS = {
                                                                        x0=(1, 1, 1)),
     "TruncationStudy": lambda: importlib.import_module("nambu_bch.numeric").truncation_study(
         "ho3", "32123", orders=(2,), steps=100, every=10, x0=(1, 1, 1)),
+    "PrecisionStudy": lambda: importlib.import_module("nambu_bch.numeric").precision_study(
+        "ho3", "32123", h=0.1, steps=200, every=10, mp_steps=50, dps=20, repeats=1, timing_steps=100, x0=(1, 1, 1)),
     "RunningStats": lambda: importlib.import_module("nambu_bch.numeric").RunningStats(),
     "DirectResult": lambda: importlib.import_module("nambu_bch.shadow").direct_route(_ho3(), "12321", order=4),
     "Existence": _existence,
@@ -101,7 +103,6 @@ NOT_RESULTS = {
     "Progress": "a live progress display",
     "Kernel": "compiled machine code, rebuilt from the per-process cache",
     "StepProgram": "generated source for the compiled kernel, rebuilt per process",
-    "PrecisionStudy": "only from precision_study, minutes of mpmath iteration; its fields are plain numbers",
     "FigureSet": "matplotlib figures from paper_figures, minutes of iteration",
 }
 
