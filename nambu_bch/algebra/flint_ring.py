@@ -38,6 +38,7 @@ class FlintRing:
     """
 
     def __init__(self, names, n: int):
+        self.names = tuple(names)
         flint = importlib.import_module("flint")
         # flint names are cosmetic and ASCII-only (a generator may be called ``ω``): v0, v1, .. in the given order
         self.ctx = flint.fmpq_mpoly_ctx.get(tuple(f"v{i}" for i in range(len(tuple(names)))), "lex")
@@ -46,6 +47,16 @@ class FlintRing:
         self.gens = tuple(self.ctx.gens())
         self.zero = self.ctx.from_dict({})
         self.ring = SimpleNamespace(one=self.ctx.from_dict({(0,) * len(self.gens): 1}))
+
+    def __reduce__(self):
+        """Pickle as the generator names and the number of coordinates (a flint context is process-local)."""
+        return FlintRing, (self.names, self.n)
+
+    def __eq__(self, other):
+        return isinstance(other, FlintRing) and (self.names, self.n) == (other.names, other.n)
+
+    def __hash__(self):
+        return hash((self.names, self.n))
 
     def from_terms(self, terms: dict):
         """The polynomial ``sum c x^e`` of ``{exponent tuple: rational}`` (sympy ``QQ`` elements or flint ``fmpq``)."""

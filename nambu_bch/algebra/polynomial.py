@@ -19,10 +19,12 @@ from functools import cached_property
 
 import sympy
 from sympy.core.mul import _mulsort
-from sympy.polys.domains import QQ
+from sympy.polys.domains import QQ, ZZ, FractionField
+from sympy.polys.fields import FracElement, FracField
 from sympy.polys.polyerrors import CoercionFailed, GeneratorsError, PolynomialError
 from sympy.polys.polyutils import expr_from_dict
-from sympy.polys.rings import PolyElement, ring
+from sympy.polys.orderings import lex
+from sympy.polys.rings import PolyElement, PolyRing
 
 from ..errors import InvalidSystemError
 from ..parsing import as_expression
@@ -75,6 +77,191 @@ def _monomial_denominator_terms(c, gens, m, params, powers) -> list:
     return out
 
 
+# -- pickling -----------------------------------------------------------------------------
+# sympy's own pickling of rings and rational-function fields fails (PolyRing.__getstate__ deletes keys of the
+# dict it iterates, sympy 1.14) and would tie a pickle to sympy's and the ground types' internals.  The rings
+# and coefficient fields built here therefore pickle as a plain description instead: generator names with
+# their assumptions, the coefficient field (extension numbers, parameters), and each element's terms as
+# exponent tuples with exact rational coefficients in Python ints.  Subclasses carry this, so sympy's own
+# classes (and a user's own rings) are untouched; every operation is sympy's.
+
+def _symbol_description(s) -> tuple:
+    # the assumptions as given (what sympy's own pickle of a Symbol keeps): Symbol("x", commutative=True) equals
+    # Symbol("x") but is another object, which sympy's cache would then hand to unrelated expressions
+    (name,), assumptions = s.__getnewargs_ex__()
+    return (name, tuple(sorted(assumptions.items())))
+
+
+def _symbol_from(description) -> sympy.Symbol:
+    name, assumptions = description
+    return sympy.Symbol(name, **dict(assumptions))
+
+
+def _ground(domain):
+    return domain.domain if getattr(domain, "is_FractionField", False) else domain
+
+
+def _ground_description(ground):
+    """``()`` for ``QQ``, ``"ZZ"`` for ``ZZ`` (a ring's ``clone`` may pass to it), the extension numbers (sympy
+    expressions such as ``2**(1/3)``) for ``QQ<ext>``."""
+    if ground.is_QQ or ground.is_ZZ:
+        return () if ground.is_QQ else "ZZ"
+    if not ground.is_AlgebraicField:
+        raise TypeError(f"polynomials over {ground} do not pickle (QQ, ZZ and algebraic number fields do)")
+    return tuple(ground.orig_ext)
+
+
+def _ground_from(description):
+    if description == "ZZ":
+        return ZZ
+    return QQ.algebraic_field(*description) if description else QQ
+
+
+def _domain_from(extension, parameters):
+    """``QQ``, ``QQ<extension>``, ``QQ(parameters)`` or ``QQ<extension>(parameters)``, the fraction field picklable."""
+    ground = QQ.algebraic_field(*extension) if extension else QQ
+    return FractionField(_PicklableField(tuple(parameters), ground)) if parameters else ground
+
+
+def _primitive(ground):
+    """The primitive element in which algebraic numbers are written, a sympy expression (``None`` over ``QQ``)."""
+    return ground.ext.as_expr() if ground.is_AlgebraicField else None
+
+
+def _rational(c) -> tuple:
+    return (int(QQ.numer(c)), int(QQ.denom(c)))
+
+
+def _ground_codec(ground, primitive=None):
+    """``(describe, rebuild)``: an element of ``QQ``, ``ZZ`` or ``QQ<a>`` (dense in ``a``) as ints, and back.
+
+    ``primitive`` is the writer's primitive element; if this sympy chose another one, numbers go through sympy.
+    """
+    if ground.is_QQ:
+        return _rational, lambda d: QQ(*d)
+    if ground.is_ZZ:
+        return int, ZZ
+    if primitive is not None and primitive != ground.ext.as_expr():
+        return None, lambda d: ground.from_sympy(sympy.Add(*(sympy.Rational(*c) * primitive**k
+                                                             for k, c in enumerate(reversed(d)))))
+    return (lambda c: tuple(map(_rational, c.to_list())),
+            lambda d: ground.new([QQ(*c) for c in d]))
+
+
+def _terms(p, describe) -> tuple:
+    return tuple((m, describe(c)) for m, c in p.items())
+
+
+def _ring_from(symbols, ground):
+    """The polynomial ring described by :meth:`_PicklableRing.__reduce__`."""
+    return _PicklableRing(tuple(map(_symbol_from, symbols)), _ground_from(ground))
+
+
+def _ring_over_field_from(symbols, field):
+    """A polynomial ring over a rational-function field described by :meth:`_PicklableRing.__reduce__`."""
+    return _PicklableRing(tuple(map(_symbol_from, symbols)), FractionField(field))
+
+
+def _polynomial_from(ring, terms, primitive=None):
+    """The polynomial described by :meth:`_PicklablePolynomial.__reduce__`."""
+    domain = ring.domain
+    if getattr(domain, "is_FractionField", False):
+        field, codec = domain.field, _ground_codec(domain.domain, primitive)[1]
+        return ring.dtype({m: _fraction(field, numer, denom, codec) for m, (numer, denom) in terms})
+    rebuild = _ground_codec(domain, primitive)[1]
+    return ring.dtype({m: rebuild(c) for m, c in terms})
+
+
+def _fraction(field, numer, denom, rebuild):
+    new = field.ring.from_dict
+    return field.raw_new(new({m: rebuild(a) for m, a in numer}), new({m: rebuild(a) for m, a in denom}))
+
+
+def _fraction_from(field, numer, denom, primitive=None):
+    """The rational function described by :meth:`_PicklableFraction.__reduce__`."""
+    return _fraction(field, numer, denom, _ground_codec(field.domain, primitive)[1])
+
+
+def _field_from(symbols, ground):
+    """The rational-function field described by :meth:`_PicklableField.__reduce__`."""
+    return _PicklableField(tuple(map(_symbol_from, symbols)), _ground_from(ground))
+
+
+class _PicklablePolynomial(PolyElement):
+    """sympy's ``PolyElement`` (every operation inherited) that pickles as exponent tuples and exact coefficients."""
+
+    def __reduce__(self):
+        domain = self.ring.domain
+        ground = _ground(domain)
+        describe = _ground_codec(ground)[0]
+        if ground is domain:
+            terms = _terms(self, describe)
+        else:
+            terms = tuple((m, (_terms(c.numer, describe), _terms(c.denom, describe))) for m, c in self.items())
+        return _polynomial_from, (self.ring, terms, _primitive(ground))
+
+
+class _PicklableRing(PolyRing):
+    """sympy's lexicographic ``PolyRing`` whose elements are :class:`_PicklablePolynomial` and which pickles as
+    its generators' names and its coefficient domain's description."""
+
+    def __new__(cls, symbols, domain, order=lex):
+        obj = super().__new__(cls, symbols, domain, order)
+        # hash like sympy's ring of the same content, which it equals
+        obj._hash_tuple = ("PolyRing", *obj._hash_tuple[1:])
+        obj._hash = hash(obj._hash_tuple)
+        obj.dtype = _PicklablePolynomial(obj, ()).new
+        obj.gens = obj._gens()
+        obj._gens_set = set(obj.gens)
+        for symbol, generator in zip(obj.symbols, obj.gens):
+            if isinstance(symbol, sympy.Symbol) and isinstance(getattr(obj, symbol.name, None), PolyElement):
+                setattr(obj, symbol.name, generator)
+        return obj
+
+    def __reduce__(self):
+        if self.order != lex:
+            raise TypeError(f"only lexicographic polynomial rings pickle, not {self.order}")
+        symbols = tuple(map(_symbol_description, self.symbols))
+        if getattr(self.domain, "is_FractionField", False):
+            return _ring_over_field_from, (symbols, _picklable_field(self.domain.field))
+        return _ring_from, (symbols, _ground_description(self.domain))
+
+
+class _PicklableFraction(FracElement):
+    """sympy's ``FracElement`` that pickles as its numerator's and denominator's terms."""
+
+    def __reduce__(self):
+        ground = self.field.domain
+        describe = _ground_codec(ground)[0]
+        return _fraction_from, (self.field, _terms(self.numer, describe), _terms(self.denom, describe), _primitive(ground))
+
+
+class _PicklableField(FracField):
+    """sympy's lexicographic ``FracField`` whose elements are :class:`_PicklableFraction` and which pickles as its
+    generators' names and its ground field's description."""
+
+    def __new__(cls, symbols, domain, order=lex):
+        obj = super().__new__(cls, symbols, domain, order)
+        obj._hash_tuple = ("FracField", *obj._hash_tuple[1:])
+        obj._hash = hash(obj._hash_tuple)
+        obj.dtype = _PicklableFraction(obj, obj.ring.zero).raw_new
+        obj.zero, obj.one = obj.dtype(obj.ring.zero), obj.dtype(obj.ring.one)
+        obj.gens = obj._gens()
+        for symbol, generator in zip(obj.symbols, obj.gens):
+            if isinstance(symbol, sympy.Symbol) and isinstance(getattr(obj, symbol.name, None), FracElement):
+                setattr(obj, symbol.name, generator)
+        return obj
+
+    def __reduce__(self):
+        if self.order != lex:
+            raise TypeError(f"only lexicographic rational-function fields pickle, not {self.order}")
+        return _field_from, (tuple(map(_symbol_description, self.symbols)), _ground_description(self.domain))
+
+
+def _picklable_field(field):
+    return field if isinstance(field, _PicklableField) else _PicklableField(field.symbols, field.domain, field.order)
+
+
 class PolynomialAlgebra:
     """Polynomials in ``coordinates`` (and ``constants``) over ``QQ(parameters)``.
 
@@ -108,13 +295,27 @@ class PolynomialAlgebra:
             raise InvalidSystemError(
                 f"symbols {sorted(map(str, clash))} are used both as coordinates and as parameters/constants"
             )
-        domain = QQ.algebraic_field(*self.extension) if self.extension else QQ
-        if self.parameters:
-            domain = domain.frac_field(*self.parameters)
-        self.domain = domain
-        self.ring, *gens = ring(list(self.coordinates + self.constants), domain)
-        self.gens = tuple(gens)
+        self.domain = domain = _domain_from(self.extension, self.parameters)
+        self.ring = _PicklableRing(self.coordinates + self.constants, domain)
+        self.gens = self.ring.gens
         self.n = len(self.coordinates)
+
+    def _key(self) -> tuple:
+        return (self.coordinates, self.parameters, self.constants, self.extension)
+
+    def __eq__(self, other):
+        # two algebras built from the same description are the same algebra (and share content-keyed caches)
+        if not isinstance(other, PolynomialAlgebra):
+            return NotImplemented
+        return self._key() == other._key()
+
+    def __hash__(self):
+        return hash(self._key())
+
+    def __reduce__(self):
+        """Pickle as the description: symbol names with assumptions, and the extension numbers."""
+        symbols = tuple(tuple(map(_symbol_description, group)) for group in self._key()[:3])
+        return _algebra_from, (*symbols, self.extension)
 
     def __repr__(self):
         return f"PolynomialAlgebra(coordinates={self.coordinates}, parameters={self.parameters}, constants={self.constants})"
@@ -288,3 +489,8 @@ class PolynomialAlgebra:
         if all(isinstance(v, PolyElement) for v in values):
             return values
         return tuple(self.to_sympy(v) for v in values)
+
+
+def _algebra_from(coordinates, parameters, constants, extension) -> PolynomialAlgebra:
+    """The algebra described by :meth:`PolynomialAlgebra.__reduce__`."""
+    return PolynomialAlgebra(*(map(_symbol_from, group) for group in (coordinates, parameters, constants)), extension)

@@ -48,6 +48,10 @@ class VectorField:
         self.algebra = algebra
         self.components = algebra.common(*(algebra.convert(c) for c in components))
 
+    def __reduce__(self):
+        """Pickle as the algebra and the components (ring elements pickle as exponent tuples and exact coefficients)."""
+        return _vector_field_from, (self.algebra, self.components)
+
     @classmethod
     def zero(cls, algebra: PolynomialAlgebra) -> "VectorField":
         return cls(algebra, [algebra.zero] * algebra.n)
@@ -139,6 +143,13 @@ class VectorField:
 
     def __repr__(self):
         return f"VectorField({self.to_sympy()})"
+
+
+def _vector_field_from(algebra, components) -> VectorField:
+    """The field :meth:`VectorField.__reduce__` described (components already in the algebra's representation)."""
+    X = object.__new__(VectorField)
+    X.algebra, X.components = algebra, tuple(components)
+    return X
 
 
 def lie_bracket(X: VectorField, Y: VectorField) -> VectorField:

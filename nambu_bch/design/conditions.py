@@ -347,6 +347,17 @@ class OrderConditions:
     def _repr_latex_(self):
         return f"${self.to_latex()}$"
 
+    def __reduce__(self):
+        """Pickle the equations expanded: sympy's own pickle re-evaluates ``factor_terms``' ``-(2 a + b)/4``
+        into ``-a/2 - b/4``, so the copy would print differently."""
+        expanded = tuple((w, sympy.expand(e)) for w, e in self.equations)
+        return _order_conditions_from, (self.template, self.order, expanded, self.unknowns)
+
+
+def _order_conditions_from(template, order, expanded, unknowns) -> OrderConditions:
+    """The conditions :meth:`OrderConditions.__reduce__` described, in :func:`order_conditions`' form."""
+    return OrderConditions(template, order, tuple((w, sympy.factor_terms(e)) for w, e in expanded), unknowns)
+
 
 def symbolic_defects(T: Template, degree: int) -> dict:
     """``{Lyndon word w: q! [w](log Phi - sum X)}`` of length ``q = degree``, exact polynomials in the unknowns.

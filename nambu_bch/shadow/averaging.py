@@ -46,7 +46,7 @@ Hairer, Norsett, Wanner, Solving Ordinary Differential Equations I, Sect. II.5 (
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 import sympy
@@ -88,6 +88,13 @@ class OrbitFunctions:
     integrand_names: tuple
     values: object = None
     levels: object = None
+    source: tuple = field(default=None, repr=False, compare=False)
+
+    def __reduce__(self):
+        """Pickle as the arguments of :func:`orbit_functions` (the compiled functions are local to this process)."""
+        if self.source is None:
+            raise TypeError("OrbitFunctions built without their source (orbit_functions' arguments) do not pickle")
+        return orbit_functions, self.source
 
 
 def orbit_functions(system, integrands, params: dict, names=None) -> OrbitFunctions:
@@ -123,6 +130,7 @@ def orbit_functions(system, integrands, params: dict, names=None) -> OrbitFuncti
         tuple(names) if names else tuple(f"g{a}" for a in range(len(ints))),
         lambda x: [float(v) for v in f(x[:n])],
         lambda x: [float(v) for v in H(x[:n])],
+        (system, tuple(integrands), dict(params), names),
     )
 
 

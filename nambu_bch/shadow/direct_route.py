@@ -57,6 +57,7 @@ Horikoshi, Eqs. (L1), (L2), (SHPV), (SHPV1), (BCH5), (SH12321a)-(SG12321c),
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass, field
 from itertools import product
@@ -287,6 +288,13 @@ def needed_degree(gdeg, rhs_deg: int) -> tuple:
     return max(1, max(rhs_deg + 1 - s for s in sums)), max(sums)
 
 
+def _sympy_forms(alg, fam, mem_polys) -> tuple:
+    """The sympy forms of a solved order's family and members (:attr:`OrderSolution.corrections`, ``members``)."""
+    memo: dict = {}  # the members and the family share most coefficients: each converted once
+    return (tuple(alg.to_sympy(f, memo) for f in fam),
+            tuple(tuple(alg.to_sympy(p, memo) for p in polys) for polys in mem_polys))
+
+
 class _Solver:
     def __init__(self, system, comp, order, degree, max_unknowns=None):
         self.max_unknowns = max_unknowns
@@ -503,11 +511,8 @@ class _Solver:
         gauge = [ansatz.expressions(v, alg.coordinates, domain) for v in kernel]
         psi_dim = self._psi_dim(ansatz, D) if self.slots == 2 else None
 
-        def convert():  # on first access (OrderSolution): the sympy forms of the family and the members
-            memo: dict = {}  # the members and the family share most coefficients: each converted once
-            return (tuple(alg.to_sympy(f, memo) for f in fam),
-                    tuple(tuple(alg.to_sympy(p, memo) for p in polys) for polys in mem_polys))
-
+        # on first access (OrderSolution); a partial of a module function, so that an unconverted solution pickles
+        convert = functools.partial(_sympy_forms, alg, tuple(fam), tuple(map(tuple, mem_polys)))
         return OrderSolution(j, "solved", degree=D, corrections=None, members=None, gauge=gauge,
                              kernel_dim=len(kernel), psi_dim=psi_dim, rhs=rhs, convert=convert)
 

@@ -305,6 +305,11 @@ class LiouvilleSum:
     def __hash__(self):
         return hash(frozenset(self.terms))
 
+    def __reduce__(self):
+        """Pickle with the atoms of the keys by content: atom ids are this process's."""
+        keys = tuple(tuple((kind, _ATOMS[v] if kind == 1 else v) for kind, v in key) for key in self.terms)
+        return _liouville_sum_from, (self.algebra, keys, tuple(self.terms.values()), self.atoms)
+
     # -- evaluation and output --------------------------------------------------------
     def monomial(self, entry) -> sympy.Expr:
         """The function of a slot entry: ``x^a`` for ``(0, a)``, the atom for ``(1, k)``."""
@@ -335,3 +340,13 @@ class LiouvilleSum:
 
     def __repr__(self):
         return "LiouvilleSum(" + " + ".join(f"({c})*X_{{{', '.join(map(str, mons))}}}" for c, mons in self.items()) + ")"
+
+
+def _liouville_sum_from(algebra, keys, coefficients, atoms) -> LiouvilleSum:
+    """The sum described by :meth:`LiouvilleSum.__reduce__`, its keys canonical again under this process's atom ids."""
+    context = _context(algebra, atoms)
+    terms: dict = {}
+    for key, c in zip(keys, coefficients):
+        sign, canonical = context.key(tuple((kind, _atom_id(v) if kind == 1 else v) for kind, v in key))
+        terms[canonical] = terms.get(canonical, algebra.domain.zero) + (c if sign > 0 else -c)
+    return LiouvilleSum(algebra, terms, atoms)
