@@ -1,4 +1,4 @@
-"""Time of nb.shadow_hamiltonians for the systems of issue 12 (one run; prints seconds, asserts nothing)."""
+"""Time of nb.shadow_hamiltonians for systems beyond the paper (one run; prints seconds, asserts nothing)."""
 
 import time
 

@@ -13,7 +13,7 @@ machine hits them alike, and the load average is printed with the numbers) for
 the ratios to the -O3 -march=native C with the targets (single <= 1.3x, batch through the public
 iterate() <= 2x, numpy fallback <= 20x), the kernel compile time (cold: empty cache, in a
 subprocess) versus loading it from the disk cache, and the first iterate() of a new process
-whose kernel is cached (issue 14: no sympy on that path).
+whose kernel is cached (no sympy on that path).
 
 Usage (from the repository root):
     python benchmarks/bench_iterate.py                       # ho3, 32123 (Sect. 5.5)
@@ -177,7 +177,7 @@ def main(argv=None):
         except Exception as exc:  # pragma: no cover - depends on the compiler
             print(f"(no -O2 build: {exc})")
 
-    # Lotka-Volterra: the hand-written one-exp-per-piece C loop (issue 14's reference)
+    # Lotka-Volterra: the hand-written one-exp-per-piece C loop (the reference)
     if cref is not None and system.name == "lotka-volterra":
         from bench_iterate_c import CSource, lotka_volterra_one_exp_source
 

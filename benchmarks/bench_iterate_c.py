@@ -70,7 +70,7 @@ def lotka_volterra_one_exp_source(factors) -> str:
 
     Piece ``k`` (``X_{x_k, G}``, ``G = x1 x2 x3``) moves the two other coordinates:
     ``x_{k+1} <- x_{k+1} / E``, ``x_{k+2} <- x_{k+2} E`` with ``E = exp(c h x_k)`` (indices
-    cyclic) -- the reference of issue 14 ("C with one exp per piece").  It multiplies by the
+    cyclic) -- the reference "C with one exp per piece".  It multiplies by the
     exponential instead of adding ``x expm1(u)``, so it rounds differently from the generated
     kernels (the benchmark compares the states to ~1e-12, not bit for bit).
     ``factors`` are ``(piece, coefficient)``; ``K[j] = c_j h`` is passed at run time.

@@ -17,7 +17,7 @@ free ones to zero), and its result is checked against ours.
 The issue-14 rows (docs/history/performance.md, Sect. 3) time the whole ``shadow_hamiltonians`` call
 in a fresh child process each (cold, CPU seconds), ours against the package's previous
 elimination (``nambu_bch.algebra.elimination.FAST_PATHS = False``: sympy's sparse
-``DomainMatrix.rref`` over the full coefficient field; since session 12 this also switches off
+``DomainMatrix.rref`` over the full coefficient field; this also switches off
 the python-flint arithmetic over ``QQ(params)``: the elimination, the fraction-free fields and the
 effective field's brackets, docs/history/performance.md Sect. 5), and for row c also against the
 plain-sympy baseline; the two results are compared (members alpha = 0 and 1).
@@ -179,7 +179,7 @@ def issue14(limit: float = 150.0, only=None):
     """
     import os
 
-    print(f"issue 14 rows (cold child process each, CPU s; load average {os.getloadavg()[0]:.1f})")
+    print(f"the --issue14 rows (cold child process each, CPU s; load average {os.getloadavg()[0]:.1f})")
     rows = []
     for label, name, word, order, goal in ISSUE14:
         if only and label[0] not in only:

@@ -19,7 +19,7 @@ from pathlib import Path
 sys.path.insert(0, str(Path(__file__).parent))
 
 # (file, test name prefix) of the tests that take >= ~2 s each on the idle two-core machine, roughly longest first
-# (a cold ``pytest -n 2 --durations=0`` of session 12's branch ts, load 2-4; docs/suite_time.md).  Tests that reuse
+# (a cold ``pytest -n 2 --durations=0`` of the suite, load 2-4; docs/suite_time.md).  Tests that reuse
 # a result of a long one (tests/shared_results.py: computed once per worker process) follow it, so that both run
 # early in the same worker instead of each computing it (the rest of their file may be stolen by the other worker).
 LONG = (
@@ -53,7 +53,7 @@ LONG = (
 #: Plugin distributions whose modules pytest marks for assertion rewriting (every module of a distribution with a
 #: ``pytest11`` entry point).  None of them has an ``assert`` the suite relies on (the package has none at all), but
 #: every pytest process re-parsed and rewrote ~150 of their modules as they were imported, ~0.7 s of CPU per process,
-#: since ``PYTHONDONTWRITEBYTECODE`` keeps pytest from caching the result (docs/suite_time.md, session 11).
+#: since ``PYTHONDONTWRITEBYTECODE`` keeps pytest from caching the result (docs/suite_time.md).
 NOT_REWRITTEN = ("nambu_bch", "hypothesis", "_hypothesis_pytestplugin", "_hypothesis_globals", "_hypothesis_ftz_detector",
                  "xdist", "platformdirs")
 

@@ -1,4 +1,4 @@
-"""Results several tests check, computed once per test process (issue 11: the suite's time).
+"""Results several tests check, computed once per test process (the suite's time).
 
 Each function here calls the library exactly as the tests did before, with the same arguments; what changes is
 only that a second test asking for the same result (the same model, word, order and options) reuses the first

@@ -1,4 +1,4 @@
-"""Any system a physicist brings (issue 12): canonical d >= 1, non-polynomial, canonical triplets, Lie-Poisson.
+"""Any system a physicist brings: canonical d >= 1, non-polynomial, canonical triplets, Lie-Poisson.
 
 Each value names its source: the paper's equations (Horikoshi, Eqs. SHPV1, CL1, NB), Hairer-Lubich-Wanner,
 *Geometric Numerical Integration* (HLW), Sect. III.4.2 (symmetric BCH formula) and Sect. IX.4 (modified

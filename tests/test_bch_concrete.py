@@ -123,7 +123,7 @@ def _half_commutators(S, word):
 def test_lie_trotter_operator_order_against_numeric_step(name, word):
     """Word "12" (step_function applies piece 1 first): X_eff = X_1 + X_2 + h/2 [X_1, X_2] + ..., so the
     local error of the step against the flow of Z_0 + h Z_1 is O(h^3); with [X_2, X_1] it would be O(h^2).
-    (Every word uses every piece of its splitting: a word leaving one out is refused, issue 10.)"""
+    (Every word uses every piece of its splitting: a word leaving one out is refused.)"""
     system = model(name)
     S = system.splitting
     X = effective_field_bch(S, word, 1)
@@ -183,7 +183,7 @@ def test_unknown_piece():
 
 @pytest.mark.parametrize("name,word,order", [("ho3", "yoshida:12321", 4), ("ho", "yoshida:121", 4), ("ho3", "12321", 4)])
 def test_route_by_cost_gives_the_same_field_as_both_routes(monkeypatch, name, word, order):
-    """Issue 14: algebraic coefficients take backward error analysis, rational ones the BCH route; the field is
+    """Algebraic coefficients take backward error analysis, rational ones the BCH route; the field is
     the same exact X_eff either way (compared with both routes)."""
     from nambu_bch.bch import concrete
 

@@ -119,7 +119,7 @@ def test_caches_do_not_change_results():
 
 @pytest.mark.parametrize("fast", [True, False])
 def test_rigid_body_h6_representations(fast):
-    """Rigid body to h^6 (issue 6): Laurent and QQ(I1, I2, I3) representations of the BCH route agree with
+    """Rigid body to h^6: Laurent and QQ(I1, I2, I3) representations of the BCH route agree with
     backward error analysis, and every odd coefficient of the symmetric word vanishes."""
     S = model("rigid-body").splitting
     X = effective_field_bch(S, "12321", 6, fast=fast)

@@ -152,7 +152,7 @@ def test_bernoulli_coefficients_of_ad_powers(m):
 # -- size guard ----------------------------------------------------------------------------------------
 
 def test_degrees_accepted_and_refused_by_the_sparse_estimate():
-    """Issue 14: no cap below degree 20 (2 generators) and 14 (3 generators); refusals name the estimate."""
+    """No cap below degree 20 (2 generators) and 14 (3 generators); refusals name the estimate."""
     assert formal_module.check_degree(20, 2) == 20 and formal_module.check_degree(14, 3) == 14
     with pytest.raises(InvalidOrderError, match="Witt's formula.*same-content Lyndon pairs"):
         formal_module.check_degree(23, 2)

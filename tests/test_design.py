@@ -1,4 +1,4 @@
-"""Tests of nambu_bch.design: error constants, order conditions, designed compositions, comparisons (issue 15).
+"""Tests of nambu_bch.design: error constants, order conditions, designed compositions, comparisons.
 
 Published error constants (LEM) are those of SplittingOrderConditions.jl (H. Hofstaetter),
 ``examples/CheckMethods.ipynb``, table "AB / ABC": the ABC column is the AB method with B

@@ -191,7 +191,7 @@ def test_property_invariant_along_exact_rational_orbits(word, state, params):
 
 
 def test_invariant_search_too_large_is_refused_up_front():
-    """Bounded work (issue 10, item 8): the rigid body's 12321 at ansatz degree 4 (about 142 000 image terms,
+    """Bounded work: the rigid body's 12321 at ansatz degree 4 (about 142 000 image terms,
     200 s) is refused from the size estimate in one line; degree 2 (the default) still runs."""
     from nambu_bch.errors import ResourceLimitError
 

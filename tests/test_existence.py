@@ -1,4 +1,4 @@
-"""Issue 17: existence of shadow Hamiltonians decided in smooth functions (orbit averages), not only polynomials.
+"""Existence of shadow Hamiltonians decided in smooth functions (orbit averages), not only polynomials.
 
 The criterion (nambu_bch/shadow/existence.py, docs/existence.md): at the first order h^j that the polynomial
 ansatz does not solve, a shadow pair exists in smooth functions iff the orbit averages <R_j . grad H_a> vanish on
@@ -162,7 +162,7 @@ def test_issue_example_non_symmetric_word_drifts(ex17):
 
 def test_inconsistent_word_is_refused_not_reported_as_an_obstruction():
     """ho3 with Phi^{12} (the README once said 'none at h^1'): piece 3 is missing, Z_0 != X_{H,G}; the word
-    does not integrate this system at all, so it is refused up front (issue 10, item 1), never answered."""
+    does not integrate this system at all, so it is refused up front, never answered."""
     with pytest.raises(InconsistentCoefficientsError, match=r"never applies piece\(s\) \[3\]"):
         shadow_hamiltonians(model("ho3"), "12", 1)
 
@@ -171,7 +171,7 @@ def test_inconsistent_word_is_refused_not_reported_as_an_obstruction():
 
 def test_issue_example_has_a_smooth_pair_not_polynomial(ex17, ex17_12321):
     """H = x1^2/2 + x2^2/2 + x2^4/4 + x3^2, G = x1^2/2 + x1^4/8 + x2^2/2 + x3^2/2 + x3^4/4, Phi^{12321}, h^2:
-    the polynomial solve (degree 14, 1360 unknowns: within the default bounded work since issue 14, about 1 s) is
+    the polynomial solve (degree 14, 1360 unknowns: within the default bounded work, about 1 s) is
     obstructed -- a certificate that no polynomial pair of degree <= 14 exists -- and the averages vanish exactly by
     reversibility (x_i -> -x_i fixes H, G and makes R_2.grad H, R_2.grad G odd; HGW Sect. XI.1), numerically too."""
     F = ex17_12321
@@ -192,7 +192,7 @@ def test_issue_example_has_a_smooth_pair_not_polynomial(ex17, ex17_12321):
 
 
 def test_bounded_work_refuses_an_elimination_above_the_cost_budget(ex17, ex17_12321, monkeypatch):
-    """Bounded work (issue 17, kept by issue 14): with max_unknowns given, an order whose elimination is estimated
+    """Bounded work: with max_unknowns given, an order whose elimination is estimated
     (elimination_cost of the built matrix) above direct_route.SOLVE_COST is refused up front, before anything is
     eliminated, and the averages decide; below the budget the solve runs (ex17, 12321, h^2: obstructed)."""
     import importlib

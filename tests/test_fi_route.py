@@ -1,4 +1,4 @@
-"""The FI route at every order (issue 13): recursive hulls of nested FI representations, h^4 / h^6 families.
+"""The FI route at every order: recursive hulls of nested FI representations, h^4 / h^6 families.
 
 Every value is checked two independent ways:
 * the recursive affine hull (``fi_nested``) against the brute-force enumeration of the labelled

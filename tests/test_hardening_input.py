@@ -1,7 +1,7 @@
-"""Issue 10, the input side: never a silent wrong answer, never a way in, bounded work, one line on every fault.
+"""The input side: never a silent wrong answer, never a way in, bounded work, one line on every fault.
 
-Items (issue 10): 1 words that leave out a piece, 4 silent coercions, 5 names and raw text, 7 ``--output``,
-8 bounded work, 10 Ctrl-C / closed stdout; and "done when": the API raises only the package's exception
+Classes: words that leave out a piece, silent coercions, names and raw text, ``--output``,
+bounded work, Ctrl-C / closed stdout; and "done when": the API raises only the package's exception
 family for misuse, and the whole CLI keeps the one-line / exit-2 / nothing-executed contract.
 Most CLI cases run in process through ``nambu_bch.cli.main(argv)``; a few subprocesses test signals and pipes.
 """
@@ -64,7 +64,7 @@ def one_line(capsys, code, *fragments, status=2):
 @pytest.mark.parametrize("name", THREE_PIECES)
 @pytest.mark.parametrize("word", ["121", "212", "12", "1:1/2,2:1,1:1/2"])
 def test_word_leaving_out_piece_3_is_refused_naming_it(name, word):
-    """121, 212, 12 never apply piece 3 of a three-piece splitting: refused, naming piece 3 (issue 10, item 1)."""
+    """121, 212, 12 never apply piece 3 of a three-piece splitting: refused, naming piece 3."""
     S = nb.model(name)
     assert len(S.splitting) == 3
     with pytest.raises(InconsistentCoefficientsError, match=r"never applies piece\(s\) \[3\]"):
@@ -126,7 +126,7 @@ def test_composition_check_is_the_one_place():
     sources = [p for p in (REPO / "nambu_bch").rglob("*.py") if p.name != "composition.py"]
     hits = [str(p.relative_to(REPO)) for p in sources if ".check(system.splitting)" in p.read_text()
             or ".check(splitting)" in p.read_text()]
-    # numeric/* is maintained separately (issue 10, numeric side); it calls the same Composition.check
+    # numeric/* is maintained separately; it calls the same Composition.check
     assert all(h.startswith("nambu_bch/numeric/") for h in hits), hits
 
 
@@ -200,7 +200,7 @@ def test_the_paper_words_still_pass():
     [(1, [1])], [(10**30, 1)], [(0, 1)], [(-1, 1)],
 ])
 def test_explicit_composition_no_coercion(spec):
-    """composition([(1.5, 1)]) used to become piece 1; every such spec is refused now (issue 10, item 4)."""
+    """composition([(1.5, 1)]) used to become piece 1; every such spec is refused now."""
     with pytest.raises(InvalidCompositionError):
         composition(spec)
 
@@ -566,7 +566,7 @@ API_MISUSE = {
 
 @pytest.mark.parametrize("call", list(API_MISUSE))
 def test_api_misuse_raises_the_package_family(call):
-    """Each of these raised TypeError, AttributeError, OverflowError, ValueError or hung before (issue 10)."""
+    """Each of these raised TypeError, AttributeError, OverflowError, ValueError or hung before."""
     with pytest.raises(NambuBCHError) as info:
         API_MISUSE[call]()
     message = str(info.value)

@@ -1,6 +1,6 @@
-"""Issue 10, numeric side: degenerate systems, non-finite results, generated source, the kernel cache, streaming.
+"""The numeric side: degenerate systems, non-finite results, generated source, the kernel cache, streaming.
 
-Each test names the item of issue 10 it guards.  Values are checked two ways where a value is
+Each test names the fault class it guards.  Values are checked two ways where a value is
 produced (an exact identity, or the streamed result against the one-shot computation).
 """
 
@@ -66,7 +66,7 @@ def _exact_verlet(steps, h, x):
 
 _INTERNAL = re.compile(r"(?:[skpcdytSQRefu]\d+|_[A-Za-z_0-9]*|a|abs|max|big|prod|small|nonfinite|subnormal|res|i|c|x|X|K|P|C|h|n|j|m|b|b0|b1|B|nb|chunk|steps|every|out|"
                        r"math|np|range|min|constants|run\w*|progress|"
-                       # the batch loops' flags and the compiled scan's block reductions (issue 14)
+                       # the batch loops' flags and the compiled scan's block reductions
                        r"start|back|bad|buf|off|over|v\d*|N|W|row|g|nf|sb|top|I[bps]|i?[bps]m(?:ax|in)|m\d)")
 
 
@@ -242,7 +242,7 @@ def _files(root):
 
 
 def test_cache_layout_modes_and_sympy_free_reload(fresh_cache):
-    """Item 6 / issue 14: private directories; a second process loads the verified source without sympy."""
+    """Private directories; a second process loads the verified source without sympy."""
     kern = K.kernel(model("ho"), "121")
     kdir, sources, indexes = _files(fresh_cache)
     assert kern.directory == kdir and len(sources) == len(indexes) == 1
@@ -428,16 +428,16 @@ def test_check_memory_is_bounded():
 
 
 def test_check_label_names_the_difference():
-    """Issue 16 item 7: check prints max |x1^o - x1|, not max |x1_o|."""
+    """`check` prints max |x1^o - x1|, not max |x1_o|."""
     text = str(check("ho3", "32123", 0.1, 50, [1.0, 1.0, 1.0], include=("H", "o")))
     assert "max |x1^o - x1|" in text and "x1_o" not in text and "max |H(t) - H(0)|" in text
 
 
-# -- item 7 (plot) and issue 16 item 6: figures as a set, returned, streamed ----------------------------------
+# -- plot: figures as a set, returned, streamed ----------------------------------
 
 
 def test_paper_figures_returns_figures_with_parameters(tmp_path):
-    """Issue 16 item 6: the matplotlib figures come back with the paths; titles show h, the parameters, x(0)."""
+    """The matplotlib figures come back with the paths; titles show h, the parameters, x(0)."""
     from matplotlib.figure import Figure
 
     from nambu_bch.numeric.figures import paper_figures
@@ -487,7 +487,7 @@ def test_long_plot_is_an_envelope_of_the_run(monkeypatch):
     assert y.max() == diff.max() and y.min() == diff.min() and env["o"].max_abs == np.abs(diff).max()
 
 
-# -- issue 14: the batch guards in one compiled pass ------------------------------------------------------------
+# -- the batch guards in one compiled pass ------------------------------------------------------------
 
 
 def test_compiled_scan_agrees_with_numpy_guards():

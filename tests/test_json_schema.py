@@ -1,4 +1,4 @@
-"""The CLI's JSON output against its JSON Schema (docs/schema/nambu-bch.schema.json, docs/json.md), issue 16 item 4.
+"""The CLI's JSON output against its JSON Schema (docs/schema/nambu-bch.schema.json, docs/json.md).
 
 Each document is checked twice: by the schema (shape) and by sympy (content: the
 series by order re-sum to the flat expressions; the brackets read back).
@@ -159,7 +159,7 @@ def test_schema_rejects_malformed_documents(capsys):
         change(d)
         broken.append(not v.is_valid(d))
     assert all(broken), broken
-    # the keys issue 17 adds to the shadow JSON are allowed (optional)
+    # the existence keys of the shadow JSON are allowed (optional)
     d = copy.deepcopy(good)
     d.update(polynomial=True, drift=None, evidence={"kind": "test"})
     v.validate(d)

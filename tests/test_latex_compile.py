@@ -1,4 +1,4 @@
-r"""Every LaTeX output compiles with pdflatex, without overfull lines (issue 16 item 1; docs/latex.md).
+r"""Every LaTeX output compiles with pdflatex, without overfull lines (docs/latex.md).
 
 Skipped only when no ``pdflatex`` is installed (CI installs TeX Live, see .ci/run).  Each
 document is compiled with ``-halt-on-error``; the log must show no error and no
@@ -88,7 +88,7 @@ def test_api_blocks_compile_in_display_math(tmp_path):
         conserved_quantities(ho3, "32123"), exact_shadow_hamiltonians(ho3, "12321"),
         formal_bch("12321", 5), effective_field(ho3.splitting, "12321", 2),
     ]
-    rb = model("rigid-body")  # a hostile name is refused at the door (issue 10) and neutralised by latex_text anyway
+    rb = model("rigid-body")  # a hostile name is refused at the door and neutralised by latex_text anyway
     with pytest.raises(InvalidSystemError):
         System(rb.coordinates, rb.hamiltonians, rb.parameters, name=HOSTILE, split=rb.split)
     assert "\\input" not in latex_text(HOSTILE) and r"\_" in latex_text(HOSTILE)

@@ -10,7 +10,7 @@ on random sparse matrices (hypothesis): zero rows, rank-deficient (dependent row
 primes; beyond int64), augmented systems with an inconsistent right-hand side.  Unlucky primes (Cabay 1971; von zur
 Gathen & Gerhard, *Modern Computer Algebra*, Sect. 5.5: ``p`` divides a minor the elimination needs) are built on
 purpose from the first prime used, ``2^31 - 1``.  The exact verification and the Hadamard-bound refusal are tested
-directly.  The N = 4 single-split system of issue 14 (1234321) is compared end to end with python-flint and with
+directly.  The N = 4 single-split system (1234321) is compared end to end with python-flint and with
 the modular route at h^4.
 """
 
@@ -201,7 +201,7 @@ N4 = ["x1**2/2 + x2**2/2 + x3**2/2 + x4**2/2", "x1**2/2 + x2**2 + 3*x3**2/2 + 2*
 
 
 def test_n4_single_split_h4_same_with_modular_and_flint(monkeypatch):
-    """Issue 14, row d (benchmarks/bench_shadow.py): N = 4 single split, 1234321, h^4 (630 unknowns, 1204 equations at
+    """Row d of benchmarks/bench_shadow.py --issue14:: N = 4 single split, 1234321, h^4 (630 unknowns, 1204 equations at
     h^4): the members alpha = 0, 1 are identical with the modular route and with python-flint's fmpq_mat.rref (or,
     without python-flint, sympy's DomainMatrix.rref): two eliminations, one answer."""
     S = System("x1 x2 x3 x4", N4, name="n4-single", split="single")

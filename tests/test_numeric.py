@@ -1,4 +1,4 @@
-"""Tests of the numeric backend: generated kernels, backends, sampling, Kahan, mpmath, cache, progress (issue 6).
+"""Tests of the numeric backend: generated kernels, backends, sampling, Kahan, mpmath, cache, progress.
 
 Numerical tests carry explicit tolerances; the numba and numpy paths are compared bit for bit on
 polynomial flows (the generated code performs the same IEEE operations in the same order).
@@ -130,7 +130,7 @@ def test_exponential_flows_use_expm1():
 def test_numba_loops_copy_rows_element_by_element(name, word):
     """The compiled loops move states between arrays only by element loops, never by a slice assignment
     (``S0[:nb] = X[0, b0:b0 + nb]``): numba compiles a slice assignment's broadcasting error path, which
-    doubled the batch kernels' compile time (docs/suite_time.md, session 11).  The numpy fallback keeps its
+    doubled the batch kernels' compile time (docs/suite_time.md).  The numpy fallback keeps its
     whole-array statements.  Checked on the parsed source: no subscript-with-slice target outside run_numpy*."""
     import ast
 
@@ -370,7 +370,7 @@ def test_kernels_are_cached_on_disk(tmp_path, monkeypatch):
 
 @numba_only
 def test_auto_interprets_small_runs_until_compiling_pays(tmp_path, monkeypatch):
-    """backend="auto" (issue 11): while a loop is neither compiled in the process nor in numba's disk
+    """backend="auto": while a loop is neither compiled in the process nor in numba's disk
     cache, runs of INTERPRET_STEPS trajectory-steps in total take the interpreter -- the same statements
     on Python floats and the C library's functions, so the same bits as the compiled loop (checked here
     against backend="numba", and for the library functions of every kind of flow in
@@ -604,7 +604,7 @@ def test_user_symbols_named_like_generated_ones():
     assert np.allclose(x, y, rtol=1e-12, atol=1e-12)
 
 
-# -- issue 14: the batch path reads x0 in place, fuses the sample-0 copy and the result check ------------------
+# -- the batch path reads x0 in place, fuses the sample-0 copy and the result check ------------------
 
 
 @pytest.mark.parametrize("backend", [pytest.param("numba", marks=numba_only), "numpy"])

@@ -1,4 +1,4 @@
-"""Tests of the diagnostics, the studies and the paper's figures (issue 6, items 2-4).
+"""Tests of the diagnostics, the studies and the paper's figures.
 
 Literature values: Table (table) (H_c, G_c of 32123), Eqs. (OHsol), (CQsol), (SHsol), Figs. 1-4 of
 Horikoshi, Sect. 5.5.  Numerical tests: observed order by log-log fit, bounded drift.

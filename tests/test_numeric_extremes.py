@@ -1,4 +1,4 @@
-"""Stability of the numeric backend at the extremes (issue 6, item 5).
+"""Stability of the numeric backend at the extremes.
 
 h -> 0, omega h -> 2, omega h >= 2, 10^5-step runs, huge and tiny amplitudes, non-finite input.
 Every failure must be a clear NambuBCHError subclass, never a silent NaN.

@@ -1,4 +1,4 @@
-"""Printing of results (issue 16 items 2, 3, 5): sympy printer hooks, H + h^2(...) layout, progress bars, lazy CLI.
+"""Printing of results: sympy printer hooks, H + h^2(...) layout, progress bars, lazy CLI.
 
 Values come from Horikoshi, Eqs. (SH12321c), (SG12321c), (BCH2), (ESH12321), (ESG12321) and Table (table);
 each printed form is checked against the result it prints (parsed back), not only by its look.
@@ -220,7 +220,7 @@ def test_models_listing_is_cached_and_identical(tmp_path):
 
 def test_models_cache_is_not_trusted_in_a_shared_directory(tmp_path, monkeypatch, capsys):
     """A cache directory writable by others (or a planted file in it) is never read back: the listing is
-    computed, so another local user cannot choose what `nambu-bch models` prints (issue 10, item 6)."""
+    computed, so another local user cannot choose what `nambu-bch models` prints."""
     import os
 
     from nambu_bch.cli import main

@@ -1,10 +1,9 @@
 """The public surface, pinned: the names each package re-exports (``__all__``) and the cache registry.
 
 A change of the public API (a name added, renamed or dropped) must be deliberate:
-it fails here until the table below is updated with it (issue 11, "a test pins the
-public surface").  Each listed name must also resolve, and ``nambu_bch.clear_caches``
+it fails here until the table below is updated with it.  Each listed name must also resolve, and ``nambu_bch.clear_caches``
 must know every ``functools.lru_cache`` and module-level cache dictionary of the
-package (issue 11 item 7), checked by scanning every module.
+package, checked by scanning every module.
 """
 
 from __future__ import annotations

@@ -526,7 +526,7 @@ def test_fi_route_agrees_with_direct_at_h1(name, word):
 
 
 def test_family_is_frozen_and_built_by_named_constructors():
-    """A ShadowFamily is immutable (issue 11, item 6) and is what its named constructor makes of the route's own
+    """A ShadowFamily is immutable and is what its named constructor makes of the route's own
     result: ``from_direct(direct_route(...))`` and ``from_fi(fi_route(...))`` equal ``shadow_hamiltonians``
     (ho3, Phi^{12321}, Eqs. SH12321c, SG12321c); an undecided obstruction keeps its order (ho3, Phi^{123}, h^1)."""
     import dataclasses

@@ -1,4 +1,4 @@
-"""Re-run the existence claims of README "Results beyond the paper" and notebook 04 with the three outcomes (issue 17).
+"""Re-run the existence claims of README "Results beyond the paper" and notebook 04 with the three outcomes.
 
 Writes the table between the markers of docs/existence.md:
 
@@ -32,8 +32,8 @@ CASES = [
     ("N = 4 separable, full", lambda: System("x1 x2 x3 x4", N4, name="n4"), "1234", 1),
     ("N = 4 separable, single", lambda: System("x1 x2 x3 x4", N4, name="n4", split="single"), "1234321", 2),
     ("N = 4 separable, single", lambda: System("x1 x2 x3 x4", N4, name="n4", split="single"), "1234", 2),
-    ("issue 17 quartic, full", lambda: System("x1 x2 x3", EX17, name="ex17"), "12321", 2),
-    ("issue 17 quartic, full", lambda: System("x1 x2 x3", EX17, name="ex17"), "123", 2),
+    ("quartic example, full", lambda: System("x1 x2 x3", EX17, name="ex17"), "12321", 2),
+    ("quartic example, full", lambda: System("x1 x2 x3", EX17, name="ex17"), "123", 2),
 ]
 
 

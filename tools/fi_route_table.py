@@ -1,4 +1,4 @@
-"""Compute the FI-vs-direct comparison tables of docs/fi_route.md (issue 13) and write them between the markers.
+"""Compute the FI-vs-direct comparison tables of docs/fi_route.md and write them between the markers.
 
 Run:  PYTHONPATH=. python tools/fi_route_table.py          (rewrites docs/fi_route.md in place, atomically)
       PYTHONPATH=. python tools/fi_route_table.py --print  (prints the tables only)

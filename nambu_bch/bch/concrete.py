@@ -79,7 +79,7 @@ def effective_field_by_cost(splitting, comp, order: int = 2) -> EffectiveField:
     Algebraic coefficients (``yoshida:*``, ``2^(1/3)``) go to backward error analysis
     (:func:`~nambu_bch.bch.backward.effective_field`): the formal series would run in the
     dense engine with field elements of ``QQ(2^(1/3))`` on all ``g^d`` words and evaluate
-    thousands of brackets with algebraic coefficients (issue 14: ho3 ``yoshida:12321`` to
+    thousands of brackets with algebraic coefficients (ho3 ``yoshida:12321`` to
     ``h^8`` over 100 s by BCH, 0.45 s backward).  Rational compositions keep the BCH route
     (:func:`effective_field_bch`), whose Lyndon brackets are shared across compositions.
 

@@ -1,4 +1,4 @@
-"""``nambu-bch compare``: work-precision comparison of integrators on a system (issue 15).
+"""``nambu-bch compare``: work-precision comparison of integrators on a system.
 
 The work is :func:`nambu_bch.design.compare`.
 """

@@ -46,7 +46,7 @@ def run(args):
 
 
 def _nested(args, system, word, comp):
-    """``fi --order K``: the brackets at ``h^K`` with the affine hulls of their FI representations (issue 13)."""
+    """``fi --order K``: the brackets at ``h^K`` with the affine hulls of their FI representations."""
     from ..shadow.fi_route import count_brackets, fi_brackets
 
     limit = args.limit  # converted and bounded with every other flag (_options.MAX_LIMIT)

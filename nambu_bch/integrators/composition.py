@@ -432,7 +432,7 @@ def _build(spec, n_pieces):
         inner = composition(base, n_pieces)
         return _five_jump(inner) if head == "suzuki" else _triple_jump(inner)
     if low.partition(":")[0] in _CATALOG:
-        from ..design.catalog import lookup  # literature methods with citations (issue 15)
+        from ..design.catalog import lookup  # literature methods with citations
 
         return lookup(text, n_pieces)
     head = low.partition(":")[0].strip()

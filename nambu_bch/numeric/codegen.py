@@ -215,7 +215,7 @@ def _validate(program, system):
     The increments may use only the state ``s_i``, the constants ``k_j`` and the whitelisted
     functions; the constants only the parameters, ``h`` and those functions; neither may be
     singular (``zoo``, ``nan``, ``oo``).  So no name a user chose ever reaches a kernel
-    (issue 10, item 5): parameters enter through ``P[i]``, coordinates through ``x[i]``.
+    (no user text reaches the source): parameters enter through ``P[i]``, coordinates through ``x[i]``.
     """
     allowed = set(program.state) | {k for k, _ in program.constants}
     for u in program.updates:
@@ -641,7 +641,7 @@ def {name}({args}):
             # shared exponentials: one branch-free pass over the chunk (vectorised); if some |u| left the
             # series range, the chunk's step is undone and redone with the library branch -- the same bits
             # as the branchy loop either way.  The redo (scalar, rare) calls the pair function instead of
-            # repeating its statements per sub-flow: half the source numba compiles (issue 11)
+            # repeating its statements per sub-flow: half the source numba compiles
             fast = body_lines(program, scalar, kahan, select=True)
             redo = body_lines(program, scalar, kahan, pair_call=PAIR_FUNCTION)
             saved = [line for q, r in enumerate(rows) for line in _row_copy(f"R{q}", r)]

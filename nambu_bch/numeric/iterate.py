@@ -305,7 +305,7 @@ def iterate_chunks(system, word, h, steps, x0=None, params=None, every=1, *, kah
     blocks together are exactly :func:`sample_steps` and the samples :func:`iterate` returns
     (the state and Kahan compensation carry over from block to block), but at most
     ``chunk_samples`` of them are held at a time -- so diagnostics of ``10^8`` steps sampled at
-    every step run in bounded memory (issue 10, item 9).
+    every step run in bounded memory.
 
     Raises
     ------

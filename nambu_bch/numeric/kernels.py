@@ -11,7 +11,7 @@ loads the machine code from disk instead of compiling again.
 Cache directory: ``$NAMBU_BCH_CACHE`` if set, else ``~/.cache/nambu_bch``;
 kernels live in ``<cache>/kernels``.  Deleting it is always safe.
 
-What is cached, and how it is trusted (issue 10 item 6, issue 14):
+What is cached, and how it is trusted (docs/hardening.md):
 
 * ``nambu_bch_index_<key>.json`` -- ``key`` is :func:`input_key`, a digest of the
   exact inputs (fields of the pieces, exact coefficients, the generator's own code);

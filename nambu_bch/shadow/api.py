@@ -34,7 +34,7 @@ def _system(system):
 
 
 def _decision(result, existence: bool, params):
-    """The existence decision (orbit averages, issue 17) of a direct result without a polynomial pair; None if not asked."""
+    """The existence decision (orbit averages, docs/existence.md) of a direct result without a polynomial pair; None if not asked."""
     if not existence or result is None or result.exists:
         return None
     from .existence import decide

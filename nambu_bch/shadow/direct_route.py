@@ -453,7 +453,7 @@ class _Solver:
                 f"(corrections need degree >= {needed}); pass degree >= {needed} or None"
             )
         if self.max_unknowns is not None and Ansatz.size(self.n, D, self.slots) > self.max_unknowns:
-            # bounded work (issue 17): the exact solve is refused up front, the order stays undecided
+            # bounded work: the exact solve is refused up front, the order stays undecided
             return OrderSolution(j, "refused", degree=D, rhs=rhs)
         _check_ansatz_size(self.slots, self.n, D)
         ansatz = Ansatz(self.n, D, self.slots)

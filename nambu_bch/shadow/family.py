@@ -40,7 +40,7 @@ def existence_fields(decision, failed_order) -> dict:
 
     References
     ----------
-    The three outcomes of issue 17 (pair / certified non-existence / undecided); Horikoshi, Eq. (L2).
+    The three outcomes (pair / certified non-existence / undecided); Horikoshi, Eq. (L2).
 
     >>> existence_fields(None, 3)["evidence"]["outcome"]
     'undecided'
@@ -119,7 +119,7 @@ class ShadowFamily(Printable):
     system, composition
     order : int -- highest power of ``h`` kept
     route : ``"direct"`` or ``"fi"``
-    exists : True / False / None -- a pair exists / non-existence is certified / undecided (issue 17)
+    exists : True / False / None -- a pair exists / non-existence is certified / undecided
     polynomial : bool or None -- the pair found is polynomial (False: no polynomial pair up to the degree tried)
     drift : dict or None -- predicted secular drift ``dH'/dt`` per Hamiltonian of a certified non-existence
     evidence : dict or None -- the existence decision as data (:meth:`~nambu_bch.shadow.existence.Existence.evidence`)
@@ -256,7 +256,7 @@ class ShadowFamily(Printable):
                    fi_span=[] if route == "fi" else None)
 
     def _outcome_headline(self) -> str:
-        """The existence outcome of a family without a polynomial pair (the three outcomes of issue 17)."""
+        """The existence outcome of a family without a polynomial pair (pair / certified non-existence / undecided)."""
         return {True: "shadow Hamiltonians exist in smooth functions but are not polynomial",
                 False: "no shadow Hamiltonians (certified)", None: "existence undecided"}[self.exists]
 

@@ -22,7 +22,7 @@ canonical members and their alpha-family (the direct route's rule, one
 implementation: :mod:`nambu_bch.algebra.ansatz`), and :meth:`FIResult.check_member` to
 test a given choice, e.g. the paper's Eqs. (CL5a)-(CL8a) with (SH12321a).
 
-Higher orders (``order`` up to ``MAX_FI_ORDER = 6``; issue 13).  At ``h^j`` the
+Higher orders (``order`` up to ``MAX_FI_ORDER = 6``).  At ``h^j`` the
 BCH brackets have depth ``j`` (Lyndon basis, not all right-nested); the FI
 representations of each are kept as their affine hull, built recursively
 (:mod:`nambu_bch.shadow.fi_nested`: base = Eq. CL2a at every pair, labelled
