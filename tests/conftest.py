@@ -23,6 +23,12 @@ sys.path.insert(0, str(Path(__file__).parent))
 # a result of a long one (tests/shared_results.py: computed once per worker process) follow it, so that both run
 # early in the same worker instead of each computing it (the rest of their file may be stolen by the other worker).
 LONG = (
+    ("test_cache_safety.py", "test_"),                                      # 15-30 s each: numba recompiles in subprocesses
+    ("test_pickle.py", "test_results_come_back_from_spawned_workers"),      # two spawned workers import and compute
+    ("test_docs.py", "test_api_reference_builds_without_warnings"),         # a Sphinx build in a subprocess
+    ("test_packaging.py", "test_"),                                         # wheel and sdist built, installed, run
+    ("test_fuzz_api.py", "test_"),
+    ("test_fuzz_cli.py", "test_"),
     ("test_cli.py", "test_every_subcommand_runs_as_a_subprocess"),          # 14 s: nine subprocesses, two at a time
     ("test_elimination.py", "test_solve_affine_matches_plain_domainmatrix"),  # 12 s at QQ<2^(1/3)>(a,b)
     ("test_direct_route_fast.py", "test_rigid_body_symbolic_yoshida_family_over_base_field"),

@@ -365,15 +365,18 @@ def check(system, word, h, steps, x0=None, params=None, *, order=2, alpha=0.5, e
     Returns
     -------
     CheckResult -- ``.to_dict()["max_abs_error"]`` has ``H, G, H_c, G_c, H_S, G_S``,
-    ``H_S_exact, G_S_exact`` and ``x1_o .. xN_s`` where they are defined; ``skipped`` names the quantities
-    that are singular at the given parameters.
+        ``H_S_exact, G_S_exact`` and ``x1_o .. xN_s`` where they are defined; ``skipped`` names the quantities
+        that are singular at the given parameters.
 
     Raises
     ------
-    InvalidOrderError -- ``order`` outside ``0..MAX_ORDER``
-    ResourceLimitError -- more steps than a run accepts (:func:`~nambu_bch.numeric.guards.check_work`)
-    NumericalRangeError -- a non-finite ``alpha``, or a quantity that is not finite along the run
-    (float64 overflow in evaluating it, e.g. ``x0 = (1e154, 1e154, 1)``).
+    InvalidOrderError
+        ``order`` outside ``0..MAX_ORDER``.
+    ResourceLimitError
+        More steps than a run accepts (:func:`~nambu_bch.numeric.guards.check_work`).
+    NumericalRangeError
+        A non-finite ``alpha``, or a quantity that is not finite along the run
+        (float64 overflow in evaluating it, e.g. ``x0 = (1e154, 1e154, 1)``).
 
     References
     ----------
