@@ -48,6 +48,31 @@ def check_flag(value, what, none=False):
     return bool(value)
 
 
+def check_int(value, what, low=None, high=None) -> int:
+    """``value`` as an int if :func:`is_int` accepts it (numpy integers too), else one line naming ``what``."""
+    if not is_int(value, low, high, numpy=True):
+        if low is not None and high is not None:
+            accepted = f"an integer from {low} to {high}"
+        elif low is not None:
+            accepted = f"an integer >= {low}"
+        else:
+            accepted = "an integer" if high is None else f"an integer <= {high}"
+        raise InvalidRunError(f"{what} must be {accepted}, got {show(value)}")
+    return int(value)
+
+
+def check_type(value, kind, what):
+    """``value`` if it is an instance of ``kind`` (a class or a tuple of classes), else one line naming ``what``.
+
+    For the arguments that must be one of the package's objects (a splitting, a vector field, a
+    composition): a wrong object is refused at the entry instead of failing deep inside.
+    """
+    if not isinstance(value, kind):
+        names = " or ".join(k.__name__ for k in (kind if isinstance(kind, tuple) else (kind,)))
+        raise InvalidRunError(f"{what} must be a {names}, got {show(value)}")
+    return value
+
+
 def show(value) -> str:
     """``repr(value)``, shortened to one readable piece (a 400-digit integer is not echoed whole)."""
     text = repr(value)

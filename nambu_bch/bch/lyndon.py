@@ -32,6 +32,7 @@ from functools import lru_cache
 import numpy as np
 import sympy
 
+from ..checks import check_int
 from ..errors import UnknownPieceError
 
 
@@ -81,6 +82,7 @@ def witt_dimension(n_letters: int, degree: int) -> int:
     >>> [witt_dimension(3, d) for d in range(1, 10)]
     [3, 3, 8, 18, 48, 116, 312, 810, 2184]
     """
+    n_letters, degree = check_int(n_letters, "n_letters", 0), check_int(degree, "degree")
     if degree < 1:
         return 0
     total = sum(mobius(e) * n_letters ** (degree // e) for e in divisors(degree))
@@ -121,7 +123,7 @@ def lyndon_words(n_letters: int, degree: int) -> list:
     >>> lyndon_words(2, 3)
     [(0, 0, 1), (0, 1, 1)]
     """
-    return list(_lyndon_words(n_letters, degree))
+    return list(_lyndon_words(check_int(n_letters, "n_letters"), check_int(degree, "degree")))
 
 
 @lru_cache(maxsize=None)

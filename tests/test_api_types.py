@@ -1,0 +1,56 @@
+"""Wrong argument types and values at the public entries: one NambuBCHError naming the argument, never a crash."""
+
+from __future__ import annotations
+
+import pytest
+import sympy
+
+import nambu_bch as nb
+from nambu_bch import bch, design, exact, integrators
+from nambu_bch.errors import InvalidCompositionError, InvalidRunError, NambuBCHError, NoExactResultError
+
+x1, x2 = sympy.symbols("x1 x2")
+
+
+@pytest.mark.parametrize(
+    "call, error, words",
+    [
+        (lambda: integrators.strang_word(2**63 - 1), InvalidRunError, "Strang word"),  # used to hang
+        (lambda: integrators.strang_word(()), InvalidRunError, "Strang word"),
+        (lambda: bch.estimate_size(0, 0), InvalidRunError, "n_generators"),  # used to recurse without end
+        (lambda: bch.estimate_size("", 3), InvalidRunError, "n_generators"),
+        (lambda: bch.estimate_size(3, 10**6), InvalidRunError, "max_degree"),
+        (lambda: bch.check_order(2, limit=None), InvalidRunError, "limit"),
+        (lambda: bch.lyndon_words("", 3), InvalidRunError, "n_letters"),
+        (lambda: bch.witt_dimension("", 3), InvalidRunError, "n_letters"),
+        (lambda: exact.linear_core("", (x2, -x1)), NoExactResultError, "coordinates"),
+        (lambda: exact.linear_core({1: 2}, (x2, -x1)), NoExactResultError, "coordinates"),
+        (lambda: exact.linear_core(1, (x2, -x1)), NoExactResultError, "coordinates"),
+        (lambda: exact.linear_core((x1, x2), (x2,)), NoExactResultError, "right-hand side"),
+        (lambda: design.cost(2), InvalidRunError, "comp"),
+        (lambda: nb.lie_bracket(0, 0), InvalidRunError, "VectorField"),
+        (lambda: nb.Composition(pieces=int, coefficients=(1,)), InvalidCompositionError, "pieces"),
+        (lambda: nb.Composition(pieces=(1,), coefficients=5), InvalidCompositionError, "coefficients"),
+        (lambda: nb.VectorField(algebra=0, components=0), InvalidRunError, "PolynomialAlgebra"),
+        (lambda: nb.VectorField(nb.PolynomialAlgebra([x1, x2]), 0), NambuBCHError, "components"),
+    ],
+)
+def test_wrong_argument_is_one_named_error(call, error, words):
+    with pytest.raises(error, match=words) as info:
+        call()
+    assert "\n" not in str(info.value)
+
+
+def test_valid_calls_unchanged():
+    assert integrators.strang_word(3) == "12321"
+    assert bch.estimate_size(3, 7)["lyndon"] == 508
+    assert bch.lyndon_words(2, 3) == [(0, 0, 1), (0, 1, 1)]
+    assert exact.linear_core((x1, x2), (x2, -x1)).Omega == 1
+    assert design.cost(nb.composition("12321")) == (4, 1)
+
+
+def test_one_stage_strang_template_is_answered():
+    # a univariate Groebner basis (python-flint) once failed on the ordering given by name
+    C = nb.optimize_composition("strang", parts=2, order=2, stages=1)
+    assert C.pieces == (1, 2, 1)
+    assert C.coefficients == (sympy.Rational(1, 2), 1, sympy.Rational(1, 2))
