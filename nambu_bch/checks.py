@@ -13,7 +13,7 @@ import math
 import numbers
 import sys
 
-from .errors import InvalidRunError, NumericalRangeError
+from .errors import InvalidRunError, NumericalRangeError, one_line
 
 #: The accepted truncation orders ``k`` (``h^0 .. h^k``) of every symbolic route and of ``--order``: one range
 #: for the API and the command line.  Order 0 is the exact answer ``H_S = H, G_S = G`` (no correction is kept).
@@ -74,8 +74,10 @@ def check_type(value, kind, what):
 
 
 def show(value) -> str:
-    """``repr(value)``, shortened to one readable piece (a 400-digit integer is not echoed whole)."""
+    """``repr(value)`` on one line, shortened to one readable piece (a 400-digit integer is not echoed whole)."""
     text = repr(value)
+    if "\n" in text:  # an array's or a matrix's repr: one line (a string's repr has no line break)
+        text = one_line(text, len(text))
     return text if len(text) <= 60 else f"{text[:30]}...{text[-12:]} ({len(text)} characters)"
 
 

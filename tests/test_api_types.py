@@ -7,7 +7,7 @@ import sympy
 
 import nambu_bch as nb
 from nambu_bch import bch, design, exact, integrators
-from nambu_bch.errors import InvalidCompositionError, InvalidRunError, NambuBCHError, NoExactResultError
+from nambu_bch.errors import InvalidCompositionError, InvalidRunError, NambuBCHError, NoExactResultError, UnknownModelError
 
 x1, x2 = sympy.symbols("x1 x2")
 
@@ -54,3 +54,20 @@ def test_one_stage_strang_template_is_answered():
     C = nb.optimize_composition("strang", parts=2, order=2, stages=1)
     assert C.pieces == (1, 2, 1)
     assert C.coefficients == (sympy.Rational(1, 2), 1, sympy.Rational(1, 2))
+
+
+def test_array_in_a_message_is_shown_on_one_line():
+    import numpy as np
+
+    with pytest.raises(UnknownModelError) as info:
+        nb.model(np.ones((3, 3, 3)))
+    message = str(info.value)
+    assert "\n" not in message and "unknown model array(" in message
+
+
+def test_cli_and_library_share_the_one_line_helpers():
+    from nambu_bch import errors
+    from nambu_bch.cli import _options
+
+    assert _options.one_line is errors.one_line and _options.shown is errors.shown
+    assert errors.one_line("a\n  b\x1b") == "a b\\x1b"
