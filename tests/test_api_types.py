@@ -71,3 +71,33 @@ def test_cli_and_library_share_the_one_line_helpers():
 
     assert _options.one_line is errors.one_line and _options.shown is errors.shown
     assert errors.one_line("a\n  b\x1b") == "a b\\x1b"
+
+
+@pytest.mark.parametrize(
+    "call, words",
+    [
+        (lambda: bch.standard_bracketing(None), "word"),
+        (lambda: bch.standard_bracketing(""), "Lyndon word"),
+        (lambda: bch.lie_to_associative(2), "terms"),
+        (lambda: bch.lie_to_associative("20"), "coefficient, tree"),
+        (lambda: bch.terms_to_latex(None), "terms"),
+        (lambda: bch.terms_to_latex("x(:("), "coefficient, tree"),
+        (lambda: bch.tree_to_latex(0, names=0), "names"),
+        (lambda: nb.full_split(2), "System"),
+        (lambda: __import__("nambu_bch.algebra", fromlist=["field_backend"]).field_backend(1, {}), "PolynomialAlgebra"),
+        (lambda: nb.exact_flow(float("nan"), "strang:"), "Piece"),
+        (lambda: nb.exact_flow(nb.model("ho3").splitting.pieces[0], 0), "coordinates"),
+    ],
+)
+def test_wrong_object_is_refused_at_the_entry(call, words):
+    with pytest.raises(InvalidRunError, match=words):
+        call()
+
+
+def test_objects_still_accepted():
+    S = nb.model("ho3").splitting
+    assert bch.standard_bracketing((0, 0, 1), letters=(1, 2)) == (1, (1, 2))
+    assert bch.lie_to_associative([(1, (1, (2, 3))), (1, (2, (3, 1))), (1, (3, (1, 2)))]) == {}
+    assert bch.tree_to_latex((1, (1, 2))) == "[X_{1},[X_{1},X_{2}]]"
+    assert nb.exact_flow(S.pieces[0], S.system.coordinates).kind
+    assert len(nb.full_split(nb.model("ho3")).pieces) == 3

@@ -16,6 +16,7 @@ import sympy
 
 from ..checks import check_type, show
 from ..errors import NambuBCHError
+from .flint_ring import FlintRing
 from .polynomial import PolynomialAlgebra
 
 
@@ -41,7 +42,7 @@ class VectorField:
     __slots__ = ("algebra", "components")
 
     def __init__(self, algebra: PolynomialAlgebra, components):
-        check_type(algebra, PolynomialAlgebra, "algebra")
+        check_type(algebra, (PolynomialAlgebra, FlintRing), "algebra")
         if isinstance(components, (str, bytes, dict)) or not hasattr(components, "__iter__"):
             raise NambuBCHError(f"the components of a vector field are a sequence of expressions, got {show(components)}")
         components = tuple(components)
