@@ -101,3 +101,12 @@ def test_objects_still_accepted():
     assert bch.tree_to_latex((1, (1, 2))) == "[X_{1},[X_{1},X_{2}]]"
     assert nb.exact_flow(S.pieces[0], S.system.coordinates).kind
     assert len(nb.full_split(nb.model("ho3")).pieces) == 3
+
+
+@pytest.mark.parametrize("kwargs, words", [({"total": None}, "total"), ({"total": "True"}, "total"),
+                                           ({"total": 3, "delay": float("nan")}, "delay")])
+def test_progress_arguments_are_checked(kwargs, words):
+    from nambu_bch.numeric import Progress
+
+    with pytest.raises(NambuBCHError, match=words):
+        Progress(enabled=False, **kwargs)
