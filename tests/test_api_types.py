@@ -110,3 +110,12 @@ def test_progress_arguments_are_checked(kwargs, words):
 
     with pytest.raises(NambuBCHError, match=words):
         Progress(enabled=False, **kwargs)
+
+
+def test_exact_with_a_transcendental_parameter_is_refused_with_a_reason(capsys):
+    # m = exp(2) is not in the polynomial ring; the composed map once failed there with AttributeError
+    from nambu_bch.cli import main
+
+    assert main(["exact", "--param", "m=exp(2)"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert "\n" not in err and "m=exp(2)" in err
