@@ -13,7 +13,7 @@ import math
 import numbers
 import sys
 
-from .errors import InvalidRunError, NumericalRangeError
+from .errors import InvalidRunError, NumericalRangeError, one_line
 
 #: The accepted truncation orders ``k`` (``h^0 .. h^k``) of every symbolic route and of ``--order``: one range
 #: for the API and the command line.  Order 0 is the exact answer ``H_S = H, G_S = G`` (no correction is kept).
@@ -48,9 +48,36 @@ def check_flag(value, what, none=False):
     return bool(value)
 
 
+def check_int(value, what, low=None, high=None) -> int:
+    """``value`` as an int if :func:`is_int` accepts it (numpy integers too), else one line naming ``what``."""
+    if not is_int(value, low, high, numpy=True):
+        if low is not None and high is not None:
+            accepted = f"an integer from {low} to {high}"
+        elif low is not None:
+            accepted = f"an integer >= {low}"
+        else:
+            accepted = "an integer" if high is None else f"an integer <= {high}"
+        raise InvalidRunError(f"{what} must be {accepted}, got {show(value)}")
+    return int(value)
+
+
+def check_type(value, kind, what):
+    """``value`` if it is an instance of ``kind`` (a class or a tuple of classes), else one line naming ``what``.
+
+    For the arguments that must be one of the package's objects (a splitting, a vector field, a
+    composition): a wrong object is refused at the entry instead of failing deep inside.
+    """
+    if not isinstance(value, kind):
+        names = " or ".join(k.__name__ for k in (kind if isinstance(kind, tuple) else (kind,)))
+        raise InvalidRunError(f"{what} must be a {names}, got {show(value)}")
+    return value
+
+
 def show(value) -> str:
-    """``repr(value)``, shortened to one readable piece (a 400-digit integer is not echoed whole)."""
+    """``repr(value)`` on one line, shortened to one readable piece (a 400-digit integer is not echoed whole)."""
     text = repr(value)
+    if "\n" in text:  # an array's or a matrix's repr: one line (a string's repr has no line break)
+        text = one_line(text, len(text))
     return text if len(text) <= 60 else f"{text[:30]}...{text[-12:]} ({len(text)} characters)"
 
 

@@ -70,6 +70,35 @@ class ResourceLimitError(NambuBCHError):
     """A request whose size, estimated from the input before any work, exceeds what can finish (refused up front)."""
 
 
+#: Longest error line printed (a huge input echoed back is shortened).
+MAX_MESSAGE = 600
+
+
+def shown(value, limit: int = 80) -> str:
+    """A user string as echoed in a message: quoted, control characters, bidi marks and newlines escaped, shortened.
+
+    The one way the command line echoes text it was given (paths, names, flag values) so that a
+    message cannot carry terminal escapes, right-to-left overrides or line breaks.
+    """
+    text = str(value)
+    if len(text) > limit:
+        text = text[: limit - 3] + "..."
+    return repr(text)
+
+
+def one_line(message: str, limit: int = MAX_MESSAGE) -> str:
+    """``message`` as one printable line: whitespace runs become one space, other unprintable characters are escaped.
+
+    The last filter of every line the command line prints on stderr, and how the library's messages
+    show a user value whose ``repr`` spans lines (a numpy array, a matrix).
+    """
+    text = " ".join(str(message).split())
+    text = "".join(ch if ch.isprintable() else ch.encode("unicode_escape").decode("ascii") for ch in text)
+    if len(text) > limit:  # a huge input echoed back: keep the line readable
+        text = text[: limit - 3] + "..."
+    return text
+
+
 def did_you_mean(word, candidates) -> str:
     """``" (did you mean 'x'?)"`` for the candidate closest to ``word``, or ``""`` when none is close.
 

@@ -56,8 +56,9 @@ from sympy.polys.constructor import construct_domain
 from sympy.polys.domains import ZZ
 from sympy.polys.rings import PolyElement, ring
 
+from ..checks import check_type
 from ..errors import NambuBCHError
-from .flint_ring import exponents
+from .flint_ring import FlintRing, exponents
 from .vector_field import VectorField
 
 
@@ -656,6 +657,10 @@ def field_backend(algebra, fields: dict, laurent: bool = True) -> FieldBackend:
     >>> type(B).__name__, B.laurent
     ('PolynomialBackend', True)
     """
+    from .polynomial import PolynomialAlgebra
+
+    check_type(algebra, (PolynomialAlgebra, FlintRing), "algebra")
+    check_type(fields, dict, "fields")
     backend = PolynomialBackend.build(algebra, fields, laurent)
     if backend is not None:
         return backend

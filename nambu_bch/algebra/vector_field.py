@@ -14,7 +14,9 @@ from __future__ import annotations
 
 import sympy
 
+from ..checks import check_type, show
 from ..errors import NambuBCHError
+from .flint_ring import FlintRing
 from .polynomial import PolynomialAlgebra
 
 
@@ -40,6 +42,9 @@ class VectorField:
     __slots__ = ("algebra", "components")
 
     def __init__(self, algebra: PolynomialAlgebra, components):
+        check_type(algebra, (PolynomialAlgebra, FlintRing), "algebra")
+        if isinstance(components, (str, bytes, dict)) or not hasattr(components, "__iter__"):
+            raise NambuBCHError(f"the components of a vector field are a sequence of expressions, got {show(components)}")
         components = tuple(components)
         if len(components) != algebra.n:
             raise NambuBCHError(
@@ -154,4 +159,6 @@ def _vector_field_from(algebra, components) -> VectorField:
 
 def lie_bracket(X: VectorField, Y: VectorField) -> VectorField:
     """``[X, Y] = XY - YX`` as differential operators (Eq. CL1 convention)."""
+    check_type(X, VectorField, "X")
+    check_type(Y, VectorField, "Y")
     return X.bracket(Y)

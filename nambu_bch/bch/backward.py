@@ -25,7 +25,7 @@ import sympy
 
 from ..algebra import VectorField
 from ..algebra.backend import field_backend
-from ..checks import MAX_ORDER, check_flag
+from ..checks import MAX_ORDER, check_flag, check_int
 from ..errors import InvalidOrderError
 from ..integrators.composition import composition_for
 from ..printing import Printable, aligned
@@ -42,6 +42,7 @@ def check_order(order, limit: int = MAX_ORDER) -> int:
     >>> check_order(2.0)
     2
     """
+    limit = check_int(limit, "limit", 0)
     if isinstance(order, (bool, str, bytes)) or order is None:
         raise InvalidOrderError(f"order must be a non-negative integer, got {order!r}")
     if not isinstance(order, int):

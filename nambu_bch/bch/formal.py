@@ -54,6 +54,7 @@ import sympy
 from sympy.polys.constructor import construct_domain
 from sympy.polys.domains import QQ
 
+from ..checks import check_int
 from ..errors import InvalidCompositionError, InvalidOrderError
 from ..integrators.composition import Composition
 from ..integrators.composition import composition as make_composition
@@ -123,7 +124,9 @@ def estimate_size(n_generators: int, max_degree: int) -> dict:
     >>> estimate_size(3, 7)["lyndon"], estimate_size(3, 9)["expansion"], estimate_size(2, 4)["pairs"]
     (508, 687417, 0)
     """
-    g = n_generators
+    # the content enumeration recurses on the number of letters: it needs at least one
+    g = check_int(n_generators, "n_generators", 1)
+    max_degree = check_int(max_degree, "max_degree", 1, _HARD_DEGREE)
     return {
         "lyndon": sum(witt_dimension(g, d) for d in range(1, max_degree + 1)),
         "words": sum(g**d for d in range(1, max_degree + 1)),

@@ -32,7 +32,8 @@ from functools import lru_cache
 import numpy as np
 import sympy
 
-from ..errors import UnknownPieceError
+from ..checks import check_int, show
+from ..errors import InvalidRunError, UnknownPieceError
 
 
 def is_bracket(tree) -> bool:
@@ -81,6 +82,7 @@ def witt_dimension(n_letters: int, degree: int) -> int:
     >>> [witt_dimension(3, d) for d in range(1, 10)]
     [3, 3, 8, 18, 48, 116, 312, 810, 2184]
     """
+    n_letters, degree = check_int(n_letters, "n_letters", 0), check_int(degree, "degree")
     if degree < 1:
         return 0
     total = sum(mobius(e) * n_letters ** (degree // e) for e in divisors(degree))
@@ -121,7 +123,7 @@ def lyndon_words(n_letters: int, degree: int) -> list:
     >>> lyndon_words(2, 3)
     [(0, 0, 1), (0, 1, 1)]
     """
-    return list(_lyndon_words(n_letters, degree))
+    return list(_lyndon_words(check_int(n_letters, "n_letters"), check_int(degree, "degree")))
 
 
 @lru_cache(maxsize=None)
@@ -162,7 +164,7 @@ def standard_factorization(word: tuple) -> tuple:
     for i in range(1, len(word)):
         if is_lyndon(word[i:]):
             return word[:i], word[i:]
-    raise ValueError(f"{word!r} is a letter or not a Lyndon word; standard factorisation needs a Lyndon word of length >= 2")
+    raise InvalidRunError(f"{word!r} is a letter or not a Lyndon word; standard factorisation needs a Lyndon word of length >= 2")
 
 
 def standard_bracketing(word, letters=None):
@@ -171,7 +173,7 @@ def standard_bracketing(word, letters=None):
     >>> standard_bracketing((0, 0, 1), letters=(1, 2))
     (1, (1, 2))
     """
-    word = tuple(word)
+    word = tuple(_sequence(word, "word"))
     if len(word) == 1:
         return word[0] if letters is None else letters[word[0]]
     u, v = standard_factorization(word)
@@ -228,6 +230,23 @@ def tree_to_associative(tree) -> dict:
     return {w: c for w, c in out.items() if c != 0}
 
 
+def _sequence(value, what):
+    """``value`` if it can be iterated as a sequence (a string too), else one line naming ``what``."""
+    if not hasattr(value, "__iter__") or isinstance(value, dict):
+        raise InvalidRunError(f"{what} must be a sequence, got {show(value)}")
+    return value
+
+
+def _terms(terms, lengths):
+    """The ``(coefficient, tree[, factor])`` items of ``terms``, each checked to be a tuple of an accepted length."""
+    lengths = lengths if isinstance(lengths, tuple) else (lengths,)
+    form = " or ".join({2: "(coefficient, tree)", 3: "(coefficient, tree, factor)"}[n] for n in lengths)
+    for item in _sequence(terms, "terms"):
+        if not isinstance(item, (tuple, list)) or len(item) not in lengths:
+            raise InvalidRunError(f"each term must be a {form} tuple, got {show(item)}")
+        yield item
+
+
 def lie_to_associative(terms) -> dict:
     """``sum c * tree`` over ``(c, tree)`` pairs, in the free associative algebra: ``{word: c}``.
 
@@ -240,7 +259,7 @@ def lie_to_associative(terms) -> dict:
     {}
     """
     out: dict = {}
-    for c, tree in terms:
+    for c, tree in _terms(terms, 2):
         for w, k in tree_to_associative(tree).items():
             out[w] = out.get(w, 0) + c * k
     return {w: c for w, c in out.items() if c != 0}
@@ -255,6 +274,8 @@ def tree_to_latex(tree, names=None) -> str:
     >>> tree_to_latex((1, (1, 2)))
     '[X_{1},[X_{1},X_{2}]]'
     """
+    if names is not None and not (callable(names) or isinstance(names, dict)):
+        raise InvalidRunError(f"names must be a dict or a callable, got {show(names)}")
     if is_bracket(tree):
         return f"[{tree_to_latex(tree[0], names)},{tree_to_latex(tree[1], names)}]"
     if names is not None:
@@ -287,7 +308,7 @@ def terms_to_latex(terms, names=None) -> str:
     'X_T + X_V - \\frac{1}{24} [X_T,[X_T,X_V]] + \\frac{1}{12} [X_V,[X_V,X_T]]'
     """
     parts = []
-    for item in terms:
+    for item in _terms(terms, (2, 3)):
         c, tree, factor = item if len(item) == 3 else (*item, sympy.Integer(1))
         c = sympy.sympify(c, strict=True)
         body = tree_to_latex(tree, names)

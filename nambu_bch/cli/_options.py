@@ -12,15 +12,13 @@ import argparse
 import re
 
 from ..checks import MAX_ORDER as MAX_CLI_ORDER  # the API's range of orders (light module: no sympy here)
-from ..errors import NambuBCHError
+from ..errors import MAX_MESSAGE, NambuBCHError, one_line, shown  # noqa: F401 -- re-exported to the cli modules
 
 PROG = "nambu-bch"
 DEFAULT_MODEL = "ho3"
 MAX_STEPS = 100_000_000
 #: Largest ``fi --limit`` (brackets and directions listed).
 MAX_LIMIT = 10**6
-#: Longest error line printed (a huge input echoed back is shortened).
-MAX_MESSAGE = 600
 #: Longest accepted path (--system, --output, --outdir).
 MAX_PATH = 4096
 _SYMBOLIC = ("latex", "text", "json")
@@ -55,31 +53,6 @@ class _Parser(argparse.ArgumentParser):
             raise argparse.ArgumentError(
                 action, f"invalid choice: {shown(value)}{did_you_mean(value, list(action.choices))} (choose from {choices})"
             )
-
-
-def shown(value, limit: int = 80) -> str:
-    """A user string as echoed in a message: quoted, control characters, bidi marks and newlines escaped, shortened.
-
-    The one way the command line echoes text it was given (paths, names, flag values) so that a
-    message cannot carry terminal escapes, right-to-left overrides or line breaks.
-    """
-    text = str(value)
-    if len(text) > limit:
-        text = text[: limit - 3] + "..."
-    return repr(text)
-
-
-def one_line(message: str, limit: int = MAX_MESSAGE) -> str:
-    """``message`` as one printable line: whitespace runs become one space, other unprintable characters are escaped.
-
-    The last filter of every line the command line prints on stderr (messages of the library
-    echo user text with ``repr``, which this leaves as it is).
-    """
-    text = " ".join(str(message).split())
-    text = "".join(ch if ch.isprintable() else ch.encode("unicode_escape").decode("ascii") for ch in text)
-    if len(text) > limit:  # a huge input echoed back: keep the line readable
-        text = text[: limit - 3] + "..."
-    return text
 
 
 def unknown_argument_message(parser, command, extras) -> str:

@@ -10,7 +10,7 @@ from ._options import MAX_MESSAGE, one_line, shown
 
 
 def say(line: str) -> None:
-    """``line`` on stderr as one printable line (:func:`~nambu_bch.cli._options.one_line`).
+    """``line`` on stderr as one printable line (:func:`~nambu_bch.errors.one_line`).
 
     A closed or failing stderr loses the line, and it never goes to stdout: started with
     ``2>&-`` Python sets ``sys.stderr`` to ``None``, and ``print(file=None)`` would write to stdout.

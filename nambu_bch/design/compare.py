@@ -34,9 +34,9 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..atomic import write_atomic
-from ..checks import finite_float, is_int, show
+from ..checks import check_type, finite_float, is_int, show
 from ..errors import InvalidCompositionError, InvalidRunError, NambuBCHError
-from ..integrators.composition import composition as make_composition, composition_for
+from ..integrators.composition import Composition, composition as make_composition, composition_for
 from ..integrators.step import parameter_values
 from ..numeric import iterate
 from ..numeric.figures import MAX_DPI
@@ -59,6 +59,7 @@ def cost(comp) -> tuple:
     >>> cost(make_composition("12321")), cost(make_composition("123"))
     ((4, 1), (3, 0))
     """
+    check_type(comp, Composition, "comp")
     runs = [k for i, k in enumerate(comp.pieces) if i == 0 or comp.pieces[i - 1] != k]
     if len(runs) > 1 and runs[0] == runs[-1]:
         return len(runs) - 1, 1

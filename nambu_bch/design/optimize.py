@@ -45,6 +45,7 @@ import mpmath
 import numpy as np
 import sympy
 from sympy.polys.domains import QQ
+from sympy.polys.orderings import grevlex
 
 from ..algebra.elimination import solve_affine
 from ..checks import is_int
@@ -388,7 +389,9 @@ def _quotient_dimension(G, limit):
     O'Shea, *Ideals, Varieties, and Algorithms*, Sect. 5.3, Prop. 4); they lie in the box below the pure powers
     ``x_i^{a_i}`` that lead some element (Sect. 5.3, Thm. 6).
     """
-    leads = [P.monoms(order="grevlex")[0] for P in G.polys]
+    # the ordering object, not its name: a univariate basis is stored in python-flint's DMP, whose ``monoms``
+    # reads ``order.alias`` and fails on the string
+    leads = [P.monoms(order=grevlex)[0] for P in G.polys]
     n = len(G.gens)
     box = [min(m[i] for m in leads if all(e == 0 for j, e in enumerate(m) if j != i) and m[i] > 0) for i in range(n)]
     count = 0

@@ -23,6 +23,7 @@ from dataclasses import dataclass
 
 import sympy
 
+from ..checks import show
 from ..errors import NoExactResultError
 
 H_STEP = sympy.Symbol("h")
@@ -79,7 +80,13 @@ def linear_core(coordinates, rhs, name="system") -> LinearCore:
     >>> linear_core((x1, x2, x3), (x2/m, -m*omega**2*x1, 2*x1*x2/m)).Omega   # Eq. (NambuOHeqs)
     omega
     """
+    if isinstance(coordinates, (str, bytes)) or not hasattr(coordinates, "__iter__"):
+        raise NoExactResultError(f"the coordinates of {name} are a sequence of sympy symbols, got {show(coordinates)}")
     coords = tuple(coordinates)
+    if not coords or not all(isinstance(c, sympy.Symbol) for c in coords) or len(set(coords)) != len(coords):
+        raise NoExactResultError(f"the coordinates of {name} must be distinct sympy symbols, got {show(coordinates)}")
+    if isinstance(rhs, (str, bytes)) or not hasattr(rhs, "__iter__") or len(rhs := tuple(rhs)) != len(coords):
+        raise NoExactResultError(f"{name} needs one right-hand side per coordinate ({len(coords)}), got {show(rhs)}")
     rhs = [sympy.expand(r) for r in rhs]
     fail = NoExactResultError(
         f"{name} has no harmonic core: the equations {tuple(rhs)} are not of the form (y1, y2)' = A y with "

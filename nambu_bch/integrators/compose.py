@@ -30,7 +30,9 @@ def composed_map(splitting, comp, h=STEP) -> tuple:
     coords = system.coordinates
     flows = [(exact_flow(splitting[k], coords), c) for k, c in comp.factors()]
     if all(f.polynomial for f, _ in flows):
-        return _compose_in_ring(system, flows, comp, h)
+        composed = _compose_in_ring(system, flows, comp, h)
+        if composed is not None:
+            return composed
     state = list(coords)
     for flow, c in flows:
         step = flow.at(c * h)
@@ -44,7 +46,10 @@ def _compose_in_ring(system, flows, comp, h):
     hh = algebra.gens[algebra.n + algebra.constants.index(h)]
     state = list(algebra.gens[: algebra.n])
     for flow, c in flows:
-        step = [algebra.convert(e).compose(t, hh * algebra.convert(c)) for e in flow.expressions]
+        step = [algebra.convert(e) for e in flow.expressions]
+        if not all(algebra.is_polynomial(e) for e in step):  # a constant such as m = exp(2) is not in the ring
+            return None
+        step = [e.compose(t, hh * algebra.convert(c)) for e in step]
         substitution = list(zip(algebra.gens[: algebra.n], state))
         state = [e.compose(substitution) for e in step]
     return tuple(algebra.to_sympy(e) for e in state)

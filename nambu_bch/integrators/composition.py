@@ -55,7 +55,7 @@ import sympy
 from sympy.polys.domains import QQ
 
 from ..algebra.zero import is_zero
-from ..checks import is_int
+from ..checks import check_int, is_int, show
 from ..errors import InconsistentCoefficientsError, InvalidCompositionError, UnknownPieceError, did_you_mean
 
 #: Names resolved by :mod:`nambu_bch.design.catalog` (literature methods, ``name`` or ``name:WORD``).
@@ -90,6 +90,9 @@ class Composition:
     citation: str = ""
 
     def __post_init__(self):
+        for what, value in (("pieces", self.pieces), ("coefficients", self.coefficients)):
+            if not isinstance(value, (tuple, list)):
+                raise InvalidCompositionError(f"the {what} of a composition are a tuple, got {show(value)}")
         if not self.pieces:
             raise InvalidCompositionError("a composition needs at least one factor, got none")
         if len(self.pieces) != len(self.coefficients):
@@ -216,6 +219,7 @@ def strang_word(n: int) -> str:
     >>> strang_word(3), strang_word(2), strang_word(1)
     ('12321', '121', '1')
     """
+    check_int(n, "the number of pieces of a Strang word", 1, MAX_PIECES)  # pieces are digits
     word = "".join(str(k) for k in range(1, n + 1))
     return word + word[-2::-1]
 

@@ -22,7 +22,8 @@ from functools import lru_cache
 
 import sympy
 
-from ..errors import NoExactFlowError
+from ..checks import check_type, show
+from ..errors import InvalidRunError, NoExactFlowError
 
 #: The symbol of the sub-flow's time in :attr:`ExactFlow.expressions`.
 TIME = sympy.Symbol("t")
@@ -50,7 +51,15 @@ class ExactFlow:
 
 def exact_flow(piece, coordinates) -> ExactFlow:
     """The exact flow of ``piece`` (a :class:`~nambu_bch.systems.Piece`)."""
-    return _exact_flow(piece, tuple(coordinates))
+    from ..systems.splitting import Piece
+
+    check_type(piece, Piece, "piece")
+    if isinstance(coordinates, (str, bytes)) or not hasattr(coordinates, "__iter__"):
+        raise InvalidRunError(f"coordinates must be a sequence of sympy symbols, got {show(coordinates)}")
+    coordinates = tuple(coordinates)
+    if len(coordinates) != piece.field.algebra.n:
+        raise InvalidRunError(f"piece {piece.number} moves {piece.field.algebra.n} coordinates, got {show(coordinates)}")
+    return _exact_flow(piece, coordinates)
 
 
 @lru_cache(maxsize=256)

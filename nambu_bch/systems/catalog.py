@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from ..checks import show
 from ..errors import UnknownModelError, did_you_mean
 from .system import System
 
@@ -200,7 +201,7 @@ def model(name: str) -> System:
     """
     if not isinstance(name, str) or name not in _MODELS:
         raise UnknownModelError(
-            f"unknown model {name!r}{did_you_mean(name, _MODELS)}; built-in models are {', '.join(_MODELS)}"
+            f"unknown model {show(name)}{did_you_mean(name, _MODELS)}; built-in models are {', '.join(_MODELS)}"
         )
     if name not in _CACHE:
         _CACHE[name] = _MODELS[name]()

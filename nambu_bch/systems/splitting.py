@@ -27,6 +27,7 @@ from itertools import permutations
 import sympy
 
 from ..algebra import VectorField, liouville_field
+from ..checks import check_type
 from .separable import separate
 
 
@@ -94,6 +95,9 @@ def _moving(field: VectorField) -> tuple:
 
 def full_split(system) -> Splitting:
     """Split every Hamiltonian per coordinate; piece ``i`` moves ``x_i`` (Eqs. X1-X3)."""
+    from .system import System
+
+    check_type(system, System, "system")
     coords = system.coordinates
     names = [system._ham_name(k, len(system.hamiltonians)) for k in range(len(system.hamiltonians))]
     parts = [separate(H, coords, name) for H, name in zip(system.hamiltonians, names)]
