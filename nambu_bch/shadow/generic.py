@@ -44,6 +44,7 @@ from ..algebra.zero import is_zero
 from ..bch.backward import check_order, effective_field
 from ..bch.evaluation import BracketEvaluator
 from ..bch.formal import formal_bch
+from ..bch.lyndon import witt_dimension
 from ..errors import NambuBCHError, NoExactResultError, ResourceLimitError
 from ..integrators.composition import composition_for
 
@@ -135,36 +136,12 @@ def math_prod(values):
     return out
 
 
-def lyndon_words(letters: int, length: int) -> int:
-    """The number of Lyndon words of ``length`` over ``letters`` letters (the necklace polynomial).
-
-    It bounds the number of brackets of that length in the BCH series of a composition of
-    ``letters`` pieces (a basis of the free Lie algebra's degree-``length`` part).
-
-    >>> [lyndon_words(2, j) for j in range(1, 10)]
-    [2, 1, 2, 3, 6, 9, 18, 30, 56]
-    """
-    return sum(_mobius(d) * letters ** (length // d) for d in range(1, length + 1) if length % d == 0) // length
-
-
-def _mobius(n: int) -> int:
-    result, p = 1, 2
-    while p * p <= n:
-        if n % p == 0:
-            n //= p
-            if n % p == 0:
-                return 0
-            result = -result
-        p += 1
-    return -result if n > 1 else result
-
-
 def bch_work(system, pieces, hams, order: int) -> tuple:
     """``(work, worst piece)``: the size of a BCH request on non-polynomial Hamiltonians, from its input alone.
 
-    ``work = sum_j lyndon_words(pieces, j) * sum_H sum_x derivative_terms(H, x, j)`` over the bracket
+    ``work = sum_j witt_dimension(pieces, j) * sum_H sum_x derivative_terms(H, x, j)`` over the bracket
     lengths ``j = 1 .. order + 1``: a bracket of ``j`` letters differentiates the pieces up to ``j`` times,
-    and there are at most ``lyndon_words(pieces, j)`` of them.  Polynomial Hamiltonians are left out (their
+    and there are at most ``witt_dimension(pieces, j)`` of them.  Polynomial Hamiltonians are left out (their
     derivatives only shrink); so the estimate is 0 for polynomial systems.
     """
     coords = system.coordinates
@@ -177,7 +154,7 @@ def bch_work(system, pieces, hams, order: int) -> tuple:
         size = 0
         for j in range(1, order + 2):
             terms = sum(derivative_terms(expr, [x], j, memo) for x in coords)
-            size = min(_CAP_TERMS, size + lyndon_words(pieces, j) * terms)
+            size = min(_CAP_TERMS, size + witt_dimension(pieces, j) * terms)
         work = min(_CAP_TERMS, work + size)
         worst = max(worst, (size, expr), key=lambda pair: pair[0])
     return work, worst[1]
