@@ -630,6 +630,43 @@ def test_batch_reads_x0_in_place_and_leaves_it_unchanged(backend):
     assert np.array_equal(iterate("ho3", "32123", 0.1, 0, X, backend=backend), X[None])   # steps = 0: x0 only
 
 
+@pytest.mark.parametrize("backend", [pytest.param("numba", marks=numba_only), "numpy"])
+def test_out_receives_the_samples_in_place(backend):
+    """out= is filled in place and returned, every element written (garbage in it does not matter),
+    with the bits of a run that allocates its own result: single, batch, Kahan, progress segments."""
+    X = np.random.default_rng(5).normal(size=(3, 50))
+    for x0, kw in ((X, {}), (X, {"kahan": True}), (X[:, 3], {}), (X[:, 3], {"kahan": True})):
+        want = iterate("ho3", "32123", 0.1, 40, x0, every=7, backend=backend, **kw)
+        out = np.full(want.shape, np.nan)
+        got = iterate("ho3", "32123", 0.1, 40, x0, every=7, backend=backend, out=out, **kw)
+        assert got is out and np.array_equal(out, want)
+    out = np.full((1, 3, 50), 7.0)
+    assert np.array_equal(iterate("ho3", "32123", 0.1, 0, X, out=out, backend=backend), X[None])
+
+
+def test_out_is_refused_unless_it_can_take_the_samples_in_place():
+    """A wrong dtype, shape or layout, a read-only array, an array overlapping x0 or an mpmath run: one
+    InvalidRunError line naming out, and the bad array is left as it was."""
+    X = np.ones((3, 8))
+    good = (2, 3, 8)
+    frozen = np.zeros(good)
+    frozen.flags.writeable = False
+    bad = [np.zeros(good, dtype=np.float32), np.zeros((3, 3, 8)), np.zeros(good, order="F"), frozen,
+           np.zeros((2, 3, 16))[:, :, ::2], [[0.0] * 8] * 3, "out"]
+    for out in bad:
+        with pytest.raises(InvalidRunError, match="^out must be") as info:
+            iterate("ho3", "32123", 0.1, 5, X, every=5, out=out)
+        assert "\n" not in str(info.value)
+        assert out is frozen or not isinstance(out, np.ndarray) or not out.any()
+    overlap = np.ones((3, 3, 8))
+    with pytest.raises(InvalidRunError, match="shares memory with x0"):
+        iterate("ho3", "32123", 0.1, 5, overlap[1], every=5, out=overlap[:2])        # a batch
+    with pytest.raises(InvalidRunError, match="shares memory with x0"):
+        iterate("ho3", "32123", 0.1, 5, overlap[0, :, 0], every=5, out=overlap.reshape(-1)[:6].reshape(2, 3))
+    with pytest.raises(InvalidRunError, match="mpmath"):
+        iterate("ho3", "32123", 0.1, 5, [1.0, 1.0, 1.0], every=5, dps=20, out=np.empty((2, 3)))
+
+
 def test_segmented_kahan_batch_carries_the_compensation(monkeypatch, capsys):
     """A Kahan batch cut into progress segments (each starting from the last sample written, the
     compensation carried in place) gives the bits of the uncut run and of each state's own run."""

@@ -28,8 +28,8 @@ from ..errors import InvalidRunError, InvalidSystemError, NumericalRangeError
 from ..progress import Progress, progress_wanted
 from ..systems import System, model
 from ..checks import check_flag
-from .guards import (check_backend, check_count, check_inputs, check_range, check_result, check_stability, check_work,
-                     initial_state, run_label, scan_states)
+from .guards import (check_backend, check_count, check_inputs, check_out, check_range, check_result, check_stability,
+                     check_work, initial_state, run_label, scan_states)
 from .kernels import kernel, resolve_backend
 from .precision import check_dps, run_mpmath
 from .samples import MAX_SAMPLE_BYTES, n_samples, sample_steps
@@ -48,7 +48,7 @@ def as_system(system) -> System:
 
 
 def iterate(system, word, h, steps, x0=None, params=None, every=1, *, kahan=False, dps=None,
-            backend="auto", progress=None, chunk=None, check_stable=True):
+            backend="auto", progress=None, chunk=None, check_stable=True, out=None):
     """Iterate ``Phi_h`` of ``word`` on ``system`` ``steps`` times from ``x0``; the samples every ``every`` steps.
 
     The step is generated once from the exact sub-flows (Eqs. hX1e-hX3e for ``ho3``)
@@ -72,13 +72,16 @@ def iterate(system, word, h, steps, x0=None, params=None, every=1, *, kahan=Fals
     progress : bool or None -- a progress line on stderr; None: only on a terminal and for long runs
     chunk : int, optional -- states per cache block of a batch (tuning only)
     check_stable : bool -- refuse steps outside the stability interval (:func:`~nambu_bch.numeric.guards.check_stability`)
+    out : numpy.ndarray, optional -- receives the samples in place and is returned: float64 of the shape
+        returned, C-contiguous, writeable, sharing no memory with ``x0`` (:func:`~nambu_bch.numeric.guards.check_out`).
+        Every element is written (``np.empty`` suffices), so repeated runs allocate nothing.  float64 runs only.
 
     Returns
     -------
     numpy.ndarray
         ``(n_samples, N)`` for one trajectory, ``(n_samples, N, batch)`` for a batch, with
         ``n_samples = ceil(steps / every) + 1`` at the steps :func:`sample_steps` lists
-        (``samples[0] == x0``); float64, or ``object`` (``mpmath.mpf``) with ``dps``.
+        (``samples[0] == x0``); float64 (``out`` when given), or ``object`` (``mpmath.mpf``) with ``dps``.
 
     Raises
     ------
@@ -110,6 +113,8 @@ def iterate(system, word, h, steps, x0=None, params=None, every=1, *, kahan=Fals
         dps = check_dps(dps)
         if kahan:
             raise InvalidRunError("kahan=True applies to float64 runs; an mpmath run (dps=...) needs no compensation")
+        if out is not None:
+            raise InvalidRunError("out= receives float64 samples; an mpmath run (dps=...) returns a new object array")
         h, steps, every, X, _ = check_inputs(system, h, steps, every, x0, params, exact=True)
         if check_stable:
             check_stability(kern, h, kern.constants(float(h), params), params)
@@ -126,11 +131,15 @@ def iterate(system, word, h, steps, x0=None, params=None, every=1, *, kahan=Fals
     single = X.ndim == 1
     batch = 1 if single else X.shape[1]
     count = n_samples(steps, every)
-    nbytes = count * system.N * batch * 8
-    if nbytes > MAX_SAMPLE_BYTES:
-        raise InvalidRunError(f"{count} samples of {system.N} x {batch} states need {nbytes / 2**30:.1f} GiB "
-                              f"(limit {MAX_SAMPLE_BYTES / 2**30:.0f} GiB); sample less often (larger every)")
-    out = np.empty((count, system.N) if single else (count, system.N, batch), dtype=np.float64)
+    shape = (count, system.N) if single else (count, system.N, batch)
+    if out is not None:  # the caller's memory: only its layout is checked
+        out = check_out(out, shape, x0, X)
+    else:
+        nbytes = count * system.N * batch * 8
+        if nbytes > MAX_SAMPLE_BYTES:
+            raise InvalidRunError(f"{count} samples of {system.N} x {batch} states need {nbytes / 2**30:.1f} GiB "
+                                  f"(limit {MAX_SAMPLE_BYTES / 2**30:.0f} GiB); sample less often (larger every)")
+        out = np.empty(shape, dtype=np.float64)  # not zeroed: the kernels write every sample
     what = run_label(system, kern.word, h, X, origin)
     reporter = Progress(steps * batch, f"iterate {system.name} {kern.word}",
                         enabled=_enabled(progress, steps * batch * (30 if be == "numpy" and single else 1)))
