@@ -412,6 +412,42 @@ def test_auto_loads_a_loop_from_numbas_disk_cache(tmp_path, monkeypatch):
     assert np.array_equal(x, iterate("ho", "TVT", 0.1, 100, X0["ho"], backend="numpy"))
 
 
+def _host_fuses():
+    """Whether the machine numba compiles for has fused multiply-add instructions."""
+    from llvmlite import binding
+
+    return bool(binding.get_host_cpu_features().get("fma", False))
+
+
+@numba_only
+def test_fma_contracts_only_when_asked_and_is_cached_apart(tmp_path, monkeypatch):
+    """fma=True runs a second compiled loop that may fuse a*b + c: close to the default run, which keeps the
+    interpreter's bits (and so does fma=True on the interpreter).  Each loop's machine code is cached
+    under its own name, so a fresh Kernel loads both from disk without mixing them up: numba's cache
+    key covers the bytecode and the signature, not the compile flags."""
+    from nambu_bch.numeric import kernels as K
+
+    monkeypatch.setenv("NAMBU_BCH_CACHE", str(tmp_path))
+    run = lambda x0, **kw: iterate("ho", "TVT", 0.1, 3000, x0, every=1000, **kw)  # noqa: E731
+    X = np.array([X0["ho"], [0.3, -0.2], [1e-3, 2.0]]).T
+    plain, fused = run(X0["ho"], backend="numba"), run(X0["ho"], backend="numba", fma=True)
+    plain_b, fused_b = run(X, backend="numpy", fma=True), run(X, backend="numba", fma=True)  # numpy: the compiled bits
+    assert np.array_equal(plain, run(X0["ho"], backend="numpy", fma=True))
+    assert np.allclose(fused, plain, rtol=1e-12, atol=1e-14) and np.allclose(fused_b, plain_b, rtol=1e-12, atol=1e-14)
+    if _host_fuses():
+        assert not np.array_equal(fused, plain) and not np.array_equal(fused_b, plain_b)
+    k = kernel(model("ho"), "TVT")
+    cached = {p.name.split("-")[0] for p in (tmp_path / "kernels" / "__pycache__").glob("*.nbi")}
+    assert cached == {f"{k.path.stem}.{name}" for name in ("run", "run+contract", "run_batch+contract")}
+    K._kernel.cache_clear()
+    K._kernel_for_word.cache_clear()
+    fresh = kernel(model("ho"), "TVT")
+    assert fresh is not k and fresh.ready("run") and fresh.ready("run+contract") and not fresh.ready("run_kahan+contract")
+    assert np.array_equal(run(X0["ho"], fma=True), fused) and np.array_equal(run(X0["ho"]), plain)
+    assert np.array_equal(run(X, fma=True), fused_b)
+    assert fresh.interpreted == {}
+
+
 @numba_only
 def test_auto_small_batches_take_numpy_only_where_it_gives_the_compiled_bits(tmp_path, monkeypatch):
     """numpy's expm1 differs from the C library's in the last bit for some arguments (see
