@@ -305,7 +305,8 @@ class Kernel:
     @staticmethod
     def loop_name(kahan=False, batch=False, fma=False) -> str:
         """The name a compiled loop is known by: ``run``, ``run_batch_kahan``, ``run+contract``, ..."""
-        return ("run_batch" if batch else "run") + ("_kahan" if kahan else "") + cache_variant(CONTRACT if fma else None)
+        name = ("run_batch" if batch else "run") + ("_kahan" if kahan else "")
+        return name + cache_variant(CONTRACT if fma else None)
 
     def function(self, name: str, backend: str = "numba"):
         """The loop ``name`` (``run``, ``run_kahan``, ``run_batch``, ``run_batch_kahan``, each optionally with the
