@@ -11,6 +11,8 @@ first process filled (a temporary ``NAMBU_BCH_CACHE``, so the machine's own cach
                                     ``INTERPRET_STEPS``: compiled), split into importing numba, loading
                                     the cached machine code (numba's type context included) and the rest
   the run with numba imported first -- the same, numba's import moved before the timer
+  a short run                    -- the same with ``--short`` steps (within ``INTERPRET_STEPS``: interpreted,
+                                    numba not imported)
 
 Usage (from the repository root):
     python benchmarks/bench_iterate_cold.py                  # ho3, 32123, 10^6 steps
@@ -44,28 +46,28 @@ from nambu_bch.numeric import iterate, kernel
 marks["import"] = clock()
 system = model(sys.argv[2])
 marks["model"] = clock()
-had_numba = "numba" in sys.modules
 x = iterate(system, sys.argv[3], 0.1, int(sys.argv[4]), [0.7] * system.N, every=int(sys.argv[4]))
 marks["iterate"] = clock()
 k = kernel(system, sys.argv[3])
-print(json.dumps({"marks": marks, "load": k.compile_seconds.get("run"), "had_numba": had_numba,
+print(json.dumps({"marks": marks, "load": k.compile_seconds.get("run"), "interpreted": k.interpreted.get("run", 0),
                   "from_cache": k.from_cache, "numba_import": NUMBA_IMPORT[0] if NUMBA_IMPORT else None}))
 """
 
-#: Prefix of the run's child: times ``import numba`` wherever it happens (a meta-path hook, no patching of ours).
+#: Prefix of the run's child: times the first ``import numba`` statement wherever it runs (``__import__``
+#: wrapped; ``importlib.util.find_spec``, which locates numba without importing it, does not pass here).
 HOOK = """
-import sys, time
+import builtins, sys, time
 NUMBA_IMPORT = []
-class _Timer:
-    def find_spec(self, name, path=None, target=None):
-        if name == "numba" and not NUMBA_IMPORT:
-            NUMBA_IMPORT.append(None)
-            sys.meta_path.remove(self)
-            t = time.perf_counter()
-            __import__("numba")
-            NUMBA_IMPORT[0] = time.perf_counter() - t
-        return None
-sys.meta_path.insert(0, _Timer())
+_import = builtins.__import__
+def _timed(name, *args, **kwargs):
+    if name != "numba" or NUMBA_IMPORT or "numba" in sys.modules:
+        return _import(name, *args, **kwargs)
+    start = time.perf_counter()
+    try:
+        return _import(name, *args, **kwargs)
+    finally:
+        NUMBA_IMPORT.append(time.perf_counter() - start)
+builtins.__import__ = _timed
 """
 
 
@@ -79,7 +81,8 @@ def child(kind, args, env):
         after = os.times()
         return {"wall": time.perf_counter() - start,
                 "cpu": (after.children_user - before.children_user) + (after.children_system - before.children_system)}
-    res = subprocess.run([sys.executable, "-c", HOOK + CHILD, kind, args.system, args.word, str(args.steps)],
+    steps = args.short if kind == "short" else args.steps
+    res = subprocess.run([sys.executable, "-c", HOOK + CHILD, kind, args.system, args.word, str(steps)],
                          env=env, capture_output=True, text=True, check=True)
     return json.loads(res.stdout.strip().splitlines()[-1])
 
@@ -89,6 +92,7 @@ def main(argv=None):
     ap.add_argument("--system", default="ho3")
     ap.add_argument("--word", default="32123")
     ap.add_argument("--steps", type=int, default=1_000_000, help="steps of the run (compiled: > INTERPRET_STEPS)")
+    ap.add_argument("--short", type=int, default=100, help="steps of the short run (interpreted)")
     ap.add_argument("--repeats", type=int, default=7)
     ap.add_argument("--json", action="store_true")
     args = ap.parse_args(argv)
@@ -97,7 +101,7 @@ def main(argv=None):
     with tempfile.TemporaryDirectory(prefix="nambu_bch_cold_") as cache:
         env["NAMBU_BCH_CACHE"] = cache
         filled = child("run", args, env)  # compiles and caches the kernel
-        rows = {"pass": [], "numba": [], "run": [], "numba_first": []}
+        rows = {"pass": [], "numba": [], "run": [], "numba_first": [], "short": []}
         load_before = os.getloadavg()
         for _ in range(args.repeats):
             for kind in rows:
@@ -116,7 +120,8 @@ def main(argv=None):
                         ("numba", "python -c 'import numba' (whole process)")):
         print(f"{label:58s} {stat([r['wall'] for r in rows[kind]])}  {stat([r['cpu'] for r in rows[kind]])}")
     summary = {}
-    for kind, title in (("run", "the run"), ("numba_first", "the run, numba imported before the timer")):
+    for kind, title in (("run", "the run"), ("numba_first", "the run, numba imported before the timer"),
+                        ("short", f"a short run, {args.short} steps")):
         phases = {}
         for r in rows[kind]:
             m = r["marks"]
@@ -125,10 +130,12 @@ def main(argv=None):
                 phases.setdefault(b, []).append((m[b][0] - m[a][0], m[b][1] - m[a][1]))
             if r["numba_import"] is not None and kind == "run":
                 phases.setdefault("iterate: of which import numba", []).append((r["numba_import"], float("nan")))
-            phases.setdefault("iterate: of which loading the machine code", []).append((r["load"], float("nan")))
+            if r["load"] is not None:
+                phases.setdefault("iterate: of which loading the machine code", []).append((r["load"], float("nan")))
         print(f"{title}:")
         labels = {"numba": "import numba", "import": "import nambu_bch.numeric (sympy, numpy)",
-                  "model": f"model({args.system!r})", "iterate": f"first iterate(), {args.steps} steps"}
+                  "model": f"model({args.system!r})",
+                  "iterate": f"first iterate(), {args.short if kind == 'short' else args.steps} steps"}
         for name, values in phases.items():
             wall = [w for w, _ in values]
             cpu = [c for _, c in values]
