@@ -1,24 +1,30 @@
 """Speed of nambu_bch.numeric.iterate against a C reference loop, measured in one run.
 
-Prints nanoseconds per trajectory-step (best of --repeats, both sides warm: compiled and loaded
-before timing; the contenders are called in turn in every round, so a change of load on a shared
-machine hits them alike, and the load average is printed with the numbers) for
-  C (gcc -O3 -march=native, the strongest build; generated from the same step program)
+Both sides are measured the same way: the call alone (ours: the public ``iterate()``, validation and
+result check included; C: the generated loop through ctypes, plus the copy of the start states its
+batch loop advances in place), warm (compiled and loaded before timing), called in turn in every
+round so that a change of load on a shared machine hits them alike, repeated ``--repeats`` times.
+Every row prints the best and the median wall time per trajectory-step and the best CPU time; the
+load average is printed with the numbers.  The contenders:
+
+  C, gcc's default optimised build (-O3 -march=native: gcc contracts a*b + c into FMA)
                                                      -- single trajectory and batch,
-  C (gcc -O2, for context)                           -- single trajectory and batch,
+  C, the same build with -ffp-contract=off (bit for bit the numba kernels) -- single and batch,
   C with one exp per piece (hand-written; Lotka-Volterra only) -- single trajectory,
-  our numba kernel                                   -- single trajectory and batch (--batch states),
+  numba via iterate(): default (bit-reproducible) and fma=True -- single; batch into out= (both),
+      batch allocating its result, and the batch kernel alone,
   our numpy fallback                                 -- batch (vectorised) and single (scalar Python loop),
   a plain Python loop over nambu_bch.integrators.step_function,
-the ratios to the -O3 -march=native C with the targets (single <= 1.3x, batch through the public
-iterate() <= 2x, numpy fallback <= 20x), the kernel compile time (cold: empty cache, in a
-subprocess) versus loading it from the disk cache, and the first iterate() of a new process
-whose kernel is cached (no sympy on that path).
+the ratios with the targets (one trajectory, fma=True, <= 1.05x the default C build; batch through
+iterate() into out= <= 1.5x the default C batch loop; numpy fallback <= 20x) and the kernel compile
+time (cold: empty cache, in a subprocess) versus loading it from the disk cache.  The first compiled
+run of a fresh process is measured by bench_iterate_cold.py.
 
 Usage (from the repository root):
     python benchmarks/bench_iterate.py                       # ho3, 32123 (Sect. 5.5)
     python benchmarks/bench_iterate.py --system lotka-volterra --word 12321 --steps 2000000
     python benchmarks/bench_iterate.py --quick               # smaller sizes, a few seconds
+    python benchmarks/bench_iterate.py --rows                # also the README's iteration rows (markdown)
 """
 
 from __future__ import annotations
@@ -41,27 +47,24 @@ from nambu_bch import model  # noqa: E402
 from nambu_bch.integrators import step_function  # noqa: E402
 from nambu_bch.numeric import iterate, kernel  # noqa: E402
 from nambu_bch.numeric.kernels import NUMBA_CHUNK, numba_available  # noqa: E402
-
-
-def best(fn, repeats):
-    times = []
-    for _ in range(repeats):
-        start = time.perf_counter()
-        fn()
-        times.append(time.perf_counter() - start)
-    return min(times)
+from nambu_bch.numeric.samples import n_samples  # noqa: E402
 
 
 def alternate(work, repeats):
-    """Seconds per trajectory-step of each ``{name: (fn, steps per call)}``: the best of ``repeats`` calls,
-    the contenders called in turn in every round, so a change of load hits them all alike."""
-    times = {name: [] for name in work}
+    """``{name: (best wall, median wall, best CPU)}`` in seconds per trajectory-step of each
+    ``{name: (fn, steps per call)}``, the contenders called in turn in every round, so a change of
+    load hits them all alike."""
+    wall = {name: [] for name in work}
+    cpu = {name: [] for name in work}
     for _ in range(repeats):
         for name, (fn, _) in work.items():
-            start = time.perf_counter()
+            c0, t0 = time.process_time(), time.perf_counter()
             fn()
-            times[name].append(time.perf_counter() - start)
-    return {name: min(times[name]) / steps for name, (_, steps) in work.items()}
+            t1, c1 = time.perf_counter(), time.process_time()
+            wall[name].append(t1 - t0)
+            cpu[name].append(c1 - c0)
+    return {name: (min(wall[name]) / steps, float(np.median(wall[name])) / steps, min(cpu[name]) / steps)
+            for name, (_, steps) in work.items()}
 
 
 COMPILE_SNIPPET = """
@@ -70,18 +73,10 @@ t0 = time.perf_counter()
 from nambu_bch import model
 from nambu_bch.numeric import kernel
 t1 = time.perf_counter()
-system = model(sys.argv[1])
-x0 = [0.7] * system.N
-t2 = time.perf_counter()
-from nambu_bch.numeric import iterate
-iterate(system, sys.argv[2], 0.1, 100, x0)          # the first call of the process (auto backend)
-t3 = time.perf_counter()
-k = kernel(system, sys.argv[2])
-t4 = time.perf_counter()
+k = kernel(model(sys.argv[1]), sys.argv[2])
 single = k.compile()
 batch = k.compile(batch=True)
-print(json.dumps({"import": t1 - t0, "first_iterate": t3 - t2, "generate": t4 - t3, "from_cache": k.from_cache,
-                  "single": single, "batch": batch}))
+print(json.dumps({"import": t1 - t0, "single": single, "batch": batch}))
 """
 
 
@@ -100,6 +95,33 @@ def compile_times(system, word):
     return out
 
 
+LABELS = {
+    "c_single": "C -O3 -march=native (gcc default, FMA), single",
+    "c_exact_single": "C ... -ffp-contract=off, single",
+    "c_one_exp_single": "C one exp per piece (hand-written), single",
+    "numba_single": "iterate(), single",
+    "numba_single_fma": "iterate(fma=True), single",
+    "c_batch": "C -O3 -march=native (gcc default, FMA), batch",
+    "c_exact_batch": "C ... -ffp-contract=off, batch",
+    "numba_batch": "iterate(out=), batch",
+    "numba_batch_fma": "iterate(out=, fma=True), batch",
+    "numba_batch_alloc": "iterate(), batch (allocates its result)",
+    "numba_batch_kernel": "numba batch kernel alone",
+    "numpy_batch": "numpy fallback iterate(), batch",
+    "numpy_batch_kernel": "numpy fallback kernel alone, batch",
+    "numpy_single_python": "numpy fallback, single (scalar Python loop)",
+    "plain_python_loop": "plain Python loop over step_function",
+}
+#: (ours, peer, target or None): the ratios printed, ours / peer, from the best times.
+RATIOS = [("numba_single_fma", "c_single", 1.05), ("numba_single", "c_exact_single", None),
+          ("numba_single", "c_single", None), ("numba_single", "c_one_exp_single", 1.3),
+          ("numba_single_fma", "c_one_exp_single", None),
+          ("numba_batch", "c_batch", 1.5), ("numba_batch_fma", "c_batch", None), ("numba_batch", "c_exact_batch", None),
+          ("numba_batch_alloc", "c_batch", None), ("numba_batch_kernel", "c_batch", None),
+          ("numpy_batch", "c_batch", 20.0), ("numpy_batch_kernel", "c_batch", None),
+          ("numpy_single_python", "c_single", None), ("plain_python_loop", "c_single", None)]
+
+
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--system", default="ho3")
@@ -110,9 +132,10 @@ def main(argv=None):
     ap.add_argument("--batch-steps", type=int, default=50)
     ap.add_argument("--numpy-steps", type=int, default=10, help="steps of the numpy batch run")
     ap.add_argument("--python-steps", type=int, default=20_000)
-    ap.add_argument("--repeats", type=int, default=5)
+    ap.add_argument("--repeats", type=int, default=7)
     ap.add_argument("--quick", action="store_true", help="1e6 steps, 1e5 states, 3 repeats")
     ap.add_argument("--json", action="store_true", help="also print the numbers as one JSON line")
+    ap.add_argument("--rows", action="store_true", help="also print the README's iteration rows (markdown)")
     ap.add_argument("--no-compile-times", action="store_true")
     args = ap.parse_args(argv)
     if args.quick:
@@ -125,7 +148,7 @@ def main(argv=None):
     x0 = np.full(N, 0.7)
     X0 = np.random.default_rng(0).uniform(0.5, 1.5, size=(N, args.batch))
     print(f"# {system.name} {args.word}: {len(k.program.updates)} sub-flows, ~{k.program.n_operations} flops/step; "
-          f"h = {args.h}; best of {args.repeats}")
+          f"h = {args.h}; {args.repeats} rounds")
     results = {}
 
     # -- compile times -------------------------------------------------------------------------------------
@@ -133,52 +156,41 @@ def main(argv=None):
         cold, warm = compile_times(args.system, args.word)
         results["compile_cold_s"] = cold["single"] + cold["batch"]
         results["compile_warm_s"] = warm["single"] + warm["batch"]
-        results["first_iterate_cold_s"] = cold["first_iterate"]
-        results["first_iterate_cached_s"] = warm["first_iterate"]
         print(f"kernel compile (empty cache, single + batch):   {results['compile_cold_s']:.2f} s "
               f"(import of nambu_bch {cold['import']:.2f} s)")
         print(f"kernel load from disk cache (single + batch):   {results['compile_warm_s']:.3f} s")
-        print(f"first iterate() of a process, 100 steps: empty cache {cold['first_iterate']:.3f} s, "
-              f"kernel cached {warm['first_iterate']:.3f} s (target < 0.05 s; cached source used: {warm['from_cache']})")
 
     # -- the contenders: (callable, trajectory-steps per call); all warmed up, then timed alternately ------------
     work = {}
     batch_work = args.batch_steps * args.batch
-    cref = None
+    finals, closers = {}, []
     try:
-        from bench_iterate_c import CReference, c_compiler
+        from bench_iterate_c import DEFAULT_FLAGS, EXACT_FLAGS, CReference, c_compiler
 
-        if c_compiler():
-            cref = CReference(k.program, flags=("-O3", "-march=native"))
+        builds = {"c": CReference(k.program, DEFAULT_FLAGS), "c_exact": CReference(k.program, EXACT_FLAGS)} \
+            if c_compiler() else {}
     except Exception as exc:  # no compiler, or compilation failed: report and go on
         print(f"(no C reference: {exc})")
-    finals, closers = {}, []
-    if cref is not None:
+        builds = {}
+    for name, cref in builds.items():
         closers.append(cref)
         x, X = x0.copy(), X0.copy()
 
-        def c_single():
+        def c_single(cref=cref, x=x):
             x[:] = x0
             cref.run(x, K, args.steps)
 
-        def c_batch():  # the C loop advances X in place: a fresh copy of the start states each call (counted)
+        def c_batch(cref=cref, X=X):  # the C loop advances X in place: a fresh copy of the start states each call
             np.copyto(X, X0)
             cref.run_batch(X, K, args.batch_steps, NUMBA_CHUNK)
 
         c_single(), c_batch()
-        finals["c_single"], finals["c_batch"] = x.copy(), X.copy()
-        work["c_single"] = (c_single, args.steps)
-        work["c_batch"] = (c_batch, batch_work)
-        try:  # the plain -O2 build, for context
-            o2 = CReference(k.program, flags=("-O2",))
-            closers.append(o2)
-            work["c_o2_single"] = (lambda: o2.run(x0.copy(), K, args.steps), args.steps)
-            work["c_o2_batch"] = (lambda: o2.run_batch(X0.copy(), K, args.batch_steps, NUMBA_CHUNK), batch_work)
-        except Exception as exc:  # pragma: no cover - depends on the compiler
-            print(f"(no -O2 build: {exc})")
+        finals[f"{name}_single"], finals[f"{name}_batch"] = x.copy(), X.copy()
+        work[f"{name}_single"] = (c_single, args.steps)
+        work[f"{name}_batch"] = (c_batch, batch_work)
 
     # Lotka-Volterra: the hand-written one-exp-per-piece C loop (the reference)
-    if cref is not None and system.name == "lotka-volterra":
+    if builds and system.name == "lotka-volterra":
         from bench_iterate_c import CSource, lotka_volterra_one_exp_source
 
         factors = k.composition.factors()
@@ -192,12 +204,24 @@ def main(argv=None):
 
     holder = {}
     if numba_available():
-        iterate(system, args.word, args.h, 10, x0)            # compile / load outside the timing
-        iterate(system, args.word, args.h, 10, X0[:, :10])
-        work["numba_single"] = (lambda: holder.__setitem__(
-            "x", iterate(system, args.word, args.h, args.steps, x0, every=args.steps)), args.steps)
-        work["numba_batch"] = (lambda: holder.__setitem__(
-            "X", iterate(system, args.word, args.h, args.batch_steps, X0, every=args.batch_steps)), batch_work)
+        batch_out = {fma: np.empty((n_samples(args.batch_steps, args.batch_steps), N, args.batch)) for fma in (0, 1)}
+        for fma in (False, True):  # compile / load outside the timing
+            iterate(system, args.word, args.h, 10, x0, fma=fma, backend="numba")
+            iterate(system, args.word, args.h, 10, X0[:, :10], fma=fma, backend="numba")
+
+        def single(fma):
+            holder["x", fma] = iterate(system, args.word, args.h, args.steps, x0, every=args.steps, fma=fma)[-1].copy()
+
+        def batch(fma):
+            holder["X", fma] = iterate(system, args.word, args.h, args.batch_steps, X0, every=args.batch_steps,
+                                       fma=fma, out=batch_out[fma])
+
+        work["numba_single"] = (lambda: single(False), args.steps)
+        work["numba_single_fma"] = (lambda: single(True), args.steps)
+        work["numba_batch"] = (lambda: batch(False), batch_work)
+        work["numba_batch_fma"] = (lambda: batch(True), batch_work)
+        work["numba_batch_alloc"] = (lambda: iterate(system, args.word, args.h, args.batch_steps, X0,
+                                                     every=args.batch_steps), batch_work)
         out = np.empty((2, N, args.batch))
         Xk = X0.copy()
 
@@ -229,54 +253,70 @@ def main(argv=None):
     for fn, _ in work.values():  # warm: compiled, loaded, caches touched
         fn()
     load_before = os.getloadavg()
-    results.update(alternate(work, args.repeats))
-    results["load_average"] = [round(v, 2) for v in load_before + os.getloadavg()]
+    times = alternate(work, args.repeats)
+    load_after = os.getloadavg()
+    results["load_average"] = [round(v, 2) for v in load_before + load_after]
     print(f"load average (1, 5, 15 min) before {load_before[0]:.2f} {load_before[1]:.2f} {load_before[2]:.2f}, "
-          f"after {results['load_average'][3]:.2f} on {os.cpu_count()} CPUs (best of {args.repeats}, run alternately)")
-    if "numba_single" in work and "c_single" in finals:
-        same_single = np.array_equal(holder["x"][-1], finals["c_single"])
-        same_batch = np.array_equal(holder["X"][-1], finals["c_batch"])
-        print(f"numba == C bit for bit: single {same_single}, batch {same_batch}")
+          f"after {load_after[0]:.2f} {load_after[1]:.2f} {load_after[2]:.2f} on {os.cpu_count()} CPUs "
+          f"({args.repeats} rounds, contenders in turn)")
+    if "numba_single" in work and "c_exact_single" in finals:
+        same = (np.array_equal(holder["x", False], finals["c_exact_single"]),
+                np.array_equal(holder["X", False][-1], finals["c_exact_batch"]))
+        print(f"iterate() == C -ffp-contract=off bit for bit: single {same[0]}, batch {same[1]}")
+        for what, ours, theirs in (("single", holder["x", True], finals["c_single"]),
+                                   ("batch", holder["X", True][-1], finals["c_batch"])):
+            ref = holder["x", False] if what == "single" else holder["X", False][-1]
+            rel = float(np.max(np.abs(ours - ref) / np.maximum(np.abs(ref), 1e-300)))
+            print(f"iterate(fma=True), {what}: == C default build bit for bit {np.array_equal(ours, theirs)}; "
+                  f"largest relative difference to the default run {rel:.1e}")
     if "numba_single" in work and "c_one_exp_single" in finals:
         ref = finals["c_one_exp_single"]
-        rel = float(np.max(np.abs(holder["x"][-1] - ref) / np.abs(ref)))
-        print(f"numba vs the one-exp C loop after {args.steps} steps: max relative difference {rel:.1e} (rounding)")
+        rel = float(np.max(np.abs(holder["x", False] - ref) / np.abs(ref)))
+        print(f"iterate() vs the one-exp C loop after {args.steps} steps: max relative difference {rel:.1e} (rounding)")
 
     # -- report --------------------------------------------------------------------------------------------------
-    ns = {key: v * 1e9 for key, v in results.items() if not key.startswith(("compile", "first", "load"))}
-    labels = {
-        "c_single": "C -O3 -march=native, single trajectory",
-        "c_batch": f"C -O3 -march=native, batch of {args.batch:.0e}",
-        "c_one_exp_single": "C one exp per piece (hand-written), single",
-        "c_o2_single": "C -O2, single (context)",
-        "c_o2_batch": "C -O2, batch (context)",
-        "numba_single": "numba, single trajectory via iterate()",
-        "numba_batch": f"numba, batch of {args.batch:.0e} via iterate()",
-        "numba_batch_kernel": f"numba, batch of {args.batch:.0e}, kernel only",
-        "numpy_batch": f"numpy fallback, batch of {args.batch:.0e} via iterate()",
-        "numpy_batch_kernel": f"numpy fallback, batch of {args.batch:.0e}, kernel only",
-        "numpy_single_python": "numpy fallback, single (scalar Python loop)",
-        "plain_python_loop": "plain Python loop over step_function",
-    }
-    print(f"{'':46s} {'ns / trajectory-step':>22s}")
-    for key, label in labels.items():
+    ns = {key: tuple(v * 1e9 for v in t) for key, t in times.items()}
+    print(f"{'ns / trajectory-step':48s} {'best':>9s} {'median':>9s} {'CPU best':>9s}")
+    for key, label in LABELS.items():
         if key in ns:
-            print(f"{label:46s} {ns[key]:22.2f}")
-    print("ratios (target):")
-    checks = [("numba_single", "c_single", 1.3), ("numba_single", "c_one_exp_single", 1.3), ("numba_batch", "c_batch", 2.0), ("numba_batch_kernel", "c_batch", None),
-              ("numpy_batch", "c_batch", 20.0), ("numpy_batch_kernel", "c_batch", None),
-              ("numba_single", "c_o2_single", None), ("numba_batch", "c_o2_batch", None),
-              ("numpy_single_python", "c_single", None), ("plain_python_loop", "c_single", None)]
-    for a, b, target in checks:
+            print(f"{label:48s} {ns[key][0]:9.3f} {ns[key][1]:9.3f} {ns[key][2]:9.3f}")
+    print(f"ratios, ours / peer (best; median in brackets), batch of {args.batch:.0e} x {args.batch_steps} steps:")
+    ratios = {}
+    for a, b, target in RATIOS:
         if a in ns and b in ns:
-            r = ns[a] / ns[b]
-            verdict = "" if target is None else (f"  (target <= {target:g}: {'met' if r <= target else 'MISSED'})")
-            print(f"  {labels[a]:44s} / {labels[b]:36s}: {r:7.2f}{verdict}")
+            r, rm = ns[a][0] / ns[b][0], ns[a][1] / ns[b][1]
+            ratios[f"{a}/{b}"] = (r, rm)
+            verdict = "" if target is None else f"  (target <= {target:g}: {'met' if r <= target else 'MISSED'})"
+            print(f"  {LABELS[a]:44s} / {LABELS[b]:46s}: {r:6.2f} ({rm:5.2f}){verdict}")
+    if args.rows:
+        print_rows(args, system, ns, ratios, results["load_average"])
     if args.json:
         print(json.dumps({"system": system.name, "word": args.word, "ns_per_step": ns,
-                          **{k2: v for k2, v in results.items() if k2.startswith(("compile", "first", "load"))}}))
+                          "ratios": ratios, **{k2: v for k2, v in results.items()}}))
     for c in closers:
         c.close()
+
+
+def print_rows(args, system, ns, ratios, load):
+    """The README's iteration rows (markdown) from this run's numbers, labelled with the load."""
+    where = f"load {load[0]:.1f}-{load[3]:.1f} on {os.cpu_count()} CPUs"
+    cmd = f"`bench_iterate.py{'' if system.name == 'ho3' else f' --system {system.name} --word {args.word}'}`"
+    rows = []
+
+    def row(what, a, b, extra=""):
+        if a in ns and b in ns:
+            r, rm = ratios[f"{a}/{b}"]
+            rows.append(f"| {what} ({cmd}, {where}) | {ns[a][0]:.2f} ns/step (median {ns[a][1]:.2f}) | "
+                        f"{LABELS[b]}: {ns[b][0]:.2f} (median {ns[b][1]:.2f}) | {r:.2f}× (median {rm:.2f}×){extra} |")
+
+    row(f"iteration, {system.name} {args.word}, one trajectory, `fma=True`", "numba_single_fma", "c_single")
+    row(f"iteration, {system.name} {args.word}, one trajectory, default (bit-reproducible)", "numba_single",
+        "c_exact_single")
+    row(f"iteration, {system.name} {args.word}, one trajectory, default", "numba_single", "c_single")
+    row(f"iteration, batch of {args.batch:.0e} x {args.batch_steps} steps, `iterate(out=)`", "numba_batch", "c_batch")
+    row(f"iteration, same batch, `iterate()` allocating its result", "numba_batch_alloc", "c_batch")
+    row(f"numpy fallback, batch of {args.batch:.0e} x {args.numpy_steps} steps", "numpy_batch", "c_batch")
+    print("\n".join(rows))
 
 
 if __name__ == "__main__":

@@ -74,6 +74,21 @@ def numba_cache_directory(py_file):
     return _NUMBA_DIRS[key]
 
 
+def cache_variant(fastmath) -> str:
+    """The suffix of a cache entry's name for the ``fastmath`` option it was compiled with (``""`` without).
+
+    numba's cache keys an entry by the function's bytecode and signature, not by its compile
+    flags, so the same function compiled with and without contraction (``{"contract"}``) would
+    load each other's machine code; the suffix keeps their files apart.
+
+    >>> cache_variant(False), cache_variant({"contract"}), cache_variant(True)
+    ('', '+contract', '+fast')
+    """
+    if not fastmath:
+        return ""
+    return "+" + "+".join(sorted(fastmath) if isinstance(fastmath, (set, frozenset, list, tuple)) else ["fast"])
+
+
 def enable_private_cache(dispatcher, directory=None) -> bool:
     """Give a numba dispatcher a disk cache in ``directory`` (default :func:`numba_cache_directory`); whether it got one.
 
@@ -95,7 +110,8 @@ def enable_private_cache(dispatcher, directory=None) -> bool:
             directory = numba_cache_directory(py_file)
         if directory is None or untrusted(directory) is not None or not os.path.exists(py_file):
             return False
-        dispatcher._cache = _cache_class()(dispatcher.py_func, str(directory))
+        variant = cache_variant(getattr(dispatcher, "targetoptions", {}).get("fastmath"))
+        dispatcher._cache = _cache_class()(dispatcher.py_func, str(directory), variant)
     except (ImportError, AttributeError, TypeError, OSError):
         return False
     return True
@@ -172,13 +188,13 @@ def _define_cache_class():
             return hashlib.sha256(read_private(self._py_file, MAX_NUMBA_FILE, owned=False)).digest()
 
     class PrivateImpl(caching.CompileResultCacheImpl):
-        def __init__(self, py_func, directory):  # numba's __init__ without its search for a locator
+        def __init__(self, py_func, directory, variant):  # numba's __init__ without its search for a locator
             self._lineno = py_func.__code__.co_firstlineno
             qualname = getattr(py_func, "__qualname__", py_func.__name__)
             filename = inspect.getfile(py_func)
             self._locator = PrivateLocator(py_func, filename, directory)
             modname = os.path.splitext(os.path.basename(filename))[0]
-            self._filename_base = self.get_filename_base(f"{modname}.{qualname}", getattr(sys, "abiflags", ""))
+            self._filename_base = self.get_filename_base(f"{modname}.{qualname}{variant}", getattr(sys, "abiflags", ""))
 
     class VerifiedFile(caching.IndexDataCacheFile):
         def _private(self):
@@ -221,10 +237,10 @@ def _define_cache_class():
                 raise OSError(f"{self._cache_path} is no longer private")
 
     class PrivateFunctionCache(caching.FunctionCache):
-        def __init__(self, py_func, directory):  # numba's Cache.__init__ with the classes above
+        def __init__(self, py_func, directory, variant=""):  # numba's Cache.__init__ with the classes above
             self._name = repr(py_func)
             self._py_func = py_func
-            self._impl = PrivateImpl(py_func, directory)
+            self._impl = PrivateImpl(py_func, directory, variant)
             self._cache_path = directory
             self._cache_file = VerifiedFile(cache_path=directory, filename_base=self._impl.filename_base,
                                             source_stamp=self._impl.locator.get_source_stamp())

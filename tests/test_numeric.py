@@ -412,6 +412,42 @@ def test_auto_loads_a_loop_from_numbas_disk_cache(tmp_path, monkeypatch):
     assert np.array_equal(x, iterate("ho", "TVT", 0.1, 100, X0["ho"], backend="numpy"))
 
 
+def _host_fuses():
+    """Whether the machine numba compiles for has fused multiply-add instructions."""
+    from llvmlite import binding
+
+    return bool(binding.get_host_cpu_features().get("fma", False))
+
+
+@numba_only
+def test_fma_contracts_only_when_asked_and_is_cached_apart(tmp_path, monkeypatch):
+    """fma=True runs a second compiled loop that may fuse a*b + c: close to the default run, which keeps the
+    interpreter's bits (and so does fma=True on the interpreter).  Each loop's machine code is cached
+    under its own name, so a fresh Kernel loads both from disk without mixing them up: numba's cache
+    key covers the bytecode and the signature, not the compile flags."""
+    from nambu_bch.numeric import kernels as K
+
+    monkeypatch.setenv("NAMBU_BCH_CACHE", str(tmp_path))
+    run = lambda x0, **kw: iterate("ho", "TVT", 0.1, 3000, x0, every=1000, **kw)  # noqa: E731
+    X = np.array([X0["ho"], [0.3, -0.2], [1e-3, 2.0]]).T
+    plain, fused = run(X0["ho"], backend="numba"), run(X0["ho"], backend="numba", fma=True)
+    plain_b, fused_b = run(X, backend="numpy", fma=True), run(X, backend="numba", fma=True)  # numpy: the compiled bits
+    assert np.array_equal(plain, run(X0["ho"], backend="numpy", fma=True))
+    assert np.allclose(fused, plain, rtol=1e-12, atol=1e-14) and np.allclose(fused_b, plain_b, rtol=1e-12, atol=1e-14)
+    if _host_fuses():
+        assert not np.array_equal(fused, plain) and not np.array_equal(fused_b, plain_b)
+    k = kernel(model("ho"), "TVT")
+    cached = {p.name.split("-")[0] for p in (tmp_path / "kernels" / "__pycache__").glob("*.nbi")}
+    assert cached == {f"{k.path.stem}.{name}" for name in ("run", "run+contract", "run_batch+contract")}
+    K._kernel.cache_clear()
+    K._kernel_for_word.cache_clear()
+    fresh = kernel(model("ho"), "TVT")
+    assert fresh is not k and fresh.ready("run") and fresh.ready("run+contract") and not fresh.ready("run_kahan+contract")
+    assert np.array_equal(run(X0["ho"], fma=True), fused) and np.array_equal(run(X0["ho"]), plain)
+    assert np.array_equal(run(X, fma=True), fused_b)
+    assert fresh.interpreted == {}
+
+
 @numba_only
 def test_auto_small_batches_take_numpy_only_where_it_gives_the_compiled_bits(tmp_path, monkeypatch):
     """numpy's expm1 differs from the C library's in the last bit for some arguments (see
@@ -628,6 +664,43 @@ def test_batch_reads_x0_in_place_and_leaves_it_unchanged(backend):
     for b in (0, 1234, X.shape[1] - 1):
         assert np.array_equal(a[:, :, b], iterate("ho3", "32123", 0.1, 40, X[:, b], every=7, backend=backend))
     assert np.array_equal(iterate("ho3", "32123", 0.1, 0, X, backend=backend), X[None])   # steps = 0: x0 only
+
+
+@pytest.mark.parametrize("backend", [pytest.param("numba", marks=numba_only), "numpy"])
+def test_out_receives_the_samples_in_place(backend):
+    """out= is filled in place and returned, every element written (garbage in it does not matter),
+    with the bits of a run that allocates its own result: single, batch, Kahan, progress segments."""
+    X = np.random.default_rng(5).normal(size=(3, 50))
+    for x0, kw in ((X, {}), (X, {"kahan": True}), (X[:, 3], {}), (X[:, 3], {"kahan": True})):
+        want = iterate("ho3", "32123", 0.1, 40, x0, every=7, backend=backend, **kw)
+        out = np.full(want.shape, np.nan)
+        got = iterate("ho3", "32123", 0.1, 40, x0, every=7, backend=backend, out=out, **kw)
+        assert got is out and np.array_equal(out, want)
+    out = np.full((1, 3, 50), 7.0)
+    assert np.array_equal(iterate("ho3", "32123", 0.1, 0, X, out=out, backend=backend), X[None])
+
+
+def test_out_is_refused_unless_it_can_take_the_samples_in_place():
+    """A wrong dtype, shape or layout, a read-only array, an array overlapping x0 or an mpmath run: one
+    InvalidRunError line naming out, and the bad array is left as it was."""
+    X = np.ones((3, 8))
+    good = (2, 3, 8)
+    frozen = np.zeros(good)
+    frozen.flags.writeable = False
+    bad = [np.zeros(good, dtype=np.float32), np.zeros((3, 3, 8)), np.zeros(good, order="F"), frozen,
+           np.zeros((2, 3, 16))[:, :, ::2], [[0.0] * 8] * 3, "out"]
+    for out in bad:
+        with pytest.raises(InvalidRunError, match="^out must be") as info:
+            iterate("ho3", "32123", 0.1, 5, X, every=5, out=out)
+        assert "\n" not in str(info.value)
+        assert out is frozen or not isinstance(out, np.ndarray) or not out.any()
+    overlap = np.ones((3, 3, 8))
+    with pytest.raises(InvalidRunError, match="shares memory with x0"):
+        iterate("ho3", "32123", 0.1, 5, overlap[1], every=5, out=overlap[:2])        # a batch
+    with pytest.raises(InvalidRunError, match="shares memory with x0"):
+        iterate("ho3", "32123", 0.1, 5, overlap[0, :, 0], every=5, out=overlap.reshape(-1)[:6].reshape(2, 3))
+    with pytest.raises(InvalidRunError, match="mpmath"):
+        iterate("ho3", "32123", 0.1, 5, [1.0, 1.0, 1.0], every=5, dps=20, out=np.empty((2, 3)))
 
 
 def test_segmented_kahan_batch_carries_the_compensation(monkeypatch, capsys):

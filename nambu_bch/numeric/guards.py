@@ -186,6 +186,29 @@ def check_inputs(system, h, steps, every, x0, params=None, exact=False, scan=Non
     return h, steps, every, arr, values
 
 
+def check_out(out, shape, *inputs) -> np.ndarray:
+    """``out`` if it can receive a run's samples in place, else one :class:`InvalidRunError` line.
+
+    Accepted: a numpy array of dtype float64 and exactly ``shape``, C-contiguous, aligned and
+    writeable, sharing no memory with any of ``inputs`` (the start states the run reads while
+    it writes the samples).  The run writes every element, so ``out`` may come from ``np.empty``.
+    """
+    want = f"a writeable C-contiguous float64 array of shape {shape}"
+    if not isinstance(out, np.ndarray):
+        raise InvalidRunError(f"out must be {want} (the samples of this run), got {show(out)}")
+    flags = out.flags
+    if out.dtype != np.float64 or out.shape != tuple(shape) or not (flags.c_contiguous and flags.aligned):
+        layout = "C-contiguous" if flags.c_contiguous else "not C-contiguous"
+        raise InvalidRunError(f"out must be {want} (the samples of this run), got a {layout} {out.dtype} "
+                              f"array of shape {out.shape}")
+    if not flags.writeable:
+        raise InvalidRunError(f"out must be {want}, got a read-only array")
+    if any(isinstance(a, np.ndarray) and np.may_share_memory(out, a) for a in inputs):
+        raise InvalidRunError("out shares memory with x0; the run reads x0 while it writes the samples: "
+                              "give a separate array")
+    return out
+
+
 def initial_state(system, x0):
     """``(x0, origin)``: ``x0`` as given (origin ``""``), or for ``x0=None`` the system's documented default
     (:func:`nambu_bch.systems.catalog.default_x0`) with ``origin`` saying so, e.g. ``" (the default x0 of ho3)"``."""

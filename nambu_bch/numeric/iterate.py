@@ -28,8 +28,8 @@ from ..errors import InvalidRunError, InvalidSystemError, NumericalRangeError
 from ..progress import Progress, progress_wanted
 from ..systems import System, model
 from ..checks import check_flag
-from .guards import (check_backend, check_count, check_inputs, check_range, check_result, check_stability, check_work,
-                     initial_state, run_label, scan_states)
+from .guards import (check_backend, check_count, check_inputs, check_out, check_range, check_result, check_stability,
+                     check_work, initial_state, run_label, scan_states)
 from .kernels import kernel, resolve_backend
 from .precision import check_dps, run_mpmath
 from .samples import MAX_SAMPLE_BYTES, n_samples, sample_steps
@@ -48,7 +48,7 @@ def as_system(system) -> System:
 
 
 def iterate(system, word, h, steps, x0=None, params=None, every=1, *, kahan=False, dps=None,
-            backend="auto", progress=None, chunk=None, check_stable=True):
+            backend="auto", progress=None, chunk=None, check_stable=True, out=None, fma=False):
     """Iterate ``Phi_h`` of ``word`` on ``system`` ``steps`` times from ``x0``; the samples every ``every`` steps.
 
     The step is generated once from the exact sub-flows (Eqs. hX1e-hX3e for ``ho3``)
@@ -72,13 +72,20 @@ def iterate(system, word, h, steps, x0=None, params=None, every=1, *, kahan=Fals
     progress : bool or None -- a progress line on stderr; None: only on a terminal and for long runs
     chunk : int, optional -- states per cache block of a batch (tuning only)
     check_stable : bool -- refuse steps outside the stability interval (:func:`~nambu_bch.numeric.guards.check_stability`)
+    out : numpy.ndarray, optional -- receives the samples in place and is returned: float64 of the shape
+        returned, C-contiguous, writeable, sharing no memory with ``x0`` (:func:`~nambu_bch.numeric.guards.check_out`).
+        Every element is written (``np.empty`` suffices), so repeated runs allocate nothing.  float64 runs only.
+    fma : bool -- let the compiled loops fuse ``a*b + c`` into one rounding (faster, chiefly for one
+        trajectory; docs/numerics.md).  The samples are then close to the default ones, not equal, and
+        depend on the machine; the interpreter and numpy never fuse.  Default False: the same bits on
+        every backend.  float64 runs only.
 
     Returns
     -------
     numpy.ndarray
         ``(n_samples, N)`` for one trajectory, ``(n_samples, N, batch)`` for a batch, with
         ``n_samples = ceil(steps / every) + 1`` at the steps :func:`sample_steps` lists
-        (``samples[0] == x0``); float64, or ``object`` (``mpmath.mpf``) with ``dps``.
+        (``samples[0] == x0``); float64 (``out`` when given), or ``object`` (``mpmath.mpf``) with ``dps``.
 
     Raises
     ------
@@ -105,11 +112,17 @@ def iterate(system, word, h, steps, x0=None, params=None, every=1, *, kahan=Fals
     check_work(check_count(steps, "steps", 0), x0, mpmath=dps is not None)  # from the request, before any work
     kahan, check_stable = check_flag(kahan, "kahan"), check_flag(check_stable, "check_stable")
     progress, backend = check_flag(progress, "progress", none=True), check_backend(backend)
+    fma = check_flag(fma, "fma")
     kern = kernel(system, word)
     if dps is not None:
         dps = check_dps(dps)
         if kahan:
             raise InvalidRunError("kahan=True applies to float64 runs; an mpmath run (dps=...) needs no compensation")
+        if out is not None:
+            raise InvalidRunError("out= receives float64 samples; an mpmath run (dps=...) returns a new object array")
+        if fma:
+            raise InvalidRunError("fma=True applies to compiled float64 runs; an mpmath run (dps=...) has no fused "
+                                  "multiply-add")
         h, steps, every, X, _ = check_inputs(system, h, steps, every, x0, params, exact=True)
         if check_stable:
             check_stability(kern, h, kern.constants(float(h), params), params)
@@ -119,25 +132,29 @@ def iterate(system, word, h, steps, x0=None, params=None, every=1, *, kahan=Fals
         with reporter:
             return run_mpmath(kern, X, h, steps, every, params, dps, reporter.update if reporter.enabled else None)
 
-    run = _prepare(system, kern, h, steps, every, x0, params, backend, chunk, check_stable, kahan)
+    run = _prepare(system, kern, h, steps, every, x0, params, backend, chunk, check_stable, kahan, fma)
     h, steps, every, X, be, K = run.h, run.steps, run.every, run.X, run.backend, run.K
     chunk = run.chunk
 
     single = X.ndim == 1
     batch = 1 if single else X.shape[1]
     count = n_samples(steps, every)
-    nbytes = count * system.N * batch * 8
-    if nbytes > MAX_SAMPLE_BYTES:
-        raise InvalidRunError(f"{count} samples of {system.N} x {batch} states need {nbytes / 2**30:.1f} GiB "
-                              f"(limit {MAX_SAMPLE_BYTES / 2**30:.0f} GiB); sample less often (larger every)")
-    out = np.empty((count, system.N) if single else (count, system.N, batch), dtype=np.float64)
+    shape = (count, system.N) if single else (count, system.N, batch)
+    if out is not None:  # the caller's memory: only its layout is checked
+        out = check_out(out, shape, x0, X)
+    else:
+        nbytes = count * system.N * batch * 8
+        if nbytes > MAX_SAMPLE_BYTES:
+            raise InvalidRunError(f"{count} samples of {system.N} x {batch} states need {nbytes / 2**30:.1f} GiB "
+                                  f"(limit {MAX_SAMPLE_BYTES / 2**30:.0f} GiB); sample less often (larger every)")
+        out = np.empty(shape, dtype=np.float64)  # not zeroed: the kernels write every sample
     what = run_label(system, kern.word, h, X, origin)
     reporter = Progress(steps * batch, f"iterate {system.name} {kern.word}",
                         enabled=_enabled(progress, steps * batch * (30 if be == "numpy" and single else 1)))
     segment = steps if not reporter.enabled else max(every, (_SEGMENT_WORK // batch) // every * every)
     if not single:
         with reporter:
-            _run_batch(kern, X, K, steps, every, out, kahan, be, chunk, segment, reporter, what)
+            _run_batch(kern, X, K, steps, every, out, kahan, be, chunk, segment, reporter, what, fma)
         return out
     state = X  # check_inputs made a fresh float64 copy: advanced in place
     out[0] = state
@@ -147,7 +164,7 @@ def iterate(system, word, h, steps, x0=None, params=None, every=1, *, kahan=Fals
         while done < steps:
             seg = min(segment, steps - done)
             nseg = n_samples(seg, every)
-            n, be = _run_single(kern, state, K, seg, every, out[j:j + nseg], kahan, comp, be, run.fallback, what)
+            n, be = _run_single(kern, state, K, seg, every, out[j:j + nseg], kahan, comp, be, run.fallback, what, fma)
             if n < seg:  # stopped at a non-finite sample: the rest is undefined
                 out[j + n_samples(n, every):] = np.nan
                 break
@@ -159,7 +176,7 @@ def iterate(system, word, h, steps, x0=None, params=None, every=1, *, kahan=Fals
     return out
 
 
-def _run_single(kern, state, K, steps, every, out, kahan, comp, be, fallback, what):
+def _run_single(kern, state, K, steps, every, out, kahan, comp, be, fallback, what, fma=False):
     """One segment of a single trajectory: ``(steps done, backend for the next segment)``.
 
     The interpreter raises where compiled float64 arithmetic gives inf or nan (``math.exp``
@@ -169,18 +186,18 @@ def _run_single(kern, state, K, steps, every, out, kahan, comp, be, fallback, wh
     otherwise (``backend="numpy"``, or numba absent) the run is refused in one line.
     """
     try:
-        return kern.run(state, K, steps, every, out, kahan=kahan, comp=comp, backend=be), be
+        return kern.run(state, K, steps, every, out, kahan=kahan, comp=comp, backend=be, fma=fma), be
     except (ArithmeticError, ValueError) as exc:
         if be != "numpy":
             raise
         if fallback:
-            return kern.run(state, K, steps, every, out, kahan=kahan, comp=comp, backend="numba"), "numba"
+            return kern.run(state, K, steps, every, out, kahan=kahan, comp=comp, backend="numba", fma=fma), "numba"
         raise NumericalRangeError(f"{what}: float64 arithmetic failed on the interpreter ({exc}); the state "
                                   "left the range of the step's functions; take a smaller h, or use dps=... (mpmath)"
                                   ) from None
 
 
-def _run_batch(kern, X, K, steps, every, out, kahan, be, chunk, segment, reporter, what):
+def _run_batch(kern, X, K, steps, every, out, kahan, be, chunk, segment, reporter, what, fma=False):
     """Fill ``out`` with the samples of a batch: ``X`` (the caller's start states) is only read.
 
     The kernel copies ``X`` into ``out[0]`` while it loads each chunk, starts every later segment
@@ -197,7 +214,7 @@ def _run_batch(kern, X, K, steps, every, out, kahan, be, chunk, segment, reporte
             seg = min(segment, steps - done)
             nseg = n_samples(seg, every)
             bad = kern.run_batch(source, K, seg, every, out[j:j + nseg], kahan=kahan, comp=comp, backend=be,
-                                 chunk=chunk, start=j == 0, back=False)
+                                 chunk=chunk, start=j == 0, back=False, fma=fma)
             if bad:
                 grid = sample_steps(steps, every)
                 samples = out[1:j + nseg]
@@ -236,14 +253,14 @@ class _Run:
             setattr(self, k, v)
 
 
-def _prepare(system, kern, h, steps, every, x0, params, backend, chunk, check_stable, kahan=False) -> _Run:
+def _prepare(system, kern, h, steps, every, x0, params, backend, chunk, check_stable, kahan=False, fma=False) -> _Run:
     """Validate a float64 run, choose the backend, compute the constants, check stability and range."""
     be = resolve_backend(backend)
     steps = check_count(steps, "steps", 0)
     shape = np.shape(x0)
     fallback = False  # the interpreter chosen for speed: on an arithmetic exception the compiled loop takes over
     if backend == "auto" and be == "numba":
-        be, fallback = _interpret_small(kern, steps, shape, kahan)
+        be, fallback = _interpret_small(kern, steps, shape, kahan, fma)
     # a large batch: one pass (compiled on numba, blocked numpy otherwise) finds non-finite, subnormal and
     # extreme states; the batch itself is only read by the run, so it is not copied
     batch = len(shape) == 2
@@ -266,7 +283,7 @@ def _prepare(system, kern, h, steps, every, x0, params, backend, chunk, check_st
     return _Run(h=h, steps=steps, every=every, X=X, backend=be, K=K, chunk=chunk, fallback=fallback)
 
 
-def _interpret_small(kern, steps, shape, kahan):
+def _interpret_small(kern, steps, shape, kahan, fma=False):
     """``("numpy", True)`` if the run should take the interpreter (or numpy, for a batch), else ``("numba", False)``.
 
     A single state: the loop is not :meth:`~nambu_bch.numeric.kernels.Kernel.ready` and the steps
@@ -275,7 +292,7 @@ def _interpret_small(kern, steps, shape, kahan):
     states, and a numpy loop with the compiled loop's bits.
     """
     batch = len(shape) == 2
-    name = ("run_batch" if batch else "run") + ("_kahan" if kahan else "")
+    name = kern.loop_name(kahan, batch, fma)
     if kern.ready(name):
         return "numba", False
     if batch:

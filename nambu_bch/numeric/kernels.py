@@ -39,7 +39,9 @@ generated source contains no user text at all (:mod:`~nambu_bch.numeric.codegen`
 Backends:
 
 * ``"numba"`` -- the generated loops compiled by numba (no fast-math, so IEEE
-  operations in source order, bit-identical to the fallback);
+  operations in source order, bit-identical to the fallback); with ``fma=True`` a
+  second compiled copy of each loop may fuse ``a*b + c`` (:data:`CONTRACT`, its
+  machine code cached apart: :func:`nambu_bch.compiled.cache_variant`);
 * ``"numpy"`` -- the same generated source run by the interpreter: a scalar
   Python loop for one trajectory, numpy arrays (chunks of the batch kept in
   cache) for batches;
@@ -64,7 +66,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..compiled import enable_private_cache
+from ..compiled import cache_variant, enable_private_cache
 from ..compiled import numba_available  # noqa: F401  (re-exported: nambu_bch.numeric.numba_available)
 from ..errors import InvalidRunError, NumericalRangeError
 from ..atomic import write_atomic
@@ -74,6 +76,9 @@ from ..integrators.step import parameter_values
 from .codegen import PAIR_FUNCTION, TEMPLATE_VERSION, python_source, source_hash, step_program
 
 BACKENDS = ("auto", "numba", "numpy")
+#: numba's fast-math flags of a run with ``fma=True``: contraction of ``a*b + c`` into one fused
+#: multiply-add only -- no reassociation, no finite-math or signed-zero assumptions.
+CONTRACT = frozenset({"contract"})
 #: States per chunk of a batch: the chunk's arrays stay in L1/L2 while all steps run.
 NUMBA_CHUNK = 256
 NUMPY_CHUNK = 16384
@@ -297,13 +302,23 @@ class Kernel:
         return K
 
     # -- functions ----------------------------------------------------------------------------------
+    @staticmethod
+    def loop_name(kahan=False, batch=False, fma=False) -> str:
+        """The name a compiled loop is known by: ``run``, ``run_batch_kahan``, ``run+contract``, ..."""
+        name = ("run_batch" if batch else "run") + ("_kahan" if kahan else "")
+        return name + cache_variant(CONTRACT if fma else None)
+
     def function(self, name: str, backend: str = "numba"):
-        """The loop ``name`` (``run``, ``run_kahan``, ``run_batch``, ``run_batch_kahan``) for ``backend``."""
-        if backend == "numpy":
+        """The loop ``name`` (``run``, ``run_kahan``, ``run_batch``, ``run_batch_kahan``, each optionally with the
+        suffix ``+contract`` of :meth:`loop_name`: compiled with :data:`CONTRACT`) for ``backend``."""
+        name, plus, _ = name.partition("+")
+        fma = bool(plus)
+        if backend == "numpy":  # the interpreter never contracts
             if name.startswith("run_batch"):
                 name = name.replace("run_batch", "run_numpy")
             return getattr(self.module, name)
-        fn = self._jitted.get(name)
+        key = name + cache_variant(CONTRACT if fma else None)
+        fn = self._jitted.get(key)
         if fn is None:
             import numba
 
@@ -312,10 +327,10 @@ class Kernel:
                 self.module.__dict__[PAIR_FUNCTION] = self.function(PAIR_FUNCTION)
             py = getattr(self.module, name)
             py = getattr(py, "py_func", py)  # the compiled pair function stands in the module once bound
-            fn = numba.njit(nogil=True, fastmath=False, error_model="numpy")(py)
+            fn = numba.njit(nogil=True, fastmath=set(CONTRACT) if fma else False, error_model="numpy")(py)
             if self.path.is_file():  # numba caches next to a source file; without one, compile in memory
                 enable_private_cache(fn, self.directory / "__pycache__")
-            self._jitted[name] = fn
+            self._jitted[key] = fn
         return fn
 
     def ready(self, name: str) -> bool:
@@ -355,9 +370,9 @@ class Kernel:
         scan(X, res)
         return int(res[0]), int(res[1]), np.unique(np.concatenate([res[2:], [0, X.shape[1] - 1]]))
 
-    def compile(self, kahan: bool = False, batch: bool = False) -> float:
+    def compile(self, kahan: bool = False, batch: bool = False, fma: bool = False) -> float:
         """Compile (or load from the disk cache) one loop now; the wall time in seconds."""
-        name = ("run_batch" if batch else "run") + ("_kahan" if kahan else "")
+        name = self.loop_name(kahan, batch, fma)
         if name in self.compile_seconds:
             return self.compile_seconds[name]
         fn = self.function(name, "numba")
@@ -403,15 +418,16 @@ class Kernel:
                     pass
 
     # -- running ------------------------------------------------------------------------------------
-    def run(self, x, K, steps, every, out, *, kahan=False, comp=None, backend="numba") -> int:
+    def run(self, x, K, steps, every, out, *, kahan=False, comp=None, backend="numba", fma=False) -> int:
         """Advance one state ``x`` (shape (N,), float64, in place); ``out[0]`` holds the start, ``out[1:]`` is filled.
 
+        ``fma``: the compiled loop may contract ``a*b + c`` (:data:`CONTRACT`); the interpreter ignores it.
         Returns the number of steps done (less than ``steps`` only if a sample became non-finite).
         """
         name = "run_kahan" if kahan else "run"
         if backend == "numba":
-            self.compile(kahan=kahan)
-            fn = self.function(name)
+            self.compile(kahan=kahan, fma=fma)
+            fn = self.function(self.loop_name(kahan, False, fma))
             args = (x, comp) if kahan else (x,)
             return int(fn(*args, K, int(steps), int(every), out))
         fn = getattr(self.module, name)
@@ -425,20 +441,21 @@ class Kernel:
         return int(n)
 
     def run_batch(self, X, K, steps, every, out, *, kahan=False, comp=None, backend="numba", chunk=None,
-                  start=False, back=True) -> int:
+                  start=False, back=True, fma=False) -> int:
         """Advance states ``X`` (shape (N, batch), float64); ``out`` of shape (n, N, batch), ``out[1:]`` is filled.
 
         ``start``: also copy ``X`` into ``out[0]`` (fused with the pass that loads the states);
         ``back``: write the final states into ``X`` (in place); with ``back=False`` ``X`` is only
         read (the caller's array can be passed as it is) and the final states are ``out[-1]``.
-        Returns 0 when every sample written is finite, a positive number otherwise.
+        ``fma`` as in :meth:`run`.  Returns 0 when every sample written is finite, a positive number otherwise.
         """
         name = "run_batch_kahan" if kahan else "run_batch"
         args = (X, comp) if kahan else (X,)
         flags = (int(bool(start)), int(bool(back)))
         if backend == "numba":
-            self.compile(kahan=kahan, batch=True)
-            return int(self.function(name)(*args, K, int(steps), int(every), out, int(chunk or NUMBA_CHUNK), *flags))
+            self.compile(kahan=kahan, batch=True, fma=fma)
+            fn = self.function(self.loop_name(kahan, True, fma))
+            return int(fn(*args, K, int(steps), int(every), out, int(chunk or NUMBA_CHUNK), *flags))
         fn = self.function(name, "numpy")
         return int(fn(*args, [float(k) for k in K], int(steps), int(every), out, int(chunk or NUMPY_CHUNK), *flags))
 
