@@ -44,6 +44,7 @@ import subprocess
 import sys
 import time
 from fractions import Fraction
+from math import factorial, lcm
 from pathlib import Path
 
 os.environ["OMP_NUM_THREADS"] = "1"  # read by libgomp when libbch.so is loaded below: one thread
@@ -72,6 +73,22 @@ with open(out, "w") as fh:
         den, items = B.scaled_terms(d)
         for num, tree in items:
             fh.write("%s %d %d\n" % ("".join(map(str, tree_leaves(tree))), num, den))
+"""
+
+COLD_PARTS = r"""
+import sys, time
+clock = time.process_time
+t0 = clock()
+from nambu_bch.bch import formal_bch
+t1 = clock()
+import numba
+t2 = clock()
+from nambu_bch.bch import modular
+modular.lyndon_table(2, 3)  # the first compiled call: numba's dispatcher machinery and one cache load
+t3 = clock()
+formal_bch(sys.argv[1], int(sys.argv[2]))
+t4 = clock()
+print(t1 - t0, t2 - t1, t3 - t2, t4 - t3)
 """
 
 PRIME = "from nambu_bch.bch import formal_bch; formal_bch('123', 10); formal_bch('12', 16)"  # sparse engine
@@ -122,6 +139,56 @@ def timed_child(args, env, report: Path, stdout=subprocess.DEVNULL):
     return float(user) + float(system), float(wall), int(rss)
 
 
+def breakdown(spec: str, n: int, py_env) -> str:
+    """Where our time goes: the phases of one warm call, the kernels with one prime instead of all, a cold start."""
+    import numpy as np
+
+    from nambu_bch import clear_caches
+    from nambu_bch.bch import formal as formal_module
+    from nambu_bch.bch import modular
+    from nambu_bch.integrators import composition
+
+    comp = composition(spec)
+    generators = tuple(sorted(set(comp.pieces)))
+    scalars = formal_module._Scalars(tuple(comp.coefficients))
+    letters = [generators.index(k) for k in comp.pieces]
+    big = lcm(*range(1, n + 1))
+    dens = [factorial(d) * big * scalars.q**d for d in range(n + 1)]  # formal_bch's denominators
+    clear_caches()
+    stats = {}
+    t = time.process_time()
+    modular.lyndon_numerators(letters, scalars.values, scalars.q, len(generators), n, dens, stats)
+    engine = time.process_time() - t
+    t = time.process_time()
+    formal_module._duval_trees(len(generators), n, tuple(generators))
+    trees = time.process_time() - t
+    parts = " ".join(f"{k} {v:.4f}" for k, v in stats["seconds"].items())
+    # the two kernels again with one prime: what a single-modulus pass (one wide integer) could save at most
+    g = len(generators)
+    words, lengths, left, right = modular.lyndon_table(g, n)
+    top = stats["solved_degree"]
+    members, class_start = modular._class_order(g, n, top)
+    single = []
+    for k in (stats["primes"], 1):
+        moduli = list(modular.PRIMES[:k])
+        cpow, logk = modular._factor_tables(moduli, [int(v) for v in scalars.values], scalars.q, n)
+        primes = np.array(moduli, dtype=np.int64)
+        t = time.process_time()
+        z = modular._word_coefficients(np.asarray(letters, dtype=np.int64), cpow, logk, primes, g, n, len(lengths),
+                                       top)
+        t1 = time.process_time()
+        modular._solve(z, primes, np.zeros((k, n + 1), dtype=np.int64), words, lengths, left, right, members,
+                       class_start, g, n, top)
+        single.append(f"{k} primes: word coefficients {t1 - t:.4f} solve {time.process_time() - t1:.4f}")
+    cold = subprocess.run([sys.executable, "-c", COLD_PARTS, spec, str(n)], check=True, env=py_env, cwd=ROOT,
+                          capture_output=True, text=True).stdout.split()
+    cold = " ".join(f"{k} {float(v):.3f}" for k, v in zip(("import_nambu_bch", "import_numba", "first_compiled_call",
+                                                           "series"), cold))
+    return (f"#   {spec} {n}: engine call {engine:.4f} s ({parts}; {stats['primes']} primes, "
+            f"{stats['program_nodes']} lane-nodes), trees {trees:.4f} s\n#     {'; '.join(single)}\n"
+            f"#     cold process CPU s: {cold}")
+
+
 def c_terms(path: Path, letters: int) -> dict:
     """``{Lyndon word (letters 0..): Fraction}`` from the C table (standard factors p1, p2 per basis element)."""
     words, out = {}, {}
@@ -155,6 +222,8 @@ def main(argv=None):
     ap.add_argument("--three-degrees", default="9,11,13", help="the three-generator word 12321")
     ap.add_argument("--repeat", type=int, default=3, help="warm calls per side (median reported)")
     ap.add_argument("--build", action="store_true", help="run the checkout's Makefile first (make clean; make bch)")
+    ap.add_argument("--breakdown", action="store_true",
+                    help="after each row of our own, print where the time goes (phases, one prime, cold start)")
     ap.add_argument("--work", type=Path, default=Path("/tmp/bch_c_reference"))
     args = ap.parse_args(argv)
     checkout = args.checkout.resolve()
@@ -223,6 +292,8 @@ def main(argv=None):
               f"{c_cold[0]:>6.3f} ({c_cold[1]:>5.2f}) {ours_cold[0]:>6.3f} ({ours_cold[1]:>5.2f}) "
               f"{ours_cold[0] / max(c_cold[0], 0.005):>5.1f}x | {c_cold[2] / 1024:>6.1f} {ours_cold[2] / 1024:>7.1f} "
               f"{ours_cold[2] / c_cold[2]:>5.1f}x | {str(same):5} {load[0]:.2f}", flush=True)
+        if args.breakdown:
+            print(breakdown(spec, n, py_env), flush=True)
     print("# cold ratio: CPU seconds, C times below 0.005 s (its process start) counted as 0.005 s.")
     print("# " + json.dumps({"load_end": os.getloadavg(), "rows": len(rows), "all_identical": all(r["identical"]
                                                                                                for r in rows)}))

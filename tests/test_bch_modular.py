@@ -333,3 +333,13 @@ def test_rational_scalars_skip_the_domain_search_with_the_same_result():
     assert K.is_QQ and scalars.K is None
     assert (scalars.q, scalars.values) == (6, [3, -18, 4, 0])
     assert formal_module._Scalars((sympy.Integer(2) ** R(1, 3), R(1))).K is not None  # algebraic: the field
+
+
+def test_stats_report_the_phases():
+    """``stats`` names the primes, the solved degree and the CPU seconds of each phase (the benchmark's breakdown)."""
+    stats = {}
+    dens = [factorial(d) * lcm(*range(1, 9)) for d in range(9)]
+    assert modular.lyndon_numerators([0, 1], [1, 1], 1, 2, 8, dens, stats) is not None
+    assert stats["solved_degree"] == 7 and stats["primes"] >= 1
+    assert list(stats["seconds"]) == ["lyndon_tables", "factor_tables", "word_coefficients", "solve", "crt"]
+    assert all(t >= 0 for t in stats["seconds"].values())

@@ -69,6 +69,7 @@ from fractions import Fraction
 from functools import lru_cache
 from itertools import compress
 from math import factorial
+from time import process_time
 
 import numpy as np
 import sympy
@@ -511,7 +512,8 @@ def lyndon_numerators(letters, values, q, g, n, denominators, stats=None):
 
     ``letters`` (ints ``0..g-1``) and ``values`` (Python ints; coefficients ``values / q``)
     describe the factors.  ``None`` when the magnitude bound needs more than
-    :data:`MAX_PRIMES` primes (the caller then uses the dense Python-int engine).
+    :data:`MAX_PRIMES` primes (the caller then uses the dense Python-int engine).  A ``stats`` dict gets the
+    number of primes, program nodes, Lyndon words, the solved degree and ``seconds``: CPU time per phase.
     """
     total = Fraction(sum(abs(int(v)) for v in values), q)
     need = 2 * max(numerator_bound(d, total, denominators[d]) for d in range(1, n + 1)) + 1
@@ -524,11 +526,13 @@ def lyndon_numerators(letters, values, q, g, n, denominators, stats=None):
             product *= p
     if product <= need or len(moduli) > MAX_PRIMES:
         return None
+    clock = [process_time()]
     words, lengths, left, right = lyndon_table(g, n)
     count = len(lengths)
     eriksen = _eriksen_sign(letters, g, n)
     top = n - 1 if eriksen else n  # Eq. (3): the even top degree of log(e^A e^B) follows from the odd ones
     members, class_start = _class_order(g, n, top)
+    clock.append(process_time())
     primes = np.array(moduli, dtype=np.int64)
     cpow, logk = _factor_tables(moduli, [int(v) for v in values], q, n)
     beta = np.zeros((len(moduli), n + 1), dtype=np.int64)
@@ -538,12 +542,11 @@ def lyndon_numerators(letters, values, q, g, n, denominators, stats=None):
             value = eriksen * b * a**kk
             for i, p in enumerate(moduli):
                 beta[i, kk] = value.numerator % p * pow(value.denominator % p, p - 2, p) % p
+    clock.append(process_time())
     z, work = _engine(np.asarray(letters, dtype=np.int64), cpow, logk, primes, beta, g, n, top,
-                      words, lengths, left, right, members, class_start)
+                      words, lengths, left, right, members, class_start, clock)
     global runs
     runs += 1
-    if stats is not None:
-        stats.update(primes=len(moduli), program_nodes=int(work), lyndon=count, solved_degree=top)
     scale = np.array([[denominators[d] % p for p in moduli] for d in range(n + 1)], dtype=np.int64)
     residues = z * scale[lengths] % primes
     rows = np.flatnonzero(residues.any(axis=1))  # a zero residue vector is the numerator 0
@@ -553,6 +556,11 @@ def lyndon_numerators(letters, values, q, g, n, denominators, stats=None):
     for d in np.unique(degrees).tolist():
         mask = degrees == d
         out[d] = list(zip(rows[mask].tolist(), compress(numerators, mask.tolist())))
+    clock.append(process_time())
+    if stats is not None:
+        phases = ("lyndon_tables", "factor_tables", "word_coefficients", "solve", "crt")
+        seconds = dict(zip(phases, np.diff(clock).tolist()))
+        stats.update(primes=len(moduli), program_nodes=int(work), lyndon=count, solved_degree=top, seconds=seconds)
     return out
 
 
@@ -636,15 +644,22 @@ def _even_top(z, primes, lengths, right, K, beta, n):
             z[w, i] = acc[i]
 
 
-def _engine(letters, cpow, logk, primes, beta, g, n, top, words, lengths, left, right, members, class_start):
+def _engine(letters, cpow, logk, primes, beta, g, n, top, words, lengths, left, right, members, class_start,
+            clock=None):
     """Word coefficients, then the chained solve of degree ``top`` and Eq. (3) when ``top < n``.
+
+    ``clock`` (a list) gets the CPU time after each of the two (for ``stats`` of :func:`lyndon_numerators`).
 
     Two compiled entry points called from Python, not one compiled driver calling them: numba links a
     callee's code into its caller and optimises the linked module again, so a driver would cost the
     optimisation of both twice on a cold start (1.2 s of 6.5 s measured); an entry point costs a
     cache load (a few ms) in a fresh process."""
     z = _word_coefficients(letters, cpow, logk, primes, g, n, lengths.shape[0], top)
+    if clock is not None:
+        clock.append(process_time())
     work = _solve(z, primes, beta, words, lengths, left, right, members, class_start, g, n, top)
+    if clock is not None:
+        clock.append(process_time())
     return z, work
 
 
