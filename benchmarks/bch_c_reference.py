@@ -1,175 +1,303 @@
-"""Formal BCH: ours against Hofstätter's C program ``bch``, both cold, ratios measured in one run.
+"""Formal BCH: ours against Hofstätter's C program ``bch``, each row measured the same way on both sides.
 
-The C program (github.com/HaraldHofstaetter/BCH) is NOT vendored: pass the path of a local
-checkout; this script builds it with its own Makefile at its strongest flags
-(``CFLAGS=-O3 -fPIC -march=native -fopenmp``), then for every degree runs
+The C program (github.com/HaraldHofstaetter/BCH) is NOT vendored: pass the path of a local checkout
+holding its build (``bch`` and ``libbch.so``; ``--build`` runs its Makefile with
+``CFLAGS=-O3 -fPIC -march=native -fopenmp -Wall`` first).  The peer runs single-threaded
+(``OMP_NUM_THREADS=1``) in its fastest mode for each series:
 
-* C, cold: a fresh ``bch`` process, single-threaded (``OMP_NUM_THREADS=1``), CPU time
-  (user + sys, ``getrusage``) and peak RSS of the child; output to a file;
-* ours, cold: a fresh Python interpreter (``formal_bch`` imported, with sympy; numba not yet
-  imported, its cached machine code on disk), CPU time of the ``formal_bch`` call alone, which
-  includes importing and starting numba when the sparse engine runs, and the RSS growth of that call;
-* ours, data memory: in a third fresh interpreter, numba started first (a small sparse series),
-  the peak-RSS growth of the call: the engine's own memory, comparable with the C process's;
-* ours, warm: the same call again in that interpreter, numba started (if the cold call took the
-  dense engine, a small sparse series runs first, untimed) and every in-memory cache of the
-  package cleared (``nambu_bch.clear_caches``: Lyndon tables rebuilt).  The column ``engine``
-  names the engine of the cold / warm call: ``formal_bch`` takes the dense engine for small
-  problems in a process where numba has not started yet, the sparse one once it has.
+* ``12``, ``log(e^A e^B)``: its dedicated routine ``BCH(N, 0)`` (``bch`` with the default ``expression=0``);
+* ``121``, ``log(e^{A/2} e^B e^{A/2})``: its dedicated symmetric routine ``symBCH(N, 0)`` (``expression=1``);
+* ``12321``, ``log(e^{A/2} e^{B/2} e^C e^{B/2} e^{A/2})``: three generators, its general ``lie_series``
+  on the parsed expression (there is no dedicated routine).
 
-Every run is checked: the C table (``table_output=1``: index, degree, standard factors,
-coefficient) is rebuilt into Lyndon words and compared coefficient by coefficient with ours.
+Two measurements per row, the sides interleaved:
 
-Run:  python benchmarks/bch_c_reference.py /path/to/BCH [--degrees 10,12,14,16,18,20] [--no-build]
+* warm, the call alone: on the C side the library routine called in this process through ctypes on
+  ``libbch.so`` (the Lie series built and freed, nothing printed); on ours ``formal_bch`` in this process
+  with numba started and every in-memory cache of the package cleared before each call
+  (``nambu_bch.clear_caches``: Lyndon tables rebuilt, as the C routine rebuilds its own).  One untimed
+  call on each side first; then ``--repeat`` calls each, alternating, the median CPU seconds reported.
+* cold, whole processes: the ``bch`` process (``table_output=1``, its table written to a file) and
+  ``python -c`` importing ``nambu_bch`` and calling ``formal_bch`` (interpreter start and imports
+  included, numba's machine code from its on-disk cache, the series written to a file as
+  ``word numerator denominator`` lines).  CPU (user + sys), wall seconds and peak RSS of each child from
+  ``/usr/bin/time`` (the peak RSS of a child forked from this large process would be inflated otherwise).
+  The numba cache is primed once, untimed, at the start (the first use after an install compiles the
+  engine; that is a one-time cost and not what this row measures).
 
-Workloads: ``log(e^A e^B)`` (pieces "12") at the given degrees, and the five-factor Strang word
-12321 (``log(e^{A/2} e^{B/2} e^C e^{B/2} e^{A/2})``) at degrees 9 and 11.
+Every row is checked: the C table (index, degree, standard factors, coefficient) is rebuilt into Lyndon
+words and compared coefficient by coefficient with the file our cold process wrote.  The load average
+(``os.getloadavg``) is printed with every row: on a loaded machine the ratios are noisy.
+
+Run:  python benchmarks/bch_c_reference.py /path/to/BCH [--degrees 10,14,18,20] [--sym-degrees 11,15,19]
+      [--three-degrees 9,11,13] [--repeat 3] [--build]
 """
 
 from __future__ import annotations
 
 import argparse
+import ctypes
 import json
 import os
+import statistics
 import subprocess
 import sys
+import time
 from fractions import Fraction
+from math import factorial, lcm
 from pathlib import Path
 
+os.environ["OMP_NUM_THREADS"] = "1"  # read by libgomp when libbch.so is loaded below: one thread
+
 ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT))  # the checkout, whatever the working directory
+
 CFLAGS = "-O3 -fPIC -march=native -fopenmp -Wall"
+TIME = Path("/usr/bin/time")
+THREE = "log(exp(1/2*A)*exp(1/2*B)*exp(C)*exp(1/2*B)*exp(1/2*A))"
+#: series: (our spec, generators, C command-line expression or None, what the C side calls)
+SERIES = {
+    "12": ("12", 2, None, "BCH"),
+    "121": ("121", 2, "1", "symBCH"),
+    "12321": ("12321", 3, THREE, "lie_series"),
+}
 
-OURS = r"""
-import json, resource, sys, time
-from nambu_bch import clear_caches
+OURS_COLD = r"""
+import sys
 from nambu_bch.bch import formal_bch
+from nambu_bch.bch.lyndon import tree_leaves
 spec, n, out = sys.argv[1], int(sys.argv[2]), sys.argv[3]
-rss0 = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
-t = time.process_time(); B = formal_bch(spec, n); cold = time.process_time() - t  # imports numba if it needs it
-rss1 = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
-engine = "sparse" if "nambu_bch.bch.modular" in sys.modules and sys.modules["nambu_bch.bch.modular"].runs else "dense"
-from nambu_bch.bch import modular
-if not modular.runs:  # warm = numba started: a small sparse series first (3^10 words > DENSE_COLD_WORDS)
-    formal_bch("123", 10)
-clear_caches()  # every in-memory cache of the package (Lyndon tables, the dense engine's logs, ...)
-runs = modular.runs
-t = time.process_time(); formal_bch(spec, n); warm = time.process_time() - t
-engine_warm = "sparse" if modular.runs > runs else "dense"
-rows = [[list(w), str(c)] for d in range(1, n + 1) for c, w in B.words(d)]
-json.dump({"cold": cold, "warm": warm, "rss_kb": rss1 - rss0, "rss_total_kb": rss1, "terms": rows,
-           "engine": engine + "/" + engine_warm}, open(out, "w"))
+B = formal_bch(spec, n)
+with open(out, "w") as fh:
+    for d in range(1, n + 1):
+        den, items = B.scaled_terms(d)
+        for num, tree in items:
+            fh.write("%s %d %d\n" % ("".join(map(str, tree_leaves(tree))), num, den))
 """
 
-
-DATA = r"""
-import resource, sys
+COLD_PARTS = r"""
+import sys, time
+clock = time.process_time
+t0 = clock()
 from nambu_bch.bch import formal_bch
-formal_bch("123", 10)  # numba imported and started, engine code loaded (3^10 words: the sparse engine)
-spec, n = sys.argv[1], int(sys.argv[2])
-rss0 = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
-formal_bch(spec, n)
-print(resource.getrusage(resource.RUSAGE_SELF).ru_maxrss - rss0)
+t1 = clock()
+import numba
+t2 = clock()
+from nambu_bch.bch import modular
+modular.lyndon_table(2, 3)  # the first compiled call: numba's dispatcher machinery and one cache load
+t3 = clock()
+formal_bch(sys.argv[1], int(sys.argv[2]))
+t4 = clock()
+print(t1 - t0, t2 - t1, t3 - t2, t4 - t3)
 """
 
+PRIME = "from nambu_bch.bch import formal_bch; formal_bch('123', 10); formal_bch('12', 16)"  # sparse engine
 
-def build(checkout: Path) -> Path:
+
+def build(checkout: Path) -> None:
     subprocess.run(["make", "-C", str(checkout), "clean"], check=True, capture_output=True)
     subprocess.run(["make", "-C", str(checkout), f"CFLAGS={CFLAGS}", "bch"], check=True, capture_output=True)
-    exe = checkout / "bch"
-    if not exe.exists():
-        raise SystemExit(f"build failed: no {exe}")
-    return exe
 
 
-TIME = Path("/usr/bin/time")
+class Peer:
+    """The C library in this process (ctypes): one call of its routine for a series, built and freed."""
+
+    def __init__(self, checkout: Path):
+        lib = ctypes.CDLL(str(checkout / "libbch.so"))
+        lib.BCH.restype = lib.symBCH.restype = lib.lie_series.restype = lib.parse.restype = ctypes.c_void_p
+        lib.BCH.argtypes = lib.symBCH.argtypes = [ctypes.c_int, ctypes.c_int]
+        lib.lie_series.argtypes = [ctypes.c_int, ctypes.c_void_p, ctypes.c_int, ctypes.c_int]
+        lib.parse.argtypes = [ctypes.c_char_p, ctypes.c_char_p, ctypes.POINTER(ctypes.c_int)]
+        lib.free_lie_series.argtypes = [ctypes.c_void_p]
+        lib.set_verbosity_level.argtypes = [ctypes.c_int]
+        lib.dimension.argtypes = [ctypes.c_void_p]
+        lib.set_verbosity_level(0)
+        self.lib = lib
+
+    def call(self, series: str, n: int) -> int:
+        """Compute the series to degree ``n`` (the timed part), free it; returns the dimension it reported."""
+        lib = self.lib
+        if series == "12":
+            ls = lib.BCH(n, 0)
+        elif series == "121":
+            ls = lib.symBCH(n, 0)
+        else:
+            k = ctypes.c_int(0)
+            ex = lib.parse(THREE.encode(), b"ABCDEFGHIJKLMNOPQRSTUVWXYZ", ctypes.byref(k))
+            ls = lib.lie_series(k.value, ex, n, 0)
+        dim = lib.dimension(ls)
+        lib.free_lie_series(ls)
+        if series == "12321":
+            lib.free_all_expressions()
+        return dim
 
 
-def run_c(exe: Path, n: int, expression: str | None, out: Path):
-    """CPU seconds, peak RSS (kB) and the table of one cold single-threaded run.
-
-    CPU time from this process's ``wait4`` on the ``bch`` child.  The peak RSS from a second run
-    under ``/usr/bin/time`` when it exists: Linux keeps ``ru_maxrss`` across ``execve``, so a child
-    forked from this (large) Python process reports at least this process's size.  Without
-    ``/usr/bin/time`` the value is that upper bound."""
-    env = dict(os.environ, OMP_NUM_THREADS="1", LD_LIBRARY_PATH=str(exe.parent))
-    args = [str(exe), f"N={n}", "table_output=1"]
-    if expression:
-        args.append(f"expression={expression}")
-    with open(out, "w") as fh:
-        proc = subprocess.Popen(args, stdout=fh, env=env)
-        _, status, usage = os.wait4(proc.pid, 0)  # this child's own rusage (CPU and peak RSS)
-        proc.returncode = os.waitstatus_to_exitcode(status)
-    if proc.returncode:
-        raise SystemExit(f"bch failed with exit code {proc.returncode}: {' '.join(args)}")
-    rss = usage.ru_maxrss
-    if TIME.exists():
-        report = out.with_suffix(".time")
-        subprocess.run([str(TIME), "-f", "%M", "-o", str(report)] + args, stdout=subprocess.DEVNULL, env=env,
-                       check=True)
-        rss = int(report.read_text().split()[-1])
-    return usage.ru_utime + usage.ru_stime, rss, out.read_text().splitlines()
+def timed_child(args, env, report: Path, stdout=subprocess.DEVNULL):
+    """``(cpu s, wall s, peak RSS kB)`` of one child process, measured by ``/usr/bin/time``."""
+    subprocess.run([str(TIME), "-f", "%U %S %e %M", "-o", str(report)] + args, stdout=stdout, env=env, check=True)
+    user, system, wall, rss = report.read_text().split()[-4:]
+    return float(user) + float(system), float(wall), int(rss)
 
 
-def c_terms(lines, letters: int) -> dict:
+def breakdown(spec: str, n: int, py_env) -> str:
+    """Where our time goes: the phases of one warm call, the kernels with one prime instead of all, a cold start."""
+    import numpy as np
+
+    from nambu_bch import clear_caches
+    from nambu_bch.bch import formal as formal_module
+    from nambu_bch.bch import modular
+    from nambu_bch.integrators import composition
+
+    comp = composition(spec)
+    generators = tuple(sorted(set(comp.pieces)))
+    scalars = formal_module._Scalars(tuple(comp.coefficients))
+    letters = [generators.index(k) for k in comp.pieces]
+    big = lcm(*range(1, n + 1))
+    dens = [factorial(d) * big * scalars.q**d for d in range(n + 1)]  # formal_bch's denominators
+    clear_caches()
+    stats = {}
+    t = time.process_time()
+    modular.lyndon_numerators(letters, scalars.values, scalars.q, len(generators), n, dens, stats)
+    engine = time.process_time() - t
+    t = time.process_time()
+    formal_module._duval_trees(len(generators), n, tuple(generators))
+    trees = time.process_time() - t
+    parts = " ".join(f"{k} {v:.4f}" for k, v in stats["seconds"].items())
+    # the two kernels again with one prime: what a single-modulus pass (one wide integer) could save at most
+    g = len(generators)
+    words, lengths, left, right = modular.lyndon_table(g, n)
+    top = stats["solved_degree"]
+    members, class_start = modular._class_order(g, n, top)
+    single = []
+    for k in (stats["primes"], 1):
+        moduli = list(modular.PRIMES[:k])
+        cpow, logk = modular._factor_tables(moduli, [int(v) for v in scalars.values], scalars.q, n)
+        primes = np.array(moduli, dtype=np.int64)
+        t = time.process_time()
+        z = modular._word_coefficients(np.asarray(letters, dtype=np.int64), cpow, logk, primes, g, n, len(lengths),
+                                       top)
+        t1 = time.process_time()
+        modular._solve(z, primes, np.zeros((k, n + 1), dtype=np.int64), words, lengths, left, right, members,
+                       class_start, g, n, top)
+        single.append(f"{k} primes: word coefficients {t1 - t:.4f} solve {time.process_time() - t1:.4f}")
+    cold = subprocess.run([sys.executable, "-c", COLD_PARTS, spec, str(n)], check=True, env=py_env, cwd=ROOT,
+                          capture_output=True, text=True).stdout.split()
+    cold = " ".join(f"{k} {float(v):.3f}" for k, v in zip(("import_nambu_bch", "import_numba", "first_compiled_call",
+                                                           "series"), cold))
+    return (f"#   {spec} {n}: engine call {engine:.4f} s ({parts}; {stats['primes']} primes, "
+            f"{stats['program_nodes']} lane-nodes), trees {trees:.4f} s\n#     {'; '.join(single)}\n"
+            f"#     cold process CPU s: {cold}")
+
+
+def c_terms(path: Path, letters: int) -> dict:
     """``{Lyndon word (letters 0..): Fraction}`` from the C table (standard factors p1, p2 per basis element)."""
     words, out = {}, {}
-    for line in lines:
-        fields = line.split()
-        if len(fields) != 5:
-            continue
-        i, d, p1, p2, c = int(fields[0]), int(fields[1]), int(fields[2]), int(fields[3]), Fraction(fields[4])
-        words[i] = (i,) if d == 1 and i < letters else words[p1] + words[p2]
-        if c:
-            out[words[i]] = c
+    with open(path) as fh:
+        for line in fh:
+            fields = line.split()
+            if len(fields) != 5:
+                continue
+            i, d, p1, p2 = int(fields[0]), int(fields[1]), int(fields[2]), int(fields[3])
+            words[i] = (i,) if d == 1 and i < letters else words[p1] + words[p2]
+            c = Fraction(fields[4])
+            if c:
+                out[words[i]] = c
     return out
 
 
-def run_ours(spec: str, n: int, out: Path):
-    env = dict(os.environ, PYTHONPATH=str(ROOT) + os.pathsep + os.environ.get("PYTHONPATH", ""))
-    subprocess.run([sys.executable, "-c", OURS, spec, str(n), str(out)], check=True, env=env, cwd=ROOT)
-    data = json.loads(out.read_text())
-    memory = subprocess.run([sys.executable, "-c", DATA, spec, str(n)], check=True, env=env, cwd=ROOT,
-                            capture_output=True, text=True)
-    data["data_kb"] = int(memory.stdout.split()[-1])
-    terms = {}
-    for word, c in data["terms"]:
-        key = tuple(k - 1 for k in word)  # piece k is the letter k - 1 (A = 1, B = 2, C = 3)
-        terms[key] = Fraction(c)
-    return data, terms
+def our_terms(path: Path) -> dict:
+    out = {}
+    with open(path) as fh:
+        for line in fh:
+            word, num, den = line.split()
+            out[tuple(int(k) - 1 for k in word)] = Fraction(int(num), int(den))  # piece k is the letter k - 1
+    return out
 
 
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("checkout", type=Path, help="local checkout of github.com/HaraldHofstaetter/BCH (not vendored)")
-    ap.add_argument("--degrees", default="10,12,14,16,18,20")
-    ap.add_argument("--no-build", action="store_true", help="use the existing ./bch of the checkout")
+    ap.add_argument("--degrees", default="10,12,14,16,18,20", help="log(e^A e^B); 22 takes a minute or more")
+    ap.add_argument("--sym-degrees", default="11,15,19", help="log(e^{A/2} e^B e^{A/2})")
+    ap.add_argument("--three-degrees", default="9,11,13", help="the three-generator word 12321")
+    ap.add_argument("--repeat", type=int, default=3, help="warm calls per side (median reported)")
+    ap.add_argument("--build", action="store_true", help="run the checkout's Makefile first (make clean; make bch)")
+    ap.add_argument("--breakdown", action="store_true",
+                    help="after each row of our own, print where the time goes (phases, one prime, cold start)")
     ap.add_argument("--work", type=Path, default=Path("/tmp/bch_c_reference"))
     args = ap.parse_args(argv)
     checkout = args.checkout.resolve()
     if not (checkout / "Makefile").exists() or not (checkout / "bch.c").exists():
         print(f"error: {checkout} is not a checkout of HaraldHofstaetter/BCH (no Makefile / bch.c)", file=sys.stderr)
         return 2
-    exe = checkout / "bch" if args.no_build else build(checkout)
+    if args.build:
+        build(checkout)
+    exe = checkout / "bch"
+    if not exe.exists() or not (checkout / "libbch.so").exists():
+        print(f"error: no bch / libbch.so in {checkout}: build it (make) or pass --build", file=sys.stderr)
+        return 2
+    if not TIME.exists():
+        print(f"error: {TIME} is needed to measure the children's CPU time and peak RSS", file=sys.stderr)
+        return 2
     args.work.mkdir(parents=True, exist_ok=True)
-    jobs = [("12", int(d), None) for d in args.degrees.split(",")]
-    jobs += [("12321", d, "log(exp(1/2*A)*exp(1/2*B)*exp(C)*exp(1/2*B)*exp(1/2*A))") for d in (9, 11)]
-    print(f"# C: {exe} built with CFLAGS='{CFLAGS}', OMP_NUM_THREADS=1; CPU seconds; both sides cold (fresh processes)")
-    print(f"{'word':>6} {'N':>3} {'terms':>7} {'C cpu s':>9} {'ours cold':>10} {'ratio':>7} {'ours warm':>10} "
-          f"{'ratio':>7} {'C MB':>6} {'ours +MB':>8} {'data MB':>7}  identical  engine")
-    for spec, n, expr in jobs:
-        cpu, rss, lines = run_c(exe, n, expr, args.work / f"c_{spec}_{n}.txt")
-        data, ours = run_ours(spec, n, args.work / f"ours_{spec}_{n}.json")
-        reference = c_terms(lines, 3 if expr else 2)
-        same = reference == ours
-        print(f"{spec:>6} {n:>3} {len(ours):>7} {cpu:>9.4f} {data['cold']:>10.4f} {data['cold'] / max(cpu, 1e-4):>6.1f}x "
-              f"{data['warm']:>10.4f} {data['warm'] / max(cpu, 1e-4):>6.1f}x {rss / 1024:>6.1f} {data['rss_kb'] / 1024:>8.1f}"
-              f" {data['data_kb'] / 1024:>7.1f}"
-              f"  {str(same):9}  {data['engine']}")
-    print("# ratio = ours / C (CPU time; C's includes process start and writing the table; C times below 1e-4 s "
-          "count as 1e-4 s). 'C MB': peak RSS of the C process. 'ours +MB': peak-RSS growth of the cold call "
-          "(importing numba included; the interpreter with sympy holds ~130 MB before it). 'data MB': peak-RSS "
-          "growth of the call in a fresh process where numba is already started (the engine's own memory).")
-    return 0
+
+    from nambu_bch import clear_caches
+    from nambu_bch.bch import formal_bch
+
+    peer = Peer(checkout)
+    c_env = dict(os.environ, OMP_NUM_THREADS="1", LD_LIBRARY_PATH=str(checkout))
+    py_env = dict(os.environ, PYTHONPATH=str(ROOT) + os.pathsep + os.environ.get("PYTHONPATH", ""))
+    subprocess.run([sys.executable, "-c", PRIME], check=True, env=py_env, cwd=ROOT)  # numba's disk cache filled
+    formal_bch("123", 10)  # numba started in this process (the sparse engine has run)
+
+    jobs = [("12", int(d)) for d in args.degrees.split(",") if d]
+    jobs += [("121", int(d)) for d in args.sym_degrees.split(",") if d]
+    jobs += [("12321", int(d)) for d in args.three_degrees.split(",") if d]
+    print(f"# C: {exe} (CFLAGS '{CFLAGS}' with --build), OMP_NUM_THREADS=1; ours: {sys.executable}")
+    print("# warm = the call alone, in-process, median CPU s of --repeat; cold = whole process, CPU s (wall s), "
+          "peak RSS MB; ratio = ours / C")
+    print(f"{'series':>6} {'N':>3} {'terms':>6} | {'C warm':>8} {'ours warm':>9} {'ratio':>6} | "
+          f"{'C cold':>15} {'ours cold':>15} {'ratio':>6} | {'C MB':>6} {'ours MB':>7} {'ratio':>6} | same  load")
+    rows = []
+    for series, n in jobs:
+        spec, letters, expression, _ = SERIES[series]
+        peer.call(series, n)  # untimed: pages touched, code loaded
+        clear_caches()
+        formal_bch(spec, n)
+        c_warm, ours_warm = [], []
+        for _ in range(args.repeat):
+            t = time.process_time()
+            peer.call(series, n)
+            c_warm.append(time.process_time() - t)
+            clear_caches()
+            t = time.process_time()
+            formal_bch(spec, n)
+            ours_warm.append(time.process_time() - t)
+        clear_caches()
+        c_table, our_table = args.work / f"c_{series}_{n}.txt", args.work / f"ours_{series}_{n}.txt"
+        c_args = [str(exe), f"N={n}", "table_output=1"] + ([f"expression={expression}"] if expression else [])
+        with open(c_table, "w") as fh:
+            c_cold = timed_child(c_args, c_env, args.work / "c.time", stdout=fh)
+        ours_cold = timed_child([sys.executable, "-c", OURS_COLD, spec, str(n), str(our_table)], py_env,
+                                args.work / "ours.time")
+        ours = our_terms(our_table)
+        same = c_terms(c_table, letters) == ours
+        cw, ow = statistics.median(c_warm), statistics.median(ours_warm)
+        load = os.getloadavg()
+        row = dict(series=series, degree=n, terms=len(ours), c_warm=cw, ours_warm=ow, c_cold=c_cold[:2],
+                   ours_cold=ours_cold[:2], c_rss_mb=c_cold[2] / 1024, ours_rss_mb=ours_cold[2] / 1024,
+                   identical=same, load=load)
+        rows.append(row)
+        print(f"{series:>6} {n:>3} {len(ours):>6} | {cw:>8.4f} {ow:>9.4f} {ow / cw:>5.2f}x | "
+              f"{c_cold[0]:>6.3f} ({c_cold[1]:>5.2f}) {ours_cold[0]:>6.3f} ({ours_cold[1]:>5.2f}) "
+              f"{ours_cold[0] / max(c_cold[0], 0.005):>5.1f}x | {c_cold[2] / 1024:>6.1f} {ours_cold[2] / 1024:>7.1f} "
+              f"{ours_cold[2] / c_cold[2]:>5.1f}x | {str(same):5} {load[0]:.2f}", flush=True)
+        if args.breakdown:
+            print(breakdown(spec, n, py_env), flush=True)
+    print("# cold ratio: CPU seconds, C times below 0.005 s (its process start) counted as 0.005 s.")
+    print("# " + json.dumps({"load_end": os.getloadavg(), "rows": len(rows), "all_identical": all(r["identical"]
+                                                                                               for r in rows)}))
+    return 0 if all(r["identical"] for r in rows) else 1
 
 
 if __name__ == "__main__":

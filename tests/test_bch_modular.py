@@ -57,7 +57,59 @@ def test_garner_recovers_signed_integers():
     primes = list(modular.PRIMES[:4])
     values = [0, 1, -1, 10**30, -(10**30) + 7, 2**100 - 3]
     residues = np.array([[v % p for p in primes] for v in values], dtype=np.int64)
-    assert modular._garner(residues, primes).tolist() == values
+    assert modular._garner(residues, primes) == values
+
+
+def _garner_by_python_ints(residues, moduli):
+    """The CRT one value at a time in Python ints (``sum r_i M_i (M_i^-1 mod p_i) mod M``), symmetric range."""
+    M = 1
+    for p in moduli:
+        M *= p
+    out = []
+    for row in residues.tolist():
+        v = sum(r * (M // p) * pow(M // p, -1, p) for r, p in zip(row, moduli)) % M
+        out.append(v - M if v > M // 2 else v)
+    return out
+
+
+@pytest.mark.parametrize("k", [1, 2, 7, 17])
+def test_garner_equals_the_textbook_crt(k):
+    """The limb-wise Horner reconstruction against the plain CRT, random residues and the range's ends."""
+    primes = list(modular.PRIMES[:k])
+    M = 1
+    for p in primes:
+        M *= p
+    rng = np.random.default_rng(k)
+    residues = np.stack([rng.integers(0, p, size=300) for p in primes], axis=1)
+    ends = [0, 1, -1, M // 2, -(M // 2) + (M + 1) % 2, M // 2 - 1]  # the largest and smallest representable
+    residues = np.concatenate([residues, np.array([[v % p for p in primes] for v in ends], dtype=np.int64)])
+    expected = _garner_by_python_ints(residues, primes)
+    assert expected[-len(ends):] == ends
+    assert modular._garner(residues, primes) == expected
+    assert modular._garner(residues[:0], primes) == []
+
+
+@pytest.mark.parametrize("values,q,n", [([1, 1], 1, 12), ([1, 2, -3], 2, 9), ([0, 7, -5, 1], 6, 5)])
+def test_factor_tables_equal_modular_powers(values, q, n):
+    """Running products for c^r / r! and (-1)^(k+1) / k equal the entries by modular powers, prime by prime."""
+    moduli = list(modular.PRIMES[:3])
+    cpow, logk = modular._factor_tables(moduli, values, q, n)
+    for i, p in enumerate(moduli):
+        for t, v in enumerate(values):
+            c = v % p * pow(q, p - 2, p) % p
+            assert cpow[i, t].tolist() == [pow(c, r, p) * pow(factorial(r), p - 2, p) % p for r in range(n + 1)]
+        assert logk[i, 1:].tolist() == [(1 if k % 2 else p - 1) * pow(k, p - 2, p) % p for k in range(1, n + 1)]
+
+
+def test_numerator_bound_in_integers_equals_the_rational_formula():
+    """The bound in integer arithmetic is floor(D (d-1)! C^d surj(d) / d!) + 1, as with Fractions."""
+    from fractions import Fraction
+
+    for total in (Fraction(2), Fraction(5, 2), Fraction(7, 6)):
+        for d in range(1, 23):
+            den = factorial(d) * lcm(*range(1, 23)) * total.denominator**d
+            value = den * factorial(d - 1) * total**d * modular._surjection_sum(d) / factorial(d)
+            assert modular.numerator_bound(d, total, den) == int(value) + 1
 
 
 # -- the engines agree exactly -----------------------------------------------------------------------------
@@ -271,3 +323,23 @@ def test_engine_choice_dense_before_numba_starts_sparse_after(monkeypatch):
     sparse = formal_bch("12321", 8)
     assert modular.runs == 2
     assert _same(dense, sparse)
+
+
+def test_rational_scalars_skip_the_domain_search_with_the_same_result():
+    """Rational coefficients take the short path; q and the integer values equal construct_domain's route."""
+    coefficients = (R(1, 2), sympy.Integer(-3), R(2, 3), R(0))
+    scalars = formal_module._Scalars(coefficients)
+    K, _ = formal_module.construct_domain(list(coefficients), extension=True)
+    assert K.is_QQ and scalars.K is None
+    assert (scalars.q, scalars.values) == (6, [3, -18, 4, 0])
+    assert formal_module._Scalars((sympy.Integer(2) ** R(1, 3), R(1))).K is not None  # algebraic: the field
+
+
+def test_stats_report_the_phases():
+    """``stats`` names the primes, the solved degree and the CPU seconds of each phase (the benchmark's breakdown)."""
+    stats = {}
+    dens = [factorial(d) * lcm(*range(1, 9)) for d in range(9)]
+    assert modular.lyndon_numerators([0, 1], [1, 1], 1, 2, 8, dens, stats) is not None
+    assert stats["solved_degree"] == 7 and stats["primes"] >= 1
+    assert list(stats["seconds"]) == ["lyndon_tables", "factor_tables", "word_coefficients", "solve", "crt"]
+    assert all(t >= 0 for t in stats["seconds"].values())

@@ -217,7 +217,10 @@ class _Scalars:
     """Coefficient arithmetic: python ints (rational compositions) or a sympy algebraic field."""
 
     def __init__(self, coefficients):
-        K, elems = construct_domain(list(coefficients), extension=True)
+        if all(getattr(c, "is_Rational", False) for c in coefficients):
+            K = QQ  # the usual case, without construct_domain's algebraic-field search (about 1 ms a call)
+        else:
+            K, elems = construct_domain(list(coefficients), extension=True)
         if K.is_ZZ or K.is_QQ:
             fracs = [sympy.Rational(c) for c in coefficients]
             self.q = lcm(*(int(f.q) for f in fracs))

@@ -69,6 +69,7 @@ from fractions import Fraction
 from functools import lru_cache
 from itertools import compress
 from math import factorial
+from time import process_time
 
 import numpy as np
 import sympy
@@ -501,8 +502,9 @@ def numerator_bound(d: int, total: Fraction, denominator: int) -> int:
     length ``d``, ``C = sum_t |c_t|`` (``<Phi - 1, u> <= C^|u| / |u|!`` term by term, then
     the compositions of ``u`` into ``k`` factors of ``(Phi - 1)^k``).
     """
-    value = denominator * factorial(d - 1) * total**d * _surjection_sum(d) / factorial(d)
-    return int(value) + 1
+    # D (d-1)! (S/q)^d surj(d) / d! with total = S/q, in integers: floor, then one more
+    s, q = total.numerator, total.denominator
+    return denominator * s**d * _surjection_sum(d) // (d * q**d) + 1
 
 
 def lyndon_numerators(letters, values, q, g, n, denominators, stats=None):
@@ -510,7 +512,8 @@ def lyndon_numerators(letters, values, q, g, n, denominators, stats=None):
 
     ``letters`` (ints ``0..g-1``) and ``values`` (Python ints; coefficients ``values / q``)
     describe the factors.  ``None`` when the magnitude bound needs more than
-    :data:`MAX_PRIMES` primes (the caller then uses the dense Python-int engine).
+    :data:`MAX_PRIMES` primes (the caller then uses the dense Python-int engine).  A ``stats`` dict gets the
+    number of primes, program nodes, Lyndon words, the solved degree and ``seconds``: CPU time per phase.
     """
     total = Fraction(sum(abs(int(v)) for v in values), q)
     need = 2 * max(numerator_bound(d, total, denominators[d]) for d in range(1, n + 1)) + 1
@@ -523,23 +526,15 @@ def lyndon_numerators(letters, values, q, g, n, denominators, stats=None):
             product *= p
     if product <= need or len(moduli) > MAX_PRIMES:
         return None
+    clock = [process_time()]
     words, lengths, left, right = lyndon_table(g, n)
     count = len(lengths)
     eriksen = _eriksen_sign(letters, g, n)
     top = n - 1 if eriksen else n  # Eq. (3): the even top degree of log(e^A e^B) follows from the odd ones
     members, class_start = _class_order(g, n, top)
+    clock.append(process_time())
     primes = np.array(moduli, dtype=np.int64)
-    cpow = np.zeros((len(moduli), len(values), n + 1), dtype=np.int64)
-    logk = np.zeros((len(moduli), n + 1), dtype=np.int64)
-    for i, p in enumerate(moduli):
-        qinv = pow(q, p - 2, p)
-        inv_fact = [pow(factorial(r) % p, p - 2, p) for r in range(n + 1)]
-        for t, v in enumerate(values):
-            c = int(v) % p * qinv % p
-            for r in range(n + 1):
-                cpow[i, t, r] = pow(c, r, p) * inv_fact[r] % p
-        for kk in range(1, n + 1):
-            logk[i, kk] = (1 if kk % 2 else p - 1) * pow(kk, p - 2, p) % p
+    cpow, logk = _factor_tables(moduli, [int(v) for v in values], q, n)
     beta = np.zeros((len(moduli), n + 1), dtype=np.int64)
     if eriksen:
         a = Fraction(int(values[letters.index(0)]), q)  # the coefficient of the letter 0
@@ -547,22 +542,56 @@ def lyndon_numerators(letters, values, q, g, n, denominators, stats=None):
             value = eriksen * b * a**kk
             for i, p in enumerate(moduli):
                 beta[i, kk] = value.numerator % p * pow(value.denominator % p, p - 2, p) % p
+    clock.append(process_time())
     z, work = _engine(np.asarray(letters, dtype=np.int64), cpow, logk, primes, beta, g, n, top,
-                      words, lengths, left, right, members, class_start)
+                      words, lengths, left, right, members, class_start, clock)
     global runs
     runs += 1
-    if stats is not None:
-        stats.update(primes=len(moduli), program_nodes=int(work), lyndon=count, solved_degree=top)
     scale = np.array([[denominators[d] % p for p in moduli] for d in range(n + 1)], dtype=np.int64)
     residues = z * scale[lengths] % primes
     rows = np.flatnonzero(residues.any(axis=1))  # a zero residue vector is the numerator 0
-    numerators = _garner(residues[rows], moduli).tolist()  # Python ints
+    numerators = _garner(residues[rows], moduli)  # Python ints
     degrees = lengths[rows]
     out: dict = {}
     for d in np.unique(degrees).tolist():
         mask = degrees == d
         out[d] = list(zip(rows[mask].tolist(), compress(numerators, mask.tolist())))
+    clock.append(process_time())
+    if stats is not None:
+        phases = ("lyndon_tables", "factor_tables", "word_coefficients", "solve", "crt")
+        seconds = dict(zip(phases, np.diff(clock).tolist()))
+        stats.update(primes=len(moduli), program_nodes=int(work), lyndon=count, solved_degree=top, seconds=seconds)
     return out
+
+
+def _inverses(p: int, n: int) -> list:
+    """``[0, 1/1, 1/2, ..., 1/n] mod p`` (``n < p``) without a modular power each: ``1/i = -(p // i) / (p mod i)``."""
+    inv = [0, 1]
+    for i in range(2, n + 1):
+        inv.append((p - p // i) * inv[p % i] % p)
+    return inv
+
+
+def _factor_tables(moduli, values, q: int, n: int):
+    """``cpow[i, t, r] = (values[t] / q)^r / r!`` and ``logk[i, k] = (-1)^(k+1) / k`` modulo ``moduli[i]`` (int64).
+
+    Powers and factorials by running products (one modular power per prime, for ``1/q``): this runs
+    on every call, and ``pow`` per entry cost more than the compiled engine at low degrees."""
+    cpow, logk = [], []
+    for p in moduli:
+        inv = _inverses(p, n)
+        qinv = pow(q, p - 2, p)
+        rows = []
+        for v in values:
+            c = v % p * qinv % p
+            row, term = [1], 1
+            for r in range(1, n + 1):
+                term = term * c % p * inv[r] % p  # c^r / r! from c^(r-1) / (r-1)!
+                row.append(term)
+            rows.append(row)
+        cpow.append(rows)
+        logk.append([0] + [inv[k] if k % 2 else p - inv[k] for k in range(1, n + 1)])
+    return np.array(cpow, dtype=np.int64).reshape((len(moduli), len(values), n + 1)), np.array(logk, dtype=np.int64)
 
 
 def _eriksen_sign(letters, g: int, n: int) -> int:
@@ -615,15 +644,22 @@ def _even_top(z, primes, lengths, right, K, beta, n):
             z[w, i] = acc[i]
 
 
-def _engine(letters, cpow, logk, primes, beta, g, n, top, words, lengths, left, right, members, class_start):
+def _engine(letters, cpow, logk, primes, beta, g, n, top, words, lengths, left, right, members, class_start,
+            clock=None):
     """Word coefficients, then the chained solve of degree ``top`` and Eq. (3) when ``top < n``.
+
+    ``clock`` (a list) gets the CPU time after each of the two (for ``stats`` of :func:`lyndon_numerators`).
 
     Two compiled entry points called from Python, not one compiled driver calling them: numba links a
     callee's code into its caller and optimises the linked module again, so a driver would cost the
     optimisation of both twice on a cold start (1.2 s of 6.5 s measured); an entry point costs a
     cache load (a few ms) in a fresh process."""
     z = _word_coefficients(letters, cpow, logk, primes, g, n, lengths.shape[0], top)
+    if clock is not None:
+        clock.append(process_time())
     work = _solve(z, primes, beta, words, lengths, left, right, members, class_start, g, n, top)
+    if clock is not None:
+        clock.append(process_time())
     return z, work
 
 
@@ -644,33 +680,37 @@ def _class_order(g: int, n: int, top: int):
     return members[order], class_start
 
 
-def _garner(residues, moduli):
-    """Integers in ``(-M/2, M/2]`` (``M`` = product of ``moduli``) from ``residues[:, i]`` mod ``moduli[i]``.
+def _garner(residues, moduli) -> list:
+    """Python ints in ``(-M/2, M/2]`` (``M`` = product of ``moduli``) from ``residues[:, i]`` mod ``moduli[i]``.
 
-    Mixed-radix digits in int64 (Knuth, TAOCP vol. 2, Sect. 4.3.2); two digits at a time are
-    joined in int64 (``d_i + p_i d_(i+1) < 2^56``), then one Python-int combination per pair
-    (object arrays)."""
+    Mixed-radix digits in int64 (Knuth, TAOCP vol. 2, Sect. 4.3.2), then Horner's rule
+    ``x = x p_i + d_i`` on 32-bit limbs held in uint64 (``limb p_i + carry < 2^61``), all rows at once;
+    each row's limbs become one Python int by ``int.from_bytes``: one object per value, no
+    object-array arithmetic."""
+    rows = residues.shape[0]
     digits = []
     for i, p in enumerate(moduli):
-        x = residues[:, i].copy()
+        x = residues[:, i].astype(np.int64)
         for j in range(i):
             x = (x - digits[j]) % p * pow(moduli[j], p - 2, p) % p
         digits.append(x)
-    pairs, radices = [], []
-    for i in range(0, len(moduli), 2):
-        if i + 1 < len(moduli):
-            pairs.append(digits[i] + moduli[i] * digits[i + 1])
-            radices.append(moduli[i] * moduli[i + 1])
-        else:
-            pairs.append(digits[i])
-            radices.append(moduli[i])
-    total = pairs[-1].astype(object)
-    for d, p in zip(reversed(pairs[:-1]), reversed(radices[:-1])):
-        total = total * p + d.astype(object)
     M = 1
     for p in moduli:
         M *= p
-    return np.where(total > M // 2, total - M, total)
+    size = (M.bit_length() + 31) // 32
+    limbs = np.zeros((rows, size), dtype=np.uint64)
+    limbs[:, 0] = digits[-1]
+    low, shift = np.uint64(0xFFFFFFFF), np.uint64(32)
+    for i in range(len(moduli) - 2, -1, -1):
+        p, carry = np.uint64(moduli[i]), digits[i].astype(np.uint64)
+        for j in range(size):
+            t = limbs[:, j] * p + carry
+            limbs[:, j] = t & low
+            carry = t >> shift
+    packed = limbs.astype("<u4").view(np.dtype((np.void, 4 * size))).reshape(-1)
+    half, from_bytes = M // 2, int.from_bytes
+    out = [from_bytes(b, "little") for b in packed.tolist()]
+    return [v - M if v > half else v for v in out]
 
 
 @njit()
