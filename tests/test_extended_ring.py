@@ -1,0 +1,121 @@
+"""The extended exact ring of non-polynomial atoms, and the check of shadow Hamiltonians done in it."""
+
+import pytest
+import sympy
+
+from nambu_bch import NambuBCHError, System, model
+from nambu_bch.algebra.extended import ExtendedRing
+from nambu_bch.errors import NoExactResultError
+from nambu_bch.shadow.generic import (PoissonShadow, _check_in_expressions, _check_in_extended_ring, bch_shadow,
+                                      check_against_backward)
+
+x, y, m = sympy.symbols("x1 x2 m")
+q1, q2 = sympy.symbols("q1 q2")
+
+
+def ring(*exprs, coords=(x, y), params=()):
+    return ExtendedRing(coords, params, exprs)
+
+
+# -- the normal form -----------------------------------------------------------------------------------
+@pytest.mark.parametrize("identity", [
+    sympy.sin(x) ** 2 + sympy.cos(x) ** 2 - 1,
+    sympy.sin(2 * x) - 2 * sympy.sin(x) * sympy.cos(x),
+    sympy.cos(3 * x) - 4 * sympy.cos(x) ** 3 + 3 * sympy.cos(x),
+    sympy.exp(2 * x) * sympy.exp(-x) - sympy.exp(x),
+    (1 + x ** 2) / (1 + x ** 2) ** 2 - 1 / (1 + x ** 2),
+    sympy.sqrt(x ** 2 + y ** 2) ** 3 - (x ** 2 + y ** 2) * sympy.sqrt(x ** 2 + y ** 2),
+    1 / sympy.sqrt(x ** 2 + y ** 2) - sympy.sqrt(x ** 2 + y ** 2) / (x ** 2 + y ** 2),
+])
+def test_identities_reduce_to_zero(identity):
+    R = ring(sympy.cos(x), sympy.exp(x), 1 / (1 + x ** 2), sympy.sqrt(x ** 2 + y ** 2), identity)
+    assert not R.convert(identity)
+
+
+@pytest.mark.parametrize("expr", [
+    sympy.sin(x) ** 2 - sympy.cos(x) ** 2,
+    sympy.exp(x) - 1 - x,
+    sympy.sqrt(x ** 2 + y ** 2) - x - y,
+    1 / (1 + x ** 2) - 1,
+])
+def test_non_zero_is_non_zero(expr):
+    R = ring(sympy.cos(x), sympy.exp(x), 1 / (1 + x ** 2), sympy.sqrt(x ** 2 + y ** 2))
+    assert R.convert(expr)
+
+
+def test_normal_form_is_canonical_on_two_writings():
+    # the same function written two ways has the same numerator and denominator exponents
+    R = ring(sympy.sin(x), 1 / (1 + x ** 2))
+    a = R.convert(sympy.sin(x) ** 3 / (1 + x ** 2))
+    b = R.convert((sympy.sin(x) - sympy.sin(x) * sympy.cos(x) ** 2) / (1 + x ** 2))
+    assert a.num == b.num and a.den == b.den
+
+
+@pytest.mark.parametrize("f", [
+    -1 / sympy.sqrt(q1 ** 2 + q2 ** 2),
+    sympy.sin(sympy.sin(q1)) * sympy.exp(-q2) / (1 + q1 ** 2),
+    sympy.cos(2 * q1) * sympy.sqrt(q1 ** 2 + q2 ** 2) ** 3,
+])
+def test_derivatives_agree_with_sympy(f):
+    R = ring(f, coords=(q1, q2))
+    for i, v in enumerate((q1, q2)):
+        d = R.diff(R.convert(f), i) - R.convert(sympy.diff(f, v))
+        assert not d
+
+
+def test_parameters_in_denominators():
+    R = ring(sympy.exp(x) / m, params=(m,))
+    f = R.convert(sympy.exp(x) / m)
+    assert not (R.diff(f, 0) - f)
+
+
+@pytest.mark.parametrize("exprs, pattern", [
+    ((sympy.tan(x),), "no rule"),
+    ((sympy.exp(x + 1),), "constant part"),
+    ((sympy.exp(x), sympy.exp(y), sympy.exp(x + y)), "linearly dependent"),
+    ((sympy.sqrt(x), sympy.sqrt(y), sympy.sqrt(x * y)), "square"),
+    ((sympy.cbrt(x),), "power"),
+    ((sympy.Function("V")(x),), "no rule"),
+    ((sympy.pi * x,), "constant"),
+])
+def test_refusals_are_one_line(exprs, pattern):
+    with pytest.raises(NoExactResultError, match=pattern) as info:
+        ring(*exprs)
+    assert "\n" not in str(info.value) and isinstance(info.value, NambuBCHError)
+
+
+# -- the check of H_S in the ring ---------------------------------------------------------------------
+CENTRAL = ("q1 q2 p1 p2", ["(p1**2 + p2**2)/2 - 1/sqrt(q1**2 + q2**2)"])
+
+
+@pytest.mark.parametrize("name, word, order", [("pendulum", "121", 4), ("exp-well", "212", 4), ("rational", "121", 4),
+                                               ("henon-heiles", "121", 4)])
+def test_ring_check_agrees_with_the_expression_check(name, word, order):
+    R = bch_shadow(model(name), word, order, verify=False)
+    assert _check_in_extended_ring(R) is True
+    _check_in_expressions(R)  # the old check passes on the same answer
+
+
+def test_central_force_is_checked_in_the_ring():
+    S = System(*CENTRAL, name="central")
+    R = bch_shadow(S, "212", 2, verify=False)
+    assert _check_in_extended_ring(R) is True
+
+
+@pytest.mark.parametrize("name", ["pendulum", "rational"])
+def test_a_wrong_shadow_is_detected(name):
+    R = bch_shadow(model(name), "121", 2, verify=False)
+    bad = dict(R.series)
+    bad[2] = bad[2] * sympy.Rational(11, 10)
+    wrong = PoissonShadow(R.system, R.composition, R.order, bad)
+    with pytest.raises(NoExactResultError, match=r"differs from the backward-error X_eff at h\^2"):
+        check_against_backward(wrong)
+
+
+def test_undefined_functions_fall_back_to_expressions():
+    from nambu_bch.shadow.generic import generic_system
+
+    R = bch_shadow(generic_system(), "121", 2, verify=False)
+    assert _check_in_extended_ring(R) is False
+    check_against_backward(R)
+    assert R.verified_orders == 2
