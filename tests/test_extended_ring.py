@@ -119,3 +119,24 @@ def test_undefined_functions_fall_back_to_expressions():
     assert _check_in_extended_ring(R) is False
     check_against_backward(R)
     assert R.verified_orders == 2
+
+
+@pytest.mark.parametrize("name, word", [("pendulum", "121"), ("exp-well", "212"), ("pendulum", "212")])
+def test_ring_solve_equals_the_expression_solve(name, word, monkeypatch):
+    import nambu_bch.shadow.generic as generic
+
+    new = bch_shadow(model(name), word, 4)
+    monkeypatch.setattr(generic, "_extended_ring", lambda system, hams: None)
+    old = bch_shadow(model(name), word, 4)
+    R = ExtendedRing(new.system.coordinates, (), [*new.series.values(), *old.series.values()])
+    for j in range(5):
+        assert not (R.convert(new.series[j]) - R.convert(old.series[j]))
+
+
+def test_central_force_h4_is_solved_and_checked_in_the_ring():
+    S = System(*CENTRAL, name="central")
+    R = bch_shadow(S, "212", 4)
+    assert R.verified_orders == 4
+    r = sympy.sqrt(q1 ** 2 + q2 ** 2)
+    # the h^2 term's potential part, -V'^2 / 24 for velocity Verlet: -(1/r^2)^2 / 24
+    assert R.series[2].subs({sympy.Symbol("p1"): 0, sympy.Symbol("p2"): 0}) == -1 / (24 * r ** 4)

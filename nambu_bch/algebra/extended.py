@@ -4,30 +4,30 @@ Each non-polynomial atom of the input becomes a generator of a polynomial ring o
 parameters are further generators, never differentiated):
 
 * ``exp(a)`` -> ``E`` with ``E' = a' E``;
-* ``sin(a)``, ``cos(a)`` -> ``S``, ``C`` with ``S' = a' C``, ``C' = -a' S`` and ``S^2 = 1 - C^2``;
+* ``sin(a)``, ``cos(a)`` -> ``S``, ``C`` with ``S' = a' C``, ``C' = -a' S`` and ``C^2 = 1 - S^2``;
 * ``P^(k/2)`` (a square root of a polynomial ``P``) -> ``u^k`` with ``u^2 = P``, ``u' = u P' / (2 P)``;
 * ``1/P`` (a denominator) -> a negative power of each irreducible factor ``D`` of ``P``.
 
 Arguments that are rational multiples of one another share one generator (``exp(2 x) = E^2``,
 ``sin(2 x) = 2 S C``); nested atoms (``sin(sin x)``) are generators over the lower ones.  An element is
 ``N / prod D_j^(a_j)``: ``N`` a polynomial (python-flint ``fmpq_mpoly``, lexicographic, the algebraic
-generators ``S``, ``u`` first) reduced modulo ``S^2 + C^2 - 1`` and ``u^2 - P``, the ``D_j`` the
+generators ``C``, ``u`` first) reduced modulo ``S^2 + C^2 - 1`` and ``u^2 - P``, the ``D_j`` the
 irreducible denominators and the exponential generators (units).  Derivatives (the chain rule through the
 generators) and products keep elements in this form, so brackets, the backward error analysis and the
 check of a shadow Hamiltonian are polynomial arithmetic.
 
 Why the zero test is exact
 --------------------------
-Let ``B = QQ[x, C, E, parameters]``.  The coordinates, the ``C`` and the ``E`` are algebraically
+Let ``B = QQ[x, S, E, parameters]``.  The coordinates, the ``S`` and the ``E`` are algebraically
 independent when the exponential arguments, and separately the trigonometric ones, are linearly
 independent over ``QQ`` modulo constants (Ax, *On Schanuel's conjectures*, Ann. Math. 93 (1971) 252,
 Theorem 3, applied to the arguments ``a`` and ``i a``; checked here on the arguments' terms, and
-arguments with a constant part are refused).  ``S`` and ``u`` are square roots over ``Frac(B)`` of
-``1 - C^2`` and ``P``; the extension has full degree ``2^k`` exactly when no product of a non-empty
+arguments with a constant part are refused).  ``C`` and ``u`` are square roots over ``Frac(B)`` of
+``1 - S^2`` and ``P``; the extension has full degree ``2^k`` exactly when no product of a non-empty
 subset of the radicands is a square in ``Frac(B)`` (Kummer theory; checked on their squarefree parts,
-over ``GF(2)``), and then ``R = B[S, u] / (S^2 + C^2 - 1, u^2 - P)`` is a domain, free over ``B`` with the
-monomials of degree < 2 in each ``S``, ``u`` as basis.  The relations have pairwise coprime leading
-terms ``S^2``, ``u^2`` in the lexicographic order with ``S``, ``u`` first, so they are a Groebner basis
+over ``GF(2)``), and then ``R = B[C, u] / (S^2 + C^2 - 1, u^2 - P)`` is a domain, free over ``B`` with the
+monomials of degree < 2 in each ``C``, ``u`` as basis.  The relations have pairwise coprime leading
+terms ``C^2``, ``u^2`` in the lexicographic order with ``C``, ``u`` first, so they are a Groebner basis
 (Cox, Little, O'Shea, *Ideals, Varieties, and Algorithms*, Sect. 2.9, Prop. 4) and the remainder of the
 division by them is the normal form.  An element ``N / prod D^a`` is zero exactly when ``N`` is (the
 ``D`` are non-zero in the domain ``R``), so the zero test is ``N == 0`` on the normal form, with no
@@ -90,6 +90,15 @@ def _direction_key(linear):
     terms = sorted(linear, key=sympy.default_sort_key)
     first = linear[terms[0]]
     return tuple((t, linear[t] / first) for t in terms), first
+
+
+def powers_of(memo, base, e):
+    """``base**e`` (sympy), remembered: the atoms of a large expression are few and repeat."""
+    key = (base, e)
+    p = memo.get(key)
+    if p is None:
+        p = memo[key] = base ** e
+    return p
 
 
 class Element:
@@ -242,17 +251,17 @@ class ExtendedRing:
     def _build(self):
         trig = list(self._trig_dirs.values())
         exps = list(self._exp_dirs.values())
-        names = ([f"S{k}" for k in range(len(trig))] + [f"u{k}" for k in range(len(self._radicands))]
-                 + [str(x) for x in self.coordinates] + [f"C{k}" for k in range(len(trig))]
+        names = ([f"C{k}" for k in range(len(trig))] + [f"u{k}" for k in range(len(self._radicands))]
+                 + [str(x) for x in self.coordinates] + [f"S{k}" for k in range(len(trig))]
                  + [f"E{k}" for k in range(len(exps))] + [str(p) for p in self.parameters])
         ctx = self._ctx = self._flint.fmpq_mpoly_ctx.get(tuple(f"v{i}" for i in range(len(names))), "lex")
         self.names = tuple(names)
         gens = ctx.gens()
         nt, nr, n = len(trig), len(self._radicands), self.n
-        self._S = gens[:nt]
+        self._C = gens[:nt]
         self._u = gens[nt:nt + nr]
         self._x = gens[nt + nr:nt + nr + n]
-        self._C = gens[nt + nr + n:nt + nr + n + nt]
+        self._S = gens[nt + nr + n:nt + nr + n + nt]
         self._E = gens[nt + nr + n + nt:nt + nr + n + nt + len(exps)]
         self._p = gens[nt + nr + n + nt + len(exps):]
         self._algebraic = nt + nr
@@ -261,14 +270,15 @@ class ExtendedRing:
         self._trig, self._exps = trig, exps
         self._trig_index = {d.key: k for k, d in enumerate(trig)}
         self._exp_index = {d.key: k for k, d in enumerate(exps)}
-        # the relations S^2 - (1 - C^2), u^2 - P (a Groebner basis: coprime leading terms S^2, u^2)
-        self._relations = [(k, self._S[k] ** 2 - (1 - self._C[k] ** 2)) for k in range(nt)]
+        # the relations C^2 - (1 - S^2), u^2 - P (a Groebner basis: coprime leading terms C^2, u^2); cosines, not
+        # sines, are reduced so that the h^2 term of a potential -cos q keeps its sin(q)^2 = V'(q)^2
+        self._relations = [(k, self._C[k] ** 2 - (1 - self._S[k] ** 2)) for k in range(nt)]
         self._plain_memo = {}
         radicand_polys = []
         for j, b in enumerate(self._radicands):
             P = self._plain(b)
             if any(P.degrees()[i] for i in range(self._algebraic)):
-                _refuse(b, "a square root of an expression holding sin or another square root")
+                _refuse(b, "a square root of an expression holding cos or another square root")
             radicand_polys.append(P)
             self._relations.append((nt + j, self._u[j] ** 2 - P))
         self._check_kummer(radicand_polys)
@@ -284,7 +294,7 @@ class ExtendedRing:
                     q, r = divmod(P, u ** d)
                     P = q if r.is_zero() else P
             if any(P.degrees()[i] for i in range(self._algebraic)):
-                _refuse(b, "a denominator holding sin or a square root")
+                _refuse(b, "a denominator holding cos or a square root")
             for f, _ in P.factor()[1]:
                 if f.is_constant() or any(f == d for d in dens):
                     continue
@@ -296,12 +306,13 @@ class ExtendedRing:
         self.one = Element(self, self._one_poly, self._zero_den)
         self._dpow_memo = {}
         self._convert_memo = {}
+        self._power_memo, self._atoms_sympy, self._dens_sympy_memo = {}, None, None  # the sympy edge
         self._den_derivs = {}  # (i, j) -> d D_j / d x_i, on first use (after the generators it holds)
         # 1/u_j = u_j / P_j with P_j = c prod D^m
         self._u_inverse = [self._inverse_of(self._u[j], radicand_polys[j]) for j in range(nr)]
         # derivatives of the generators by each coordinate, lower atoms first (their rules use the lower ones)
         self._gen_derivs = [[] for _ in range(n)]
-        at_x, at_c, at_e = nt + nr, nt + nr + n, nt + nr + n + nt  # the generators' positions
+        at_x, at_s, at_e = nt + nr, nt + nr + n, nt + nr + n + nt  # the generators' positions
         for i in range(n):
             self._gen_derivs[i].append((at_x + i, self.one))
         for kind, k, d in self._atom_order():
@@ -319,8 +330,8 @@ class ExtendedRing:
                     continue
                 if kind == "trig":
                     S, C = self._atom(self._S[k]), self._atom(self._C[k])
-                    self._gen_derivs[i].append((k, da * C))
-                    self._gen_derivs[i].append((at_c + k, -(da * S)))
+                    self._gen_derivs[i].append((at_s + k, da * C))
+                    self._gen_derivs[i].append((k, -(da * S)))
                 else:
                     self._gen_derivs[i].append((at_e + k, da * self._atom(self._E[k])))
 
@@ -335,11 +346,11 @@ class ExtendedRing:
         return sorted(items, key=lambda it: depth(self._radicands[it[1]]) if it[0] == "u" else depth(it[2].expression()))
 
     def _check_kummer(self, radicands):
-        """Refuse square roots whose radicands (with the ``1 - C^2`` of the sines) are multiplicatively dependent
+        """Refuse square roots whose radicands (with the ``1 - S^2`` of the cosines) are multiplicatively dependent
         modulo squares: then some product of them is a square and the relations are not a canonical form."""
         vectors = []
         keys: dict = {}
-        polys = [1 - c ** 2 for c in self._C] + list(radicands)
+        polys = [1 - s ** 2 for s in self._S] + list(radicands)
         for P in polys:
             content, factors = P.factor()
             bits = 0
@@ -517,7 +528,7 @@ class ExtendedRing:
         out = self.one
         degrees = num.degrees()
         for j, u in enumerate(self._u):
-            d = degrees[len(self._S) + j]
+            d = degrees[len(self._C) + j]
             if d:
                 q, r = divmod(num, u ** d)
                 if not r.is_zero():
@@ -537,26 +548,78 @@ class ExtendedRing:
         return p
 
     def to_sympy(self, x: Element) -> sympy.Expr:
-        """``x`` as a sympy expression (numerator as terms over the denominators' powers; not expanded)."""
+        """``x`` as an expanded sympy expression: one term per monomial of the numerator, over its denominators.
+
+        The numerator's part on each basis monomial in ``C``, ``u`` is put in lowest terms by itself (so
+        ``u / P^3`` and ``P / P^3`` print as ``P^(-5/2)`` and ``P^(-2)``); the powers of an exponential
+        generator in the numerator and the denominator join in one ``exp(k a)``; the numerator is
+        distributed over the denominators' powers as ``sympy.expand`` does.
+        """
+        groups: dict = {}
+        for m, c in zip(x.num.monoms(), x.num.coeffs()):
+            groups.setdefault(tuple(m[:self._algebraic]), {})[tuple(map(int, m))] = c
+        terms = []
+        for part in groups.values():
+            terms += self._terms(self.lowest_terms(Element(self, self._ctx.from_dict(part), x.den)))
+        return sympy.Add(*terms)
+
+    def _terms(self, x: Element) -> list:
         atoms = self._generator_expressions()
-        num = sympy.Add(*(sympy.Rational(int(c.p), int(c.q)) * sympy.Mul(*(a ** e for a, e in zip(atoms, m) if e))
-                          for m, c in zip(x.num.monoms(), x.num.coeffs())))
+        powers = self._power_memo
+        n_exp, first_exp = len(self._exps), len(atoms) - len(self.parameters) - len(self._exps)
         dens = self._dens_sympy()
-        return num / sympy.Mul(*(d ** a for d, a in zip(dens, x.den) if a))
+        shared = [powers_of(powers, d, -a) for d, a in zip(dens[n_exp:], x.den[n_exp:]) if a]
+        terms = []
+        for m, c in zip(x.num.monoms(), x.num.coeffs()):
+            factors = [sympy.Rational(int(c.p), int(c.q))]
+            for k, (a, e) in enumerate(zip(atoms, m)):
+                if first_exp <= k < first_exp + n_exp:
+                    e = int(e) - x.den[k - first_exp]
+                    if e:
+                        factors.append(sympy.exp(e * self._exps[k - first_exp].expression()))
+                elif e:
+                    factors.append(powers_of(powers, a, int(e)))
+            if not any(m[first_exp:first_exp + n_exp]):
+                factors += [sympy.exp(-a * self._exps[k].expression()) for k, a in enumerate(x.den[:n_exp]) if a]
+            terms.append(sympy.Mul(*factors, *shared))
+        return terms
+
+    def lowest_terms(self, x: Element) -> Element:
+        """``x`` with no denominator ``D`` dividing its numerator: the canonical form ``N / prod D^a``.
+
+        A ``D`` is free of the reduced generators (``C``, ``u``), so it divides ``N`` exactly when it divides
+        each of ``N``'s coefficients on the basis monomials, and the quotient is still reduced; with the ``D``
+        distinct irreducibles of the factorial ring ``B``, the minimal exponents are unique.
+        """
+        num, den = x.num, list(x.den)
+        if num.is_zero():
+            return self.zero
+        for j, D in enumerate(self._dens):
+            while den[j]:
+                q, r = divmod(num, D)
+                if not r.is_zero():
+                    break
+                num, den[j] = q, den[j] - 1
+        return Element(self, num, tuple(den))
 
     def _generator_expressions(self):
-        out = [sympy.sin(d.expression()) for d in self._trig]
-        out += [sympy.sqrt(b) for b in self._radicands]
-        out += list(self.coordinates)
-        out += [sympy.cos(d.expression()) for d in self._trig]
-        out += [sympy.exp(d.expression()) for d in self._exps]
-        out += list(self.parameters)
-        return out
+        if self._atoms_sympy is None:
+            out = [sympy.cos(d.expression()) for d in self._trig]
+            out += [sympy.sqrt(b) for b in self._radicands]
+            out += list(self.coordinates)
+            out += [sympy.sin(d.expression()) for d in self._trig]
+            out += [sympy.exp(d.expression()) for d in self._exps]
+            out += list(self.parameters)
+            self._atoms_sympy = out
+        return self._atoms_sympy
 
     def _dens_sympy(self):
-        atoms = self._generator_expressions()
-        return [sympy.Add(*(sympy.Rational(int(c.p), int(c.q)) * sympy.Mul(*(a ** e for a, e in zip(atoms, m) if e))
+        if self._dens_sympy_memo is None:
+            atoms = self._generator_expressions()
+            self._dens_sympy_memo = [
+                sympy.Add(*(sympy.Rational(int(c.p), int(c.q)) * sympy.Mul(*(a ** int(e) for a, e in zip(atoms, m) if e))
                             for m, c in zip(D.monoms(), D.coeffs()))) for D in self._dens]
+        return self._dens_sympy_memo
 
     # -- arithmetic -------------------------------------------------------------------------
     def add(self, a: Element, b: Element) -> Element:

@@ -214,6 +214,37 @@ def poisson_structure(system):
     return None
 
 
+def _extended_ring(system, hams):
+    """The extended exact ring of non-polynomial ``hams`` (``None`` for polynomials or atoms the ring refuses)."""
+    from ..algebra.extended import extended_ring
+
+    alg = system.algebra
+    if all(alg.is_polynomial(alg.convert(H)) for H in hams):
+        return None
+    return extended_ring(system.coordinates, system.parameters, hams)
+
+
+def _ring_bracket(ring, fixed):
+    """``P(f, g)`` on elements of the extended ring: canonical, or Nambu with the ``fixed`` Hamiltonians' slots."""
+    n = ring.n
+    if not fixed:
+        d = n // 2
+
+        def P(f, g):
+            df = [ring.diff(f, i) for i in range(n)]
+            dg = [ring.diff(g, i) for i in range(n)]
+            total = ring.zero
+            for k in range(d):
+                total = total + df[k] * dg[k + d] - df[k + d] * dg[k]
+            return total
+        return P
+    fixed_grads = [[ring.diff(G, i) for i in range(n)] for G in fixed]
+
+    def P(f, g):
+        return _det([[ring.diff(f, i) for i in range(n)], [ring.diff(g, i) for i in range(n)], *fixed_grads], ring.zero)
+    return P
+
+
 def _bracket(system, fixed):
     alg = system.algebra
 
@@ -294,19 +325,34 @@ def bch_shadow(system, word, order: int = 2, verify: bool = True) -> PoissonShad
     check_work(system, len(hams), (*hams, *fixed), order)
     alg = system.algebra
     frac = _FractionBackend.make(system, (*hams, *fixed))
+    ring = None
     if frac is not None:  # rational Hamiltonians: exact sparse fractions, no expand/cancel of sympy trees
         P, to_sympy = frac.bracket, frac.to_sympy
         leaves = {k + 1: frac.convert(Hk) for k, Hk in enumerate(hams)}
         zero_test = lambda v: not v  # noqa: E731
     else:
-        P, to_sympy = _bracket(system, fixed), alg.to_sympy
-        leaves = {k + 1: alg.convert(Hk) for k, Hk in enumerate(hams)}
-        zero_test = lambda v: alg.is_zero(v) if alg.is_polynomial(v) else is_zero(v)  # noqa: E731
+        ring = _extended_ring(system, (*hams, *fixed))
+        if ring is not None:  # exp, sin/cos, square roots: exact polynomial arithmetic in the extended ring
+            P, to_sympy = _ring_bracket(ring, [ring.convert(G) for G in fixed]), ring.to_sympy
+            leaves = {k + 1: ring.convert(Hk) for k, Hk in enumerate(hams)}
+            zero_test = lambda v: not v  # noqa: E731
+        else:
+            P, to_sympy = _bracket(system, fixed), alg.to_sympy
+            leaves = {k + 1: alg.convert(Hk) for k, Hk in enumerate(hams)}
+            zero_test = lambda v: alg.is_zero(v) if alg.is_polynomial(v) else is_zero(v)  # noqa: E731
     # [X_A, X_B] = X_{P(B, A)} (Eq. CL1 with X_F f = P(f, F))
     evaluator = BracketEvaluator(leaves, bracket=lambda A, B: P(B, A), is_zero=zero_test)
     series = formal_bch(comp, order + 1)
     out = {}
     for j in range(order + 1):
+        if ring is not None:  # sum in the ring, one conversion per order
+            total = ring.zero
+            for c, tree in series.terms(j + 1):
+                value = evaluator.value(tree)
+                if value is not None:
+                    total = total + value * ring.scalar(c)
+            out[j] = to_sympy(total)  # expanded, exponentials combined: what _tidy would make of it
+            continue
         total = sympy.Integer(0)
         for c, tree in series.terms(j + 1):
             value = evaluator.value(tree)
