@@ -180,6 +180,8 @@ class ExtendedRing:
         self._flint = importlib.import_module("flint")
         self._discover(exprs)
         self._build()
+        #: no exp, sin, cos or square root: the elements are rational functions
+        self.rational = not (self._trig or self._exps or self._radicands)
 
     # -- construction ---------------------------------------------------------------
     def _discover(self, exprs):

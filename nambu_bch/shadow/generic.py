@@ -324,22 +324,20 @@ def bch_shadow(system, word, order: int = 2, verify: bool = True) -> PoissonShad
     comp = composition_for(word, system.splitting)
     check_work(system, len(hams), (*hams, *fixed), order)
     alg = system.algebra
-    frac = _FractionBackend.make(system, (*hams, *fixed))
-    ring = None
-    if frac is not None:  # rational Hamiltonians: exact sparse fractions, no expand/cancel of sympy trees
+    ring = _extended_ring(system, (*hams, *fixed))
+    frac = None if ring is not None else _FractionBackend.make(system, (*hams, *fixed))
+    if ring is not None:  # exp, sin/cos, square roots, quotients: exact polynomial arithmetic in the extended ring
+        P, to_sympy = _ring_bracket(ring, [ring.convert(G) for G in fixed]), ring.to_sympy
+        leaves = {k + 1: ring.convert(Hk) for k, Hk in enumerate(hams)}
+        zero_test = lambda v: not v  # noqa: E731
+    elif frac is not None:  # rational Hamiltonians the ring refuses: exact sparse fractions
         P, to_sympy = frac.bracket, frac.to_sympy
         leaves = {k + 1: frac.convert(Hk) for k, Hk in enumerate(hams)}
         zero_test = lambda v: not v  # noqa: E731
     else:
-        ring = _extended_ring(system, (*hams, *fixed))
-        if ring is not None:  # exp, sin/cos, square roots: exact polynomial arithmetic in the extended ring
-            P, to_sympy = _ring_bracket(ring, [ring.convert(G) for G in fixed]), ring.to_sympy
-            leaves = {k + 1: ring.convert(Hk) for k, Hk in enumerate(hams)}
-            zero_test = lambda v: not v  # noqa: E731
-        else:
-            P, to_sympy = _bracket(system, fixed), alg.to_sympy
-            leaves = {k + 1: alg.convert(Hk) for k, Hk in enumerate(hams)}
-            zero_test = lambda v: alg.is_zero(v) if alg.is_polynomial(v) else is_zero(v)  # noqa: E731
+        P, to_sympy = _bracket(system, fixed), alg.to_sympy
+        leaves = {k + 1: alg.convert(Hk) for k, Hk in enumerate(hams)}
+        zero_test = lambda v: alg.is_zero(v) if alg.is_polynomial(v) else is_zero(v)  # noqa: E731
     # [X_A, X_B] = X_{P(B, A)} (Eq. CL1 with X_F f = P(f, F))
     evaluator = BracketEvaluator(leaves, bracket=lambda A, B: P(B, A), is_zero=zero_test)
     series = formal_bch(comp, order + 1)
@@ -351,7 +349,8 @@ def bch_shadow(system, word, order: int = 2, verify: bool = True) -> PoissonShad
                 value = evaluator.value(tree)
                 if value is not None:
                     total = total + value * ring.scalar(c)
-            out[j] = to_sympy(total)  # expanded, exponentials combined: what _tidy would make of it
+            # expanded, exponentials combined: what _tidy makes of it, except that rational functions are factored
+            out[j] = _tidy(to_sympy(total)) if ring.rational else to_sympy(total)
             continue
         total = sympy.Integer(0)
         for c, tree in series.terms(j + 1):
