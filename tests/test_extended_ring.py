@@ -140,3 +140,38 @@ def test_central_force_h4_is_solved_and_checked_in_the_ring():
     r = sympy.sqrt(q1 ** 2 + q2 ** 2)
     # the h^2 term's potential part, -V'^2 / 24 for velocity Verlet: -(1/r^2)^2 / 24
     assert R.series[2].subs({sympy.Symbol("p1"): 0, sympy.Symbol("p2"): 0}) == -1 / (24 * r ** 4)
+
+
+@pytest.mark.parametrize("f", [sympy.exp(-x), (1 - sympy.exp(-x)) ** 2, sympy.exp(2 * x) / (1 + x ** 2) - sympy.exp(-x),
+                               sympy.sin(x) ** 3 / sympy.sqrt(x ** 2 + y ** 2) ** 3])
+def test_to_sympy_round_trips(f):
+    R = ring(f, sympy.exp(x), sympy.cos(x))
+    back = R.to_sympy(R.convert(f))
+    assert not (R.convert(back) - R.convert(f))
+    assert sympy.simplify(back - f) == 0
+
+
+# -- the new built-ins: the truncated H_S drifts like h^(k+2) -------------------------------------------
+@pytest.mark.parametrize("name", ["kepler", "kepler-3d", "morse", "lennard-jones"])
+def test_builtin_truncated_shadow_drifts_like_h_k_plus_2(name):
+    """Over a fixed time the order-k truncation of H_S (k = 0, 2, 4) moves by O(h^(k+2)): log-log slopes 2, 4, 6."""
+    import numpy as np
+
+    import nambu_bch as nb
+    from nambu_bch.systems.catalog import DEFAULT_X0
+
+    S = nb.model(name)
+    params = {p: 1 for p in S.parameters}
+    R = bch_shadow(S, "212", 4)
+    h = sympy.Symbol("h")
+    hs = np.array([0.08, 0.04, 0.02])
+    for k, expected in ((0, 2), (2, 4), (4, 6)):
+        H_k = sympy.lambdify((*S.coordinates, h), sum(h**j * R.series[j] for j in range(k + 1)).subs(params), "numpy")
+        errs = []
+        for step in hs:
+            xs = nb.iterate(S, "212", h=float(step), steps=int(round(4 / step)), x0=DEFAULT_X0[name],
+                            params={str(p): 1.0 for p in S.parameters} or None)
+            vals = H_k(*xs.T, step)
+            errs.append(np.max(np.abs(vals - vals[0])))
+        slope = np.polyfit(np.log(hs), np.log(errs), 1)[0]
+        assert abs(slope - expected) < 0.4, (name, k, slope)

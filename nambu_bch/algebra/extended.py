@@ -581,8 +581,6 @@ class ExtendedRing:
                         factors.append(sympy.exp(e * self._exps[k - first_exp].expression()))
                 elif e:
                     factors.append(powers_of(powers, a, int(e)))
-            if not any(m[first_exp:first_exp + n_exp]):
-                factors += [sympy.exp(-a * self._exps[k].expression()) for k, a in enumerate(x.den[:n_exp]) if a]
             terms.append(sympy.Mul(*factors, *shared))
         return terms
 
