@@ -53,7 +53,9 @@ H_STEP = sympy.Symbol("h")
 #: Largest accepted work estimate of a BCH request on non-polynomial pieces (:func:`bch_work`).  Measured on
 #: ``sin(sin(...(x1)))`` nests under position Verlet through the CLI (docs/hardening.md, round two), the time
 #: was about 7 s + W / 60 s on a shared machine (W = 82: 9 s, 608: 20 s, 2609: 55 s, 2776: 58 s, 7630: > 120 s),
-#: so 4000 is about a minute; W grows 3x-10x per order or nesting level, so the limit is not a fine line.
+#: so 4000 is about a minute; W grows 3x-10x per order or nesting level, so the limit is not a fine line.  In the
+#: extended exact ring (algebra/extended.py) the same requests are 10x-30x faster, but W also measures the size of
+#: the printed answer (8 MB for W = 7633), which the ring does not shrink, so the limit stays.
 MAX_BCH_WORK = 4000
 
 
@@ -267,6 +269,8 @@ class PoissonShadow:
     series : dict ``j -> expr`` -- the coefficient of ``h^j`` (``series[0] = H``)
     fixed : tuple -- ``(G,)`` for a single-split Nambu system, ``()`` for canonical
     verified_orders : int -- ``X_{H_S}`` equals the backward-error ``X_eff`` through this power
+    effective : EffectiveField or None -- the backward-error field of the check when it ran in sympy expressions
+        (``None`` when it ran in the extended exact ring, whose field is not converted back)
     """
 
     system: object
