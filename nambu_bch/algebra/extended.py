@@ -390,14 +390,15 @@ class ExtendedRing:
             _refuse(arg, "an argument that is not an integer multiple of the ring's generator")
         return k, int(multiple)
 
-    def _trig_poly(self, k, n, cosine, lift):
-        """``cos(n a)``/``sin(n a)`` in ``S = sin a``, ``C = cos a`` (Chebyshev recurrences), ``n >= 1``."""
-        S, C = lift(self._S[k]), lift(self._C[k])
+    def _trig_poly(self, k, n, cosine):
+        """``cos(n a)``/``sin(n a)`` in ``S = sin a``, ``C = cos a`` (Chebyshev recurrences), ``n`` a non-zero integer;
+        not yet reduced."""
+        S, C = self._S[k], self._C[k]
         sign = 1
         if n < 0:
             n, sign = -n, (1 if cosine else -1)
-        c0, c1 = lift(self._one_poly), C
-        s0, s1 = lift(self._zero_poly), S
+        c0, c1 = self._one_poly, C
+        s0, s1 = self._zero_poly, S
         for _ in range(n - 1):
             c0, c1 = c1, C * c1 * 2 - c0
             s0, s1 = s1, C * s1 * 2 - s0
@@ -424,7 +425,7 @@ class ExtendedRing:
             out = self._reduce(self._plain(e.base) ** int(e.exp))
         elif isinstance(e, _TRIG):
             k, m = self._direction_of(self._trig, self._trig_index, e.args[0])
-            out = self._reduce(self._trig_poly(k, m, isinstance(e, sympy.cos), lambda p: p))
+            out = self._reduce(self._trig_poly(k, m, isinstance(e, sympy.cos)))
         elif isinstance(e, sympy.exp) or (e.is_Pow and e.base is sympy.E):
             k, m = self._direction_of(self._exps, self._exp_index, e.exp if e.is_Pow else e.args[0])
             if m < 0:
@@ -514,7 +515,7 @@ class ExtendedRing:
                 self, self._one_poly, tuple(-m if j == k else 0 for j in range(self._m)))
         elif isinstance(e, _TRIG):
             k, m = self._direction_of(self._trig, self._trig_index, e.args[0])
-            out = Element(self, self._reduce(self._trig_poly(k, m, isinstance(e, sympy.cos), lambda p: p)),
+            out = Element(self, self._reduce(self._trig_poly(k, m, isinstance(e, sympy.cos))),
                           self._zero_den)
         else:
             out = Element(self, self._plain(e), self._zero_den)
@@ -670,7 +671,12 @@ class ExtendedRing:
 
 
 def extended_ring(coordinates, parameters, expressions):
-    """The :class:`ExtendedRing` of ``expressions``, or ``None`` when one of their atoms is refused."""
+    """The :class:`ExtendedRing` of ``expressions``, or ``None`` when one of their atoms is refused or python-flint
+    is missing or switched off (``NAMBU_BCH_DISABLE_FLINT=1``): the callers then work in sympy expressions."""
+    from .elimination import flint_available
+
+    if not flint_available():
+        return None
     try:
         return ExtendedRing(coordinates, parameters, expressions)
     except NoExactResultError:
