@@ -28,7 +28,7 @@ x1, x2, x3, x4, y = sympy.symbols("x1 x2 x3 x4 y")
 m, omega, I1, I2, I3 = sympy.symbols("m omega I1 I2 I3")
 FULL_SPLIT_MODELS = ["ho", "ho3", "rigid-body"]
 ALL_MODELS = ["ho", "ho3", "rigid-body", "lotka-volterra", "ho3-composite", "pendulum", "henon-heiles", "fpu-beta", "toda",
-              "exp-well", "rational", "rigid-body-lp", "ho3-pair"]
+              "exp-well", "rational", "kepler", "kepler-3d", "morse", "lennard-jones", "rigid-body-lp", "ho3-pair"]
 
 
 def simplified(field):

@@ -101,3 +101,22 @@ def test_example_suite_with_explicit_plugin():
     done = _pytest("-p", "no:nambu_bch", "-p", "nambu_bch.testing", "-k", "verlet or motion or not_invariant")
     assert done.returncode == 0, done.stdout + done.stderr
     assert "4 passed" in done.stdout, done.stdout
+
+
+def test_a_failing_invariant_names_a_witness_and_the_lowest_power(ho3, rigid_body):
+    """A residual proved non-zero at a rational point is reported there, with its lowest power of h (no simplify)."""
+    with pytest.raises(AssertionError) as info:
+        assert_invariant(ho3, "12321", "x3 - x1^2")
+    text = str(info.value)
+    assert "at h = " in text and "lowest power of h (numerically there):" in text and text.endswith("h^3")
+    with pytest.raises(AssertionError) as info:
+        assert_invariant(rigid_body, "123", rigid_body.H)   # Lie-Trotter: the energy moves at h^2
+    text = str(info.value)
+    assert text.endswith("h^2") and len(text) < 1000
+
+
+def test_a_long_residual_is_cut():
+    from nambu_bch.testing import MAX_SHOWN, _short
+
+    long = sympy.Add(*(x1**k for k in range(200)))
+    assert len(_short(long)) < MAX_SHOWN + 40 and _short(long).endswith("(200 terms)")

@@ -29,25 +29,39 @@ _POINT = (sympy.Rational(7, 19), sympy.Rational(5, 13), sympy.Rational(11, 23), 
           sympy.Rational(13, 29), sympy.Rational(9, 17), sympy.Rational(17, 31), sympy.Rational(2, 11))
 
 
-def _nonzero_at_a_point(e) -> bool:
-    """``e`` evaluates, at 30 digits, to a real number clearly away from zero at a rational point (a witness that
-    ``e`` is not identically zero).
+def witness(e, point=None, digits: int = 30, tolerance: float = 1e-12):
+    """``(point, value)`` where ``e`` is clearly not zero, else ``None`` (a proof of non-zero-ness, never of zero).
 
+    ``point`` maps the free symbols to distinct, irregular rationals (:data:`_POINT`) unless given.
     sympy's ``evalf`` tracks the cancellation in sums and raises its working precision until the result has
-    the requested 30 digits; a zero expression therefore evaluates to below ``1e-30`` of its terms' size, and
-    a value above ``1e-12`` of that size is not round-off.  Where the point is outside the domain (a pole,
-    a complex value) or the evaluation does not give a number, no witness is claimed and the exact tiers decide.
+    the requested ``digits``; a zero expression therefore evaluates to below ``10^-digits`` of its terms' size,
+    and a value above ``tolerance`` times that size is not round-off (``tolerance`` well above ``10^-digits``).
+    Where the point is outside the domain (a pole, a complex value) or the evaluation does not give a number, no
+    witness is claimed.
+
+    >>> x = sympy.Symbol("x")
+    >>> witness(sympy.sin(x)**2 - 1 + sympy.cos(x)**2) is None, witness(x**2 - x)[0]
+    (True, {x: 7/19})
     """
-    symbols = sorted(e.free_symbols, key=str)
-    point = {x: _POINT[i % len(_POINT)] + i // len(_POINT) for i, x in enumerate(symbols)}
+    e = sympy.sympify(e, strict=True)
+    if point is None:
+        symbols = sorted(e.free_symbols, key=str)
+        point = {x: _POINT[i % len(_POINT)] + i // len(_POINT) for i, x in enumerate(symbols)}
     try:
-        value = e.evalf(30, subs=point)
-        scale = max((abs(t.evalf(30, subs=point)) for t in sympy.Add.make_args(e)), default=sympy.Integer(0))
+        value = e.evalf(digits, subs=point)
+        scale = max((abs(t.evalf(digits, subs=point)) for t in sympy.Add.make_args(e)), default=sympy.Integer(0))
     except (TypeError, ValueError, ArithmeticError):  # noqa: BLE001 - outside the domain: no witness
-        return False
+        return None
     if not (value.is_Number and value.is_real and scale.is_Number and scale.is_finite) or value.has(sympy.nan):
-        return False
-    return bool(abs(value) > sympy.Float(1e-12, 30) * max(scale, sympy.Integer(1)))
+        return None
+    if abs(value) > sympy.Float(tolerance, digits) * max(scale, sympy.Integer(1)):
+        return point, value
+    return None
+
+
+def _nonzero_at_a_point(e) -> bool:
+    """``e`` evaluates, at 30 digits, to a real number clearly away from zero at a rational point (:func:`witness`)."""
+    return witness(e) is not None
 
 
 def is_zero(expr) -> bool:

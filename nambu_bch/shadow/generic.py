@@ -53,7 +53,9 @@ H_STEP = sympy.Symbol("h")
 #: Largest accepted work estimate of a BCH request on non-polynomial pieces (:func:`bch_work`).  Measured on
 #: ``sin(sin(...(x1)))`` nests under position Verlet through the CLI (docs/hardening.md, round two), the time
 #: was about 7 s + W / 60 s on a shared machine (W = 82: 9 s, 608: 20 s, 2609: 55 s, 2776: 58 s, 7630: > 120 s),
-#: so 4000 is about a minute; W grows 3x-10x per order or nesting level, so the limit is not a fine line.
+#: so 4000 is about a minute; W grows 3x-10x per order or nesting level, so the limit is not a fine line.  In the
+#: extended exact ring (algebra/extended.py) the same requests are 10x-30x faster, but W also measures the size of
+#: the printed answer (8 MB for W = 7633), which the ring does not shrink, so the limit stays.
 MAX_BCH_WORK = 4000
 
 
@@ -214,6 +216,37 @@ def poisson_structure(system):
     return None
 
 
+def _extended_ring(system, hams):
+    """The extended exact ring of non-polynomial ``hams`` (``None`` for polynomials or atoms the ring refuses)."""
+    from ..algebra.extended import extended_ring
+
+    alg = system.algebra
+    if all(alg.is_polynomial(alg.convert(H)) for H in hams):
+        return None
+    return extended_ring(system.coordinates, system.parameters, hams)
+
+
+def _ring_bracket(ring, fixed):
+    """``P(f, g)`` on elements of the extended ring: canonical, or Nambu with the ``fixed`` Hamiltonians' slots."""
+    n = ring.n
+    if not fixed:
+        d = n // 2
+
+        def P(f, g):
+            df = [ring.diff(f, i) for i in range(n)]
+            dg = [ring.diff(g, i) for i in range(n)]
+            total = ring.zero
+            for k in range(d):
+                total = total + df[k] * dg[k + d] - df[k + d] * dg[k]
+            return total
+        return P
+    fixed_grads = [[ring.diff(G, i) for i in range(n)] for G in fixed]
+
+    def P(f, g):
+        return _det([[ring.diff(f, i) for i in range(n)], [ring.diff(g, i) for i in range(n)], *fixed_grads], ring.zero)
+    return P
+
+
 def _bracket(system, fixed):
     alg = system.algebra
 
@@ -236,6 +269,8 @@ class PoissonShadow:
     series : dict ``j -> expr`` -- the coefficient of ``h^j`` (``series[0] = H``)
     fixed : tuple -- ``(G,)`` for a single-split Nambu system, ``()`` for canonical
     verified_orders : int -- ``X_{H_S}`` equals the backward-error ``X_eff`` through this power
+    effective : EffectiveField or None -- the backward-error field of the check when it ran in sympy expressions
+        (``None`` when it ran in the extended exact ring, whose field is not converted back)
     """
 
     system: object
@@ -293,8 +328,13 @@ def bch_shadow(system, word, order: int = 2, verify: bool = True) -> PoissonShad
     comp = composition_for(word, system.splitting)
     check_work(system, len(hams), (*hams, *fixed), order)
     alg = system.algebra
-    frac = _FractionBackend.make(system, (*hams, *fixed))
-    if frac is not None:  # rational Hamiltonians: exact sparse fractions, no expand/cancel of sympy trees
+    ring = _extended_ring(system, (*hams, *fixed))
+    frac = None if ring is not None else _FractionBackend.make(system, (*hams, *fixed))
+    if ring is not None:  # exp, sin/cos, square roots, quotients: exact polynomial arithmetic in the extended ring
+        P, to_sympy = _ring_bracket(ring, [ring.convert(G) for G in fixed]), ring.to_sympy
+        leaves = {k + 1: ring.convert(Hk) for k, Hk in enumerate(hams)}
+        zero_test = lambda v: not v  # noqa: E731
+    elif frac is not None:  # rational Hamiltonians the ring refuses: exact sparse fractions
         P, to_sympy = frac.bracket, frac.to_sympy
         leaves = {k + 1: frac.convert(Hk) for k, Hk in enumerate(hams)}
         zero_test = lambda v: not v  # noqa: E731
@@ -307,6 +347,15 @@ def bch_shadow(system, word, order: int = 2, verify: bool = True) -> PoissonShad
     series = formal_bch(comp, order + 1)
     out = {}
     for j in range(order + 1):
+        if ring is not None:  # sum in the ring, one conversion per order
+            total = ring.zero
+            for c, tree in series.terms(j + 1):
+                value = evaluator.value(tree)
+                if value is not None:
+                    total = total + value * ring.scalar(c)
+            # expanded, exponentials combined: what _tidy makes of it, except that rational functions are factored
+            out[j] = _tidy(to_sympy(total)) if ring.rational else to_sympy(total)
+            continue
         total = sympy.Integer(0)
         for c, tree in series.terms(j + 1):
             value = evaluator.value(tree)
@@ -400,7 +449,65 @@ def _tidy(expr):
 
 
 def check_against_backward(result: PoissonShadow) -> None:
-    """Raise :class:`NoExactResultError` unless ``X_{H_S, fixed}`` equals the backward-error ``X_eff`` through ``h^order``."""
+    """Raise :class:`NoExactResultError` unless ``X_{H_S, fixed}`` equals the backward-error ``X_eff`` through ``h^order``.
+
+    When every atom of the system and of ``H_S`` has a place in the extended exact ring
+    (:mod:`nambu_bch.algebra.extended`: exp, sin, cos, square roots, denominators), both sides are computed
+    and compared there (zero = the normal form is zero; no ``simplify``).  Otherwise (undefined functions,
+    algebraic coefficients of the composition) the comparison runs in sympy expressions.
+    """
+    if not _check_in_extended_ring(result):
+        _check_in_expressions(result)
+    result.verified_orders = result.order
+
+
+def _differs(result, j, i):
+    system = result.system
+    return NoExactResultError(
+        f"{system.name}, {result.composition.name}: X_(H_S) differs from the backward-error X_eff at h^{j} "
+        f"in d{system.coordinates[i]}/dt; not returned")
+
+
+def _check_in_extended_ring(result: PoissonShadow) -> bool:
+    """The check of :func:`check_against_backward` in the extended exact ring; ``False`` when the ring refuses
+    the system's atoms (the caller then checks in sympy expressions)."""
+    from ..algebra.extended import ExtendedBackend, extended_ring
+    from ..bch.backward import _backward_graded
+
+    system, order, comp = result.system, result.order, result.composition
+    if comp.extension:
+        return False
+    alg = system.algebra
+    pieces = {p.number: [alg.to_sympy(c) for c in p.field.components] for p in system.splitting.pieces}
+    series = [sympy.sympify(result.series[j], strict=True) for j in range(order + 1)]
+    exprs = [*system.hamiltonians, *result.fixed, *series, *(c for comps in pieces.values() for c in comps)]
+    ring = extended_ring(system.coordinates, system.parameters, exprs)
+    if ring is None:
+        return False
+    try:
+        backend = ExtendedBackend(ring, pieces)
+        fixed = [ring.convert(G) for G in result.fixed]
+        hams = [ring.convert(Hj) for Hj in series]
+    except NoExactResultError:
+        return False
+    Z = _backward_graded(backend, comp, order)
+    n = ring.n
+    fixed_grads = [[ring.diff(G, i) for i in range(n)] for G in fixed]
+    for j in range(order + 1):
+        grad = [ring.diff(hams[j], i) for i in range(n)]
+        if fixed_grads:  # X^i = {x_i, H, G, ...}: the Jacobian determinant with e_i as the first row
+            comps = [_det([[ring.one if k == i else ring.zero for k in range(n)], grad, *fixed_grads], ring.zero)
+                     for i in range(n)]
+        else:  # canonical, X_F = (dF/dp, -dF/dq) (N = 2: (x1, x2) = (q, p))
+            d = n // 2
+            comps = grad[d:] + [-g for g in grad[:d]]
+        for i, (a, b) in enumerate(zip(comps, Z[j])):
+            if a - b:
+                raise _differs(result, j, i)
+    return True
+
+
+def _check_in_expressions(result: PoissonShadow) -> None:
     system, order = result.system, result.order
     X = effective_field(system.splitting, result.composition, order)
     result.effective = X
@@ -417,10 +524,7 @@ def check_against_backward(result: PoissonShadow) -> None:
         for i, (a, b) in enumerate(zip(comps, expected)):
             same = frac.equal(a, b) if frac is not None else is_zero(a - b)
             if not same:
-                raise NoExactResultError(
-                    f"{system.name}, {result.composition.name}: X_(H_S) differs from the backward-error X_eff at h^{j} "
-                    f"in d{system.coordinates[i]}/dt; not returned")
-    result.verified_orders = order
+                raise _differs(result, j, i)
 
 
 # ----------------------------------------------------------------------------------------------

@@ -108,6 +108,41 @@ def _rational():
     )
 
 
+def _kepler():
+    return System(
+        "q1 q2 p1 p2", ["(p1**2 + p2**2)/2 - mu/sqrt(q1**2 + q2**2)"], "mu", name="kepler",
+        description="Kepler problem (central force -mu/|q|) in the plane, canonical d = 2 (q1, q2, p1, p2); "
+                    "pieces 1 = T, 2 = V (212 = velocity Verlet)",
+        citation=f"{_HLW}, Sect. I.2",
+    )
+
+
+def _kepler_3d():
+    return System(
+        "q1 q2 q3 p1 p2 p3", ["(p1**2 + p2**2 + p3**2)/2 - mu/sqrt(q1**2 + q2**2 + q3**2)"], "mu", name="kepler-3d",
+        description="Kepler problem (central force -mu/|q|) in space, canonical d = 3; pieces 1 = T, 2 = V",
+        citation=f"{_HLW}, Sect. I.2",
+    )
+
+
+def _morse():
+    return System(
+        "x1 x2", ["x2**2/2 + (1 - exp(-x1))**2"], (), name="morse",
+        description="Morse oscillator V = (1 - e^(-q))^2 (well depth 1, unit width and mass), canonical (q, p); "
+                    "pieces 1 = T, 2 = V",
+        citation="Morse, Phys. Rev. 34 (1929) 57",
+    )
+
+
+def _lennard_jones():
+    return System(
+        "x1 x2", ["x2**2/2 + 4/x1**12 - 4/x1**6"], (), name="lennard-jones",
+        description="Lennard-Jones dimer in its relative coordinate r = x1 > 0 (epsilon = sigma = 1, reduced mass 1), "
+                    "canonical (r, p); pieces 1 = T, 2 = V",
+        citation="Lennard-Jones, Proc. R. Soc. A 106 (1924) 463",
+    )
+
+
 def _rigid_body_lp():
     return System(
         "x1 x2 x3", ["x1**2/(2*I1) + x2**2/(2*I2) + x3**2/(2*I3)"], "I1 I2 I3", name="rigid-body-lp",
@@ -140,6 +175,10 @@ _MODELS = {
     "toda": _toda,
     "exp-well": _exp_well,
     "rational": _rational,
+    "kepler": _kepler,
+    "kepler-3d": _kepler_3d,
+    "morse": _morse,
+    "lennard-jones": _lennard_jones,
     "rigid-body-lp": _rigid_body_lp,
     "ho3-pair": _ho3_pair,
 }
@@ -150,7 +189,9 @@ _CACHE: dict = {}
 #: ``x(0) = (1, 1, 1)`` for ho3).  Henon-Heiles at (1, 1, 1, 1) has energy 8/3, far above the escape energy
 #: 1/6, and leaves to infinity, so its default is an orbit of energy 0.13 inside the bounded well.  Toda at
 #: (1, ..., 1) drifts with total momentum 3 until the step's exponentials overflow float64 (q near 700); its
-#: default has total momentum 0.
+#: default has total momentum 0.  Kepler (mu = 1) starts on an ellipse of energy -0.28 (eccentricity 0.44; in
+#: space -0.235, inclined); Morse at energy 0.2 below the dissociation energy 1; the Lennard-Jones dimer at
+#: energy -0.85 near the minimum r = 2^(1/6) of the well of depth 1.
 DEFAULT_X0 = {
     "ho": (1.0, 1.0),
     "ho3": (1.0, 1.0, 1.0),
@@ -163,6 +204,10 @@ DEFAULT_X0 = {
     "toda": (1.0, 0.0, -1.0, 0.5, 0.0, -0.5),
     "exp-well": (1.0, 1.0),
     "rational": (1.0, 1.0),
+    "kepler": (1.0, 0.0, 0.0, 1.2),
+    "kepler-3d": (1.0, 0.0, 0.0, 0.0, 1.2, 0.3),
+    "morse": (0.5, 0.3),
+    "lennard-jones": (1.2, 0.3),
     "rigid-body-lp": (1.0, 1.0, 1.0),
     "ho3-pair": (1.0, 1.0, 1.0, 1.0, 1.0, 1.0),
 }
@@ -192,7 +237,7 @@ def model_names() -> tuple:
 def model(name: str) -> System:
     """A built-in system by name (:func:`model_names`): the paper's ``ho``, ``ho3``, ``rigid-body``,
     ``lotka-volterra``, ``ho3-composite``; canonical ``pendulum``, ``henon-heiles``, ``fpu-beta``,
-    ``toda``, ``exp-well``, ``rational``; Lie-Poisson ``rigid-body-lp``; canonical triplets ``ho3-pair``.
+    ``toda``, ``exp-well``, ``rational``, ``kepler``, ``kepler-3d``, ``morse``, ``lennard-jones``; Lie-Poisson ``rigid-body-lp``; canonical triplets ``ho3-pair``.
 
     Examples
     --------
