@@ -36,6 +36,7 @@ from ..checks import is_int, show
 from ..errors import InvalidCompositionError, InvalidOrderError
 from ..integrators.composition import MAX_FACTORS, Composition
 from ..integrators.composition import composition as make_composition
+from ..integrators.composition import three_parts
 from .words import MAX_WORK, log_coefficients, lyndon_defects, work
 
 #: Highest degree ``p + 1`` searched when the order of a composition is determined.
@@ -125,9 +126,24 @@ class ErrorConstant:
                 "error_constant": self.value, "error_constant_squared": str(self.squared), "tolerance": self.tolerance}
 
 
+def _on_three_parts(comp: Composition) -> Composition:
+    """``comp`` (pieces 1 and 2) applied to three parts by :func:`~nambu_bch.integrators.composition.three_parts`;
+    a method with decimal coefficients keeps a stated ``error_bound``, recomputed exactly for the new factors."""
+    from .catalog import _with_bound
+
+    abc = three_parts(comp)
+    return _with_bound(abc, 3) if getattr(comp, "error_bound", 0.0) else abc
+
+
 def error_analysis(spec, parts: int | None = None) -> ErrorConstant:
-    """Order and error constant of ``spec`` for ``parts`` pieces, exactly (see :func:`error_constant`)."""
+    """Order and error constant of ``spec`` for ``parts`` pieces, exactly (see :func:`error_constant`).
+
+    A method of the two pieces 1 and 2 asked for ``parts=3`` is applied to three parts by CheckMethods' ABC rule
+    (:func:`~nambu_bch.integrators.composition.three_parts`), as the ABC column of its table is computed.
+    """
     comp = make_composition(spec, _check_parts(parts))
+    if parts == 3 and set(comp.pieces) == {1, 2}:  # a two-part method on three parts: CheckMethods' ABC column
+        comp = _on_three_parts(comp)
     parts = _parts(comp, parts)
     field = _Exact(comp)
     bound = float(getattr(comp, "error_bound", 0.0) or 0.0)
@@ -161,7 +177,8 @@ def error_constant(spec, parts: int | None = None) -> float:
     ----------
     spec : word, alias or Composition (``"12"``, ``"strang"``, ``"forest-ruth"``, ``"triple-jump:12321"``)
     parts : int, optional -- number of pieces (default: the largest piece used); every piece
-        ``1..parts`` must occur
+        ``1..parts`` must occur, except that a method of pieces 1 and 2 is applied to ``parts=3`` by
+        CheckMethods' ABC rule (:func:`~nambu_bch.integrators.composition.three_parts`)
 
     References
     ----------

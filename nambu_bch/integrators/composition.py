@@ -224,6 +224,60 @@ def strang_word(n: int) -> str:
     return word + word[-2::-1]
 
 
+def three_parts(spec) -> Composition:
+    """A two-part composition applied to three parts ``X_1 + X_2 + X_3``: CheckMethods' ABC rule.
+
+    The method's piece 1 stays piece 1 (A), its piece 2 becomes piece 3 (C), and a new middle piece 2 (B) follows
+    every factor so that its running time catches up with the factor just applied: after a factor of A (C) the
+    coefficients of B applied so far sum to the coefficients of A (C) applied so far.  So
+    ``A(a_1) B(b_1) A(a_2) ...`` becomes ``A(a_1) B(a_1) C(b_1) B(b_1 - a_1) A(a_2) B(a_1 + a_2 - b_1) ...``,
+    factors with coefficient zero dropped and adjacent factors of one piece merged: Lie-Trotter ``12`` becomes
+    ``123``, Strang ``121`` becomes ``12321``, and a palindromic method stays palindromic.  The order is that of
+    the two-part method for the methods of the CheckMethods table.
+
+    Parameters
+    ----------
+    spec : a composition (or its spec) that uses exactly the pieces 1 and 2
+
+    References
+    ----------
+    SplittingOrderConditions.jl (Auzinger, Herfort, Hofstaetter, Koch), ``src/SplittingOrderConditions.jl``,
+    ``get_ABC_coeffs``, used for the ABC column of ``examples/CheckMethods.ipynb``.
+
+    >>> three_parts("121").pieces, three_parts("12").pieces
+    ((1, 2, 3, 2, 1), (1, 2, 3))
+    """
+    comp = composition(spec, 2)
+    if set(comp.pieces) != {1, 2}:
+        raise InvalidCompositionError(
+            f"the three-part rule applies to a composition of the two pieces 1 and 2, got {_shown(comp.name)} "
+            f"with pieces {sorted(set(comp.pieces))}"
+        )
+    pieces, coeffs = [], []
+
+    def emit(k, c):
+        if is_zero(c):
+            return
+        if pieces and pieces[-1] == k:
+            coeffs[-1] = sympy.expand(coeffs[-1] + c)
+            if is_zero(coeffs[-1]):
+                pieces.pop()
+                coeffs.pop()
+        else:
+            pieces.append(k)
+            coeffs.append(c)
+
+    ran = {1: sympy.Integer(0), 2: sympy.Integer(0)}
+    middle = sympy.Integer(0)
+    for k, c in comp.factors():
+        emit(1 if k == 1 else 3, c)
+        ran[k] = sympy.expand(ran[k] + c)
+        emit(2, sympy.expand(ran[k] - middle))
+        middle = ran[k]
+    return Composition(tuple(pieces), tuple(coeffs), f"three-parts:{comp.name}", comp.order,
+                       f"{comp.citation}; applied to three parts by CheckMethods' ABC rule (SplittingOrderConditions.jl)")
+
+
 def composition_for(spec, target) -> Composition:
     """The composition ``spec`` for a splitting (or a system's splitting), checked: the one entry of every route.
 
