@@ -37,6 +37,7 @@ from ..errors import InvalidCompositionError, InvalidOrderError
 from ..integrators.composition import MAX_FACTORS, Composition
 from ..integrators.composition import composition as make_composition
 from ..integrators.composition import three_parts
+from ..integrators.methods import with_error_bound
 from .words import MAX_WORK, log_coefficients, lyndon_defects, work
 
 #: Highest degree ``p + 1`` searched when the order of a composition is determined.
@@ -129,10 +130,8 @@ class ErrorConstant:
 def _on_three_parts(comp: Composition) -> Composition:
     """``comp`` (pieces 1 and 2) applied to three parts by :func:`~nambu_bch.integrators.composition.three_parts`;
     a method with decimal coefficients keeps a stated ``error_bound``, recomputed exactly for the new factors."""
-    from .catalog import _with_bound
-
     abc = three_parts(comp)
-    return _with_bound(abc, 3) if getattr(comp, "error_bound", 0.0) else abc
+    return with_error_bound(abc, 3) if getattr(comp, "error_bound", 0.0) else abc
 
 
 def error_analysis(spec, parts: int | None = None) -> ErrorConstant:

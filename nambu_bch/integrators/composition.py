@@ -57,9 +57,10 @@ from sympy.polys.domains import QQ
 from ..algebra.zero import is_zero
 from ..checks import check_int, is_int, show
 from ..errors import InconsistentCoefficientsError, InvalidCompositionError, UnknownPieceError, did_you_mean
+from .tables import DECIMAL, SUZUKI, TABLES, TRIPLE_JUMP
 
-#: Names resolved by :mod:`nambu_bch.design.catalog` (literature methods, ``name`` or ``name:WORD``).
-_CATALOG = ("kahan-li", "yoshida6", "blanes-moan")
+#: Names of the published decimal tables (:mod:`.tables`), built by :mod:`.methods` (``name`` or ``name:WORD``).
+_CATALOG = DECIMAL
 _ALIASES = {"tvt": "121", "pv": "121", "position-verlet": "121", "vtv": "212", "vv": "212", "velocity-verlet": "212"}
 _JUMPS = ("forest-ruth", "yoshida", "triple-jump", "suzuki")
 #: Most factors a composition may have (bounded work downstream: BCH, kernels).
@@ -376,8 +377,7 @@ def _triple_jump(base: Composition) -> Composition:
         g1 = field.one / (field.convert(2) - theta)
         return g1, -theta * g1, g1
 
-    return _jump(base, gammas, sympy.Integer(2) ** sympy.Rational(1, p), f"triple-jump:{base.name}",
-                 "Yoshida, Phys. Lett. A 150 (1990) 262; Forest & Ruth, Physica D 43 (1990) 105")
+    return _jump(base, gammas, sympy.Integer(2) ** sympy.Rational(1, p), f"triple-jump:{base.name}", TRIPLE_JUMP.reference)
 
 
 def _five_jump(base: Composition) -> Composition:
@@ -393,8 +393,7 @@ def _five_jump(base: Composition) -> Composition:
         g = field.one / (field.convert(4) - theta)
         return g, g, field.one - field.convert(4) * g, g, g
 
-    return _jump(base, gammas, sympy.Integer(4) ** sympy.Rational(1, p), f"suzuki:{base.name}",
-                 "Suzuki, Phys. Lett. A 146 (1990) 319")
+    return _jump(base, gammas, sympy.Integer(4) ** sympy.Rational(1, p), f"suzuki:{base.name}", SUZUKI.reference)
 
 
 def composition(spec, n_pieces: int | None = None) -> Composition:
@@ -436,23 +435,39 @@ def _composition_from_text(spec: str, n_pieces):
 
 
 def _build(spec, n_pieces):
+    """The composition of ``spec``: a registered name (:data:`_FORMS`) or the generic forms of :func:`_generic`."""
     if isinstance(spec, Composition):
         return spec
     if isinstance(spec, (list, tuple)):
-        if len(spec) > MAX_FACTORS:
-            raise InvalidCompositionError(f"an explicit composition has at most {MAX_FACTORS} factors, got {len(spec)}")
-        try:
-            pairs = [(k, c) for k, c in spec]
-        except (TypeError, ValueError):
-            raise InvalidCompositionError(f"an explicit composition is a list of (piece, coefficient) pairs, got {_shown(spec)}") from None
-        for k, _ in pairs:  # no silent coercion: 1.5, True or "1" is not a piece number
-            if isinstance(k, bool) or not isinstance(k, (int, sympy.Integer)):
-                raise UnknownPieceError(
-                    f"piece {k!r} of composition {_shown(spec)} is not an integer; pieces are numbered 1, 2, ..."
-                )
-        pieces = tuple(int(k) for k, _ in pairs)
-        coeffs = tuple(c for _, c in pairs)
-        return _with_order(Composition(pieces, coeffs, ",".join(f"{k}:{c}" for k, c in pairs)))
+        return _from_pairs(spec)
+    text = _checked_text(spec)
+    head, sep, _ = text.lower().partition(":")
+    form = _FORMS.get(head)
+    if form is not None and (form.with_word if sep else form.alone):
+        return form.build(text, n_pieces)
+    return _generic(text)
+
+
+def _from_pairs(spec) -> Composition:
+    """An explicit ``[(piece, coefficient), ...]``."""
+    if len(spec) > MAX_FACTORS:
+        raise InvalidCompositionError(f"an explicit composition has at most {MAX_FACTORS} factors, got {len(spec)}")
+    try:
+        pairs = [(k, c) for k, c in spec]
+    except (TypeError, ValueError):
+        raise InvalidCompositionError(f"an explicit composition is a list of (piece, coefficient) pairs, got {_shown(spec)}") from None
+    for k, _ in pairs:  # no silent coercion: 1.5, True or "1" is not a piece number
+        if isinstance(k, bool) or not isinstance(k, (int, sympy.Integer)):
+            raise UnknownPieceError(
+                f"piece {k!r} of composition {_shown(spec)} is not an integer; pieces are numbered 1, 2, ..."
+            )
+    pieces = tuple(int(k) for k, _ in pairs)
+    coeffs = tuple(c for _, c in pairs)
+    return _with_order(Composition(pieces, coeffs, ",".join(f"{k}:{c}" for k, c in pairs)))
+
+
+def _checked_text(spec) -> str:
+    """``spec`` stripped, if it is non-empty text of the accepted characters."""
     if not isinstance(spec, str) or not spec.strip():
         raise InvalidCompositionError(f"a composition is a word such as '12321', an alias or 'k:c,...' list, got {_shown(spec)}")
     text = spec.strip()
@@ -461,39 +476,56 @@ def _build(spec, n_pieces):
         raise InvalidCompositionError(
             f"composition {_shown(text)} contains {''.join(bad)!r}; accepted are letters, digits, spaces and {_TEXT_PUNCTUATION.strip()}"
         )
-    low = text.lower()
-    if low in _ALIASES:
-        if n_pieces is not None and n_pieces != 2:
-            raise InvalidCompositionError(
-                f"{text!r} is {_ALIASES[low]} and exists only for two-piece splittings; this splitting has {n_pieces} "
-                f"pieces (use the Strang word {strang_word(n_pieces)} or 'strang')"
-            )
-        comp = _strang(_ALIASES[low])
-        return Composition(comp.pieces, comp.coefficients, text, 2, comp.citation)
-    if low in ("lie-trotter", "strang"):
-        if not n_pieces:
-            raise InvalidCompositionError(f"{text!r} needs the number of pieces of the splitting")
-        _digit_pieces(text, n_pieces)
-        word = "".join(str(k) for k in range(1, n_pieces + 1))
-        return composition(word if low == "lie-trotter" else strang_word(n_pieces))
-    if low in _JUMPS or low.startswith(tuple(j + ":" for j in _JUMPS[1:])):
-        head, _, base = low.partition(":")
-        if not base:  # over the splitting's own Strang word (two pieces, 121, when unknown)
-            base = strang_word(_digit_pieces(text, n_pieces) if n_pieces else 2)
-        else:
-            base = text.split(":", 1)[1].strip()
-            if base.lower().startswith(tuple(j + ":" for j in _JUMPS[1:])) or base.lower() in _JUMPS:
-                raise InvalidCompositionError(
-                    f"composition {_shown(text)}: nested jumps (order >= 6) are not supported; "
-                    "give one jump of a symmetric second-order word, e.g. yoshida:12321"
-                )
-        inner = composition(base, n_pieces)
-        return _five_jump(inner) if head == "suzuki" else _triple_jump(inner)
-    if low.partition(":")[0] in _CATALOG:
-        from ..design.catalog import lookup  # literature methods with citations
+    return text
 
-        return lookup(text, n_pieces)
-    head = low.partition(":")[0].strip()
+
+def _alias(text, n_pieces) -> Composition:
+    """``TVT``, ``VV``, ...: the Verlet words of a two-piece splitting."""
+    low = text.lower()
+    if n_pieces is not None and n_pieces != 2:
+        raise InvalidCompositionError(
+            f"{text!r} is {_ALIASES[low]} and exists only for two-piece splittings; this splitting has {n_pieces} "
+            f"pieces (use the Strang word {strang_word(n_pieces)} or 'strang')"
+        )
+    comp = _strang(_ALIASES[low])
+    return Composition(comp.pieces, comp.coefficients, text, 2, comp.citation)
+
+
+def _over_pieces(text, n_pieces) -> Composition:
+    """``lie-trotter`` (``12..n``) and ``strang`` (``12..n..21``) over the splitting's pieces."""
+    if not n_pieces:
+        raise InvalidCompositionError(f"{text!r} needs the number of pieces of the splitting")
+    _digit_pieces(text, n_pieces)
+    word = "".join(str(k) for k in range(1, n_pieces + 1))
+    return composition(word if text.lower() == "lie-trotter" else strang_word(n_pieces))
+
+
+def _jump_form(text, n_pieces) -> Composition:
+    """``forest-ruth``, ``yoshida[:WORD]``, ``triple-jump[:WORD]``, ``suzuki[:WORD]``."""
+    head, _, base = text.lower().partition(":")
+    if not base:  # over the splitting's own Strang word (two pieces, 121, when unknown)
+        base = strang_word(_digit_pieces(text, n_pieces) if n_pieces else 2)
+    else:
+        base = text.split(":", 1)[1].strip()
+        if base.lower().startswith(tuple(j + ":" for j in _JUMPS[1:])) or base.lower() in _JUMPS:
+            raise InvalidCompositionError(
+                f"composition {_shown(text)}: nested jumps (order >= 6) are not supported; "
+                "give one jump of a symmetric second-order word, e.g. yoshida:12321"
+            )
+    inner = composition(base, n_pieces)
+    return _five_jump(inner) if head == "suzuki" else _triple_jump(inner)
+
+
+def _table_method(text, n_pieces) -> Composition:
+    """A method of the published decimal tables (:mod:`.tables`, built by :mod:`.methods`)."""
+    from .methods import lookup  # methods builds on this module
+
+    return lookup(text, n_pieces)
+
+
+def _generic(text) -> Composition:
+    """The forms without a name: ``'piece:coefficient,...'`` and digit words; else the one-line refusal."""
+    head = text.lower().partition(":")[0].strip()
     if ":" in text and not head.isdigit():
         raise InvalidCompositionError(_named_form_message(text, head))
     if ":" in text:
@@ -517,9 +549,27 @@ def _build(spec, n_pieces):
     return Composition(tuple(int(ch) for ch in text), (sympy.Integer(1),) * len(text), text, 1, "plain product (Lie-Trotter)")
 
 
+@dataclass(frozen=True)
+class _Form:
+    """How a name is written: alone (``NAME``) and/or with a base word (``NAME:WORD``), and what builds it."""
+
+    alone: bool
+    with_word: bool
+    build: object
+
+
 _TEXT_PUNCTUATION = " :,/.+-*()^_"
+#: The registry of names: the token before ``:`` (lower case) -> its form.  A name written in a form it does not
+#: take (``strang:12321``) falls through to :func:`_generic`, which says so.
+_FORMS = {
+    **{alias: _Form(True, False, _alias) for alias in _ALIASES},
+    "lie-trotter": _Form(True, False, _over_pieces),
+    "strang": _Form(True, False, _over_pieces),
+    **{jump: _Form(True, jump != "forest-ruth", _jump_form) for jump in _JUMPS},
+    **{name: _Form(True, True, _table_method) for name in _CATALOG},
+}
 #: Names that take a base word after a colon (``yoshida:12321``) and names that stand alone.
-_WITH_WORD = (*_JUMPS[1:], *(c for c in _CATALOG if c != "blanes-moan"))
+_WITH_WORD = (*_JUMPS[1:], *(c for c in _CATALOG if TABLES[c].takes_word))
 _NAMES = (*_ALIASES, "lie-trotter", "strang", *_JUMPS, *_CATALOG)
 
 
