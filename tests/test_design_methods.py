@@ -12,7 +12,7 @@ import pytest
 
 import nambu_bch as nb
 from nambu_bch.design import error_analysis, error_constant, optimize_composition, order_conditions
-from nambu_bch.errors import InvalidCompositionError
+from nambu_bch.errors import InvalidCompositionError, NambuBCHError
 from nambu_bch.integrators.composition import three_parts
 
 
@@ -94,3 +94,69 @@ def test_exact_optimum_satisfies_order_conditions(twelve_one):
     assert all(sympy.simplify(p.subs(values)) == 0 for p in order_conditions("word:12121", 2).polynomials)
     assert nb.composition_order(twelve_one, 2) == 2
 
+
+
+# ------------------------------------------------------------------------------------------------
+# 3. complex coefficients
+
+
+#: The complex triple jump of the Strang step ABA: gamma_1 = 1/(2 - 2^(1/3) e^(2 pi i/3)), gamma_2 = 1 - 2 gamma_1
+#: (Castella, Chartier, Descombes, Vilmart, BIT 49 (2009) 487; Hansen & Ostermann, BIT 49 (2009) 527).  It is the
+#: complex solution of the order-4 conditions of the palindromic ABABABA method (word:1212121), CheckMethods' row
+#: "A 4-4 c".
+_G = "1/(2-2^(1/3)*(-1/2+sqrt(3)*I/2))"
+COMPLEX_TRIPLE_JUMP = f"1:{_G}/2,2:{_G},1:(1-{_G})/2,2:1-2*{_G},1:(1-{_G})/2,2:{_G},1:{_G}/2"
+#: The complex third-order method B A B A B with coefficients 1/4 -+ sqrt(3) i/12, 1/2 -+ sqrt(3) i/6, 1/2: the
+#: exact complex solution of the order-3 conditions of word-general:12121 (pieces swapped), CheckMethods' row "A 3-3 c".
+COMPLEX_THIRD_ORDER = "2:1/4-sqrt(3)*I/12,1:1/2-sqrt(3)*I/6,2:1/2,1:1/2+sqrt(3)*I/6,2:1/4+sqrt(3)*I/12"
+
+
+def test_complex_coefficients_are_parsed_exactly():
+    comp = nb.composition("1:1/4+I/4,2:1/2+I/2,1:1/2,2:1/2-I/2,1:1/4-I/4")
+    assert comp.coefficients[0] == sympy.Rational(1, 4) + sympy.I / 4 and comp.is_complex
+    assert not nb.composition("12321").is_complex and not nb.composition("1:sqrt(2)/2,2:1,1:1-sqrt(2)/2").is_complex
+    with pytest.raises(NambuBCHError, match="'J' is not declared"):
+        nb.composition("1:1/2+J,2:1,1:1/2-J")                     # I is the one name of coefficient text
+    with pytest.raises(InvalidCompositionError, match="must sum to 1"):
+        nb.composition("1:1/2+I/2,2:1,1:1/2")
+
+
+@pytest.mark.parametrize("spec, order, ab, abc", [
+    (COMPLEX_TRIPLE_JUMP, 4, 0.42, 1.22),     # row "A 4-4 c": AB p 4, LEM 0.42; ABC p 4, LEM 1.22
+    (COMPLEX_THIRD_ORDER, 3, 0.36, 1.49),     # row "A 3-3 c": AB p 3, LEM 0.36; ABC p 3, LEM 1.49
+])
+def test_complex_rows_of_check_methods(spec, order, ab, abc):
+    """CheckMethods.ipynb, first table, complex rows: LEM = 2-norm of the complex Lyndon defects, exact over QQ(i, ...)."""
+    E = error_analysis(spec, 2)
+    assert E.order == order and round(E.value, 2) == ab
+    assert E.squared.is_real and not E.squared.has(sympy.I)     # sum |d|^2, exact
+    E3 = error_analysis(spec, 3)
+    assert E3.order == order and round(E3.value, 2) == abc
+
+
+def test_complex_third_order_method_solves_its_order_conditions():
+    """Second route: the symbolic order-3 conditions of word-general:21212 vanish at the complex coefficients, and
+    these are the only solutions (the method and its complex conjugate)."""
+    comp = nb.composition(COMPLEX_THIRD_ORDER)
+    C = order_conditions("word-general:21212", 3)
+    assert all(sympy.expand(p.subs(dict(zip(C.unknowns, comp.coefficients)))) == 0 for p in C.polynomials)
+    solutions = sympy.solve(C.polynomials, C.unknowns, dict=True)
+    assert len(solutions) == 2 and {s[C.unknowns[0]] for s in solutions} == {
+        comp.coefficients[0], sympy.conjugate(comp.coefficients[0])}
+
+
+def test_complex_formal_bch_agrees_with_the_defects():
+    """formal BCH (Lyndon basis) against the Lyndon defects of error_analysis, on a method with complex defects."""
+    from nambu_bch.bch import formal_bch
+
+    spec = "1:1/2+I/2,2:1,1:1/2-I/2"
+    E = error_analysis(spec, 2)
+    # by hand: log(e^{aX} e^{Y} e^{bX}) = (a + b) X + Y + (a - b)/2 [X, Y] + ..., a - b = i
+    assert E.order == 1 and E.defects == {(1, 2): sympy.I}          # 2! times the coefficient of [X1, X2]
+    B = formal_bch(spec, 2)
+    assert B.terms(2) == [(sympy.I / 2, (1, 2))]
+
+
+def test_complex_coefficients_refused_on_a_system():
+    with pytest.raises(InvalidCompositionError, match="complex coefficients.*not yet on a system"):
+        nb.effective_field(nb.model("ho").splitting, "1:1/2+I/2,2:1,1:1/2-I/2", order=2)

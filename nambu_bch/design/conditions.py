@@ -149,15 +149,18 @@ def error_analysis(spec, parts: int | None = None) -> ErrorConstant:
 
     def vanishes(defects):
         if bound:
-            return all(abs(float(field.K.to_sympy(v))) <= bound for v in defects.values())
+            return all(abs(complex(field.K.to_sympy(v))) <= bound for v in defects.values())
         return all(v == field.K.zero for v in defects.values())
 
     for degree in range(2, MAX_DEGREE + 1):
         _check_work(parts, degree, len(comp.pieces), f"order of {comp.name!r}")
         defects = field.defects(parts, degree)
         if not vanishes(defects):
-            squared = field.K.to_sympy(sum((v * v for v in defects.values()), field.K.zero))
             exact = {w: field.K.to_sympy(v) for w, v in defects.items()}
+            if comp.is_complex:  # the 2-norm of a complex vector: sum |v|^2
+                squared = sympy.nsimplify(sympy.expand(sum(v * sympy.conjugate(v) for v in exact.values())))
+            else:
+                squared = field.K.to_sympy(sum((v * v for v in defects.values()), field.K.zero))
             return ErrorConstant(comp, parts, degree - 1, squared, exact, bound)
     raise InvalidOrderError(
         f"composition {comp.name!r} has order >= {MAX_DEGREE} (or its defects vanish to degree {MAX_DEGREE}); "
