@@ -138,7 +138,7 @@ def test_word_coefficients_of_a_prefix_tree_equal_the_block_sums():
 
 def test_error_constant_bad_input():
     with pytest.raises(InvalidCompositionError, match="every piece 1..3"):
-        error_constant("12", 3)
+        error_constant("13", 3)                # pieces 1 and 2 on three parts: the ABC rule (test_design_methods)
     with pytest.raises(InvalidCompositionError, match="parts"):
         error_constant("12", 0)
     with pytest.raises(NambuBCHError):
@@ -278,6 +278,19 @@ def test_designed_composition_beats_triple_jump_and_suzuki(designed):
     assert lem_at(c0 - 1e-3) > D.lem and lem_at(c0 + 1e-3) > D.lem
 
 
+def test_designed_optimum_is_an_isolated_algebraic_number(designed):
+    """The minimiser of this template is a root of an irreducible polynomial of degree 24 (no radicals sought): it is
+    returned as ``CRootOf`` (certified isolating interval), and the composition, an exact order-4 solution next to
+    it in real radicals, says that it is not the optimum itself."""
+    D = designed
+    assert not D.optimal and D.exact
+    g3 = dict(D.optimum)[sympy.Symbol("gamma3")]
+    roots = list(g3.atoms(sympy.CRootOf))
+    assert len(roots) == 1 and sympy.Poly(roots[0].expr).degree() == 24 and sympy.Poly(roots[0].expr).is_irreducible
+    assert abs(sympy.N(g3, 30) - sympy.Float("-0.78327532055276065131", 30)) < 1e-18   # the 30-digit Newton polish
+    assert all(not v.is_Rational for _, v in D.optimum)
+
+
 def test_designed_composition_usable_everywhere(designed):
     D = designed
     assert nb.composition(D) is D
@@ -308,7 +321,8 @@ def test_rational_fallback_states_its_bound(designed, designed_rational):
     E = error_analysis(R, 3)
     assert E.order == 4 and E.tolerance == R.error_bound             # defects below the bound count as zero
     assert abs(E.value - designed.lem_optimum) < 1e-12               # the 30-digit optimum itself
-    assert R.optimum == designed.optimum
+    # exact=False keeps the optimum as 30-digit decimals; the exact form is that algebraic minimiser
+    assert all(abs(sympy.Float(r, 30) - sympy.N(e, 30)) < 1e-25 for (_, r), (_, e) in zip(R.optimum, designed.optimum))
     # the exact symbolic route sees the rationals as they are: an h^2 term of the size of the bound
     Z2 = nb.effective_field(nb.model("ho3").splitting, R, order=2)[2].to_sympy()
     coeffs = [abs(c) for comp in Z2 for c in sympy.Poly(comp, *sympy.symbols("x1 x2 x3")).coeffs()]
@@ -332,7 +346,7 @@ def test_optimize_finds_yoshidas_sixth_order_solution():
 
 
 def test_rational_form_keeps_the_degree_one_conditions_exact(designed_rational):
-    """Module docstring of design/optimize, step 5: the 30-digit rationals are re-solved on the degree-1 conditions
+    """Module docstring of design/optimize, step 6: the 30-digit rationals are re-solved on the degree-1 conditions
     (consistency, one per piece: the coefficients of each piece sum to 1), so those hold exactly, not to 1e-30."""
     R = designed_rational
     for k in (1, 2, 3):

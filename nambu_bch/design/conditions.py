@@ -36,6 +36,8 @@ from ..checks import is_int, show
 from ..errors import InvalidCompositionError, InvalidOrderError
 from ..integrators.composition import MAX_FACTORS, Composition
 from ..integrators.composition import composition as make_composition
+from ..integrators.composition import three_parts
+from ..integrators.methods import with_error_bound
 from .words import MAX_WORK, log_coefficients, lyndon_defects, work
 
 #: Highest degree ``p + 1`` searched when the order of a composition is determined.
@@ -125,24 +127,40 @@ class ErrorConstant:
                 "error_constant": self.value, "error_constant_squared": str(self.squared), "tolerance": self.tolerance}
 
 
+def _on_three_parts(comp: Composition) -> Composition:
+    """``comp`` (pieces 1 and 2) applied to three parts by :func:`~nambu_bch.integrators.composition.three_parts`;
+    a method with decimal coefficients keeps a stated ``error_bound``, recomputed exactly for the new factors."""
+    abc = three_parts(comp)
+    return with_error_bound(abc, 3) if getattr(comp, "error_bound", 0.0) else abc
+
+
 def error_analysis(spec, parts: int | None = None) -> ErrorConstant:
-    """Order and error constant of ``spec`` for ``parts`` pieces, exactly (see :func:`error_constant`)."""
+    """Order and error constant of ``spec`` for ``parts`` pieces, exactly (see :func:`error_constant`).
+
+    A method of the two pieces 1 and 2 asked for ``parts=3`` is applied to three parts by CheckMethods' ABC rule
+    (:func:`~nambu_bch.integrators.composition.three_parts`), as the ABC column of its table is computed.
+    """
     comp = make_composition(spec, _check_parts(parts))
+    if parts == 3 and set(comp.pieces) == {1, 2}:  # a two-part method on three parts: CheckMethods' ABC column
+        comp = _on_three_parts(comp)
     parts = _parts(comp, parts)
     field = _Exact(comp)
     bound = float(getattr(comp, "error_bound", 0.0) or 0.0)
 
     def vanishes(defects):
         if bound:
-            return all(abs(float(field.K.to_sympy(v))) <= bound for v in defects.values())
+            return all(abs(complex(field.K.to_sympy(v))) <= bound for v in defects.values())
         return all(v == field.K.zero for v in defects.values())
 
     for degree in range(2, MAX_DEGREE + 1):
         _check_work(parts, degree, len(comp.pieces), f"order of {comp.name!r}")
         defects = field.defects(parts, degree)
         if not vanishes(defects):
-            squared = field.K.to_sympy(sum((v * v for v in defects.values()), field.K.zero))
             exact = {w: field.K.to_sympy(v) for w, v in defects.items()}
+            if comp.is_complex:  # the 2-norm of a complex vector: sum |v|^2
+                squared = sympy.nsimplify(sympy.expand(sum(v * sympy.conjugate(v) for v in exact.values())))
+            else:
+                squared = field.K.to_sympy(sum((v * v for v in defects.values()), field.K.zero))
             return ErrorConstant(comp, parts, degree - 1, squared, exact, bound)
     raise InvalidOrderError(
         f"composition {comp.name!r} has order >= {MAX_DEGREE} (or its defects vanish to degree {MAX_DEGREE}); "
@@ -161,7 +179,8 @@ def error_constant(spec, parts: int | None = None) -> float:
     ----------
     spec : word, alias or Composition (``"12"``, ``"strang"``, ``"forest-ruth"``, ``"triple-jump:12321"``)
     parts : int, optional -- number of pieces (default: the largest piece used); every piece
-        ``1..parts`` must occur
+        ``1..parts`` must occur, except that a method of pieces 1 and 2 is applied to ``parts=3`` by
+        CheckMethods' ABC rule (:func:`~nambu_bch.integrators.composition.three_parts`)
 
     References
     ----------

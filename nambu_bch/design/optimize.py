@@ -13,15 +13,22 @@ Algorithm
    ranked by ``f`` and the three best are polished by Newton in mpmath (``dps`` digits,
    default 30); the smallest ``f`` wins.  With as many independent conditions as unknowns
    this is the plain solve, polished by Newton.
-4. An exact form: the ``n - r`` unknowns left free by the conditions are fixed to nearby
+4. The exact minimiser, when the conditions leave ``n - r > 0`` unknowns free: the critical-point equations
+   (conditions and Lagrange minors) are polynomial over QQ and, when small enough, solved exactly through a lex
+   Groebner basis in shape position; the root near the numerical optimum is certified by its isolating interval
+   and by reducing every equation to zero in ``QQ[t]/(g)`` (:func:`_exact_critical_point`).  In real radicals it is
+   the returned composition (``optimal=True``; ``word:12121`` gives McLachlan's 0.19318332750378...); otherwise
+   it is ``optimum`` as ``CRootOf`` values and the composition comes from step 5.
+5. An exact form: the ``n - r`` unknowns left free by the conditions are fixed to nearby
    rationals (each choice of free unknowns is tried), the remaining conditions are solved
    exactly through a lex Groebner basis in shape position (a univariate polynomial of degree
    <= 4, solved in radicals, the lowest degree preferred); a solution counts only if it is
    real and written in real radicals,
    and it is then *verified exactly* (every log defect of length ``<= p`` is zero in the
    algebraic field of the coefficients).  The exact composition nearest in error constant
-   to the numerical optimum is returned.
-5. If no such exact form exists, the coefficients are the ``dps``-digit optimum as
+   to the numerical optimum is returned, with ``optimal=False`` when unknowns were fixed (it is an exact solution
+   of the order conditions next to the minimiser, not the minimiser).
+6. If no such exact form exists, the coefficients are the ``dps``-digit optimum as
    rationals (the degree-1 conditions re-solved exactly, so the scheme is consistent), the
    result is marked ``exact=False`` and carries ``error_bound``: the largest absolute
    Lyndon defect of length ``<= p``, computed exactly.  Symbolic routes then analyse these
@@ -70,12 +77,17 @@ class DesignedComposition(Composition):
     Extra attributes
     ----------------
     template : str            -- the template's name
-    values : tuple            -- ``(unknown, exact value)`` pairs
-    optimum : tuple           -- ``(unknown, dps-digit value)`` of the true constrained optimum
+    values : tuple            -- ``(unknown, exact value)`` pairs: the coefficients of *this* composition
+    optimum : tuple           -- ``(unknown, value)`` of the constrained minimiser: exact algebraic numbers (real
+                                 radicals, or ``CRootOf`` of the minimal polynomial, whose isolating interval
+                                 certifies which root) when the critical-point equations were solved exactly,
+                                 else ``dps``-digit decimal strings
     lem : float               -- the error constant of *this* composition (exact, as float)
     lem_optimum : float       -- the error constant at the numerical optimum
     exact : bool              -- True: order conditions hold exactly; False: see ``error_bound``
     error_bound : float       -- largest absolute Lyndon defect of length <= order (0 when exact)
+    optimal : bool            -- True: ``values`` are the minimiser itself (exactly); False: an exact solution
+                                 of the order conditions near it, or its decimals (see ``optimum``)
     """
 
     template: str = ""
@@ -85,10 +97,12 @@ class DesignedComposition(Composition):
     lem_optimum: float = float("nan")
     exact: bool = True
     error_bound: float = 0.0
+    optimal: bool = False
 
     def summary(self) -> dict:
         return {
             "name": self.name, "template": self.template, "order": self.order, "exact": self.exact,
+            "optimal": self.optimal,
             "error_bound": self.error_bound, "error_constant": self.lem, "error_constant_optimum": self.lem_optimum,
             "values": {str(k): str(v) for k, v in self.values},
             "optimum": {str(k): str(v) for k, v in self.optimum},
@@ -365,12 +379,103 @@ def optimize_composition(spec, parts: int | None = None, order: int = 4, stages:
     label = name or f"designed:{T.name}:p{final_order}"
     citation = (f"optimize_composition({T.name!r}, order={order}): smallest error constant among "
                 f"{len(found)} critical points found")
+    critical = _exact_critical_point(objective, selected, x, best, dps) if exact and len(selected) < n else None
+    if critical is not None:
+        optimum, radical = critical
+        if radical:  # the minimiser itself in real radicals: it is the composition
+            found_exact = _verified(T, [dict(optimum)], final_order, label, citation)
+            if found_exact is not None:
+                comp, values, lem = found_exact
+                return DesignedComposition(comp.pieces, comp.coefficients, label, final_order, citation, T.name,
+                                           values, optimum, lem, lem_opt, True, 0.0, True)
     found_exact = _exact_form(T, selected, x, best, final_order, max_denominator, label, citation) if exact else None
     if found_exact is not None:
         comp, values, lem = found_exact
         return DesignedComposition(comp.pieces, comp.coefficients, label, final_order, citation,
-                                   T.name, values, optimum, lem, lem_opt, True, 0.0)
+                                   T.name, values, optimum, lem, lem_opt, True, 0.0, len(selected) == n)
     return _rational_form(T, conds, x, best, final_order, dps, label, citation, optimum, lem_opt)
+
+
+#: Largest Bezout number (product of the degrees) of the critical-point equations that are solved exactly.
+MAX_CRITICAL_BEZOUT = 100
+#: Largest degree of the minimal polynomial of an exact minimiser (beyond it the decimals stand).
+MAX_CRITICAL_DEGREE = 40
+
+
+def _exact_critical_point(objective, selected, x, best, dps):
+    """The constrained minimiser near ``best`` as exact algebraic numbers: ``(optimum, radical)`` or ``None``.
+
+    A critical point of ``f`` on ``{F = 0}`` (``F`` the ``r`` independent conditions, ``r < n``) solves ``F = 0``
+    and the vanishing of every ``(r+1)``-minor of the Jacobian of ``(f, F)`` (``grad f`` in the row space of
+    ``grad F``): polynomial equations over QQ.  Their lex Groebner basis in shape position,
+    ``x_i - r_i(x_n)`` and ``q(x_n)``, gives the minimiser from the irreducible factor ``g`` of ``q`` with a real root
+    at ``best``; which root is certified by its isolating interval (``CRootOf``).  Exactness is then checked in
+    ``QQ[t]/(g)``: every condition and every minor reduces to zero at ``x_i = r_i(t)``.  ``radical`` is True when
+    sympy writes that root in real radicals (``deg g <= 4``; the values are then radical expressions), else the
+    values are polynomials in the ``CRootOf``.  ``None`` when the equations are too large
+    (:data:`MAX_CRITICAL_BEZOUT`, :data:`MAX_CRITICAL_DEGREE`) or not in shape position.
+    """
+    n, r = len(x), len(selected)
+    f = objective.as_expr()
+    F = [sympy.Poly(e, *x) for e in selected]
+    M = sympy.Matrix([[sympy.diff(g, v) for v in x] for g in [f, *selected]])
+    minor_degree = (objective.total_degree() - 1) + sum(P.total_degree() - 1 for P in F)
+    if np.prod([P.total_degree() for P in F]) * minor_degree ** (n - r) > MAX_CRITICAL_BEZOUT:
+        return None
+    minors = [sympy.expand(M.extract(list(range(r + 1)), list(cols)).det()) for cols in combinations(range(n), r + 1)]
+    system = [P.as_expr() for P in F] + [m for m in minors if m != 0]
+    G = sympy.groebner(system, *x, order="grevlex")
+    if G.exprs == [1] or not G.is_zero_dimensional or _quotient_dimension(G, MAX_CRITICAL_DEGREE) > MAX_CRITICAL_DEGREE:
+        return None
+    polys = list(G.fglm("lex").polys)
+    last = x[-1]
+    if len(polys) != n or polys[-1].free_symbols - {last}:
+        return None
+    t = sympy.Dummy("t")
+    shape = {}
+    for var, P in zip(x[:-1], polys[:-1]):
+        P = sympy.Poly(P.as_expr(), var)
+        if P.degree() != 1 or P.LC().free_symbols or P.as_expr().free_symbols - {var, last}:
+            return None
+        shape[var] = sympy.Poly(sympy.expand(-P.nth(0) / P.LC()).subs(last, t), t, domain=QQ)
+    shape[last] = sympy.Poly(t, t, domain=QQ)
+    target = [mpmath.mpf(b) for b in best]
+    with mpmath.workdps(dps + 10):
+        for g, _ in sympy.Poly(polys[-1].as_expr(), last).factor_list()[1]:
+            g = sympy.Poly(g.as_expr().subs(last, t), t, domain=QQ)
+            rem = {v: P.rem(g) for v, P in shape.items()}
+            for root in g.real_roots():
+                value = mpmath.mpf(str(root.evalf(dps + 10)))
+                point = [mpmath.polyval([mpmath.mpf(c.p) / c.q for c in rem[v].all_coeffs()], value) for v in x]
+                if max(abs(a - b) for a, b in zip(point, target)) > mpmath.mpf(10) ** (-(dps // 2)):
+                    continue
+                if not all(_vanishes_at(e, x, rem, g) for e in system):
+                    return None
+                return _algebraic_values(g, root, rem, x, t)
+    return None
+
+
+def _vanishes_at(e, x, rem, g) -> bool:
+    """Exact certificate: ``e(r_1(t), ..., r_n(t)) = 0`` in ``QQ[t]/(g)``, every product reduced modulo ``g``."""
+    powers = {v: [rem[v].one] for v in x}
+    total = g.zero
+    for monom, c in sympy.Poly(e, *x).terms():
+        term = g.one * c
+        for v, k in zip(x, monom):
+            while len(powers[v]) <= k:
+                powers[v].append((powers[v][-1] * rem[v]).rem(g))
+            term = (term * powers[v][k]).rem(g)
+        total += term
+    return total.rem(g).is_zero
+
+
+def _algebraic_values(g, root, rem, x, t):
+    """``((unknown, value), ...)`` with ``t = root``: real radicals when sympy finds them, else in ``CRootOf``."""
+    if g.degree() <= 4:
+        for candidate in sympy.roots(g, t):
+            if _is_real_radical(candidate) and abs(sympy.N(candidate - root, 50)) < sympy.Float(10) ** -40:
+                return tuple((v, sympy.radsimp(sympy.expand(rem[v].as_expr().subs(t, candidate)))) for v in x), True
+    return tuple((v, sympy.expand(rem[v].as_expr().subs(t, root))) for v in x), False
 
 
 def _is_real_radical(v) -> bool:
@@ -444,7 +549,7 @@ def _shape_solutions(system, rest, max_degree=4):
 
 
 def _exact_form(T, selected, x, best, order, max_denominator, label, citation):
-    """The simplest verified exact composition near ``best`` (module docstring, step 4), or ``None``."""
+    """The simplest verified exact composition near ``best`` (module docstring, step 5), or ``None``."""
     n, r = len(x), len(selected)
     candidates = []
     for free in combinations(range(n), n - r):
@@ -463,7 +568,14 @@ def _exact_form(T, selected, x, best, order, max_denominator, label, citation):
             if any(abs(sympy.N(values[x[i]], 30) - sympy.Float(str(best[i]), 30)) > 1e-4 for i in range(n)):
                 continue
             candidates.append((degree, sum(sympy.count_ops(v) for v in values.values()), len(candidates), values))
-    for *_, values in sorted(candidates, key=lambda c: c[:3]):
+    return _verified(T, [values for *_, values in sorted(candidates, key=lambda c: c[:3])], order, label, citation)
+
+
+def _verified(T, candidates, order, label, citation):
+    """The first of the exact ``candidates`` (``{unknown: value}``) whose Lyndon defects of length ``<= order`` all
+    vanish exactly and whose order is exactly ``order``: ``(composition, values, LEM)``, or ``None``."""
+    x = T.unknowns
+    for values in candidates:
         try:
             comp = T.instantiate(values, label, order, citation)
         except NambuBCHError:

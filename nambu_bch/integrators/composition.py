@@ -57,9 +57,10 @@ from sympy.polys.domains import QQ
 from ..algebra.zero import is_zero
 from ..checks import check_int, is_int, show
 from ..errors import InconsistentCoefficientsError, InvalidCompositionError, UnknownPieceError, did_you_mean
+from .tables import DECIMAL, SUZUKI, TABLES, TRIPLE_JUMP
 
-#: Names resolved by :mod:`nambu_bch.design.catalog` (literature methods, ``name`` or ``name:WORD``).
-_CATALOG = ("kahan-li", "yoshida6", "blanes-moan")
+#: Names of the published decimal tables (:mod:`.tables`), built by :mod:`.methods` (``name`` or ``name:WORD``).
+_CATALOG = DECIMAL
 _ALIASES = {"tvt": "121", "pv": "121", "position-verlet": "121", "vtv": "212", "vv": "212", "velocity-verlet": "212"}
 _JUMPS = ("forest-ruth", "yoshida", "triple-jump", "suzuki")
 #: Most factors a composition may have (bounded work downstream: BCH, kernels).
@@ -139,6 +140,12 @@ class Composition:
                 atoms |= {sympy.root(a.base, a.exp.q) for a in c.atoms(sympy.Pow) if a.exp.is_Rational and not a.exp.is_Integer}
         return tuple(sorted(atoms, key=str))
 
+    @property
+    def is_complex(self) -> bool:
+        """Some coefficient is not real (``1/4 + I/4``): supported by the error constants, the order and formal BCH
+        so far; :meth:`check` refuses it on a system."""
+        return any(c.has(sympy.I) and not c.is_real for c in self.coefficients)
+
     def remainder_power(self, order: int) -> int:
         """The first power of ``h`` after ``h**order`` that ``X_eff`` can contain.
 
@@ -178,6 +185,12 @@ class Composition:
             )
         n = len(splitting)
         name = getattr(splitting.system, "name", "the system")
+        if self.is_complex:
+            raise InvalidCompositionError(
+                f"composition {_shown(self.name)} has complex coefficients; they are supported by error_constant, "
+                "error_analysis, composition_order and formal_bch so far, not yet on a system (X_eff, shadow "
+                "Hamiltonians, numerics)"
+            )
         extra = sorted({k for k in self.pieces if k > n})
         if extra:
             raise UnknownPieceError(
@@ -224,6 +237,60 @@ def strang_word(n: int) -> str:
     return word + word[-2::-1]
 
 
+def three_parts(spec) -> Composition:
+    """A two-part composition applied to three parts ``X_1 + X_2 + X_3``: CheckMethods' ABC rule.
+
+    The method's piece 1 stays piece 1 (A), its piece 2 becomes piece 3 (C), and a new middle piece 2 (B) follows
+    every factor so that its running time catches up with the factor just applied: after a factor of A (C) the
+    coefficients of B applied so far sum to the coefficients of A (C) applied so far.  So
+    ``A(a_1) B(b_1) A(a_2) ...`` becomes ``A(a_1) B(a_1) C(b_1) B(b_1 - a_1) A(a_2) B(a_1 + a_2 - b_1) ...``,
+    factors with coefficient zero dropped and adjacent factors of one piece merged: Lie-Trotter ``12`` becomes
+    ``123``, Strang ``121`` becomes ``12321``, and a palindromic method stays palindromic.  The order is that of
+    the two-part method for the methods of the CheckMethods table.
+
+    Parameters
+    ----------
+    spec : a composition (or its spec) that uses exactly the pieces 1 and 2
+
+    References
+    ----------
+    SplittingOrderConditions.jl (Auzinger, Herfort, Hofstaetter, Koch), ``src/SplittingOrderConditions.jl``,
+    ``get_ABC_coeffs``, used for the ABC column of ``examples/CheckMethods.ipynb``.
+
+    >>> three_parts("121").pieces, three_parts("12").pieces
+    ((1, 2, 3, 2, 1), (1, 2, 3))
+    """
+    comp = composition(spec, 2)
+    if set(comp.pieces) != {1, 2}:
+        raise InvalidCompositionError(
+            f"the three-part rule applies to a composition of the two pieces 1 and 2, got {_shown(comp.name)} "
+            f"with pieces {sorted(set(comp.pieces))}"
+        )
+    pieces, coeffs = [], []
+
+    def emit(k, c):
+        if is_zero(c):
+            return
+        if pieces and pieces[-1] == k:
+            coeffs[-1] = sympy.expand(coeffs[-1] + c)
+            if is_zero(coeffs[-1]):
+                pieces.pop()
+                coeffs.pop()
+        else:
+            pieces.append(k)
+            coeffs.append(c)
+
+    ran = {1: sympy.Integer(0), 2: sympy.Integer(0)}
+    middle = sympy.Integer(0)
+    for k, c in comp.factors():
+        emit(1 if k == 1 else 3, c)
+        ran[k] = sympy.expand(ran[k] + c)
+        emit(2, sympy.expand(ran[k] - middle))
+        middle = ran[k]
+    return Composition(tuple(pieces), tuple(coeffs), f"three-parts:{comp.name}", comp.order,
+                       f"{comp.citation}; applied to three parts by CheckMethods' ABC rule (SplittingOrderConditions.jl)")
+
+
 def composition_for(spec, target) -> Composition:
     """The composition ``spec`` for a splitting (or a system's splitting), checked: the one entry of every route.
 
@@ -261,13 +328,22 @@ def _exact(c, name):
     if isinstance(c, str):
         from ..parsing import parse_expression
 
-        c = parse_expression(c, [], what=f"coefficient of composition {name!r}")
+        # the imaginary unit is the one name of coefficient text: exact complex coefficients, e.g. 1/4+I/4
+        c = parse_expression(c, {"I": sympy.I}, what=f"coefficient of composition {name!r}")
     try:
         c = sympy.sympify(c, strict=True)
     except (sympy.SympifyError, TypeError, ValueError):
         raise InvalidCompositionError(f"coefficient {c!r} of composition {_shown(name)} is not an exact number") from None
-    if not isinstance(c, sympy.Expr) or not c.is_number or c.has(sympy.Float) or not c.is_real:
+    if not isinstance(c, sympy.Expr) or not c.is_number or c.has(sympy.Float) or not c.is_finite:
         raise InvalidCompositionError(f"coefficient {c} of composition {name!r} must be an exact real number")
+    if not c.is_real:
+        real, imag = c.as_real_imag()
+        if real.has(sympy.re, sympy.im) or imag.has(sympy.re, sympy.im) or imag.is_zero is not False:
+            raise InvalidCompositionError(
+                f"coefficient {c} of composition {name!r} must be an exact real number or a complex one a + b*I "
+                "with exact real a, b"
+            )
+        c = sympy.expand(real + sympy.I * imag)
     return c
 
 
@@ -322,8 +398,7 @@ def _triple_jump(base: Composition) -> Composition:
         g1 = field.one / (field.convert(2) - theta)
         return g1, -theta * g1, g1
 
-    return _jump(base, gammas, sympy.Integer(2) ** sympy.Rational(1, p), f"triple-jump:{base.name}",
-                 "Yoshida, Phys. Lett. A 150 (1990) 262; Forest & Ruth, Physica D 43 (1990) 105")
+    return _jump(base, gammas, sympy.Integer(2) ** sympy.Rational(1, p), f"triple-jump:{base.name}", TRIPLE_JUMP.reference)
 
 
 def _five_jump(base: Composition) -> Composition:
@@ -339,8 +414,7 @@ def _five_jump(base: Composition) -> Composition:
         g = field.one / (field.convert(4) - theta)
         return g, g, field.one - field.convert(4) * g, g, g
 
-    return _jump(base, gammas, sympy.Integer(4) ** sympy.Rational(1, p), f"suzuki:{base.name}",
-                 "Suzuki, Phys. Lett. A 146 (1990) 319")
+    return _jump(base, gammas, sympy.Integer(4) ** sympy.Rational(1, p), f"suzuki:{base.name}", SUZUKI.reference)
 
 
 def composition(spec, n_pieces: int | None = None) -> Composition:
@@ -382,23 +456,39 @@ def _composition_from_text(spec: str, n_pieces):
 
 
 def _build(spec, n_pieces):
+    """The composition of ``spec``: a registered name (:data:`_FORMS`) or the generic forms of :func:`_generic`."""
     if isinstance(spec, Composition):
         return spec
     if isinstance(spec, (list, tuple)):
-        if len(spec) > MAX_FACTORS:
-            raise InvalidCompositionError(f"an explicit composition has at most {MAX_FACTORS} factors, got {len(spec)}")
-        try:
-            pairs = [(k, c) for k, c in spec]
-        except (TypeError, ValueError):
-            raise InvalidCompositionError(f"an explicit composition is a list of (piece, coefficient) pairs, got {_shown(spec)}") from None
-        for k, _ in pairs:  # no silent coercion: 1.5, True or "1" is not a piece number
-            if isinstance(k, bool) or not isinstance(k, (int, sympy.Integer)):
-                raise UnknownPieceError(
-                    f"piece {k!r} of composition {_shown(spec)} is not an integer; pieces are numbered 1, 2, ..."
-                )
-        pieces = tuple(int(k) for k, _ in pairs)
-        coeffs = tuple(c for _, c in pairs)
-        return _with_order(Composition(pieces, coeffs, ",".join(f"{k}:{c}" for k, c in pairs)))
+        return _from_pairs(spec)
+    text = _checked_text(spec)
+    head, sep, _ = text.lower().partition(":")
+    form = _FORMS.get(head)
+    if form is not None and (form.with_word if sep else form.alone):
+        return form.build(text, n_pieces)
+    return _generic(text)
+
+
+def _from_pairs(spec) -> Composition:
+    """An explicit ``[(piece, coefficient), ...]``."""
+    if len(spec) > MAX_FACTORS:
+        raise InvalidCompositionError(f"an explicit composition has at most {MAX_FACTORS} factors, got {len(spec)}")
+    try:
+        pairs = [(k, c) for k, c in spec]
+    except (TypeError, ValueError):
+        raise InvalidCompositionError(f"an explicit composition is a list of (piece, coefficient) pairs, got {_shown(spec)}") from None
+    for k, _ in pairs:  # no silent coercion: 1.5, True or "1" is not a piece number
+        if isinstance(k, bool) or not isinstance(k, (int, sympy.Integer)):
+            raise UnknownPieceError(
+                f"piece {k!r} of composition {_shown(spec)} is not an integer; pieces are numbered 1, 2, ..."
+            )
+    pieces = tuple(int(k) for k, _ in pairs)
+    coeffs = tuple(c for _, c in pairs)
+    return _with_order(Composition(pieces, coeffs, ",".join(f"{k}:{c}" for k, c in pairs)))
+
+
+def _checked_text(spec) -> str:
+    """``spec`` stripped, if it is non-empty text of the accepted characters."""
     if not isinstance(spec, str) or not spec.strip():
         raise InvalidCompositionError(f"a composition is a word such as '12321', an alias or 'k:c,...' list, got {_shown(spec)}")
     text = spec.strip()
@@ -407,39 +497,56 @@ def _build(spec, n_pieces):
         raise InvalidCompositionError(
             f"composition {_shown(text)} contains {''.join(bad)!r}; accepted are letters, digits, spaces and {_TEXT_PUNCTUATION.strip()}"
         )
-    low = text.lower()
-    if low in _ALIASES:
-        if n_pieces is not None and n_pieces != 2:
-            raise InvalidCompositionError(
-                f"{text!r} is {_ALIASES[low]} and exists only for two-piece splittings; this splitting has {n_pieces} "
-                f"pieces (use the Strang word {strang_word(n_pieces)} or 'strang')"
-            )
-        comp = _strang(_ALIASES[low])
-        return Composition(comp.pieces, comp.coefficients, text, 2, comp.citation)
-    if low in ("lie-trotter", "strang"):
-        if not n_pieces:
-            raise InvalidCompositionError(f"{text!r} needs the number of pieces of the splitting")
-        _digit_pieces(text, n_pieces)
-        word = "".join(str(k) for k in range(1, n_pieces + 1))
-        return composition(word if low == "lie-trotter" else strang_word(n_pieces))
-    if low in _JUMPS or low.startswith(tuple(j + ":" for j in _JUMPS[1:])):
-        head, _, base = low.partition(":")
-        if not base:  # over the splitting's own Strang word (two pieces, 121, when unknown)
-            base = strang_word(_digit_pieces(text, n_pieces) if n_pieces else 2)
-        else:
-            base = text.split(":", 1)[1].strip()
-            if base.lower().startswith(tuple(j + ":" for j in _JUMPS[1:])) or base.lower() in _JUMPS:
-                raise InvalidCompositionError(
-                    f"composition {_shown(text)}: nested jumps (order >= 6) are not supported; "
-                    "give one jump of a symmetric second-order word, e.g. yoshida:12321"
-                )
-        inner = composition(base, n_pieces)
-        return _five_jump(inner) if head == "suzuki" else _triple_jump(inner)
-    if low.partition(":")[0] in _CATALOG:
-        from ..design.catalog import lookup  # literature methods with citations
+    return text
 
-        return lookup(text, n_pieces)
-    head = low.partition(":")[0].strip()
+
+def _alias(text, n_pieces) -> Composition:
+    """``TVT``, ``VV``, ...: the Verlet words of a two-piece splitting."""
+    low = text.lower()
+    if n_pieces is not None and n_pieces != 2:
+        raise InvalidCompositionError(
+            f"{text!r} is {_ALIASES[low]} and exists only for two-piece splittings; this splitting has {n_pieces} "
+            f"pieces (use the Strang word {strang_word(n_pieces)} or 'strang')"
+        )
+    comp = _strang(_ALIASES[low])
+    return Composition(comp.pieces, comp.coefficients, text, 2, comp.citation)
+
+
+def _over_pieces(text, n_pieces) -> Composition:
+    """``lie-trotter`` (``12..n``) and ``strang`` (``12..n..21``) over the splitting's pieces."""
+    if not n_pieces:
+        raise InvalidCompositionError(f"{text!r} needs the number of pieces of the splitting")
+    _digit_pieces(text, n_pieces)
+    word = "".join(str(k) for k in range(1, n_pieces + 1))
+    return composition(word if text.lower() == "lie-trotter" else strang_word(n_pieces))
+
+
+def _jump_form(text, n_pieces) -> Composition:
+    """``forest-ruth``, ``yoshida[:WORD]``, ``triple-jump[:WORD]``, ``suzuki[:WORD]``."""
+    head, _, base = text.lower().partition(":")
+    if not base:  # over the splitting's own Strang word (two pieces, 121, when unknown)
+        base = strang_word(_digit_pieces(text, n_pieces) if n_pieces else 2)
+    else:
+        base = text.split(":", 1)[1].strip()
+        if base.lower().startswith(tuple(j + ":" for j in _JUMPS[1:])) or base.lower() in _JUMPS:
+            raise InvalidCompositionError(
+                f"composition {_shown(text)}: nested jumps (order >= 6) are not supported; "
+                "give one jump of a symmetric second-order word, e.g. yoshida:12321"
+            )
+    inner = composition(base, n_pieces)
+    return _five_jump(inner) if head == "suzuki" else _triple_jump(inner)
+
+
+def _table_method(text, n_pieces) -> Composition:
+    """A method of the published decimal tables (:mod:`.tables`, built by :mod:`.methods`)."""
+    from .methods import lookup  # methods builds on this module
+
+    return lookup(text, n_pieces)
+
+
+def _generic(text) -> Composition:
+    """The forms without a name: ``'piece:coefficient,...'`` and digit words; else the one-line refusal."""
+    head = text.lower().partition(":")[0].strip()
     if ":" in text and not head.isdigit():
         raise InvalidCompositionError(_named_form_message(text, head))
     if ":" in text:
@@ -463,9 +570,27 @@ def _build(spec, n_pieces):
     return Composition(tuple(int(ch) for ch in text), (sympy.Integer(1),) * len(text), text, 1, "plain product (Lie-Trotter)")
 
 
+@dataclass(frozen=True)
+class _Form:
+    """How a name is written: alone (``NAME``) and/or with a base word (``NAME:WORD``), and what builds it."""
+
+    alone: bool
+    with_word: bool
+    build: object
+
+
 _TEXT_PUNCTUATION = " :,/.+-*()^_"
+#: The registry of names: the token before ``:`` (lower case) -> its form.  A name written in a form it does not
+#: take (``strang:12321``) falls through to :func:`_generic`, which says so.
+_FORMS = {
+    **{alias: _Form(True, False, _alias) for alias in _ALIASES},
+    "lie-trotter": _Form(True, False, _over_pieces),
+    "strang": _Form(True, False, _over_pieces),
+    **{jump: _Form(True, jump != "forest-ruth", _jump_form) for jump in _JUMPS},
+    **{name: _Form(True, True, _table_method) for name in _CATALOG},
+}
 #: Names that take a base word after a colon (``yoshida:12321``) and names that stand alone.
-_WITH_WORD = (*_JUMPS[1:], *(c for c in _CATALOG if c != "blanes-moan"))
+_WITH_WORD = (*_JUMPS[1:], *(c for c in _CATALOG if TABLES[c].takes_word))
 _NAMES = (*_ALIASES, "lie-trotter", "strang", *_JUMPS, *_CATALOG)
 
 
