@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import sympy
 
+from ..checks import check_type
 from ..symbols import STEP
 from .composition import composition_for
 from .flows import TIME, exact_flow
@@ -26,6 +27,7 @@ def composed_map(splitting, comp, h=STEP) -> tuple:
     -h**2*omega**2*x2/2 - h*m*omega**2*x1 + x2
     """
     comp = composition_for(comp, splitting)
+    check_type(h, sympy.Symbol, "h")  # the step is a symbol of the ring the map is composed in
     system = splitting.system
     coords = system.coordinates
     flows = [(exact_flow(splitting[k], coords), c) for k, c in comp.factors()]
