@@ -262,7 +262,7 @@ def assert_invariant(system, word, I, h=STEP):
     from .integrators import composed_map
 
     system = as_system(system)
-    expr = _as_expr(I, system, "I")
+    expr = as_expression(I, system.symbols(), "I")
     image = composed_map(system.splitting, word, h)
     moved = expr.subs(dict(zip(system.coordinates, image)), simultaneous=True)
     residual = _zero_or_simplified(moved - expr)

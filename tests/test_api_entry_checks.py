@@ -149,3 +149,30 @@ def test_jet_algebra_multi_indices_are_unchanged():
                                                     ("A", (0, 1, 0))]
     with pytest.raises(ResourceLimitError):
         JetAlgebra(X, "ABCDEFGH", 20)
+
+
+MORE = {  # found with NAMBU_BCH_FUZZ_EXAMPLES=30
+    "jacobian(empty arrays)": lambda: jacobian(np.zeros(0), np.zeros(0)),
+    "is_symplectic(empty arrays)": lambda: nb.is_symplectic(np.zeros(0), np.zeros(0)),
+    "satisfies_nambu_condition(empty arrays)": lambda: nb.satisfies_nambu_condition(np.zeros(0), np.zeros(0)),
+    "tree_to_latex(bytearray leaf)": lambda: __import__("nambu_bch.bch", fromlist=["x"]).tree_to_latex(
+        bytearray(b"x1"), names={"m": 1}),
+    "Progress(enabled=array)": lambda: __import__("nambu_bch.numeric", fromlist=["x"]).Progress(0, enabled=np.zeros(0)),
+    "assert_invariant(I=None)": lambda: assert_invariant(ho3(), "12321", None),
+}
+
+
+@pytest.mark.parametrize("case", sorted(MORE))
+def test_more_wrong_arguments_are_one_family_line(case):
+    with pytest.raises(NambuBCHError) as info:
+        MORE[case]()
+    assert "\n" not in str(info.value)
+
+
+def test_composed_map_takes_an_expression_as_the_step():
+    """``h`` may be ``-h`` (time reversal) or a number; text is read, never run."""
+    S = ho3().splitting
+    h = sympy.Symbol("h")
+    forward, backward = nb.composed_map(S, "12321"), nb.composed_map(S, "12321", -h)
+    assert backward == tuple(sympy.expand(e.subs(h, -h)) for e in forward)
+    assert nb.composed_map(S, "12321", "-h") == backward

@@ -22,6 +22,8 @@ from .zero import is_zero
 def _checked(map_components, coordinates) -> tuple:
     """The map's components and the coordinates as tuples, of the same length, else one line naming the argument."""
     coordinates = as_symbols(coordinates, "coordinates")
+    if not coordinates:
+        raise NambuBCHError("a map needs at least one coordinate, got none")
     map_components = check_sequence(map_components, "map_components", "expressions")
     if len(map_components) != len(coordinates):
         raise NambuBCHError(

@@ -192,7 +192,7 @@ def standard_bracketing(word, letters=None):
         letters = check_sequence(letters, "letters", "leaves")
     top = None if letters is None else len(letters) - 1
     if not word or not all(is_int(a, 0, top, numpy=True) for a in word):
-        raise InvalidRunError(f"word must be a non-empty sequence of letters 0..{'g-1' if top is None else top} "
+        raise InvalidRunError(f"word must be a non-empty Lyndon word of letters 0..{'g-1' if top is None else top} "
                               f"(integers), got {show(word)}")
     return _bracketing(word, letters)
 
@@ -319,8 +319,13 @@ def tree_to_latex(tree, names=None) -> str:
     if names is not None:
         if callable(names):
             return names(tree)
-        if tree not in names:
-            raise UnknownPieceError(f"no LaTeX name for generator {tree!r}; names given for {sorted(names, key=str)}")
+        try:
+            known = tree in names
+        except TypeError:  # an unhashable leaf cannot be a key of names
+            known = False
+        if not known:
+            raise UnknownPieceError(f"no LaTeX name for generator {show(tree)}; names given for "
+                                    f"{show(sorted(names, key=str))}")
         return names[tree]
     if isinstance(tree, tuple):
         return "X_{" + ",".join(sympy.latex(e) for e in tree) + "}"

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import sympy
 
-from ..checks import check_type
+from ..parsing import as_expression
 from ..symbols import STEP
 from .composition import composition_for
 from .flows import TIME, exact_flow
@@ -27,11 +27,12 @@ def composed_map(splitting, comp, h=STEP) -> tuple:
     -h**2*omega**2*x2/2 - h*m*omega**2*x1 + x2
     """
     comp = composition_for(comp, splitting)
-    check_type(h, sympy.Symbol, "h")  # the step is a symbol of the ring the map is composed in
     system = splitting.system
+    h = as_expression(h, system.symbols(), "h")
     coords = system.coordinates
     flows = [(exact_flow(splitting[k], coords), c) for k, c in comp.factors()]
-    if all(f.polynomial for f, _ in flows):
+    # the ring route takes the step as a generator: a symbol (h = -h or 0.1 compose by substitution)
+    if isinstance(h, sympy.Symbol) and all(f.polynomial for f, _ in flows):
         composed = _compose_in_ring(system, flows, comp, h)
         if composed is not None:
             return composed
