@@ -40,7 +40,7 @@ CACHES = (
     ("nambu_bch.bch.modular", "_surjection_sum"),
     ("nambu_bch.bch.modular", "_class_order"),
     ("nambu_bch.bch.modular", "_tanh_half_coefficients"),
-    ("nambu_bch.bch.lyndon", "witt_dimension"),
+    ("nambu_bch.bch.lyndon", "_witt_dimension"),
     ("nambu_bch.bch.lyndon", "_lyndon_words"),
     ("nambu_bch.bch.lyndon", "standard_factorization"),
     ("nambu_bch.bch.lyndon", "lyndon_expansion"),

@@ -73,6 +73,22 @@ def check_type(value, kind, what):
     return value
 
 
+def check_sequence(value, what, of="items", length=None) -> tuple:
+    """``value`` as a tuple if it is a sequence (a list, tuple, array, ...; not a string, bytes, a mapping or a set),
+    else one line naming ``what``; with ``length``, also that it has that many items.
+
+    The one check of "a sequence of ..." arguments (coordinates, slots, components, terms): a string
+    would otherwise be iterated character by character and a number fail deep inside.
+    """
+    if isinstance(value, (str, bytes, bytearray, dict, set, frozenset)) or not hasattr(value, "__iter__") \
+            or getattr(value, "ndim", 1) != 1:
+        raise InvalidRunError(f"{what} must be a sequence of {of}, got {show(value)}")
+    out = tuple(value)
+    if length is not None and len(out) != length:
+        raise InvalidRunError(f"{what} must be a sequence of {length} {of}, got {len(out)}: {show(value)}")
+    return out
+
+
 def show(value) -> str:
     """``repr(value)`` on one line, shortened to one readable piece (a 400-digit integer is not echoed whole)."""
     text = repr(value)

@@ -67,6 +67,7 @@ from fractions import Fraction
 import sympy
 from sympy.polys.rings import PolyElement
 
+from .checks import check_sequence, show
 from .errors import ExpressionParseError, did_you_mean
 
 #: Longest accepted input, in characters.
@@ -280,6 +281,22 @@ def as_expression(value, symbols, what: str = "expression") -> sympy.Expr:
         f"{what} must be a sympy expression, a number or a string such as 'x2^2/2 + x1^2/2', "
         f"got {type(value).__name__}{'' if isinstance(value, (list, tuple, dict, set)) else ' ' + _shown(repr(value), 40)}"
     )
+
+
+def as_symbols(value, what: str = "coordinates", names: bool = False) -> tuple:
+    """``value`` as a tuple of sympy Symbols, else one line naming ``what`` (never a sympified string).
+
+    A sequence (:func:`~nambu_bch.checks.check_sequence`) of Symbols; with ``names=True`` a string item
+    is a name and becomes ``Symbol(name)`` (the name is not read as an expression).
+    """
+    out = []
+    for item in check_sequence(value, what, "sympy Symbols"):
+        if names and isinstance(item, str) and item:
+            item = sympy.Symbol(item)
+        if not isinstance(item, sympy.Symbol):
+            raise ExpressionParseError(f"{what} must be sympy Symbols{' or names' if names else ''}, got {show(item)}")
+        out.append(item)
+    return tuple(out)
 
 
 def to_ascii(text: str, what: str = "expression") -> str:

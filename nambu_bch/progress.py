@@ -90,12 +90,13 @@ class Progress:
     """
 
     def __init__(self, total, label="iterate", enabled=None, stream=None, delay=1.0, interval=0.5, unit="step"):
-        from .checks import check_int, finite_float
+        from .checks import check_flag, check_int, finite_float
 
         self.total = max(check_int(total, "total", 0), 1)
         self.label = label
         self.stream = stream
-        self.enabled = progress_wanted(stream) if enabled is None else bool(enabled)
+        enabled = check_flag(enabled, "enabled", none=True)
+        self.enabled = progress_wanted(stream) if enabled is None else enabled
         self.delay = finite_float(delay, "delay")
         self.interval = finite_float(interval, "interval")
         self._bar = _bar(self.total, label, stream, self.delay, self.interval, unit) if self.enabled else None

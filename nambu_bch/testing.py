@@ -34,9 +34,10 @@ import sympy
 
 from .algebra.zero import witness
 from .errors import NambuBCHError
-from .parsing import as_expression
+from .parsing import as_expression, as_symbols
 from .symbols import STEP
 from .systems import model
+from .systems.system import as_system
 
 __all__ = [
     "assert_fields_equal",
@@ -89,9 +90,11 @@ def liouville_components(coordinates, *hamiltonians, parameters=()) -> tuple:
     >>> liouville_components((x1, x2), "x2^2/(2*m) + m*omega^2*x1^2/2", parameters="m omega")
     (x2/m, -m*omega**2*x1)
     """
-    coords = tuple(coordinates)
-    extra = parameters.split() if isinstance(parameters, str) else list(parameters)
-    extra = [sympy.Symbol(p) if isinstance(p, str) else p for p in extra]
+    coords = as_symbols(coordinates, "coordinates")
+    extra = as_symbols(parameters.split() if isinstance(parameters, str) else parameters, "parameters", names=True)
+    if len(hamiltonians) != len(coords) - 1:
+        raise NambuBCHError(f"a Liouville field on {len(coords)} coordinates needs {len(coords) - 1} Hamiltonians, "
+                            f"got {len(hamiltonians)}")
     names = _text_symbols((*coords, *extra), hamiltonians)
     hamiltonians = [as_expression(Hk, names, f"Hamiltonian {k + 1}") for k, Hk in enumerate(hamiltonians)]
     grads = [[sympy.diff(Hk, x) for x in coords] for Hk in hamiltonians]
@@ -195,6 +198,7 @@ def assert_fields_equal(X, Y, coordinates=None, msg: str = ""):
     algebra = getattr(X, "algebra", None) or getattr(Y, "algebra", None)
     if coordinates is None:
         coordinates = algebra.coordinates if algebra is not None else sympy.symbols(f"x1:{len(a) + 1}")
+    coordinates = as_symbols(coordinates, "coordinates")
     names = _text_symbols(coordinates, (*a, *b))
     if algebra is not None:
         names.update(algebra.symbol_table)
@@ -227,6 +231,7 @@ def assert_shadow_pair(system, word, H_S, G_S=None, order: int = 2):
     __tracebackhide__ = True
     from .bch import effective_field
 
+    system = as_system(system)
     hams = [_as_expr(H_S, system, "H_S")]
     if isinstance(G_S, (list, tuple)):
         hams += [_as_expr(G, system, "G_S") for G in G_S]
@@ -299,7 +304,8 @@ def assert_invariant(system, word, I, h=STEP):
     __tracebackhide__ = True
     from .integrators import composed_map
 
-    expr = _as_expr(I, system, "I")
+    system = as_system(system)
+    expr = as_expression(I, system.symbols(), "I")
     image = composed_map(system.splitting, word, h)
     moved = expr.subs(dict(zip(system.coordinates, image)), simultaneous=True)
     residual = moved - expr

@@ -26,15 +26,16 @@ from sympy.polys.polyutils import expr_from_dict
 from sympy.polys.orderings import lex
 from sympy.polys.rings import PolyElement, PolyRing
 
+from ..checks import check_sequence
 from ..errors import InvalidSystemError
-from ..parsing import as_expression
+from ..parsing import as_expression, as_symbols
 from .zero import is_zero
 
 _CONVERSION_ERRORS = (CoercionFailed, GeneratorsError, PolynomialError, ValueError, TypeError)
 
 
-def _symbols(names) -> tuple[sympy.Symbol, ...]:
-    return tuple(sympy.Symbol(n) if isinstance(n, str) else n for n in names)
+def _symbols(names, what="symbols") -> tuple[sympy.Symbol, ...]:
+    return as_symbols(names, what, names=True)
 
 
 def _symbol_powers(factors) -> dict | None:
@@ -286,10 +287,13 @@ class PolynomialAlgebra:
     """
 
     def __init__(self, coordinates, parameters=(), constants=(), extension=()):
-        self.coordinates = _symbols(coordinates)
-        self.parameters = _symbols(parameters)
-        self.constants = _symbols(constants)
-        self.extension = tuple(as_expression(e, (), "extension of a PolynomialAlgebra") for e in extension)
+        self.coordinates = _symbols(coordinates, "coordinates")
+        if not self.coordinates:
+            raise InvalidSystemError("a PolynomialAlgebra needs at least one coordinate, got none")
+        self.parameters = _symbols(parameters, "parameters")
+        self.constants = _symbols(constants, "constants")
+        self.extension = tuple(as_expression(e, (), "extension of a PolynomialAlgebra")
+                               for e in check_sequence(extension, "extension", "algebraic numbers"))
         clash = set(self.coordinates) & (set(self.parameters) | set(self.constants))
         if clash:
             raise InvalidSystemError(

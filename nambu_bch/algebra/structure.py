@@ -13,9 +13,23 @@ from __future__ import annotations
 
 import sympy
 
+from ..checks import check_sequence
 from ..errors import NambuBCHError
-from ..parsing import as_expression
+from ..parsing import as_expression, as_symbols
 from .zero import is_zero
+
+
+def _checked(map_components, coordinates) -> tuple:
+    """The map's components and the coordinates as tuples, of the same length, else one line naming the argument."""
+    coordinates = as_symbols(coordinates, "coordinates")
+    if not coordinates:
+        raise NambuBCHError("a map needs at least one coordinate, got none")
+    map_components = check_sequence(map_components, "map_components", "expressions")
+    if len(map_components) != len(coordinates):
+        raise NambuBCHError(
+            f"a map of {len(coordinates)} coordinates needs {len(coordinates)} components, got {len(map_components)}"
+        )
+    return map_components, coordinates
 
 
 def _components(map_components, coordinates) -> list:
@@ -26,10 +40,7 @@ def _components(map_components, coordinates) -> list:
 
 def jacobian(map_components, coordinates) -> sympy.Matrix:
     """``dy_i/dx_j`` of a map given as sympy expressions ``y_i(x)``."""
-    if len(map_components) != len(coordinates):
-        raise NambuBCHError(
-            f"a map of {len(coordinates)} coordinates needs {len(coordinates)} components, got {len(map_components)}"
-        )
+    map_components, coordinates = _checked(map_components, coordinates)
     return sympy.Matrix(_components(map_components, coordinates)).jacobian(sympy.Matrix(coordinates))
 
 
@@ -71,8 +82,7 @@ def satisfies_nambu_condition(map_components, coordinates) -> bool:
     Polynomial maps (coefficients rational in the parameters) are checked exactly in a sparse
     polynomial ring, where the determinant is the Nambu bracket ``{y_1, ..., y_N}``; other maps by sympy.
     """
-    if len(map_components) != len(coordinates):
-        jacobian(map_components, coordinates)  # raises, naming the mismatch
+    map_components, coordinates = _checked(map_components, coordinates)
     result = _ring_condition(map_components, coordinates)
     if result is not None:
         return result
@@ -81,6 +91,7 @@ def satisfies_nambu_condition(map_components, coordinates) -> bool:
 
 def is_symplectic(map_components, coordinates) -> bool:
     """Eq. (Symplectic): ``J eps J^T = eps`` with the canonical ``eps`` of ``(q.., p..)``."""
+    map_components, coordinates = _checked(map_components, coordinates)
     n = len(coordinates)
     if n % 2:
         raise NambuBCHError(f"symplecticity needs an even number of coordinates, got {n}")

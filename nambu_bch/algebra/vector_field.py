@@ -19,6 +19,9 @@ from ..errors import NambuBCHError
 from .flint_ring import FlintRing
 from .polynomial import PolynomialAlgebra
 
+#: The algebras a field, a bracket or a Liouville field lives in (what an ``algebra`` argument is checked against).
+ALGEBRAS = (PolynomialAlgebra, FlintRing)
+
 
 class VectorField:
     """A vector field on the coordinates of ``algebra``.
@@ -42,7 +45,7 @@ class VectorField:
     __slots__ = ("algebra", "components")
 
     def __init__(self, algebra: PolynomialAlgebra, components):
-        check_type(algebra, (PolynomialAlgebra, FlintRing), "algebra")
+        check_type(algebra, ALGEBRAS, "algebra")
         if isinstance(components, (str, bytes, dict)) or not hasattr(components, "__iter__"):
             raise NambuBCHError(f"the components of a vector field are a sequence of expressions, got {show(components)}")
         components = tuple(components)

@@ -24,19 +24,25 @@ from itertools import product
 
 from ..algebra import liouville_field
 from ..algebra.backend import field_backend
+from ..checks import check_flag, check_sequence, check_type, is_int, show
 from ..errors import UnknownPieceError
 from .evaluation import BracketEvaluator
-from .lyndon import is_bracket
+from .lyndon import _terms, is_bracket, tree_leaves
 
 
 def _expand_tree(tree, splitting):
     if is_bracket(tree):
         return [(a, b) for a, b in product(_expand_tree(tree[0], splitting), _expand_tree(tree[1], splitting))]
-    if not isinstance(tree, int) or not 1 <= tree <= len(splitting):
+    return list(splitting[_leaf(tree, splitting)].terms)
+
+
+def _leaf(leaf, splitting) -> int:
+    """``leaf`` if it is a piece number of ``splitting``, else one line naming it."""
+    if not is_int(leaf, 1, len(splitting)):
         raise UnknownPieceError(
-            f"bracket tree leaf {tree!r} is not a piece of the splitting (pieces are 1..{len(splitting)})"
+            f"bracket tree leaf {show(leaf)} is not a piece of the splitting (pieces are 1..{len(splitting)})"
         )
-    return list(splitting[tree].terms)
+    return leaf
 
 
 def _evaluator(algebra, fields: dict) -> BracketEvaluator:
@@ -86,6 +92,17 @@ def expand_terms(terms, splitting, prune: bool = True, evaluators=None) -> list:
     >>> len(expand_terms(formal_bch("12321", 3).terms(3), S, prune=False)), len(expand_terms(formal_bch("12321", 3).terms(3), S))
     (8, 4)
     """
+    from ..systems.splitting import Splitting
+
+    check_type(splitting, Splitting, "splitting")
+    prune = check_flag(prune, "prune")
+    if evaluators is not None:
+        for e in check_sequence(evaluators, "evaluators", "BracketEvaluators", length=2):
+            check_type(e, BracketEvaluator, "each of evaluators")
+    terms = list(_terms(terms, 2))
+    for _, tree in terms:  # every leaf a piece, before a tree is evaluated
+        for leaf in tree_leaves(tree):
+            _leaf(leaf, splitting)
     pieces_eval, terms_eval = evaluators or (piece_evaluator(splitting), term_evaluator(splitting)) if prune else (None, None)
     out = []
     for c, tree in terms:

@@ -32,8 +32,8 @@ from functools import lru_cache
 import numpy as np
 import sympy
 
-from ..checks import check_int, show
-from ..errors import InvalidRunError, UnknownPieceError
+from ..checks import check_int, check_sequence, is_int, show
+from ..errors import InvalidRunError, ResourceLimitError, UnknownPieceError
 
 
 def is_bracket(tree) -> bool:
@@ -72,7 +72,13 @@ def tree_leaves(tree) -> tuple:
     return (tree,)
 
 
-@lru_cache(maxsize=4096)
+#: Largest number of bits of ``n_letters ** degree`` that :func:`witt_dimension` computes (the degree is a BCH
+#: degree, at most a few dozen in any series the package can build).
+MAX_WITT_BITS = 10**5
+#: Highest degree of a tree that :func:`tree_to_associative` expands (the BCH routes stop at degree 13).
+MAX_TREE_DEGREE = 16
+
+
 def witt_dimension(n_letters: int, degree: int) -> int:
     """Number of Lyndon words of length ``degree`` over ``n_letters`` letters (Witt's formula).
 
@@ -85,6 +91,14 @@ def witt_dimension(n_letters: int, degree: int) -> int:
     n_letters, degree = check_int(n_letters, "n_letters", 0), check_int(degree, "degree")
     if degree < 1:
         return 0
+    if degree * max(1, n_letters.bit_length()) > MAX_WITT_BITS:  # before the trial division and the powers
+        raise ResourceLimitError(f"witt_dimension({show(n_letters)}, {show(degree)}) has about "
+                                 f"{show(degree * n_letters.bit_length())} bits; at most {MAX_WITT_BITS} are computed")
+    return _witt_dimension(n_letters, degree)
+
+
+@lru_cache(maxsize=4096)
+def _witt_dimension(n_letters: int, degree: int) -> int:
     total = sum(mobius(e) * n_letters ** (degree // e) for e in divisors(degree))
     return int(total) // degree
 
@@ -174,10 +188,20 @@ def standard_bracketing(word, letters=None):
     (1, (1, 2))
     """
     word = tuple(_sequence(word, "word"))
+    if letters is not None:
+        letters = check_sequence(letters, "letters", "leaves")
+    top = None if letters is None else len(letters) - 1
+    if not word or not all(is_int(a, 0, top, numpy=True) for a in word):
+        raise InvalidRunError(f"word must be a non-empty Lyndon word of letters 0..{'g-1' if top is None else top} "
+                              f"(integers), got {show(word)}")
+    return _bracketing(word, letters)
+
+
+def _bracketing(word, letters):
     if len(word) == 1:
         return word[0] if letters is None else letters[word[0]]
     u, v = standard_factorization(word)
-    return (standard_bracketing(u, letters), standard_bracketing(v, letters))
+    return (_bracketing(u, letters), _bracketing(v, letters))
 
 
 @lru_cache(maxsize=None)
@@ -219,9 +243,23 @@ def tree_to_associative(tree) -> dict:
     >>> sorted(tree_to_associative((1, 2)).items())
     [((1, 2), 1), ((2, 1), -1)]
     """
+    degree = tree_degree(tree)
+    if degree > MAX_TREE_DEGREE:  # the expansion has up to 2^(degree - 1) words
+        raise ResourceLimitError(f"a bracket tree of degree {degree} expands into up to 2^{degree - 1} words; "
+                                 f"at most degree {MAX_TREE_DEGREE} is expanded")
+    for leaf in tree_leaves(tree):
+        try:
+            hash(leaf)
+        except TypeError:
+            raise InvalidRunError(f"the leaves of a bracket tree must be hashable (numbers, symbols, tuples), "
+                                  f"got {show(leaf)}") from None
+    return _associative(tree)
+
+
+def _associative(tree) -> dict:
     if not is_bracket(tree):
         return {(tree,): 1}
-    left, right = tree_to_associative(tree[0]), tree_to_associative(tree[1])
+    left, right = _associative(tree[0]), _associative(tree[1])
     out: dict = {}
     for a, ca in left.items():
         for b, cb in right.items():
@@ -281,8 +319,13 @@ def tree_to_latex(tree, names=None) -> str:
     if names is not None:
         if callable(names):
             return names(tree)
-        if tree not in names:
-            raise UnknownPieceError(f"no LaTeX name for generator {tree!r}; names given for {sorted(names, key=str)}")
+        try:
+            known = tree in names
+        except TypeError:  # an unhashable leaf cannot be a key of names
+            known = False
+        if not known:
+            raise UnknownPieceError(f"no LaTeX name for generator {show(tree)}; names given for "
+                                    f"{show(sorted(names, key=str))}")
         return names[tree]
     if isinstance(tree, tuple):
         return "X_{" + ",".join(sympy.latex(e) for e in tree) + "}"

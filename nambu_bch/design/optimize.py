@@ -55,13 +55,16 @@ from sympy.polys.domains import QQ
 from sympy.polys.orderings import grevlex
 
 from ..algebra.elimination import solve_affine
-from ..checks import is_int
+from ..checks import check_flag, check_int, is_int, show
 from ..errors import InvalidOrderError, NambuBCHError
 from ..integrators.composition import Composition
+from ..systems.system import check_name
 from .conditions import _Exact, defect_polynomials, error_analysis, order_conditions, template
 
 #: Largest number of unknowns accepted by :func:`optimize_composition`.
 MAX_UNKNOWNS = 8
+#: Most starting points of the float search (each is a Newton projection; the default is 40).
+MAX_STARTS = 10_000
 #: Solutions with a coefficient larger than this in absolute value are not searched (useless in practice).
 MAX_COEFFICIENT = 50.0
 
@@ -317,12 +320,18 @@ def optimize_composition(spec, parts: int | None = None, order: int = 4, stages:
     """
     T = template(spec, parts, stages)
     if not is_int(order, 1):
-        raise InvalidOrderError(f"order must be a positive integer, got {order!r}")
+        raise InvalidOrderError(f"order must be a positive integer, got {show(order)}")
+    starts = check_int(starts, "starts", 1, MAX_STARTS)
+    seed = check_int(seed, "seed", 0, 2**32 - 1)  # numpy's RandomState seeds
+    max_denominator = check_int(max_denominator, "max_denominator", 1)
+    exact = check_flag(exact, "exact")
+    if name is not None:
+        check_name(name, "name", strict=False)
     n = len(T.unknowns)
     if n > MAX_UNKNOWNS:
         raise InvalidOrderError(f"template {T.name!r} has {n} unknowns; the search accepts at most {MAX_UNKNOWNS}")
     if not is_int(dps, 15, 200):
-        raise InvalidOrderError(f"dps must be an integer in 15..200, got {dps!r}")
+        raise InvalidOrderError(f"dps must be an integer in 15..200, got {show(dps)}")
     conds = order_conditions(T, order)
     eqs = conds.polynomials
     degree = order + 1

@@ -48,6 +48,7 @@ from math import comb, prod
 import sympy
 
 from ..algebra import PolynomialAlgebra
+from ..systems.system import as_system
 from ..algebra.ansatz import Ansatz, Rows
 from ..algebra.zero import is_zero
 from ..algebra.elimination import nullspace, rank, solve_affine
@@ -374,6 +375,7 @@ def is_invariant(system, word, quantity) -> bool:
     >>> is_invariant(model("ho"), "121", H - omega**2*h**2*x2**2/(8*m))   # Eq. (CQPV)
     True
     """
+    system = as_system(system)
     quantity = as_expression(quantity, system.symbols(), "quantity")
     phi = composed_map(system.splitting, word)
     image = quantity.subs(dict(zip(system.coordinates, phi)), simultaneous=True)

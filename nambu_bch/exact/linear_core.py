@@ -25,6 +25,7 @@ import sympy
 
 from ..checks import show
 from ..errors import NoExactResultError
+from ..parsing import as_expression
 
 H_STEP = sympy.Symbol("h")
 
@@ -87,7 +88,7 @@ def linear_core(coordinates, rhs, name="system") -> LinearCore:
         raise NoExactResultError(f"the coordinates of {name} must be distinct sympy symbols, got {show(coordinates)}")
     if isinstance(rhs, (str, bytes)) or not hasattr(rhs, "__iter__") or len(rhs := tuple(rhs)) != len(coords):
         raise NoExactResultError(f"{name} needs one right-hand side per coordinate ({len(coords)}), got {show(rhs)}")
-    rhs = [sympy.expand(r) for r in rhs]
+    rhs = [sympy.expand(as_expression(r, coords, f"right-hand side {i + 1} of {name}")) for i, r in enumerate(rhs)]
     fail = NoExactResultError(
         f"{name} has no harmonic core: the equations {tuple(rhs)} are not of the form (y1, y2)' = A y with "
         "tr A = 0, det A > 0 and the other coordinates driven by a quadratic in y (linear oscillators such as ho, ho3)"

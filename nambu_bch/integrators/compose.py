@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import sympy
 
+from ..parsing import as_expression
 from ..symbols import STEP
 from .composition import composition_for
 from .flows import TIME, exact_flow
@@ -27,9 +28,11 @@ def composed_map(splitting, comp, h=STEP) -> tuple:
     """
     comp = composition_for(comp, splitting)
     system = splitting.system
+    h = as_expression(h, system.symbols(), "h")
     coords = system.coordinates
     flows = [(exact_flow(splitting[k], coords), c) for k, c in comp.factors()]
-    if all(f.polynomial for f, _ in flows):
+    # the ring route takes the step as a generator: a symbol (h = -h or 0.1 compose by substitution)
+    if isinstance(h, sympy.Symbol) and all(f.polynomial for f, _ in flows):
         composed = _compose_in_ring(system, flows, comp, h)
         if composed is not None:
             return composed

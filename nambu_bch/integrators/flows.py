@@ -24,6 +24,7 @@ import sympy
 
 from ..checks import check_type, show
 from ..errors import InvalidRunError, NoExactFlowError
+from ..parsing import as_symbols
 
 #: The symbol of the sub-flow's time in :attr:`ExactFlow.expressions`.
 TIME = sympy.Symbol("t")
@@ -54,9 +55,7 @@ def exact_flow(piece, coordinates) -> ExactFlow:
     from ..systems.splitting import Piece
 
     check_type(piece, Piece, "piece")
-    if isinstance(coordinates, (str, bytes)) or not hasattr(coordinates, "__iter__"):
-        raise InvalidRunError(f"coordinates must be a sequence of sympy symbols, got {show(coordinates)}")
-    coordinates = tuple(coordinates)
+    coordinates = as_symbols(coordinates, "coordinates")
     if len(coordinates) != piece.field.algebra.n:
         raise InvalidRunError(f"piece {piece.number} moves {piece.field.algebra.n} coordinates, got {show(coordinates)}")
     return _exact_flow(piece, coordinates)

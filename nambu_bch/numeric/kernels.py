@@ -472,6 +472,9 @@ def kernel(system, word) -> Kernel:
     >>> [float(v) for v in k.constants(0.1)]
     [0.05, -0.1]
     """
+    from ..systems.system import as_system
+
+    system = as_system(system)  # before the memo hashes it
     directory = str(cache_dir())
     if isinstance(word, str):  # resolving a word can be slow (triple jumps: exact algebraic coefficients)
         return _kernel_for_word(system, word, directory)

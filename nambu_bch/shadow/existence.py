@@ -72,7 +72,7 @@ import sympy
 
 from ..algebra.ansatz import Ansatz, Rows
 from ..algebra.elimination import solve_affine
-from ..checks import is_int
+from ..checks import check_flag, check_type, finite_float, is_int, show
 from ..errors import NambuBCHError
 from ..parsing import as_expression
 from .averaging import orbit_average, orbit_functions, sample_points, section_integral
@@ -301,18 +301,18 @@ def _check_params(system, params):
     if params is None:
         return _default_params(system)
     if not isinstance(params, dict):
-        raise NambuBCHError(f"params must be a dict name -> number, got {params!r}")
+        raise NambuBCHError(f"params must be a dict name -> number, got {show(params)}")
     by_name = {str(p): p for p in system.parameters}
     out = _default_params(system)
     for k, v in params.items():
         if str(k) not in by_name:
-            raise NambuBCHError(f"unknown parameter {k!r}; the system has {sorted(by_name)}")
+            raise NambuBCHError(f"unknown parameter {show(k)}; the system has {sorted(by_name)}")
         try:
             val = sympy.nsimplify(as_expression(v, (), f"parameter {k}"))  # nsimplify would sympify text
         except (sympy.SympifyError, TypeError) as exc:
-            raise NambuBCHError(f"parameter {k} must be a number, got {v!r}") from exc
+            raise NambuBCHError(f"parameter {k} must be a number, got {show(v)}") from exc
         if not val.is_real or not val.is_number:
-            raise NambuBCHError(f"parameter {k} must be a real number, got {v!r}")
+            raise NambuBCHError(f"parameter {k} must be a real number, got {show(v)}")
         out[by_name[str(k)]] = val
     return out
 
@@ -342,9 +342,15 @@ def decide(result, params=None, points=None, orbits: int = DEFAULT_ORBITS, measu
     >>> d.outcome, d.method, d.averages
     ('none', 'exact', [omega**2*(G*m*omega**2 - 2*H)/4, (G*m*omega**2 - 2*H)/(2*m)])
     """
-    system = result.system
+    from .direct_route import DirectResult
+
+    system = check_type(result, DirectResult, "result").system
     if not is_int(orbits, 1, 64):
-        raise NambuBCHError(f"orbits must be an integer in 1..64, got {orbits!r}")
+        raise NambuBCHError(f"orbits must be an integer in 1..64, got {show(orbits)}")
+    measure = check_flag(measure, "measure")
+    rtol = finite_float(rtol, "rtol")
+    if not 0 < rtol < 1:
+        raise NambuBCHError(f"rtol must be a tolerance between 0 and 1, got {show(rtol)}")
     params = _check_params(system, params)
     gs, j = integrands(result)
     names = _names(system)
@@ -359,9 +365,12 @@ def decide(result, params=None, points=None, orbits: int = DEFAULT_ORBITS, measu
     if points is None:
         pts = sample_points(n, orbits)
     else:
-        pts = np.asarray(points, dtype=float)
-        if pts.ndim != 2 or pts.shape[1] != n or len(pts) > 64 or not np.all(np.isfinite(pts)):
-            raise NambuBCHError(f"points must be at most 64 finite points of {n} coordinates, got shape {pts.shape}")
+        try:
+            pts = np.asarray(points, dtype=float)
+        except (TypeError, ValueError, OverflowError):  # text, ragged or complex entries: named below
+            pts = np.zeros(0)
+        if pts.ndim != 2 or pts.shape[1] != n or not 1 <= len(pts) <= 64 or not np.all(np.isfinite(pts)):
+            raise NambuBCHError(f"points must be 1 to 64 finite points of {n} coordinates, got {show(points)}")
     F = orbit_functions(system, gs, params, names)
     found = [orbit_average(F, x, rtol=rtol) for x in pts]
     closed = [o for o in found if o.closed]

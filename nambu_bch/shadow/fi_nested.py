@@ -230,7 +230,7 @@ class RawOps:
             sign, key = self.context.key(entries)
             if sign:
                 terms[key] = terms.get(key, self.domain.zero) + sign * c * c0
-        return LiouvilleSum(self.algebra, terms, self.atoms)
+        return LiouvilleSum._trusted(self.algebra, terms, self.atoms)  # canonical keys from the context
 
 
 @dataclass

@@ -60,11 +60,13 @@ from ..algebra.elimination import Echelon, kernel_rref, normal_form, rank, solve
 from ..algebra.zero import is_zero
 from ..bch import expand_terms, formal_bch
 from ..bch.expansion import piece_evaluator, term_evaluator
-from ..bch.lyndon import is_bracket
-from ..checks import is_int
+from ..bch.lyndon import _terms, is_bracket, tree_degree, tree_leaves
+from ..checks import is_int, show
 from ..errors import InvalidOrderError, NambuBCHError
 from ..integrators.composition import composition_for
+from ..parsing import as_expression
 from ..symbols import ALPHA, STEP
+from ..systems.system import as_system
 from .direct_route import needed_degree, operator_columns
 from .fi_nested import RawOps, nested_hull
 from .fundamental_identity import representations, single_representations
@@ -417,6 +419,17 @@ def _target_term(ctx, a, correction) -> LiouvilleSum:
     return total
 
 
+def _check_term_tree(tree, slots, power) -> None:
+    """A user's tree of ``terms=``: a bracket of depth ``power`` whose leaves are Liouville terms (``slots`` expressions)."""
+    def leaf_ok(leaf):
+        return type(leaf) is tuple and len(leaf) == slots and all(isinstance(f, sympy.Expr) for f in leaf)
+
+    leaves = tree_leaves(tree)
+    if not is_bracket(tree) or tree_degree(tree) != power + 1 or not all(leaf_ok(leaf) for leaf in leaves):
+        raise NambuBCHError(f"each tree of terms must be a bracket of {power + 1} Liouville terms (tuples of {slots} "
+                            f"sympy expressions, as in Piece.terms), got {show(tree)}")
+
+
 def _as_double(coef, tree):
     """``(coefficient, (a, b, c))`` with the tree brought to ``[a, [b, c]]`` form by antisymmetry."""
     left, right = tree
@@ -479,8 +492,6 @@ def fi_route(system, word, order: int = 2, degree=None, terms=None) -> FIResult:
     ----------
     Horikoshi, Eqs. (BCH2)-(BCH5), (CL2a), (CL2b), (1AX)-(2BY), (CL5)-(CL8), (SH12321c), (Xeff3).
     """
-    from ..systems.system import as_system
-
     system = as_system(system)
     splitting = system.splitting
     comp = composition_for(word, splitting)
@@ -499,11 +510,13 @@ def fi_route(system, word, order: int = 2, degree=None, terms=None) -> FIResult:
         terms = expand_terms(formal_bch(comp, power + 1).terms(power + 1), splitting, prune=True,
                              evaluators=_evaluators(splitting))
     entries = []
-    for coef, tree in terms:
+    for coef, tree in _terms(terms, 2):
+        coef = as_expression(coef, None, "a coefficient of terms")
+        _check_term_tree(tree, len(system.hamiltonians), power)
         if power == 2:
-            entries.append(_as_double(sympy.sympify(coef, strict=True), tree))
+            entries.append(_as_double(coef, tree))
         else:
-            entries.append((sympy.sympify(coef, strict=True), tuple(tree)))
+            entries.append((coef, tuple(tree)))
     entries = _merge(entries)
     commutators = []
     ops = _raw_ops(alg, atoms)
@@ -902,9 +915,10 @@ def fi_brackets(system, word, order: int, limit=None) -> FIBrackets:
     >>> len(B), [b.hull.dimension for b in B]
     (6, [1, 1, 2, 2, 1, 1])
     """
+    system = as_system(system)
     comp = _bracket_composition(system, word, order)
     if limit is not None and not is_int(limit, 1):
-        raise NambuBCHError(f"limit must be a positive integer or None, got {limit!r}")
+        raise NambuBCHError(f"limit must be a positive integer or None, got {show(limit)}")
     atoms, _ = _atoms(system)
     trees = _merged_trees(system, formal_bch(comp, order + 1), order)
     ops = RawOps(system.algebra, atoms)
@@ -920,6 +934,7 @@ def count_brackets(system, word, order: int) -> int:
     >>> count_brackets(model("ho3"), "12321", 4), count_brackets(model("ho3"), "12321", 5)
     (6, 0)
     """
+    system = as_system(system)
     comp = _bracket_composition(system, word, order)
     return len(_merged_trees(system, formal_bch(comp, order + 1), order))
 
@@ -927,7 +942,7 @@ def count_brackets(system, word, order: int) -> int:
 def _bracket_composition(system, word, order):
     comp = composition_for(word, system.splitting)
     if not is_int(order, 1, MAX_FI_ORDER):
-        raise InvalidOrderError(f"order must be an integer between 1 and {MAX_FI_ORDER} for the FI brackets, got {order!r}")
+        raise InvalidOrderError(f"order must be an integer between 1 and {MAX_FI_ORDER} for the FI brackets, got {show(order)}")
     return comp
 
 

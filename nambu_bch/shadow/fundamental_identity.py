@@ -33,7 +33,9 @@ from itertools import product
 import sympy
 from sympy.polys.rings import PolyElement
 
-from ..algebra import nambu_bracket
+from ..algebra import PolynomialAlgebra, nambu_bracket
+from ..checks import check_sequence, check_type, show
+from ..errors import NambuBCHError
 from ..parsing import as_expression
 from .liouville_terms import LiouvilleTerm
 
@@ -69,7 +71,7 @@ def _commutator(left, right, way: str, bracket) -> list:
     elif way == "b":
         base, other, sign = left, right, -1
     else:
-        raise ValueError(f"way must be 'a' (Eq. CL2a) or 'b' (Eq. CL2b), got {way!r}")
+        raise NambuBCHError(f"way must be 'a' (Eq. CL2a) or 'b' (Eq. CL2b), got {show(way)}")
     out = []
     for j in range(len(base)):
         slots = list(base)
@@ -85,6 +87,12 @@ def _double(a, b, c, label: str, bracket) -> list:
     for (s1, slots), way in zip(_commutator(b, c, inner, bracket), outer):
         out.extend((s1 * s2, t) for s2, t in _commutator(a, slots, way, bracket))
     return out
+
+
+def _slots(algebra, *fields) -> list:
+    """The slot tuples of Liouville fields on ``algebra``, each ``N - 1`` functions, else one line naming the argument."""
+    check_type(algebra, PolynomialAlgebra, "algebra")
+    return [check_sequence(slots, what, "functions", length=algebra.n - 1) for what, slots in fields]
 
 
 def commutator_terms(algebra, left, right, way: str, coefficient=1) -> list:
@@ -108,8 +116,9 @@ def commutator_terms(algebra, left, right, way: str, coefficient=1) -> list:
     >>> [str(t) for t in commutator_terms(alg, (x[1], x[2]), (x[0]**2, x[2]), "a")]
     ['X_{2*x1, x3}', 'X_{x1**2, 0}']
     """
+    left, right = _slots(algebra, ("left", left), ("right", right))
     c = as_expression(coefficient, algebra.symbol_table, "coefficient")
-    pairs = _commutator(tuple(left), tuple(right), way, lambda *fs: _bracket(algebra, *fs))
+    pairs = _commutator(left, right, way, lambda *fs: _bracket(algebra, *fs))
     return [LiouvilleTerm(slots, sign * c) for sign, slots in pairs]
 
 
@@ -140,13 +149,17 @@ def double_commutator_terms(algebra, a, b, c, label: str, coefficient=1) -> list
     >>> [str(t) for t in double_commutator_terms(alg, AC, AC, BD, "1AX") if not t.vanishes(alg.coordinates)]   # Eq. (CL5)
     ['X_{m*omega**2*x3/2, -2*x2**2/m**2}']
     """
+    a, b, c = _slots(algebra, ("a", a), ("b", b), ("c", c))
+    if not isinstance(label, str) or label not in labels(len(a)):
+        raise NambuBCHError(f"label must be one of {', '.join(labels(len(a)))}, got {show(label)}")
     c_ = as_expression(coefficient, algebra.symbol_table, "coefficient")
-    pairs = _double(tuple(a), tuple(b), tuple(c), label, lambda *fs: _bracket(algebra, *fs))
+    pairs = _double(a, b, c, label, lambda *fs: _bracket(algebra, *fs))
     return [LiouvilleTerm(slots, sign * c_) for sign, slots in pairs]
 
 
 def representations(algebra, a, b, c, coefficient=1) -> dict:
     """All ``label -> [LiouvilleTerm, ...]`` representations of ``coefficient * [X_a, [X_b, X_c]]``."""
+    a, b, c = _slots(algebra, ("a", a), ("b", b), ("c", c))  # before the 2^(N-1) labels are listed
     return {lab: double_commutator_terms(algebra, a, b, c, lab, coefficient) for lab in labels(len(a))}
 
 

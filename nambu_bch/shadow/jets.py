@@ -22,15 +22,31 @@ spaces, total derivatives); Horikoshi, Eqs. (1AX)-(2BY).
 
 from __future__ import annotations
 
-from itertools import product
+import math
 
 import sympy
 from sympy.polys.domains import QQ
 from sympy.polys.rings import PolyElement, ring
 
 from ..algebra import PolynomialAlgebra
-from ..errors import NambuBCHError
-from ..parsing import as_expression
+from ..checks import check_int, check_type
+from ..errors import InvalidSystemError, NambuBCHError, ResourceLimitError
+from ..parsing import as_expression, as_symbols
+from ..systems.system import _symbol_name
+
+#: Most jet variables (ring generators) of a :class:`JetAlgebra`: the fundamental identity at order 3 for
+#: seven functions of three coordinates needs 140.
+MAX_JETS = 2000
+
+
+def _multi_indices(n: int, order: int):
+    """The multi-indices ``alpha`` in ``N^n`` with ``|alpha| <= order``, lexicographically (only those are visited)."""
+    if n == 0:
+        yield ()
+        return
+    for first in range(order + 1):
+        for rest in _multi_indices(n - 1, order - first):
+            yield (first, *rest)
 
 
 class JetAlgebra(PolynomialAlgebra):
@@ -53,7 +69,21 @@ class JetAlgebra(PolynomialAlgebra):
     """
 
     def __init__(self, coordinates, functions, max_order: int):
-        self.coordinates = tuple(coordinates)
+        self.coordinates = as_symbols(coordinates, "coordinates")
+        if not self.coordinates:
+            raise InvalidSystemError("a JetAlgebra needs at least one coordinate, got none")
+        if isinstance(functions, str):
+            functions = tuple(functions)  # "ABC": one letter per function
+        functions = tuple(check_type(f, str, "a function name") for f in check_type(functions, (list, tuple), "functions"))
+        for f in functions:
+            _symbol_name(f, "function")
+        max_order = check_int(max_order, "max_order", 0)
+        # the ring has one generator per jet: refuse from the count, before enumerating the multi-indices
+        n_jets = len(functions) * math.comb(len(self.coordinates) + max_order, max_order)
+        if n_jets > MAX_JETS:
+            raise ResourceLimitError(f"JetAlgebra with {len(functions)} function(s) of {len(self.coordinates)} "
+                                     f"coordinate(s) up to order {max_order} needs {n_jets} jet variables; at most "
+                                     f"{MAX_JETS} are accepted")
         self.parameters = ()
         self.constants = ()
         self.extension = ()
@@ -61,7 +91,7 @@ class JetAlgebra(PolynomialAlgebra):
         self.names = tuple(functions)
         self.max_order = max_order
         self.domain = QQ
-        alphas = [a for a in product(range(max_order + 1), repeat=self.n) if sum(a) <= max_order]
+        alphas = list(_multi_indices(self.n, max_order))
         self.jets = [(name, a) for name in self.names for a in alphas]
         jet_symbols = [sympy.Symbol(f"{name}_{''.join(map(str, a))}") for name, a in self.jets]
         self.ring, *gens = ring(list(self.coordinates) + jet_symbols, QQ)

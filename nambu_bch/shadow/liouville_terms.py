@@ -34,11 +34,13 @@ from functools import lru_cache
 import sympy
 from sympy.core.sorting import default_sort_key
 from sympy.polys.domains import QQ
+from sympy.polys.polyerrors import CoercionFailed
 from sympy.polys.rings import PolyElement
 
-from ..algebra import VectorField, liouville_field
+from ..algebra import PolynomialAlgebra, VectorField, liouville_field
 from ..algebra.brackets import permutation_sign
 from ..algebra.elimination import rank
+from ..checks import check_sequence, check_type, is_int, show
 from ..errors import NambuBCHError
 from ..parsing import as_expression
 
@@ -64,7 +66,7 @@ class LiouvilleTerm:
     def __post_init__(self):
         # ring elements (exact sparse polynomials) are kept as they are: nested brackets stay fast
         object.__setattr__(self, "slots", tuple(s if isinstance(s, PolyElement) else as_expression(s, None, "a slot of a LiouvilleTerm")
-                                                for s in self.slots))
+                                                for s in check_sequence(self.slots, "slots", "expressions")))
         object.__setattr__(self, "coefficient", as_expression(self.coefficient, None, "the coefficient of a LiouvilleTerm"))
 
     @property
@@ -196,6 +198,35 @@ def _to_domain(algebra, c):
     return algebra.domain.convert(c)
 
 
+def _checked_key(algebra, key) -> tuple:
+    """A user's term key of a :class:`LiouvilleSum`: a tuple of slot entries ``(0, exponents)`` or ``(1, atom id)``."""
+    def entry_ok(entry):
+        if not (isinstance(entry, tuple) and len(entry) == 2):
+            return False
+        kind, value = entry
+        if kind == 0 and not isinstance(kind, bool):
+            return isinstance(value, tuple) and len(value) == algebra.n and all(is_int(e, 0) for e in value)
+        return kind == 1 and not isinstance(kind, bool) and is_int(value, 0, len(_ATOMS) - 1)
+
+    if not (isinstance(key, tuple) and key and all(entry_ok(e) for e in key)):
+        raise NambuBCHError(f"a key of LiouvilleSum terms must be a tuple of slot entries (0, exponents of the "
+                            f"{algebra.n} coordinates) or (1, atom id), got {show(key)}")
+    return key
+
+
+def _checked_coefficient(algebra, value):
+    """A user's coefficient of a :class:`LiouvilleSum` term as an element of the algebra's coefficient domain."""
+    if algebra.domain.of_type(value):
+        return value
+    c = as_expression(value, None, "a coefficient of LiouvilleSum terms")
+    try:
+        return _to_domain(algebra, c)
+    except (CoercionFailed, TypeError, ValueError):
+        raise NambuBCHError(f"a coefficient of LiouvilleSum terms must be a number of the algebra's coefficient "
+                            f"field (rational in {', '.join(map(str, algebra.parameters)) or 'no parameters'}), "
+                            f"got {show(value)}") from None
+
+
 class LiouvilleSum:
     """A formal sum ``sum_k c_k X_{e_k1, ..., e_k(N-1)}`` modulo multilinearity, antisymmetry, vanishing.
 
@@ -231,9 +262,25 @@ class LiouvilleSum:
     __slots__ = ("algebra", "terms", "atoms")
 
     def __init__(self, algebra, terms=None, atoms=()):
+        check_type(algebra, PolynomialAlgebra, "algebra")
+        atoms = tuple(as_expression(a, algebra.symbol_table, "an atom of a LiouvilleSum")
+                      for a in check_sequence(atoms, "atoms", "expressions"))
+        if terms is not None:
+            terms = {_checked_key(algebra, k): _checked_coefficient(algebra, v)
+                     for k, v in check_type(terms, dict, "terms").items()}
+        self._set(algebra, terms, atoms)
+
+    def _set(self, algebra, terms, atoms):
         self.algebra = algebra
-        self.atoms = tuple(atoms)
+        self.atoms = atoms
         self.terms = {k: v for k, v in (terms or {}).items() if v}
+
+    @classmethod
+    def _trusted(cls, algebra, terms, atoms) -> "LiouvilleSum":
+        """A sum built by this module from checked parts (canonical keys, domain coefficients): not checked again."""
+        self = cls.__new__(cls)
+        self._set(algebra, terms, atoms)
+        return self
 
     @classmethod
     def zero(cls, algebra, atoms=()) -> "LiouvilleSum":
@@ -263,7 +310,7 @@ class LiouvilleSum:
         terms: dict = {}
         context = _context(algebra, atoms)
         cls._expand(polys, 0, (), coeff, terms, context)
-        return cls(algebra, terms, atoms)
+        return cls._trusted(algebra, terms, atoms)
 
     @staticmethod
     def _expand(polys, i, entries, coeff, out, context):
@@ -280,19 +327,19 @@ class LiouvilleSum:
         out = dict(self.terms)
         for k, v in other.terms.items():
             out[k] = out.get(k, 0) + v
-        return LiouvilleSum(self.algebra, out, self.atoms or other.atoms)
+        return LiouvilleSum._trusted(self.algebra, out, self.atoms or other.atoms)
 
     __radd__ = lambda self, other: self if other == 0 else self.__add__(other)  # noqa: E731  (sum())
 
     def __neg__(self):
-        return LiouvilleSum(self.algebra, {k: -v for k, v in self.terms.items()}, self.atoms)
+        return LiouvilleSum._trusted(self.algebra, {k: -v for k, v in self.terms.items()}, self.atoms)
 
     def __sub__(self, other):
         return self + (-other)
 
     def scale(self, c) -> "LiouvilleSum":
         c = _to_domain(self.algebra, c)
-        return LiouvilleSum(self.algebra, {k: c * v for k, v in self.terms.items()}, self.atoms)
+        return LiouvilleSum._trusted(self.algebra, {k: c * v for k, v in self.terms.items()}, self.atoms)
 
     def is_zero(self) -> bool:
         return not self.terms
@@ -349,4 +396,4 @@ def _liouville_sum_from(algebra, keys, coefficients, atoms) -> LiouvilleSum:
     for key, c in zip(keys, coefficients):
         sign, canonical = context.key(tuple((kind, _atom_id(v) if kind == 1 else v) for kind, v in key))
         terms[canonical] = terms.get(canonical, algebra.domain.zero) + (c if sign > 0 else -c)
-    return LiouvilleSum(algebra, terms, atoms)
+    return LiouvilleSum._trusted(algebra, terms, atoms)

@@ -5,7 +5,7 @@ from __future__ import annotations
 import sympy
 
 from ..errors import NotSeparableError
-from ..parsing import as_expression
+from ..parsing import as_expression, as_symbols
 
 
 def separate(expr, coordinates, name: str = "H") -> tuple:
@@ -26,7 +26,7 @@ def separate(expr, coordinates, name: str = "H") -> tuple:
     >>> separate(x3 - x1**2, [x1, x2, x3], "G")
     (-x1**2, 0, x3)
     """
-    coords = tuple(coordinates)
+    coords = as_symbols(coordinates, "coordinates")
     pieces = [sympy.Integer(0)] * len(coords)
     for term in sympy.Add.make_args(sympy.expand(as_expression(expr, coords, name))):
         used = [i for i, x in enumerate(coords) if term.has(x)]

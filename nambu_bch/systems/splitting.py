@@ -27,7 +27,7 @@ from itertools import permutations
 import sympy
 
 from ..algebra import VectorField, liouville_field
-from ..checks import check_type
+from ..checks import check_flag, check_type
 from .separable import separate
 
 
@@ -118,6 +118,9 @@ def full_split(system) -> Splitting:
 
 def single_split(system) -> Splitting:
     """Split only the first Hamiltonian: pieces ``X_{H_i, G}`` (the paper's footnote)."""
+    from .system import System
+
+    check_type(system, System, "system")
     coords = system.coordinates
     parts = separate(system.H, coords, "H")
     rest = system.hamiltonians[1:]
@@ -168,7 +171,10 @@ def canonical_split(system, fine: bool = False) -> Splitting:
     [(p1, p2, 0, 0), (0, 0, -2*q1*q2, -q1**2)]
     """
     from ..errors import NotSeparableError
+    from .system import System
 
+    check_type(system, System, "system")
+    fine = check_flag(fine, "fine")
     coords = system.coordinates
     d = system.N // 2
     q, p = coords[:d], coords[d:]
@@ -220,7 +226,10 @@ def triplet_split(system, single: bool = False) -> Splitting:
     """
     from ..errors import NoExactFlowError
     from ..integrators.flows import exact_flow
+    from .system import System
 
+    check_type(system, System, "system")
+    single = check_flag(single, "single")
     coords = system.coordinates
     H_terms = list(sympy.Add.make_args(sympy.expand(system.H)))
     G_terms = [system.G] if single else list(sympy.Add.make_args(sympy.expand(system.G)))

@@ -10,6 +10,7 @@ from functools import cached_property
 import sympy
 
 from ..algebra import PolynomialAlgebra, VectorField, liouville_field
+from ..checks import check_int, show
 from ..errors import InvalidSystemError, NambuBCHError
 from ..parsing import as_expression
 
@@ -104,9 +105,9 @@ def infer_bracket(n_coords: int, n_hams: int, bracket=None) -> str:
     >>> infer_bracket(4, 1), infer_bracket(3, 2), infer_bracket(6, 2), infer_bracket(3, 1, "lie-poisson")
     ('canonical', 'nambu', 'triplets', 'lie-poisson')
     """
-    N, k = n_coords, n_hams
-    if bracket is not None and bracket not in BRACKETS:
-        raise InvalidSystemError(f"bracket {bracket!r} is not known; accepted are {', '.join(BRACKETS)} (or None to infer)")
+    N, k = check_int(n_coords, "n_coords", 1), check_int(n_hams, "n_hams", 1)
+    if bracket is not None and (not isinstance(bracket, str) or bracket not in BRACKETS):
+        raise InvalidSystemError(f"bracket {show(bracket)} is not known; accepted are {', '.join(BRACKETS)} (or None to infer)")
     if bracket == "lie-poisson":
         if (N, k) != (3, 1):
             raise InvalidSystemError(
