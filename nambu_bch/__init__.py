@@ -21,6 +21,7 @@ _LAZY = {
     ".numeric": ("check", "iterate", "paper_figures", "sample_times", "shadow_along", "ShadowTrajectory"),
     ".shadow": ("LiouvilleSum", "LiouvilleTerm", "ShadowFamily", "direct_route", "fi_route", "representations",
                 "shadow_hamiltonians"),
+    ".parallel": ("sweep",),
     ".systems": ("Splitting", "System", "full_split", "model", "model_names", "separate", "single_split"),
 }
 _WHERE = {name: module for module, names in _LAZY.items() for name in names}

@@ -29,7 +29,7 @@ SURFACE = {
         "lie_bracket", "liouville_field", "model", "model_names", "modified_equations", "modified_solution",
         "nambu_bracket", "optimize_composition", "order_conditions", "paper_figures", "poisson_bracket",
         "representations", "sample_times", "satisfies_nambu_condition", "separate", "shadow_along",
-        "shadow_hamiltonians", "single_split", "step_function",
+        "shadow_hamiltonians", "single_split", "step_function", "sweep",
     ),
     "nambu_bch.algebra": (
         "ExpressionBackend", "FieldBackend", "PolynomialAlgebra", "PolynomialBackend", "VectorField",
