@@ -103,30 +103,34 @@ def _dask(function, tasks, client):
             raise InvalidRunError("backend='dask' needs a cluster: pass client=distributed.Client(...)") from None
     elif not isinstance(client, distributed.Client):
         raise InvalidRunError(f"client must be a distributed.Client, got {show(client)}")
-    # pure=False: equal tasks are still run once each, as the serial loop runs them.  Each task travels
-    # inside a _Packed object, which Dask does not look into: a tuple whose first item is callable would
-    # otherwise be read as a task of its graph, and collections would be traversed for futures.
-    futures = client.map(_run_packed, [_Packed(function, task) for task in tasks], pure=False)
-    return list(client.gather(futures))
+    # Tasks travel in batches, about four per worker thread: Dask's per-task overhead (scheduling, one
+    # message each way) is far above the cost of a small task.  pure=False: equal batches are still run
+    # once each, as the serial loop runs them.  A batch travels inside a _Packed object, which Dask does
+    # not look into: a tuple whose first item is callable would otherwise be read as a task of its graph.
+    threads = max(1, sum(client.nthreads().values()))
+    size = -(-len(tasks) // (4 * threads))
+    batches = [_Packed(function, tasks[i:i + size]) for i in range(0, len(tasks), size)]
+    futures = client.map(_run_batch, batches, pure=False)
+    return [result for batch in client.gather(futures) for result in batch]
 
 
 class _Packed:
-    """A function and one task, opaque to Dask."""
+    """A function and a list of tasks, opaque to Dask."""
 
-    __slots__ = ("function", "task")
+    __slots__ = ("function", "tasks")
 
-    def __init__(self, function, task):
-        self.function, self.task = function, task
+    def __init__(self, function, tasks):
+        self.function, self.tasks = function, tasks
 
     def __getstate__(self):
-        return self.function, self.task
+        return self.function, self.tasks
 
     def __setstate__(self, state):
-        self.function, self.task = state
+        self.function, self.tasks = state
 
 
-def _run_packed(packed):
-    return _apply(packed.function, packed.task)
+def _run_batch(packed):
+    return [_apply(packed.function, task) for task in packed.tasks]
 
 
 def _require(module, backend):
