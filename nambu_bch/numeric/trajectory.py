@@ -30,7 +30,7 @@ from ..checks import finite_float, show
 from ..errors import InvalidRunError, NumericalRangeError
 from ..integrators.composition import composition as make_composition
 from ..integrators.step import parameter_values
-from .diagnostics import QUANTITY_NAMES, DriftFit, _json_float, _names, drift_rate, numpy_function, quantities
+from .diagnostics import QUANTITY_NAMES, _json_float, _names, drift_rate, numpy_function, quantities
 from .guards import finite_array
 from .iterate import as_system
 
