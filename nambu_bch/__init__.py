@@ -18,9 +18,10 @@ _LAZY = {
     ".exact": ("F", "ConservedQuantities", "ExactShadow", "F_series", "ModifiedSolution", "conserved_quantities",
                "exact_shadow_hamiltonians", "is_invariant", "modified_equations", "modified_solution"),
     ".integrators": ("PAPER_WORDS", "Composition", "composed_map", "composition", "exact_flow", "step_function"),
-    ".numeric": ("check", "iterate", "paper_figures", "sample_times"),
+    ".numeric": ("check", "iterate", "paper_figures", "sample_times", "shadow_along", "ShadowTrajectory"),
     ".shadow": ("LiouvilleSum", "LiouvilleTerm", "ShadowFamily", "direct_route", "fi_route", "representations",
                 "shadow_hamiltonians"),
+    ".parallel": ("sweep",),
     ".systems": ("Splitting", "System", "full_split", "model", "model_names", "separate", "single_split"),
 }
 _WHERE = {name: module for module, names in _LAZY.items() for name in names}

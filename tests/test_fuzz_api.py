@@ -51,6 +51,8 @@ NOT_FUZZED = {
     "nambu_bch.cli.main": "the command line: tests/test_fuzz_cli.py drives it with random argv",
     "nambu_bch.NambuBCHError": "an exception class", "nambu_bch.cli.UsageError": "an exception class",
     "nambu_bch.design.NoSolutionError": "an exception class",
+    "nambu_bch.sweep": "runs the caller's function on the caller's tasks and raises their exceptions unchanged, as "
+                       "the serial loop would; its own arguments: tests/test_parallel.py",
 }
 #: Result records: built by the library and returned to the user, who reads them; their constructors store fields.
 RECORDS = (
@@ -59,7 +61,7 @@ RECORDS = (
     "OrderConditions", "Template", "LinearCore", "ExactFlow", "CheckResult", "DriftFit", "FigureSet", "HScan", "Kernel",
     "OrderFit", "PrecisionStudy", "StepProgram", "TruncationStudy", "DirectResult", "Existence", "FICommutator",
     "FINested", "FIOrder", "FIRepresentation", "FIResult", "OrderSolution", "Piece", "FieldBackend",
-    "ExpressionBackend", "PolynomialBackend",
+    "ExpressionBackend", "PolynomialBackend", "ShadowTrajectory",
 )
 
 
@@ -198,6 +200,8 @@ def _base_table():
         "nambu_bch.iterate": num,
         "nambu_bch.numeric.iterate_chunks": num,
         "nambu_bch.sample_times": lambda v: dict(h=0.1, steps=10),
+        "nambu_bch.shadow_along": lambda v: dict(system=v["ho3"], word="12321", trajectory=[[1.0, 1.0, 1.0]] * 4, h=0.1,
+                                                 which=("H", "H_S")),
         "nambu_bch.paper_figures": lambda v: dict(outdir="figures", t_short=1.0, t_long=2.0, every_long=1, dpi=10),
         "nambu_bch.numeric.Progress": lambda v: dict(total=10, enabled=False),
         "nambu_bch.numeric.RunningStats": lambda v: {},

@@ -65,6 +65,8 @@ ENTRIES = {
                                      chunk_samples=4)),
     "check": (numeric.check, dict(system=S, word="32123", h=0.1, steps=10, x0=[1.0, 1.0, 1.0], params=None, order=2,
                                   alpha=0.5, every=1, include=("H",), chunk_samples=None, kahan=False, backend="auto")),
+    "shadow_along": (numeric.shadow_along, dict(system=S, word="12321", trajectory=[[1.0, 1.0, 1.0]] * 4, h=0.1,
+                                                order=2, alpha=0.5, params=None, t=None, which=("H",))),
     "sample_times": (numeric.sample_times, dict(h=0.1, steps=10, every=1)),
     "sample_steps": (numeric.sample_steps, dict(steps=10, every=1)),
     "n_samples": (numeric.n_samples, dict(steps=10, every=1)),

@@ -22,14 +22,14 @@ SURFACE = {
     "nambu_bch": (
         "Composition", "ConservedQuantities", "EffectiveField", "ExactShadow", "F", "F_series", "FormalBCH",
         "LiouvilleSum", "LiouvilleTerm", "ModifiedSolution", "NambuBCHError", "PAPER_WORDS", "PolynomialAlgebra",
-        "ShadowFamily", "Splitting", "System", "VectorField", "check", "clear_caches", "compare", "composed_map",
-        "composition", "composition_order", "conserved_quantities", "direct_route", "effective_field",
+        "ShadowFamily", "ShadowTrajectory", "Splitting", "System", "VectorField", "check", "clear_caches", "compare",
+        "composed_map", "composition", "composition_order", "conserved_quantities", "direct_route", "effective_field",
         "effective_field_bch", "error_constant", "errors", "exact_flow", "exact_shadow_hamiltonians", "expand_terms",
         "fi_route", "formal_bch", "full_split", "is_invariant", "is_symplectic", "iterate", "leading_error",
         "lie_bracket", "liouville_field", "model", "model_names", "modified_equations", "modified_solution",
         "nambu_bracket", "optimize_composition", "order_conditions", "paper_figures", "poisson_bracket",
-        "representations", "sample_times", "satisfies_nambu_condition", "separate", "shadow_hamiltonians",
-        "single_split", "step_function",
+        "representations", "sample_times", "satisfies_nambu_condition", "separate", "shadow_along",
+        "shadow_hamiltonians", "single_split", "step_function", "sweep",
     ),
     "nambu_bch.algebra": (
         "ExpressionBackend", "FieldBackend", "PolynomialAlgebra", "PolynomialBackend", "VectorField",
@@ -62,9 +62,10 @@ SURFACE = {
     ),
     "nambu_bch.numeric": (
         "CheckResult", "DriftFit", "FigureSet", "HScan", "Kernel", "OrderFit", "PrecisionStudy", "Progress",
-        "RunningStats", "StepProgram", "TruncationStudy", "cache_dir", "check", "drift_rate", "fit_order", "h_scan",
-        "iterate", "iterate_chunks", "kernel", "n_samples", "numba_available", "observed_order", "paper_figures",
-        "precision_study", "quantities", "sample_steps", "sample_times", "step_program", "truncation_study",
+        "RunningStats", "ShadowTrajectory", "StepProgram", "TruncationStudy", "cache_dir", "check", "drift_rate",
+        "fit_order", "h_scan", "iterate", "iterate_chunks", "kernel", "n_samples", "numba_available", "observed_order",
+        "paper_figures", "precision_study", "quantities", "sample_steps", "sample_times", "shadow_along", "step_program",
+        "truncation_study",
     ),
     "nambu_bch.shadow": (
         "DirectResult", "Existence", "FICommutator", "FINested", "FIOrder", "FIRepresentation", "FIResult",

@@ -2,7 +2,8 @@
 
 ``iterate`` runs a scheme (numba kernels generated once from the exact sub-flows, numpy and
 mpmath fallbacks, optional Kahan summation); ``check`` measures every error the package
-predicts; ``paper_figures`` redraws Figs. 1-4; the studies answer speed-versus-accuracy questions.
+predicts; ``paper_figures`` redraws Figs. 1-4; ``shadow_along``
+evaluates the shadow pair along any trajectory; the studies answer speed-versus-accuracy questions.
 """
 
 from ..progress import Progress
@@ -13,6 +14,7 @@ from .figures import FigureSet, paper_figures
 from .iterate import iterate, iterate_chunks
 from .kernels import Kernel, cache_dir, kernel, numba_available
 from .samples import n_samples, sample_steps, sample_times
+from .trajectory import ShadowTrajectory, shadow_along
 from .studies import HScan, PrecisionStudy, TruncationStudy, h_scan, precision_study, truncation_study
 
 __all__ = [
@@ -25,6 +27,7 @@ __all__ = [
     "PrecisionStudy",
     "Progress",
     "RunningStats",
+    "ShadowTrajectory",
     "StepProgram",
     "TruncationStudy",
     "cache_dir",
@@ -43,6 +46,7 @@ __all__ = [
     "quantities",
     "sample_steps",
     "sample_times",
+    "shadow_along",
     "step_program",
     "truncation_study",
 ]
