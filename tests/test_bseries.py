@@ -48,7 +48,7 @@ def test_implicit_midpoint_hlw_ix1():
 
 
 def test_exact_flow_has_no_modification():
-    """The exact flow's B-series a(t) = 1/gamma(t) (HLW Theorem III.1.3) is its own modified field: only b(•) = 1."""
+    """The exact flow's B-series a(t) = 1/gamma(t) (HLW Sect. III.1) is its own modified field: only b(•) = 1."""
     exact = {t: sympy.Rational(1, T.density(t)) for n in range(1, 7) for t in T.trees(n)}
     assert T.modified_coefficients(exact, 6) == {LEAF: 1}
 
@@ -252,3 +252,13 @@ def test_euler_has_no_pair_and_gauss4_has_one_through_h4():
 def test_rk_iterate_refuses_blow_up():
     with pytest.raises(NumericalRangeError, match="left the float64 range"):
         rk_iterate("rigid-body", "euler", 0.5, 10**4, [10.0, 20.0, -30.0], {"I1": 1.0, "I2": 2.0, "I3": 3.0})
+
+
+@pytest.mark.parametrize("name", ["midpoint", "gauss4", "gauss6", "kahan"])
+def test_cli_refuses_runge_kutta_names_in_one_line(name, capsys):
+    """The CLI takes compositions only: an RK name is refused with exit 2 and one line saying where it is available."""
+    from nambu_bch.cli import main
+
+    assert main(["shadow", "--model", "rigid-body", "--integrator", name]) == 2
+    err = capsys.readouterr().err.strip()
+    assert "\n" not in err and f"{name!r} is a Runge-Kutta method" in err and "runge_kutta_shadow" in err

@@ -1,7 +1,7 @@
 """Butcher tableaux as checked data: exact coefficients, row sums, and the order conditions up to order 6.
 
 Order conditions ``Phi(t) = 1/gamma(t)`` for every rooted tree ``t`` with ``|t| <= p`` (Hairer, Lubich,
-Wanner, *Geometric Numerical Integration*, Theorem III.1.5); the tree counts 1, 1, 2, 4, 9, 20 (OEIS A000081).
+Wanner, *Geometric Numerical Integration*, Sect. III.1); the tree counts 1, 1, 2, 4, 9, 20 (OEIS A000081).
 """
 
 from __future__ import annotations
@@ -40,7 +40,7 @@ def test_order_conditions(name):
 
 
 def test_gauss_nodes_are_legendre_roots():
-    """Gauss-Legendre nodes are the zeros of the shifted Legendre polynomial P_s(2c - 1) (HLW Sect. II.1.3)."""
+    """Gauss-Legendre nodes are the zeros of the shifted Legendre polynomial P_s(2c - 1) (Hairer-Wanner II, Sect. IV.5)."""
     c = sympy.Symbol("c")
     for name, s in (("gauss4", 2), ("gauss6", 3)):
         for node in TABLEAUX[name].c:

@@ -2,12 +2,12 @@
 
 For ``y' = f(y)`` and a Runge--Kutta method (:mod:`nambu_bch.integrators.runge_kutta`) the
 numerical map is the B-series ``B(Phi, y)``; its modified field (backward error analysis,
-Hairer--Lubich--Wanner Sects. IX.1 and IX.9) is
+Hairer--Lubich--Wanner Sects. IX.1 and IX.9) is::
 
     f~ = f + h f_2 + h^2 f_3 + ...,   f_{j+1} = sum_{|t| = j+1} b(t)/sigma(t) F(t),
 
 with ``b`` from :func:`~nambu_bch.bseries.rooted_trees.modified_coefficients` and the elementary
-differentials ``F(t)`` (HLW Sect. III.1.1: ``F(•) = f``, ``F([t_1..t_m]) = f^(m)(F(t_1), .., F(t_m))``)
+differentials ``F(t)`` (HLW Sect. III.1: ``F(•) = f``, ``F([t_1..t_m]) = f^(m)(F(t_1), .., F(t_m))``)
 computed on the package's exact polynomial ring.  :func:`modified_equation_by_taylor` is the
 independent route: the stages are solved as power series in ``h`` by fixed-point iteration, and
 the map's series goes through the same backward error analysis as a composition
@@ -40,7 +40,7 @@ class ModifiedEquation:
     ----------
     coefficients : tuple of VectorField, ``Z_0 .. Z_order``
     order : int
-    method : ButcherTableau
+    method : the method's tableau (:class:`nambu_bch.integrators.runge_kutta.ButcherTableau`)
     system : System
     tree_coefficients : dict ``{tree: b(tree)}`` (HLW's normalisation, ``b(•) = 1``), trees up to ``order + 1`` vertices
     """
@@ -93,7 +93,7 @@ def _polynomial_field(system, tableau):
 
 
 def elementary_differentials(field: VectorField, upto: int) -> dict:
-    """``{t: F(t)}`` (tuples of ring elements) for every tree with at most ``upto`` vertices (HLW Sect. III.1.1).
+    """``{t: F(t)}`` (tuples of ring elements) for every tree with at most ``upto`` vertices (HLW Sect. III.1).
 
     ``f^(m)(v_1, .., v_m)^k = sum_{i_1..i_m} d^m f^k / dx_{i_1}..dx_{i_m} v_1^{i_1} .. v_m^{i_m}``: the
     derivatives act on ``f`` only, each partial derivative computed once.

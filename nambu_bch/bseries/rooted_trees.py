@@ -3,10 +3,10 @@
 A rooted tree is its sorted tuple of subtrees: ``()`` is the single vertex ``•``,
 ``((),)`` is ``[•]``, ``((), ())`` is ``[•, •]``.  Sorting makes the tuple canonical,
 so equal trees are equal tuples.  With the normalisation of Hairer--Lubich--Wanner
-(Sect. III.1, Definition 1.1) a B-series is ``B(a, y) = a(∅) y + sum_t h^|t| / sigma(t) a(t) F(t)(y)``;
-the Runge--Kutta map is ``B(Phi, y)`` with the elementary weights ``Phi(t)`` (Theorem III.1.4)
-and the exact flow ``B(1/gamma, y)`` (Theorem III.1.3), so order ``p`` means
-``Phi(t) = 1/gamma(t)`` for ``|t| <= p`` (Theorem III.1.5).
+(Sect. III.1) a B-series is ``B(a, y) = a(∅) y + sum_t h^|t| / sigma(t) a(t) F(t)(y)``;
+the Runge--Kutta map is ``B(Phi, y)`` with the elementary weights ``Phi(t)``
+and the exact flow ``B(1/gamma, y)``, so order ``p`` means
+``Phi(t) = 1/gamma(t)`` for ``|t| <= p`` (HLW Sect. III.1).
 
 The modified equation is computed in the plain coefficients ``d(t) = a(t)/sigma(t)`` (the
 coefficient of ``h^|t| F(t)``), where the Lie derivative needs no symmetry factors:
@@ -93,7 +93,7 @@ def graft(t, s) -> list:
 
 
 def elementary_weight(t, tableau):
-    """``Phi(t) = sum_i b_i Phi_i(t)``, ``Phi_i(t) = prod_children sum_j a_ij Phi_j(child)`` (HLW Sect. III.1.2), exact."""
+    """``Phi(t) = sum_i b_i Phi_i(t)``, ``Phi_i(t) = prod_children sum_j a_ij Phi_j(child)`` (HLW Sect. III.1), exact."""
     A, b = tableau.A, tableau.b
     s = len(b)
 

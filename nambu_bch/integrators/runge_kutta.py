@@ -16,8 +16,8 @@ equation of :mod:`nambu_bch.bseries` refuses it on fields of higher degree.
 
 References
 ----------
-Hairer, Lubich, Wanner, *Geometric Numerical Integration*, 2nd ed., Sect. II.1 (Tables 1.1, 1.2:
-Gauss methods of orders 4 and 6), Sect. III.1 (order conditions); Hairer, Norsett, Wanner,
+Hairer, Lubich, Wanner, *Geometric Numerical Integration*, 2nd ed., Sect. III.1 (order conditions);
+Hairer, Wanner, *Solving ODEs II*, Sect. IV.5 (Gauss methods); Hairer, Norsett, Wanner,
 *Solving ODEs I*, Sect. II.1 (classical RK4), II.7 (implicit Euler, trapezoidal rule).
 """
 
@@ -87,12 +87,12 @@ TABLEAUX = {
         _tableau("rk4", [[0, 0, 0, 0], [R(1, 2), 0, 0, 0], [0, R(1, 2), 0, 0], [0, 0, 1, 0]],
                  [R(1, 6), R(1, 3), R(1, 3), R(1, 6)], 4, "classical Runge-Kutta; Hairer-Norsett-Wanner I, Sect. II.1"),
         _tableau("gauss4", [[R(1, 4), R(1, 4) - _S3 / 6], [R(1, 4) + _S3 / 6, R(1, 4)]], [R(1, 2), R(1, 2)], 4,
-                 "Gauss-Legendre, s = 2; Hairer-Lubich-Wanner Sect. II.1.3, Table 1.1"),
+                 "Gauss-Legendre, s = 2; Hairer-Wanner II, Sect. IV.5"),
         _tableau("gauss6",
                  [[R(5, 36), R(2, 9) - _S15 / 15, R(5, 36) - _S15 / 30],
                   [R(5, 36) + _S15 / 24, R(2, 9), R(5, 36) - _S15 / 24],
                   [R(5, 36) + _S15 / 30, R(2, 9) + _S15 / 15, R(5, 36)]],
-                 [R(5, 18), R(4, 9), R(5, 18)], 6, "Gauss-Legendre, s = 3; Hairer-Lubich-Wanner Sect. II.1.3, Table 1.2"),
+                 [R(5, 18), R(4, 9), R(5, 18)], 6, "Gauss-Legendre, s = 3; Hairer-Wanner II, Sect. IV.5"),
         _tableau("kahan", [[0, 0, 0], [R(-1, 4), 1, R(-1, 4)], [R(-1, 2), 2, R(-1, 2)]], [R(-1, 2), 2, R(-1, 2)], 2,
                  "Kahan's method on quadratic fields; Celledoni-McLachlan-Owren-Quispel, J. Phys. A 46 (2013) 025201",
                  quadratic_only=True),
