@@ -262,3 +262,17 @@ def test_cli_refuses_runge_kutta_names_in_one_line(name, capsys):
     assert main(["shadow", "--model", "rigid-body", "--integrator", name]) == 2
     err = capsys.readouterr().err.strip()
     assert "\n" not in err and f"{name!r} is a Runge-Kutta method" in err and "runge_kutta_shadow" in err
+
+
+def test_wrong_arguments_are_one_line():
+    """An array given as the order or the method is shown on one line (the messages echo the value)."""
+    from nambu_bch.errors import InvalidOrderError
+
+    for call in (lambda: modified_equation("ho", "midpoint", np.ones((2, 2))),
+                 lambda: modified_equation("ho", np.ones((2, 2)), 2),
+                 lambda: rk_iterate("ho", "midpoint", 0.1, 3, [1.0, 0.0], params=np.ones((2, 2)))):
+        with pytest.raises(NambuBCHError) as info:
+            call()
+        assert "\n" not in str(info.value)
+    with pytest.raises(InvalidOrderError, match=r"got array\(\[\[1\., 1\.\], \[1\., 1\.\]\]\)"):
+        modified_equation("ho", "midpoint", np.ones((2, 2)))

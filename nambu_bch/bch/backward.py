@@ -25,7 +25,7 @@ import sympy
 
 from ..algebra import VectorField
 from ..algebra.backend import field_backend
-from ..checks import MAX_ORDER, check_flag, check_int
+from ..checks import MAX_ORDER, check_flag, check_int, show
 from ..errors import InvalidOrderError
 from ..integrators.composition import composition_for
 from ..printing import Printable, aligned
@@ -44,14 +44,14 @@ def check_order(order, limit: int = MAX_ORDER) -> int:
     """
     limit = check_int(limit, "limit", 0)
     if isinstance(order, (bool, str, bytes)) or order is None:
-        raise InvalidOrderError(f"order must be a non-negative integer, got {order!r}")
+        raise InvalidOrderError(f"order must be a non-negative integer, got {show(order)}")
     if not isinstance(order, int):
         try:
             if float(order) != int(order):
                 raise ValueError
             order = int(order)
         except (TypeError, ValueError, OverflowError):
-            raise InvalidOrderError(f"order must be a non-negative integer, got {order!r}") from None
+            raise InvalidOrderError(f"order must be a non-negative integer, got {show(order)}") from None
     if order < 0 or order > limit:
         raise InvalidOrderError(f"order must be an integer between 0 and {limit}, got {order}")
     return order

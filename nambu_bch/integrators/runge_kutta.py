@@ -27,6 +27,7 @@ from dataclasses import dataclass
 
 import sympy
 
+from ..checks import show
 from ..errors import InvalidCompositionError
 
 R = sympy.Rational
@@ -111,4 +112,4 @@ def butcher_tableau(method) -> ButcherTableau:
     if isinstance(method, str) and method in TABLEAUX:
         return TABLEAUX[method]
     raise InvalidCompositionError(
-        f"unknown Runge-Kutta method {method!r}; accepted are {', '.join(TABLEAUX)} or a ButcherTableau")
+        f"unknown Runge-Kutta method {show(method)}; accepted are {', '.join(TABLEAUX)} or a ButcherTableau")

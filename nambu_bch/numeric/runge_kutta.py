@@ -74,9 +74,11 @@ def rk_step_function(system, method, params=None):
 
 def rk_iterate(system, method, h, steps, x0, params=None, every=1) -> np.ndarray:
     """``steps`` steps of the Runge--Kutta ``method``; the states at steps ``0, every, 2 every, ..`` (shape ``(samples, N)``)."""
+    from ..integrators.step import parameter_values
     from ..systems.system import as_system
 
     system = as_system(system)
+    parameter_values(system, params)  # first: its message shows a wrong params value on one line
     h, steps, every, y, values = check_inputs(system, h, steps, every, x0, params)
     if y.ndim != 1:
         raise InvalidRunError(f"x0 must have shape ({system.N},) for a Runge-Kutta run, got {y.shape}")
