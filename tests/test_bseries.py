@@ -215,24 +215,27 @@ def test_midpoint_volume_change_measured():
     assert errors[2] < errors[1] < errors[0] and errors[2] < 0.01 * abs(div(*x0))
 
 
-def test_midpoint_iteration_keeps_h_and_g_to_round_off():
+@pytest.mark.parametrize("method", ["midpoint", "gauss4"])
+def test_gauss_iteration_keeps_h_and_g_to_round_off(method):
+    """Gauss methods keep quadratic invariants (HLW Sect. IV.2): H and G of the rigid body to round-off."""
     S = model("rigid-body")
     P = {"I1": 1.0, "I2": 2.0, "I3": 3.0}
     values = {sympy.Symbol(k): v for k, v in P.items()}
-    X = rk_iterate(S, "midpoint", 0.1, 500, [1.0, 0.5, -0.7], P, every=5)
+    X = rk_iterate(S, method, 0.1, 300, [1.0, 0.5, -0.7], P, every=5)
     for Hk in S.hamiltonians:
         q = sympy.lambdify(S.coordinates, Hk.subs(values))
         values_k = np.array([q(*x) for x in X])
         assert np.max(np.abs(values_k - values_k[0])) < 1e-13
 
 
-@pytest.mark.parametrize("system", ["ho3", "lotka-volterra"])
-def test_midpoint_shadow_pair_field_equals_modified_field(system):
+@pytest.mark.parametrize("system, method", [("ho3", "midpoint"), ("lotka-volterra", "midpoint"),
+                                            ("rigid-body", "gauss4")])
+def test_shadow_pair_field_equals_modified_field(system, method):
     """Where the pair exists, X_{H_S,G_S} equals the modified field through h^4 (both members alpha = 0, 1)."""
     S = model(system)
-    R = runge_kutta_shadow(S, "midpoint", 4)
+    R = runge_kutta_shadow(S, method, 4)
     assert R.exists
-    M = modified_equation(S, "midpoint", 4)
+    M = modified_equation(S, method, 4)
     alpha = sympy.Symbol("alpha")
     for a in (0, 1):
         pair = [sympy.expand(e.subs(alpha, a)) for e in R.shadow()]
@@ -242,11 +245,14 @@ def test_midpoint_shadow_pair_field_equals_modified_field(system):
             assert all(sympy.degree(t, h) >= 5 for t in sympy.Add.make_args(diff)) or diff == 0
 
 
-def test_euler_has_no_pair_and_gauss4_has_one_through_h4():
-    """Explicit Euler is obstructed at h^1 (it does not keep H); gauss4 on the rigid body is solved through h^4."""
+def test_euler_has_no_pair_and_gauss4_has_one_through_h4_only():
+    """Explicit Euler is obstructed at h^1 (it does not keep H); gauss4 on the rigid body is solved through h^4 and
+    obstructed at h^6, where its field's divergence is first non-zero (h^5 vanishes: a symmetric method)."""
     assert runge_kutta_shadow("rigid-body", "euler", 1).failed_order == 1
-    R = runge_kutta_shadow("rigid-body", "gauss4", 4)
-    assert R.exists and [o.status for o in R.orders] == ["vanishes"] * 3 + ["solved"]
+    R = runge_kutta_shadow("rigid-body", "gauss4", 6)
+    assert [o.status for o in R.orders] == ["vanishes"] * 3 + ["solved", "vanishes", "obstructed"]
+    M = R.effective
+    assert all(not Z.divergence() for Z in M.coefficients[:6]) and M[6].divergence()
 
 
 def test_rk_iterate_refuses_blow_up():
