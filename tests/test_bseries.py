@@ -282,3 +282,16 @@ def test_wrong_arguments_are_one_line():
         assert "\n" not in str(info.value)
     with pytest.raises(InvalidOrderError, match=r"got array\(\[\[1\., 1\.\], \[1\., 1\.\]\]\)"):
         modified_equation("ho", "midpoint", np.ones((2, 2)))
+
+
+def test_direct_route_checks_a_given_field():
+    """direct_route(effective=...) refuses something that is not h^0..h^order fields on the system's coordinates."""
+    from nambu_bch import direct_route
+
+    M = modified_equation("ho", "midpoint", 2)
+    with pytest.raises(NambuBCHError, match=r"coefficients of h\^0 \.\. h\^4"):
+        direct_route("ho", "midpoint", 4, effective=M)
+    with pytest.raises(NambuBCHError, match="vector fields on ho3's coordinates"):
+        direct_route("ho3", "midpoint", 2, effective=[1, 2, 3])
+    R = direct_route("ho", "midpoint", 2, effective=M)   # a plain label is enough
+    assert R.exists and R.composition == "midpoint"

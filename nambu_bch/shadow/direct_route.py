@@ -69,7 +69,7 @@ from ..algebra.ansatz import Ansatz, Rows
 from ..algebra import elimination, frac_rref
 from ..algebra.elimination import elimination_cost, rank, signed_sums
 from ..bch.backward import check_order
-from ..checks import check_flag
+from ..checks import check_flag, show
 from ..bch.concrete import effective_field_by_cost
 from ..errors import InvalidOrderError, NambuBCHError, ResourceLimitError
 from ..integrators.composition import composition_for
@@ -611,6 +611,8 @@ def direct_route(system, word, order: int = 2, degree=None, max_unknowns=None, p
             raise InvalidOrderError(f"degree must be a positive integer (the ansatz degree) or None, got {degree!r}")
         _check_ansatz_size(len(system.hamiltonians), system.N, degree)
     comp = composition_for(word, system.splitting) if effective is None else word
+    if effective is not None:
+        _check_effective(effective, system, order)
     if not all(system.algebra.is_polynomial(system.algebra.convert(Hk)) for Hk in system.hamiltonians):
         if effective is not None:
             raise NambuBCHError("the direct route on a given field needs polynomial Hamiltonians")
@@ -622,7 +624,7 @@ def direct_route(system, word, order: int = 2, degree=None, max_unknowns=None, p
     orders = []
     from ..progress import stages
 
-    for j in stages(range(1, order + 1), f"shadow {comp.name} on {system.name}: orders", enabled=progress):
+    for j in stages(range(1, order + 1), f"shadow {getattr(comp, 'name', comp)} on {system.name}: orders", enabled=progress):
         sol = solver.solve_order(j, corrections)
         orders.append(sol)
         if sol.status in ("obstructed", "refused"):
@@ -635,6 +637,16 @@ def direct_route(system, word, order: int = 2, degree=None, max_unknowns=None, p
             # series on their Hamiltonians is the shadow Hamiltonian (verified against backward error analysis)
             return _non_polynomial(system, comp, order)
     return DirectResult(system, comp, order, orders, solver.hams, solver.alg, solver.effective, corrections)
+
+
+def _check_effective(effective, system, order) -> None:
+    """A given modified field: its coefficients ``h^0 .. h^order`` are vector fields on the system's coordinates."""
+    try:
+        fields = [effective[j] for j in range(order + 1)]
+    except (TypeError, IndexError, KeyError):
+        raise NambuBCHError(f"effective must hold the field's coefficients of h^0 .. h^{order}, got {show(effective)}") from None
+    if not all(isinstance(Z, VectorField) and Z.algebra.coordinates == system.coordinates for Z in fields):
+        raise NambuBCHError(f"effective must hold vector fields on {system.name}'s coordinates, got {show(effective)}")
 
 
 def _non_polynomial(system, comp, order) -> DirectResult:
