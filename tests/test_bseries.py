@@ -109,6 +109,8 @@ def test_refusals():
         modified_equation(System("x1 x2", ["x2**2/2 - cos(x1)"]), "midpoint", 2)
     with pytest.raises(NambuBCHError, match="order must be"):
         modified_equation("ho", "midpoint", -1)
+    with pytest.raises(NambuBCHError, match="order must be an integer between 0 and 8, got 9"):
+        modified_equation("ho", "midpoint", 9)
     with pytest.raises(InvalidCompositionError, match="unknown Runge-Kutta method"):
         modified_equation("ho", "12321", 2)
 
