@@ -297,3 +297,12 @@ def test_direct_route_checks_a_given_field():
         direct_route("ho3", "midpoint", 2, effective=[1, 2, 3])
     R = direct_route("ho", "midpoint", 2, effective=M)   # a plain label is enough
     assert R.exists and R.composition == "midpoint"
+
+
+def test_results_pickle():
+    import pickle
+
+    M = modified_equation("rigid-body", "midpoint", 2)
+    back = pickle.loads(pickle.dumps(M))
+    assert all(a == b for a, b in zip(M.coefficients, back.coefficients)) and back.tree_coefficients == M.tree_coefficients
+    assert pickle.loads(pickle.dumps(TABLEAUX["gauss4"])) == TABLEAUX["gauss4"]
