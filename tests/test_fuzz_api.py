@@ -61,7 +61,7 @@ RECORDS = (
     "OrderConditions", "Template", "LinearCore", "ExactFlow", "CheckResult", "DriftFit", "FigureSet", "HScan", "Kernel",
     "OrderFit", "PrecisionStudy", "StepProgram", "TruncationStudy", "DirectResult", "Existence", "FICommutator",
     "FINested", "FIOrder", "FIRepresentation", "FIResult", "OrderSolution", "Piece", "FieldBackend",
-    "ExpressionBackend", "PolynomialBackend", "ShadowTrajectory",
+    "ExpressionBackend", "PolynomialBackend", "ShadowTrajectory", "ButcherTableau",
 )
 
 
@@ -182,6 +182,13 @@ def _base_table():
         "nambu_bch.is_invariant": lambda v: dict(system=v["ho3"], word="12321", quantity=v["G"]),
         "nambu_bch.modified_equations": lambda v: dict(system=v["ho3"], word="12321", kind="s"),
         "nambu_bch.modified_solution": lambda v: dict(system=v["ho3"], word="12321", kind="s"),
+        # Runge-Kutta methods
+        "nambu_bch.butcher_tableau": lambda v: dict(method="midpoint"),
+        "nambu_bch.modified_equation": lambda v: dict(system=v["ho3"], method="midpoint", order=2),
+        "nambu_bch.runge_kutta_shadow": lambda v: dict(system=v["ho3"], method="midpoint", order=2),
+        "nambu_bch.numeric.rk_iterate": lambda v: dict(system=v["ho3"], method="midpoint", h=0.1, steps=10,
+                                                       x0=(1.0, 1.0, 1.0)),
+        "nambu_bch.numeric.rk_step_function": lambda v: dict(system=v["ho3"], method="midpoint"),
         "nambu_bch.exact.linear_core": lambda v: dict(coordinates=v["x"][:2], rhs=(v["x"][1], -v["x"][0])),
         # design
         "nambu_bch.compare": lambda v: dict(system=v["ho3"], words=("12321",), t_end=1.0, steps=(4, 8), samples=5),

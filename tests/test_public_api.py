@@ -20,16 +20,19 @@ from nambu_bch.caches import CACHES
 
 SURFACE = {
     "nambu_bch": (
-        "Composition", "ConservedQuantities", "EffectiveField", "ExactShadow", "F", "F_series", "FormalBCH",
+        "ButcherTableau", "Composition", "ConservedQuantities", "EffectiveField", "ExactShadow", "F", "F_series",
+        "FormalBCH",
         "LiouvilleSum", "LiouvilleTerm", "ModifiedSolution", "NambuBCHError", "PAPER_WORDS", "PolynomialAlgebra",
-        "ShadowFamily", "ShadowTrajectory", "Splitting", "System", "VectorField", "check", "clear_caches", "compare",
-        "composed_map", "composition", "composition_order", "conserved_quantities", "direct_route", "effective_field",
+        "ShadowFamily", "ShadowTrajectory", "Splitting", "System", "VectorField", "butcher_tableau", "check",
+        "clear_caches", "compare", "composed_map", "composition", "composition_order", "conserved_quantities",
+        "direct_route", "effective_field",
         "effective_field_bch", "error_constant", "errors", "exact_flow", "exact_shadow_hamiltonians", "expand_terms",
         "fi_route", "formal_bch", "full_split", "is_invariant", "is_symplectic", "iterate", "leading_error",
-        "lie_bracket", "liouville_field", "model", "model_names", "modified_equations", "modified_solution",
+        "lie_bracket", "liouville_field", "model", "model_names", "modified_equation", "modified_equations",
+        "modified_solution",
         "nambu_bracket", "optimize_composition", "order_conditions", "paper_figures", "poisson_bracket",
-        "representations", "sample_times", "satisfies_nambu_condition", "separate", "shadow_along",
-        "shadow_hamiltonians", "single_split", "step_function", "sweep",
+        "representations", "runge_kutta_shadow", "sample_times", "satisfies_nambu_condition", "separate",
+        "shadow_along", "shadow_hamiltonians", "single_split", "step_function", "sweep",
     ),
     "nambu_bch.algebra": (
         "ExpressionBackend", "FieldBackend", "PolynomialAlgebra", "PolynomialBackend", "VectorField",
@@ -41,6 +44,10 @@ SURFACE = {
         "effective_field_bch", "estimate_size", "expand_terms", "formal_bch", "is_bracket", "lie_to_associative",
         "lyndon_words", "standard_bracketing", "terms_to_latex", "tree_degree", "tree_to_associative",
         "tree_to_latex", "witt_dimension",
+    ),
+    "nambu_bch.bseries": (
+        "ModifiedEquation", "density", "elementary_weight", "graft", "modified_coefficients", "modified_equation",
+        "modified_equation_by_taylor", "order", "runge_kutta_shadow", "symmetry", "trees",
     ),
     "nambu_bch.cli": (
         "SUBCOMMANDS", "UsageError", "build_parser", "main",
@@ -57,15 +64,16 @@ SURFACE = {
         "modified_solution",
     ),
     "nambu_bch.integrators": (
-        "Composition", "ExactFlow", "PAPER_WORDS", "composed_map", "composition", "composition_for", "exact_flow",
+        "ButcherTableau", "Composition", "ExactFlow", "PAPER_WORDS", "TABLEAUX", "butcher_tableau", "composed_map",
+        "composition", "composition_for", "exact_flow",
         "parameter_values", "step_function", "strang_word", "subflow_functions",
     ),
     "nambu_bch.numeric": (
         "CheckResult", "DriftFit", "FigureSet", "HScan", "Kernel", "OrderFit", "PrecisionStudy", "Progress",
         "RunningStats", "ShadowTrajectory", "StepProgram", "TruncationStudy", "cache_dir", "check", "drift_rate",
         "fit_order", "h_scan", "iterate", "iterate_chunks", "kernel", "n_samples", "numba_available", "observed_order",
-        "paper_figures", "precision_study", "quantities", "sample_steps", "sample_times", "shadow_along", "step_program",
-        "truncation_study",
+        "paper_figures", "precision_study", "quantities", "rk_iterate", "rk_step_function", "sample_steps",
+        "sample_times", "shadow_along", "step_program", "truncation_study",
     ),
     "nambu_bch.shadow": (
         "DirectResult", "Existence", "FICommutator", "FINested", "FIOrder", "FIRepresentation", "FIResult",

@@ -25,7 +25,7 @@ import sympy
 
 from ..algebra import VectorField
 from ..algebra.backend import field_backend
-from ..checks import MAX_ORDER, check_flag, check_int
+from ..checks import MAX_ORDER, check_flag, check_int, show
 from ..errors import InvalidOrderError
 from ..integrators.composition import composition_for
 from ..printing import Printable, aligned
@@ -44,14 +44,14 @@ def check_order(order, limit: int = MAX_ORDER) -> int:
     """
     limit = check_int(limit, "limit", 0)
     if isinstance(order, (bool, str, bytes)) or order is None:
-        raise InvalidOrderError(f"order must be a non-negative integer, got {order!r}")
+        raise InvalidOrderError(f"order must be a non-negative integer, got {show(order)}")
     if not isinstance(order, int):
         try:
             if float(order) != int(order):
                 raise ValueError
             order = int(order)
         except (TypeError, ValueError, OverflowError):
-            raise InvalidOrderError(f"order must be a non-negative integer, got {order!r}") from None
+            raise InvalidOrderError(f"order must be a non-negative integer, got {show(order)}") from None
     if order < 0 or order > limit:
         raise InvalidOrderError(f"order must be an integer between 0 and {limit}, got {order}")
     return order
@@ -185,6 +185,20 @@ def _backward_graded(backend, comp, order) -> tuple:
         for k, c in reversed(list(zip(comp.pieces, backend.constants(comp.coefficients)))):
             series = exp_pullback(backend.fields[k], c, series)
         pulled.append(series)
+    return modified_field_of_map(backend, pulled, order)
+
+
+def modified_field_of_map(backend, pulled, order) -> tuple:
+    """``Z_0 .. Z_order`` of the field whose time-``h`` flow is the map with ``[h^m] Phi_h^* x_i = pulled[i][m]``.
+
+    ``pulled[i]`` lists the ``h``-free coefficients ``m = 0 .. order + 1`` of the map's ``i``-th
+    component (elements of ``backend``'s ring); any map ``x + O(h)`` given as a series in ``h``
+    (a composition's pull-back, a Runge--Kutta step expanded by Taylor) has this modified field
+    (Hairer-Lubich-Wanner IX.1).
+    """
+    coords, zero = backend.coordinates, backend.zero
+    n = len(coords)
+    top = order + 1
     Z = []
     # U[i][k][m] = [h^m] (hY)^k x_i
     U = [[[x] + [zero] * top] + [[zero] * (top + 1) for _ in range(top)] for x in coords]

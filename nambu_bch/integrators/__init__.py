@@ -3,11 +3,15 @@
 from .compose import composed_map
 from .composition import PAPER_WORDS, Composition, composition, composition_for, strang_word
 from .flows import ExactFlow, exact_flow
+from .runge_kutta import TABLEAUX, ButcherTableau, butcher_tableau
 from .step import parameter_values, step_function, subflow_functions
 
 __all__ = [
     "PAPER_WORDS",
+    "TABLEAUX",
+    "ButcherTableau",
     "Composition",
+    "butcher_tableau",
     "ExactFlow",
     "composed_map",
     "composition",

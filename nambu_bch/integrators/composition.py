@@ -557,6 +557,12 @@ def _generic(text) -> Composition:
                 raise InvalidCompositionError(f"composition item {_shown(item)} of {_shown(text)} is not of the form 'piece:coefficient'")
             pairs.append((int(k), c.strip()))
         return composition(pairs)
+    from .runge_kutta import TABLEAUX
+
+    if low in TABLEAUX:  # a Runge-Kutta method is no word over the pieces: say where it is available
+        raise InvalidCompositionError(
+            f"{text!r} is a Runge-Kutta method, not a composition of the pieces; its modified equation and shadow "
+            "question are nambu_bch.modified_equation and nambu_bch.runge_kutta_shadow (not yet on the command line)")
     if not text.isdigit() or "0" in text:
         raise InvalidCompositionError(
             f"unknown composition {text!r}{did_you_mean(text, _NAMES) if not text.isdigit() else ''}; "

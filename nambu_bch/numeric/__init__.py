@@ -13,6 +13,7 @@ from .diagnostics import (CheckResult, DriftFit, OrderFit, RunningStats, check, 
 from .figures import FigureSet, paper_figures
 from .iterate import iterate, iterate_chunks
 from .kernels import Kernel, cache_dir, kernel, numba_available
+from .runge_kutta import rk_iterate, rk_step_function
 from .samples import n_samples, sample_steps, sample_times
 from .trajectory import ShadowTrajectory, shadow_along
 from .studies import HScan, PrecisionStudy, TruncationStudy, h_scan, precision_study, truncation_study
@@ -44,6 +45,8 @@ __all__ = [
     "paper_figures",
     "precision_study",
     "quantities",
+    "rk_iterate",
+    "rk_step_function",
     "sample_steps",
     "sample_times",
     "shadow_along",

@@ -69,7 +69,7 @@ from ..algebra.ansatz import Ansatz, Rows
 from ..algebra import elimination, frac_rref
 from ..algebra.elimination import elimination_cost, rank, signed_sums
 from ..bch.backward import check_order
-from ..checks import check_flag
+from ..checks import check_flag, show
 from ..bch.concrete import effective_field_by_cost
 from ..errors import InvalidOrderError, NambuBCHError, ResourceLimitError
 from ..integrators.composition import composition_for
@@ -296,14 +296,16 @@ def _sympy_forms(alg, fam, mem_polys) -> tuple:
 
 
 class _Solver:
-    def __init__(self, system, comp, order, degree, max_unknowns=None):
+    def __init__(self, system, comp, order, degree, max_unknowns=None, effective=None):
         self.max_unknowns = max_unknowns
         self.system = system
         self.comp = comp
         self.order = order
         self.degree = degree
         splitting = system.splitting
-        self.effective = effective_field_by_cost(splitting, comp, order)  # backward route for algebraic coefficients
+        if effective is None:
+            effective = effective_field_by_cost(splitting, comp, order)  # backward route for algebraic coefficients
+        self.effective = effective
         alg0 = self.effective[0].algebra
         self.alg = alg = alg0.with_constants(ALPHA)
         self.n = alg.n
@@ -569,7 +571,8 @@ class _Solver:
         return rank(vecs, len(ansatz), alg.domain) if vecs else 0
 
 
-def direct_route(system, word, order: int = 2, degree=None, max_unknowns=None, progress=None) -> DirectResult:
+def direct_route(system, word, order: int = 2, degree=None, max_unknowns=None, progress=None,
+                 effective=None) -> DirectResult:
     """Solve ``X_{H_S,G_S} = X_eff + O(h^{order+1})`` order by order (Eq. L2; Eq. L1 for N = 2).
 
     Parameters
@@ -582,6 +585,10 @@ def direct_route(system, word, order: int = 2, degree=None, max_unknowns=None, p
         whose elimination is estimated above :data:`SOLVE_COST`; None: neither limit (only :data:`MAX_UNKNOWNS`)
     progress : bool or None -- a progress bar over the orders (tqdm); None: on a terminal or in
         Jupyter once the run has lasted a second (:func:`nambu_bch.progress.stages`)
+    effective : optional -- a given modified field instead of the composition's (indexable by the power of
+        ``h`` through ``order``, polynomial ``VectorField``s on the system's algebra, e.g. a Runge--Kutta
+        method's :class:`~nambu_bch.bseries.modified.ModifiedEquation`); ``word`` is then only its label
+        (an object with a ``name``)
 
     Returns
     -------
@@ -603,22 +610,26 @@ def direct_route(system, word, order: int = 2, degree=None, max_unknowns=None, p
         if isinstance(degree, bool) or not isinstance(degree, int) or degree < 1:
             raise InvalidOrderError(f"degree must be a positive integer (the ansatz degree) or None, got {degree!r}")
         _check_ansatz_size(len(system.hamiltonians), system.N, degree)
-    comp = composition_for(word, system.splitting)
+    comp = composition_for(word, system.splitting) if effective is None else word
+    if effective is not None:
+        _check_effective(effective, system, order)
     if not all(system.algebra.is_polynomial(system.algebra.convert(Hk)) for Hk in system.hamiltonians):
+        if effective is not None:
+            raise NambuBCHError("the direct route on a given field needs polynomial Hamiltonians")
         return _non_polynomial(system, comp, order)
     if max_unknowns is not None and (isinstance(max_unknowns, bool) or not isinstance(max_unknowns, int) or max_unknowns < 1):
         raise InvalidOrderError(f"max_unknowns must be a positive integer or None, got {max_unknowns!r}")
-    solver = _Solver(system, comp, order, degree, max_unknowns)
+    solver = _Solver(system, comp, order, degree, max_unknowns, effective)
     corrections: dict = {}
     orders = []
     from ..progress import stages
 
-    for j in stages(range(1, order + 1), f"shadow {comp.name} on {system.name}: orders", enabled=progress):
+    for j in stages(range(1, order + 1), f"shadow {getattr(comp, 'name', comp)} on {system.name}: orders", enabled=progress):
         sol = solver.solve_order(j, corrections)
         orders.append(sol)
         if sol.status in ("obstructed", "refused"):
             break
-    if orders and orders[-1].status == "refused":  # order 0 solves nothing: H_S = H, G_S = G
+    if orders and orders[-1].status == "refused" and effective is None:  # order 0 solves nothing: H_S = H, G_S = G
         from .generic import poisson_structure
 
         if poisson_structure(system) is not None:
@@ -626,6 +637,16 @@ def direct_route(system, word, order: int = 2, degree=None, max_unknowns=None, p
             # series on their Hamiltonians is the shadow Hamiltonian (verified against backward error analysis)
             return _non_polynomial(system, comp, order)
     return DirectResult(system, comp, order, orders, solver.hams, solver.alg, solver.effective, corrections)
+
+
+def _check_effective(effective, system, order) -> None:
+    """A given modified field: its coefficients ``h^0 .. h^order`` are vector fields on the system's coordinates."""
+    try:
+        fields = [effective[j] for j in range(order + 1)]
+    except (TypeError, IndexError, KeyError):
+        raise NambuBCHError(f"effective must hold the field's coefficients of h^0 .. h^{order}, got {show(effective)}") from None
+    if not all(isinstance(Z, VectorField) and Z.algebra.coordinates == system.coordinates for Z in fields):
+        raise NambuBCHError(f"effective must hold vector fields on {system.name}'s coordinates, got {show(effective)}")
 
 
 def _non_polynomial(system, comp, order) -> DirectResult:

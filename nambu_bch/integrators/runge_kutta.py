@@ -1,0 +1,115 @@
+"""Runge--Kutta methods as frozen data: Butcher tableaux with exact coefficients.
+
+A tableau ``(A, b, c)`` defines the map ``y1 = y + h sum_i b_i f(Y_i)`` with stages
+``Y_i = y + h sum_j a_ij f(Y_j)`` (explicit when ``A`` is strictly lower triangular).
+Coefficients are sympy ``Rational`` numbers or exact radicals (Gauss--Legendre), never
+floats; each tableau names its reference and its classical order, and the test suite
+checks the order conditions ``Phi(t) = 1/gamma(t)`` on every rooted tree up to order 6
+(:mod:`nambu_bch.bseries.rooted_trees`).
+
+Kahan's method (Kahan--Hirota--Kimura) is not a Runge--Kutta method in general, but on
+*quadratic* vector fields it coincides with the three-stage method
+``(x' - x)/h = -f(x)/2 + 2 f((x + x')/2) - f(x')/2`` (Celledoni, McLachlan, Owren,
+Quispel, "Geometric properties of Kahan's method", J. Phys. A 46 (2013) 025201);
+the tableau ``"kahan"`` below is that method, and the modified
+equation of :mod:`nambu_bch.bseries` refuses it on fields of higher degree.
+
+References
+----------
+Hairer, Lubich, Wanner, *Geometric Numerical Integration*, 2nd ed., Sect. III.1 (order conditions);
+Hairer, Wanner, *Solving ODEs II*, Sect. IV.5 (Gauss methods); Hairer, Norsett, Wanner,
+*Solving ODEs I*, Sect. II.1 (classical RK4), II.7 (implicit Euler, trapezoidal rule).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import sympy
+
+from ..checks import show
+from ..errors import InvalidCompositionError
+
+R = sympy.Rational
+
+
+@dataclass(frozen=True)
+class ButcherTableau:
+    """A Runge--Kutta method ``(A, b, c)`` with exact coefficients.
+
+    Attributes
+    ----------
+    name : str -- the key of :data:`TABLEAUX`
+    A : tuple of tuples, ``s x s``
+    b, c : tuples of length ``s`` (``c_i = sum_j a_ij``)
+    order : int -- the classical order (the largest ``p`` with every order condition of order ``<= p``)
+    reference : str
+    quadratic_only : bool -- the tableau is the method's B-series only on quadratic vector fields (Kahan)
+    """
+
+    name: str
+    A: tuple
+    b: tuple
+    c: tuple
+    order: int
+    reference: str
+    quadratic_only: bool = False
+
+    @property
+    def stages(self) -> int:
+        return len(self.b)
+
+    @property
+    def is_explicit(self) -> bool:
+        return all(self.A[i][j] == 0 for i in range(self.stages) for j in range(i, self.stages))
+
+    def __str__(self):
+        return self.name
+
+
+def _tableau(name, A, b, order, reference, quadratic_only=False) -> ButcherTableau:
+    A = tuple(tuple(sympy.nsimplify(a) if not isinstance(a, sympy.Basic) else a for a in row) for row in A)
+    b = tuple(sympy.sympify(x) for x in b)
+    c = tuple(sympy.radsimp(sympy.expand(sum(row, sympy.Integer(0)))) for row in A)
+    return ButcherTableau(name, A, b, c, order, reference, quadratic_only)
+
+
+_S3, _S15 = sympy.sqrt(3), sympy.sqrt(15)
+
+#: The built-in tableaux, by the names the API accepts.
+TABLEAUX = {
+    t.name: t
+    for t in (
+        _tableau("euler", [[0]], [1], 1, "explicit Euler; Hairer-Lubich-Wanner Sect. IX.1"),
+        _tableau("implicit-euler", [[1]], [1], 1, "implicit Euler; Hairer-Norsett-Wanner I, Sect. II.7"),
+        _tableau("midpoint", [[R(1, 2)]], [1], 2, "implicit midpoint rule; Hairer-Lubich-Wanner Sect. I.1, IX.1"),
+        _tableau("trapezoid", [[0, 0], [R(1, 2), R(1, 2)]], [R(1, 2), R(1, 2)], 2,
+                 "trapezoidal rule (Lobatto IIIA, s = 2); Hairer-Lubich-Wanner Sect. II.1"),
+        _tableau("rk4", [[0, 0, 0, 0], [R(1, 2), 0, 0, 0], [0, R(1, 2), 0, 0], [0, 0, 1, 0]],
+                 [R(1, 6), R(1, 3), R(1, 3), R(1, 6)], 4, "classical Runge-Kutta; Hairer-Norsett-Wanner I, Sect. II.1"),
+        _tableau("gauss4", [[R(1, 4), R(1, 4) - _S3 / 6], [R(1, 4) + _S3 / 6, R(1, 4)]], [R(1, 2), R(1, 2)], 4,
+                 "Gauss-Legendre, s = 2; Hairer-Wanner II, Sect. IV.5"),
+        _tableau("gauss6",
+                 [[R(5, 36), R(2, 9) - _S15 / 15, R(5, 36) - _S15 / 30],
+                  [R(5, 36) + _S15 / 24, R(2, 9), R(5, 36) - _S15 / 24],
+                  [R(5, 36) + _S15 / 30, R(2, 9) + _S15 / 15, R(5, 36)]],
+                 [R(5, 18), R(4, 9), R(5, 18)], 6, "Gauss-Legendre, s = 3; Hairer-Wanner II, Sect. IV.5"),
+        _tableau("kahan", [[0, 0, 0], [R(-1, 4), 1, R(-1, 4)], [R(-1, 2), 2, R(-1, 2)]], [R(-1, 2), 2, R(-1, 2)], 2,
+                 "Kahan's method on quadratic fields; Celledoni-McLachlan-Owren-Quispel, J. Phys. A 46 (2013) 025201",
+                 quadratic_only=True),
+    )
+}
+
+
+def butcher_tableau(method) -> ButcherTableau:
+    """The :class:`ButcherTableau` named ``method`` (one of :data:`TABLEAUX`), or ``method`` itself.
+
+    >>> butcher_tableau("midpoint").A
+    ((1/2,),)
+    """
+    if isinstance(method, ButcherTableau):
+        return method
+    if isinstance(method, str) and method in TABLEAUX:
+        return TABLEAUX[method]
+    raise InvalidCompositionError(
+        f"unknown Runge-Kutta method {show(method)}; accepted are {', '.join(TABLEAUX)} or a ButcherTableau")
