@@ -46,6 +46,7 @@ BUILDERS = {
     "VectorField": lambda: _ho3().vector_field,
     "EffectiveField": lambda: nb.effective_field(_ho3().splitting, "12321", order=4),
     "FormalBCH": lambda: nb.formal_bch("12321", 3),
+    "ButcherTableau": lambda: nb.butcher_tableau("gauss4"),
     "BCHReport": lambda: importlib.import_module("nambu_bch.bch.report").bch_report(_ho3(), nb.composition("12321"), 2,
                                                                                      field=True, terms=True),
     "CatalogComposition": lambda: nb.composition("kahan-li:121"),

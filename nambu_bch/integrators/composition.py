@@ -559,7 +559,7 @@ def _generic(text) -> Composition:
         return composition(pairs)
     from .runge_kutta import TABLEAUX
 
-    if low in TABLEAUX:  # a Runge-Kutta method is no word over the pieces: say where it is available
+    if text.lower() in TABLEAUX:  # a Runge-Kutta method is no word over the pieces: say where it is available
         raise InvalidCompositionError(
             f"{text!r} is a Runge-Kutta method, not a composition of the pieces; its modified equation and shadow "
             "question are nambu_bch.modified_equation and nambu_bch.runge_kutta_shadow (not yet on the command line)")
