@@ -320,6 +320,7 @@ class _Solver:
         self._columns: dict = {}
         self._plain = None  # the polynomial ring of the fraction-free fields (_fields_cleared)
         self._cleared: dict = {}  # id of a Hamiltonian -> (its cleared polynomial, its denominator)
+        self._jacobian_rank2 = None  # H, G algebraically independent (_psi_dim), found once per solve
 
     # -- fields ------------------------------------------------------------------
     def _cleared_ok(self):
@@ -509,7 +510,7 @@ class _Solver:
         for a in range(self.slots):
             corrections[(a, j)] = fam[a]
         gauge = [ansatz.expressions(v, alg.coordinates, domain) for v in kernel]
-        psi_dim = self._psi_dim(ansatz, D) if self.slots == 2 else None
+        psi_dim = self._psi_dim(ansatz, D, sol.pivots) if self.slots == 2 else None
 
         # on first access (OrderSolution); a partial of a module function, so that an unconverted solution pickles
         convert = functools.partial(_sympy_forms, alg, tuple(fam), tuple(map(tuple, mem_polys)))
@@ -530,43 +531,66 @@ class _Solver:
             return m0 + (m1 - m0).mul_monom(alpha)
         return self.alg.ring.from_dict(coeffs) if coeffs else self.alg.zero
 
-    def _psi_dim(self, ansatz, D):
-        """Rank of ``{(psi_G, -psi_H) : psi = H^p G^q}`` within the ansatz (they lie in the kernel)."""
-        alg = self.alg
+    def _independent(self):
+        """``H, G`` are algebraically independent (a 2 x 2 minor of their Jacobian in the coordinates is non-zero)."""
+        if self._jacobian_rank2 is None:
+            alg = self.alg
+            grads = [[alg.diff(P, i) for i in range(self.n)] for P in self.hams]
+            self._jacobian_rank2 = any(grads[0][i] * grads[1][k] != grads[0][k] * grads[1][i]
+                                       for i in range(self.n) for k in range(i + 1, self.n))
+        return self._jacobian_rank2
+
+    def _psi_dim(self, ansatz, D, pivots):
+        """Dimension of ``span{(psi_G, -psi_H) : psi = H^p G^q}`` within the ansatz, without a second elimination.
+
+        Every such pair lies in ``ker L`` (``X_{f(H,G), G} = f_H X_{H,G}``: the bracket is a derivation in each
+        slot and alternating), and is a column vector of the ansatz exactly when each of its two components
+        ``q H^p G^(q-1)`` and ``-p H^(p-1) G^q`` (a zero one aside) has total degree ``<= D`` in the coordinates
+        and no constant generator (``alpha``) -- read off the degrees, since the coordinate degree and the
+        constant degree of a product add up over a polynomial ring (an integral domain).
+
+        Counting is the rank.  When the Jacobian of ``(H, G)`` in the coordinates has rank 2, ``H`` and ``G``
+        are algebraically independent over the coefficient field (the Jacobian criterion in characteristic 0:
+        Jacobi 1841; e.g. Ehrenborg and Rota, Eur. J. Combin. 14 (1993), 157-181, Thm. 3.2).  A relation
+        ``sum c_pq (q H^p G^(q-1), -p H^(p-1) G^q) = 0`` is ``(Psi_g(H, G), -Psi_h(H, G)) = 0`` for the
+        polynomial ``Psi(h, g) = sum c_pq h^p g^q``; independence makes ``Psi_g`` and ``Psi_h`` zero as
+        polynomials, so ``Psi`` is a constant and every ``c_pq`` with ``(p, q) != (0, 0)`` vanishes.  The
+        fitting pairs are therefore linearly independent, and their number is the rank the former second pass
+        computed (an elimination of those vectors).
+
+        Otherwise (a degenerate pair, ``X_{H,G} = 0``) the pairs are not independent; they still lie in the
+        kernel, whose basis from the elimination is the identity on its free columns (one vector per free
+        column, zero on the other free columns), so a kernel vector is the combination of the basis with its
+        own values on the free columns as coefficients: the rank of the pairs is the rank of their restriction
+        to the free columns (those outside the elimination's pivots), a matrix of ``len(kernel)`` columns.
+        """
+        alg, n = self.alg, self.n
         Hp, Gp = self.hams
-        index = ansatz.index
-        vecs = []
-        dh, dg = (max(_total_degree(Hp, self.n), 1), max(_total_degree(Gp, self.n), 1))
-        powers: dict = {}  # (k, l) -> H^k G^l, each product formed once
+        dh, dg = (_total_degree(P, n) for P in (Hp, Gp))
+        plain = [not any(any(m[n:]) for m in P.keys()) for P in (Hp, Gp)]  # no constant generator
 
-        def power(k, l):
-            value = powers.get((k, l))
-            if value is None:
-                value = alg.ring.one if k == l == 0 else (power(k - 1, l) * Hp if k else power(k, l - 1) * Gp)
-                powers[(k, l)] = value
-            return value
+        def fits(k, l):  # H^k G^l (k, l >= 0) is a combination of ansatz monomials
+            return dh * k + dg * l <= D and (k == 0 or plain[0]) and (l == 0 or plain[1])
 
-        for p in range(D + 2):
-            for q in range(D + 2):
-                # psi_G and psi_H must fit the ansatz degree: skip the products that cannot
-                if p + q == 0 or dh * p + dg * (q - 1) > D and dh * (p - 1) + dg * q > D:
-                    continue
-                dG = q * power(p, q - 1) if q else alg.zero  # d psi / dG
-                dH = p * power(p - 1, q) if p else alg.zero  # d psi / dH
-                pair = (dG, -dH)
-                vec, ok = {}, True
-                for a, poly in enumerate(pair):
-                    for m, c in poly.items():
-                        col = index.get((a, m[: self.n]))
-                        if col is None or any(m[self.n:]):
-                            ok = False
-                            break
-                        vec[col] = c
-                    if not ok:
-                        break
-                if ok and vec:
-                    vecs.append(vec)
-        return rank(vecs, len(ansatz), alg.domain) if vecs else 0
+        pairs = [(p, q) for p in range(D + 2) for q in range(D + 2)
+                 if p + q and (q == 0 or fits(p, q - 1)) and (p == 0 or fits(p - 1, q))]
+        if self._independent() or not pairs:
+            return len(pairs)
+        pivots = set(pivots)
+        place = {c: k for k, c in enumerate(c for c in range(len(ansatz)) if c not in pivots)}  # the free columns
+        index, vecs = ansatz.index, []
+        for p, q in pairs:
+            dG = q * Hp**p * Gp ** (q - 1) if q else alg.zero  # d psi / dG
+            dH = p * Hp ** (p - 1) * Gp**q if p else alg.zero  # d psi / dH
+            vec = {}
+            for a, poly in enumerate((dG, -dH)):
+                for m, c in poly.items():
+                    k = place.get(index[(a, m[:n])])
+                    if k is not None:
+                        vec[k] = c
+            if vec:
+                vecs.append(vec)
+        return rank(vecs, len(place), alg.domain) if vecs else 0
 
 
 def direct_route(system, word, order: int = 2, degree=None, max_unknowns=None, progress=None) -> DirectResult:
