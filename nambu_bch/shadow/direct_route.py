@@ -99,8 +99,9 @@ class OrderSolution:
     rhs : VectorField or None -- the right-hand side of Eq. (*)
 
     A solved order converts ``corrections`` and ``members`` to sympy on first access (``convert``, a callable
-    returning both; the same expressions, cached): the route itself works on the ring elements, and a
-    caller that only reads ``H_S, G_S`` never pays for the per-order sympy forms.
+    returning both; the same expressions, cached), and ``gauge`` likewise (``convert_gauge``, from the exact
+    kernel vectors): the route itself works on the ring elements, and a caller that only reads ``H_S, G_S``
+    never pays for the per-order sympy forms.
     """
 
     order: int
@@ -115,9 +116,15 @@ class OrderSolution:
     obstruction_value: object = None
     rhs: object = None
     convert: object = field(default=None, repr=False, compare=False)
+    convert_gauge: object = field(default=None, repr=False, compare=False)
 
     def _converted(self, name):
         value = self.__dict__.get("_" + name)
+        if name == "gauge":
+            if value is None and self.convert_gauge is not None:
+                value = self.__dict__["_gauge"] = self.convert_gauge()
+                self.convert_gauge = None
+            return value
         if value is None and self.convert is not None:
             self.__dict__["_corrections"], self.__dict__["_members"] = self.convert()
             self.convert = None
@@ -145,6 +152,7 @@ def _lazy(name):
 # after @dataclass: the generated __init__ assigns through the properties (defaults () stay the fields' own)
 OrderSolution.corrections = _lazy("corrections")
 OrderSolution.members = _lazy("members")
+OrderSolution.gauge = _lazy("gauge")
 
 
 @dataclass
@@ -167,6 +175,27 @@ class DirectResult:
     @property
     def failed_order(self):
         return next((o.order for o in self.orders if o.status not in ("solved", "vanishes")), None)
+
+    def has_symbol(self, symbol) -> bool:
+        """Whether ``symbol`` occurs in ``shadow()``, read off the exact data (no sympy sum is built).
+
+        The shadows are ``H^a + sum_j h^j dH^a_j`` with distinct powers of ``h`` per order, so nothing cancels: the
+        symbol occurs when it occurs in a Hamiltonian or in a correction -- as a generator of the ring (an exponent),
+        as a parameter of the coefficient field, or in a sympy correction of a non-polynomial result.
+        """
+        if any(sympy.sympify(Ha, strict=True).has(symbol) for Ha in self.system.hamiltonians):
+            return True
+        for c in self.corrections.values():
+            if not self.algebra.is_polynomial(c):
+                if sympy.sympify(c, strict=True).has(symbol):
+                    return True
+                continue
+            symbols = c.ring.symbols
+            if symbol in symbols and any(m[symbols.index(symbol)] for m in c.keys()):
+                return True
+            if symbol in getattr(c.ring.domain, "symbols", ()) and self.algebra.to_sympy(c).has(symbol):
+                return True
+        return False
 
     def shadow(self, upto=None) -> tuple:
         """``(H_S, G_S, ...)`` as sympy expressions in ``h`` and ``alpha`` through ``h^upto``."""
@@ -293,6 +322,11 @@ def _sympy_forms(alg, fam, mem_polys) -> tuple:
     memo: dict = {}  # the members and the family share most coefficients: each converted once
     return (tuple(alg.to_sympy(f, memo) for f in fam),
             tuple(tuple(alg.to_sympy(p, memo) for p in polys) for polys in mem_polys))
+
+
+def _gauge_forms(ansatz, kernel, coordinates, domain) -> list:
+    """The sympy forms of a solved order's kernel basis (:attr:`OrderSolution.gauge`), one tuple per vector."""
+    return [ansatz.expressions(v, coordinates, domain) for v in kernel]
 
 
 class _Solver:
@@ -509,13 +543,13 @@ class _Solver:
             fam[a] = self._family(mem_polys[0][a], mem_polys[1][a], alpha)
         for a in range(self.slots):
             corrections[(a, j)] = fam[a]
-        gauge = [ansatz.expressions(v, alg.coordinates, domain) for v in kernel]
         psi_dim = self._psi_dim(ansatz, D, sol.pivots) if self.slots == 2 else None
 
         # on first access (OrderSolution); a partial of a module function, so that an unconverted solution pickles
         convert = functools.partial(_sympy_forms, alg, tuple(fam), tuple(map(tuple, mem_polys)))
-        return OrderSolution(j, "solved", degree=D, corrections=None, members=None, gauge=gauge,
-                             kernel_dim=len(kernel), psi_dim=psi_dim, rhs=rhs, convert=convert)
+        gauge = functools.partial(_gauge_forms, ansatz, tuple(kernel), alg.coordinates, domain)
+        return OrderSolution(j, "solved", degree=D, corrections=None, members=None, gauge=None,
+                             kernel_dim=len(kernel), psi_dim=psi_dim, rhs=rhs, convert=convert, convert_gauge=gauge)
 
     def _family(self, m0, m1, alpha):
         """``m0 + alpha (m1 - m0)``; over ``QQ<theta>(params)`` coefficient by coefficient over ``QQ(params)``
