@@ -93,3 +93,33 @@ def test_psi_dim_degenerate_pair_is_a_rank():
     # the kernel of "no equation": every column is free
     assert solver._psi_dim(ansatz, D, ()) == reference_psi_dim(alg, (H, G), D)
 
+
+@pytest.mark.parametrize("name", ["ho3[m=1,omega=2]", "rigid-body[I=1,2,3]", "lotka-volterra", "ho[m=1,omega=1]", "n4-single"])
+def test_operator_columns_by_laplace_expansion_equal_liouville_field(name):
+    """The columns of Eq. (*) from shifted cofactors (``_Solver._monomial_field``) equal the Liouville fields themselves."""
+    from nambu_bch import System
+    from nambu_bch.algebra import liouville_field
+    from nambu_bch.integrators.composition import composition_for
+
+    if name == "n4-single":
+        sys_ = System("x1 x2 x3 x4", ["x1**2/2 + x2**2/2 + x3**2/2 + x4**2/2", "x1**2/2 + x2**2 + 3*x3**2/2 + 2*x4**2",
+                                      "x1 + x2 + x3 + x4"], name="n4-single", split="single")
+    elif name == "rigid-body[I=1,2,3]":
+        sys_ = system(name)
+    elif "[" in name:
+        base, values = name[:-1].split("[")
+        sys_ = model(base).substitute(dict(v.split("=") for v in values.split(",")))
+    else:
+        sys_ = model(name)
+    solver = dr._Solver(sys_, composition_for("12321" if sys_.N == 3 else "121" if sys_.N == 2 else "1234321",
+                                              sys_.splitting), 2, None)
+    assert solver._laplace
+    alg, hits = solver.alg, 0
+    pad = (0,) * (len(alg.gens) - alg.n)
+    for a, e in Ansatz(alg.n, 4, solver.slots).columns:
+        slots = list(solver.hams)
+        slots[a] = alg.ring.from_dict({e + pad: alg.domain.one})
+        fast = solver._monomial_field(slots)
+        hits += fast is not None
+        assert (fast if fast is not None else solver._field(slots)).components == liouville_field(alg, *slots).components
+    assert hits == sum(1 for _, e in Ansatz(alg.n, 4, solver.slots).columns if sum(e) >= 2)

@@ -355,6 +355,12 @@ class _Solver:
         self._plain = None  # the polynomial ring of the fraction-free fields (_fields_cleared)
         self._cleared: dict = {}  # id of a Hamiltonian -> (its cleared polynomial, its denominator)
         self._jacobian_rank2 = None  # H, G algebraically independent (_psi_dim), found once per solve
+        self._cofactors: dict = {}  # slot -> the fields with x_j in that slot (_monomial_field), once per solve
+        N1, n = len(hams), self.n
+        # the determinant form of Eq. (gLiouville) (liouville_field's general case), over a field without parameters:
+        # over QQ(params) the sums of shifted cofactors would add fractions, slower than the fraction-free fields
+        self._laplace = (N1 == n - 1 and not (N1 == 1 and n % 2 == 0 and n > 2) and not (N1 == 2 and n % 3 == 0 and n > 3)
+                         and not self._cleared_ok())
 
     # -- fields ------------------------------------------------------------------
     def _cleared_ok(self):
@@ -363,6 +369,55 @@ class _Solver:
 
     def _field(self, slots):
         """``X_{slots}`` (Eq. gLiouville); over ``QQ(params)`` fraction-free (:meth:`_fields_cleared`)."""
+        fast = self._monomial_field(slots)
+        return fast if fast is not None else self._general_field(slots)
+
+    def _monomial_field(self, slots):
+        """``X_{H^1, .., x^mu, .., H^{N-1}}`` (a monomial of degree >= 2 in one slot) by Laplace expansion, or None.
+
+        The Liouville field is a determinant whose row of slot ``a`` is ``grad x^mu = sum_j mu_j x^(mu - e_j) e_j``;
+        a determinant is linear in each row over the polynomial ring, so
+
+            X_{.., x^mu, ..} = sum_j mu_j x^(mu - e_j) X_{.., x_j, ..}     (x_j in slot a),
+
+        and the ``n`` fields ``X_{.., x_j, ..}`` of a slot (the cofactors) are computed once per solve: a column of
+        the operator is then a sum of shifted copies of them -- the same ring element, without a determinant of
+        polynomials per column.  Only the determinant form of Eq. (gLiouville) (``N - 1`` slots; not the
+        canonical or triplet brackets) over a coefficient field without parameters is expanded; other slots and
+        fields go the general way (None).
+        """
+        alg, n = self.alg, self.n
+        if not self._laplace:
+            return None
+        others = [b for b, p in enumerate(slots) if p is not self.hams[b]]
+        if len(others) != 1 or len(slots[others[0]]) != 1:
+            return None
+        a = others[0]
+        ((mu, c),) = slots[a].items()
+        if c != alg.domain.one or any(mu[n:]) or sum(mu) < 2:
+            return None
+        cofactors = self._cofactors.get(a)
+        if cofactors is None:
+            cofactors = []
+            for j in range(n):
+                unit = list(slots)
+                unit[a] = alg.gens[j]
+                cofactors.append(self._general_field(unit).components)
+            self._cofactors[a] = cofactors
+        sums = [{} for _ in range(n)]
+        zero = alg.domain.zero
+        for j in range(n):
+            if not mu[j]:
+                continue
+            shift = tuple(e - (k == j) for k, e in enumerate(mu))
+            for i, comp in enumerate(cofactors[j]):
+                out = sums[i]
+                for m, v in comp.items():
+                    key = tuple(x + y for x, y in zip(m, shift))
+                    out[key] = out.get(key, zero) + mu[j] * v
+        return VectorField(alg, [alg.ring.from_dict({m: v for m, v in out.items() if v}) for out in sums])
+
+    def _general_field(self, slots):
         if self._cleared_ok():
             return self._fields_cleared([slots])
         return liouville_field(self.alg, *slots)
