@@ -230,8 +230,20 @@ def _timed_ours(args, queue):
     queue.put((dt, [tuple(map(str, fam.member(alpha=a))) for a in (0, 1)], fam.degree))
 
 
-def _child(target, args, limit):
-    """``target(args, queue)`` in a fresh process; its result, or ``None`` after ``limit`` seconds."""
+def _peak_mb(pid):
+    """The peak resident set (``VmHWM``) of a live process in MB, or None (not Linux, gone)."""
+    try:
+        with open(f"/proc/{pid}/status") as f:
+            return next(int(line.split()[1]) / 1024 for line in f if line.startswith("VmHWM:"))
+    except (OSError, StopIteration, ValueError):
+        return None
+
+
+def _child(target, args, limit, stopped=None):
+    """``target(args, queue)`` in a fresh process; its result, or ``None`` after ``limit`` seconds.
+
+    ``stopped``: a dict that receives the peak RSS in MB (``"rss"``) of a child stopped at the limit.
+    """
     import queue as queues
 
     queue = mp.Queue()
@@ -242,6 +254,8 @@ def _child(target, args, limit):
     except queues.Empty:
         out = None
     if proc.is_alive():
+        if out is None and stopped is not None:
+            stopped["rss"] = _peak_mb(proc.pid)
         proc.terminate()
     proc.join()
     return out
@@ -367,10 +381,13 @@ def targets(limit: float = 600.0, only=None):
         line += f" (goal <= 60 s CPU: {'met' if sym10 and sym10[0] <= 60 else 'not met'})"
         print(line + f"  [{_load()}]", flush=True)
     if not only or "c" in only:
-        n4 = _child(_timed_run, ("ours", "n4-single", "1234321", 8), limit)
+        stopped: dict = {}
+        n4 = _child(_timed_run, ("ours", "n4-single", "1234321", 8), limit, stopped)
         line = f"c: N = 4 single split, 1234321, h^8: {_shown(n4, limit)}"
         if n4:
             line += f" (finishes; goal peak RSS < 1 GB: {'met' if n4[2] < 1024 else 'not met'})"
+        elif stopped.get("rss") is not None:
+            line += f", peak RSS {stopped['rss']:.0f} MB when stopped (goal: finishes, < 1 GB: not met)"
         print(line + f"  [{_load()}]", flush=True)
     if not only or "d" in only:
         for name, orders in TARGET_ORDERS.items():
