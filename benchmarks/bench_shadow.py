@@ -1,18 +1,25 @@
 """Benchmark of nambu_bch.shadow: both routes, and the direct route against a plain-sympy baseline.
 
-Run:  /work/venv/bin/python benchmarks/bench_shadow.py            (the rows below, then the issue-14 rows)
+Run:  /work/venv/bin/python benchmarks/bench_shadow.py --targets  (the targets of the exact-data redesign, below)
+      /work/venv/bin/python benchmarks/bench_shadow.py --targets --rows=ab  (target rows a and b only)
+      /work/venv/bin/python benchmarks/bench_shadow.py            (the rows below, then the issue-14 rows)
       /work/venv/bin/python benchmarks/bench_shadow.py --issue14  (the issue-14 rows only)
       /work/venv/bin/python benchmarks/bench_shadow.py --issue14 --rows=ab  (rows a and b only)
 
 Prints, measured in this one run (process CPU time, best of a few repeats):
 * all six ho3 words through the FI route and the direct route at O(h^2);
 * the direct route at O(h^6) for ho3 and O(h^4) for the rigid body;
-* the same order-by-order linear solve done with plain sympy expressions and
-  ``sympy.solve`` (the baseline, written below, run in a child process with a
-  60 s limit: when it hits the limit the ratio is printed as a lower bound),
-  and the ratio baseline / ours.
-The baseline reproduces the same member (it solves for all unknowns and sets the
-free ones to zero), and its result is checked against ours.
+* the same computation done with plain sympy from the start (the baseline, written below, run in a
+  child process with a 60 s limit: when it hits the limit the ratio is printed as a lower bound), and
+  the ratio baseline / ours.
+The baseline calls nothing of the package's arithmetic: it builds the pieces' fields (determinants),
+the composed map of the exact sub-flows as a series in ``h`` (Lie series, expanded sympy expressions),
+the modified field by backward error analysis, and solves the polynomial ansatz order by order with
+``sympy.linsolve`` (the free unknowns set to zero: a member of the family, not necessarily ours); its
+result is checked, outside the timing, by ``X_{H_S,G_S} = X_eff`` in exact ring arithmetic.
+
+The targets (``--targets``, :func:`targets`) time ours and the baseline cold, each in a fresh process,
+in one run, and print CPU and wall seconds, peak RSS and the load average with every row.
 
 The issue-14 rows (docs/history/performance.md, Sect. 3) time the whole ``shadow_hamiltonians`` call
 in a fresh child process each (cold, CPU seconds), ours against the package's previous
@@ -42,44 +49,124 @@ H = sympy.Symbol("h")
 
 
 
-def baseline(system, word, order, degrees):
-    """The direct route with plain sympy: unknown symbols, expanded expressions, ``sympy.solve`` per order."""
-    xs = system.coordinates
-    Hs = list(system.hamiltonians)
-    eff = effective_field(system.splitting, word, order)
+def _liouville(xs, *fs):
+    """``X_{f_1 .. f_{N-1}}`` (Eq. gLiouville) as expanded sympy expressions: ``X^i = det(e_i; grad f_1; ..)``."""
+    grads = [[sympy.diff(f, x) for x in xs] for f in fs]
+    out = []
+    for i in range(len(xs)):
+        rows = [[1 if j == i else 0 for j in range(len(xs))]] + grads
+        out.append(sympy.expand(sympy.Matrix(rows).det()))
+    return out
+
+
+def _lie(field, f, xs):
+    """``L_X f = sum_i X^i df/dx_i``, expanded."""
+    return sympy.expand(sum(c * sympy.diff(f, x) for c, x in zip(field, xs) if c != 0))
+
+
+def plain_sympy_map(system, word, top):
+    """The composed map of the exact sub-flows as a series in ``h`` through ``h^top``, all in plain sympy.
+
+    Each piece's field is built from its Liouville terms (determinants); the exact flow of ``c h X`` pulls a
+    function back by its Lie series ``exp(c h L_X) f`` (Taylor's theorem for the flow, exact order by order in
+    ``h``), and the composition pulls back through the steps in reverse.  Returns ``[[phi_0^i, .., phi_top^i]]``
+    per coordinate (``Phi(x)_i = sum_m h^m phi_m^i``).
+    """
+    from nambu_bch.integrators.composition import composition_for
+
+    xs = list(system.coordinates)
+    comp = composition_for(word, system.splitting)  # the word's pieces and step coefficients only
+    fields = {}
+    for piece in system.splitting.pieces:
+        parts = [_liouville(xs, *term) for term in piece.terms]
+        fields[piece.number] = [sympy.expand(sum(c)) for c in zip(*parts)]
+    out = []
+    for x in xs:
+        g = [x] + [sympy.Integer(0)] * top  # coefficients of h^0 .. h^top
+        for k, c in zip(reversed(comp.pieces), reversed(comp.coefficients)):
+            X = fields[k]
+            new = [sympy.Integer(0)] * (top + 1)
+            for m, gm in enumerate(g):
+                term, fact = gm, sympy.Integer(1)
+                for kk in range(0, top + 1 - m):
+                    if term == 0:
+                        break
+                    new[m + kk] += fact * term
+                    term = _lie(X, term, xs)
+                    fact = fact * c / (kk + 1)
+            g = [sympy.expand(t) for t in new]
+        out.append(g)
+    return out
+
+
+def plain_sympy_field(system, word, order):
+    """``Z_0 .. Z_order`` of the modified field (backward error analysis) from :func:`plain_sympy_map`.
+
+    ``exp(h L_Y) x = Phi(x)`` with ``Y = sum_l h^l Z_l``: ``[h^n] (h L_Y)^k x = U(k, n)``,
+    ``U(1, n) = Z_(n-1)``, ``U(k, n) = sum_l L_(Z_l) U(k-1, n-1-l)``, so
+    ``Z_j = phi_(j+1) - sum_(k>=2) U(k, j+1)/k!`` needs only ``Z_l``, ``l < j``.
+    """
+    xs = list(system.coordinates)
+    phi = plain_sympy_map(system, word, order + 1)
+    Z, memo = [], {}
+
+    def U(k, n):
+        if k == 1:
+            return Z[n - 1]
+        if (k, n) not in memo:
+            total = [sympy.Integer(0)] * len(xs)
+            for l in range(0, n - k + 1):
+                prev = U(k - 1, n - 1 - l)
+                total = [t + _lie(Z[l], p, xs) for t, p in zip(total, prev)]
+            memo[(k, n)] = [sympy.expand(t) for t in total]
+        return memo[(k, n)]
+
+    for j in range(order + 1):
+        rest = [sympy.Integer(0)] * len(xs)
+        for k in range(2, j + 2):
+            rest = [r + u / sympy.factorial(k) for r, u in zip(rest, U(k, j + 1))]
+        Z.append([sympy.expand(phi[i][j + 1] - rest[i]) for i in range(len(xs))])
+    return Z
+
+
+def baseline(system, word, order, degrees=None):
+    """The direct route with plain sympy only (N = 3): the map and the modified field of :func:`plain_sympy_field`,
+    unknown coefficients, expanded expressions, ``sympy.linsolve`` per order, the free unknowns set to zero.
+
+    ``degrees``: ``order -> ansatz degree``; default the least degree reaching the right-hand side's degree.
+    Nothing of the package is called but the system's data (coordinates, Hamiltonians, pieces) and the word's
+    step coefficients.
+    """
+    xs = list(system.coordinates)
+    Hs = [sympy.expand(Hk) for Hk in system.hamiltonians]
+    eff = plain_sympy_field(system, word, order)
+    gdeg = [sympy.Poly(Hk, *xs).total_degree() - 1 for Hk in Hs]
     corrections = {}
-
-    def lv(*fs):  # Liouville field X_{f1, f2} of N = 3, as sympy expressions (Eq. gLiouville)
-        grads = [[sympy.diff(f, x) for x in xs] for f in fs]
-        out = []
-        for i in range(len(xs)):
-            rows = [[1 if j == i else 0 for j in range(len(xs))]] + grads
-            out.append(sympy.expand(sympy.Matrix(rows).det()))
-        return out
-
     for j in range(1, order + 1):
-        rhs = [sympy.expand(c) for c in eff[j].to_sympy()]
+        rhs = list(eff[j])
         for a, b in product(range(1, j), repeat=2):
             if a + b == j and (0, a) in corrections and (1, b) in corrections:
-                rhs = [r - c for r, c in zip(rhs, lv(corrections[(0, a)], corrections[(1, b)]))]
+                rhs = [r - c for r, c in zip(rhs, _liouville(xs, corrections[(0, a)], corrections[(1, b)]))]
         if all(r == 0 for r in rhs):
             continue
-        D = degrees[j]
+        rdeg = max(sympy.Poly(r, *xs).total_degree() for r in rhs if r != 0)
+        D = degrees[j] if degrees else max(1, rdeg + 1 - min(gdeg))
         monos = [sympy.Mul(*(x**e for x, e in zip(xs, exps))) for exps in product(range(D + 1), repeat=len(xs)) if sum(exps) <= D]
         cH = sympy.symbols(f"a{j}_0:{len(monos)}")
         cG = sympy.symbols(f"b{j}_0:{len(monos)}")
-        dH = sum(c * mo for c, mo in zip(cH, monos))
-        dG = sum(c * mo for c, mo in zip(cG, monos))
-        lhs = [p + q for p, q in zip(lv(dH, Hs[1]), lv(Hs[0], dG))]
+        dH = sympy.Add(*(c * mo for c, mo in zip(cH, monos)))
+        dG = sympy.Add(*(c * mo for c, mo in zip(cG, monos)))
+        lhs = [p + q for p, q in zip(_liouville(xs, dH, Hs[1]), _liouville(xs, Hs[0], dG))]
         eqs = []
         for l, r in zip(lhs, rhs):
             eqs += sympy.Poly(sympy.expand(l - r), *xs).coeffs()
-        sol = sympy.solve(eqs, cH + cG, dict=True)
-        if not sol:
+        sols = sympy.linsolve(eqs, cH + cG)
+        if not sols:
             return None
-        sol = sol[0]
-        corrections[(0, j)] = sympy.expand(dH.subs(sol).subs({c: 0 for c in cH + cG}))
-        corrections[(1, j)] = sympy.expand(dG.subs(sol).subs({c: 0 for c in cH + cG}))
+        zero = {c: sympy.Integer(0) for c in cH + cG}  # the free unknowns (linsolve's parameters) set to zero
+        values = [v.xreplace(zero) for v in next(iter(sols))]
+        corrections[(0, j)] = sympy.expand(sympy.Add(*(v * mo for v, mo in zip(values[: len(monos)], monos))))
+        corrections[(1, j)] = sympy.expand(sympy.Add(*(v * mo for v, mo in zip(values[len(monos):], monos))))
     return tuple(sympy.expand(Hk + sum(H**j * corrections.get((a, j), 0) for j in range(1, order + 1)))
                  for a, Hk in enumerate(Hs))
 
@@ -143,8 +230,20 @@ def _timed_ours(args, queue):
     queue.put((dt, [tuple(map(str, fam.member(alpha=a))) for a in (0, 1)], fam.degree))
 
 
-def _child(target, args, limit):
-    """``target(args, queue)`` in a fresh process; its result, or ``None`` after ``limit`` seconds."""
+def _peak_mb(pid):
+    """The peak resident set (``VmHWM``) of a live process in MB, or None (not Linux, gone)."""
+    try:
+        with open(f"/proc/{pid}/status") as f:
+            return next(int(line.split()[1]) / 1024 for line in f if line.startswith("VmHWM:"))
+    except (OSError, StopIteration, ValueError):
+        return None
+
+
+def _child(target, args, limit, stopped=None):
+    """``target(args, queue)`` in a fresh process; its result, or ``None`` after ``limit`` seconds.
+
+    ``stopped``: a dict that receives the peak RSS in MB (``"rss"``) of a child stopped at the limit.
+    """
     import queue as queues
 
     queue = mp.Queue()
@@ -155,6 +254,8 @@ def _child(target, args, limit):
     except queues.Empty:
         out = None
     if proc.is_alive():
+        if out is None and stopped is not None:
+            stopped["rss"] = _peak_mb(proc.pid)
         proc.terminate()
     proc.join()
     return out
@@ -198,11 +299,112 @@ def issue14(limit: float = 150.0, only=None):
         line += f"  (same members: {same})"
         if name == "rigid-body[I=1,2,3]" and order == 8 and ours:
             t_base, ok = baseline_with_limit(name, word, order, ours[2], 60.0)
-            line += (f"; plain sympy (exact map + sympy.solve) {'>' if ok is None else ''}{t_base:.2f} s, "
+            line += (f"; plain sympy (exact map + sympy.linsolve) {'>' if ok is None else ''}{t_base:.2f} s, "
                      f"ratio {'>' if ok is None else ''}{t_base / t_ours:.1f}x (goal >= 50x; baseline valid: {ok})")
         print(line, flush=True)
         rows.append((label, t_ours, t_before, same))
     return rows
+
+
+def _timed_run(args, queue):
+    """One call in a fresh process: ``(CPU s, wall s, peak RSS in MB, members)`` of ours, or of the plain baseline."""
+    import resource
+
+    side, name, word, order = args
+    system = make_system(name)
+    t, w = time.process_time(), time.perf_counter()
+    if side == "ours":  # the family and its shadows as sympy expressions (what the baseline returns)
+        fam = shadow_hamiltonians(system, word, order)
+        out = fam.shadows
+    else:
+        out = baseline(system, word, order)
+    cpu_s, wall_s = time.process_time() - t, time.perf_counter() - w
+    rss = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024  # kB on Linux
+    if side == "ours":
+        members = [tuple(map(str, fam.member(alpha=a))) for a in (0, 1)]
+    else:  # checked outside the timed part (exact ring arithmetic, the package's X_eff)
+        members = out is not None and check_solution(system, word, order, out)
+    queue.put((cpu_s, wall_s, rss, members))
+
+
+def _load() -> str:
+    import os
+
+    return "load " + "/".join(f"{v:.1f}" for v in os.getloadavg())
+
+
+def _shown(run, limit) -> str:
+    if run is None:
+        return f"> {limit:g} s (stopped)"
+    return f"{run[0]:.2f} s CPU, {run[1]:.2f} s wall, peak RSS {run[2]:.0f} MB"
+
+
+TARGET_ORDERS = {"ho3": (6, 8, 10, 12), "rigid-body": (6, 8, 10, 12), "lotka-volterra": (6, 8, 10, 12)}
+
+
+def targets(limit: float = 600.0, only=None):
+    """The targets of the exact-data redesign, each side cold in a fresh process, in this one run.
+
+    Rows (``only``: the letters to run, e.g. ``"ab"``):
+    a. rigid body I = (1, 2, 3), 12321, h^8: ours against :func:`baseline` (plain sympy throughout), goal >= 50x;
+    b. symbolic rigid body against I = (1, 2, 3) at h^8 (goal <= 2x), and symbolic h^10 (goal <= 60 s CPU);
+    c. the N = 4 single split, 1234321, h^8: finishes, peak RSS (goal < 1 GB);
+    d. cost per two orders, h^6 to h^12, for ho3, the symbolic rigid body and Lotka-Volterra (goal <= 2x).
+    """
+    print(f"targets (each side cold in a fresh process; {_load()})", flush=True)
+    ok = True
+    ours_123 = None
+    if not only or "a" in only:
+        ours_123 = _child(_timed_run, ("ours", "rigid-body[I=1,2,3]", "12321", 8), limit)
+        plain = _child(_timed_run, ("plain", "rigid-body[I=1,2,3]", "12321", 8), limit)
+        line = f"a: rigid body I = (1, 2, 3), 12321, h^8: ours {_shown(ours_123, limit)}; plain sympy {_shown(plain, limit)}"
+        if ours_123:
+            base = plain[0] if plain else limit
+            ratio = base / ours_123[0]
+            wall = (plain[1] if plain else limit) / ours_123[1]
+            line += (f"; ratio {'>' if plain is None else ''}{ratio:.1f}x CPU, {'>' if plain is None else ''}{wall:.1f}x wall "
+                     f"(goal >= 50x: {'met' if ratio >= 50 else 'not met'}; baseline valid: "
+                     f"{None if plain is None else plain[3]})")
+            ok = ok and (plain is None or plain[3] is True)
+        print(line + f"  [{_load()}]", flush=True)
+    if not only or "b" in only:
+        if ours_123 is None:
+            ours_123 = _child(_timed_run, ("ours", "rigid-body[I=1,2,3]", "12321", 8), limit)
+        sym8 = _child(_timed_run, ("ours", "rigid-body", "12321", 8), limit)
+        line = f"b: symbolic rigid body, 12321, h^8: {_shown(sym8, limit)}"
+        if sym8 and ours_123:
+            ratio = sym8[0] / ours_123[0]
+            line += f"; against I = (1, 2, 3): {ratio:.1f}x CPU (goal <= 2x: {'met' if ratio <= 2 else 'not met'})"
+        print(line + f"  [{_load()}]", flush=True)
+        sym10 = _child(_timed_run, ("ours", "rigid-body", "12321", 10), limit)
+        line = f"b: symbolic rigid body, 12321, h^10: {_shown(sym10, limit)}"
+        line += f" (goal <= 60 s CPU: {'met' if sym10 and sym10[0] <= 60 else 'not met'})"
+        print(line + f"  [{_load()}]", flush=True)
+    if not only or "c" in only:
+        stopped: dict = {}
+        n4 = _child(_timed_run, ("ours", "n4-single", "1234321", 8), limit, stopped)
+        line = f"c: N = 4 single split, 1234321, h^8: {_shown(n4, limit)}"
+        if n4:
+            line += f" (finishes; goal peak RSS < 1 GB: {'met' if n4[2] < 1024 else 'not met'})"
+        elif stopped.get("rss") is not None:
+            line += f", peak RSS {stopped['rss']:.0f} MB when stopped (goal: finishes, < 1 GB: not met)"
+        print(line + f"  [{_load()}]", flush=True)
+    if not only or "d" in only:
+        for name, orders in TARGET_ORDERS.items():
+            runs = [(k, _child(_timed_run, ("ours", name, "12321", k), limit)) for k in orders]
+            parts, worst = [], 0.0
+            for (k0, r0), (k1, r1) in zip(runs, runs[1:]):
+                if r0 and r1:
+                    ratio = r1[0] / r0[0]
+                    worst = max(worst, ratio)
+                    parts.append(f"h^{k0}->h^{k1} {ratio:.1f}x")
+                else:
+                    parts.append(f"h^{k0}->h^{k1} n/a")
+            times = ", ".join(f"h^{k} " + ("stopped" if r is None else f"{r[0]:.2f} s") for k, r in runs)
+            print(f"d: {name}, 12321, CPU per order: {times}; per two orders: {', '.join(parts)} "
+                  f"(goal <= 2x: {'met' if worst and worst <= 2 and all(r for _, r in runs) else 'not met'})  [{_load()}]",
+                  flush=True)
+    return ok
 
 
 def _same_members(name, u, v):
@@ -229,13 +431,16 @@ def main(limit: float = 60.0):
         t_base, ok = baseline_with_limit(name, word, order, fam.degree, limit)
         bound = ">" if ok is None else ""
         rows.append((label, t_ours, t_base, ok, ours_ok))
-        print(f"{label}: ours {t_ours:.3f} s, sympy.solve baseline {bound}{t_base:.3f} s, "
+        print(f"{label}: ours {t_ours:.3f} s, plain-sympy baseline {bound}{t_base:.3f} s, "
               f"ratio {bound}{t_base / t_ours:.1f}x  (baseline valid: {'timed out' if ok is None else ok}, ours valid: {ours_ok})")
     return rows
 
 
 if __name__ == "__main__":
     ok = True
+    if "--targets" in sys.argv:
+        only = next((a.split("=", 1)[1] for a in sys.argv if a.startswith("--rows=")), None)
+        sys.exit(0 if targets(only=only) else 1)
     if "--issue14" not in sys.argv:
         ok = all(r[3] is not False and r[4] for r in main())
     only = next((a.split("=", 1)[1] for a in sys.argv if a.startswith("--rows=")), None)

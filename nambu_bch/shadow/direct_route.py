@@ -99,8 +99,9 @@ class OrderSolution:
     rhs : VectorField or None -- the right-hand side of Eq. (*)
 
     A solved order converts ``corrections`` and ``members`` to sympy on first access (``convert``, a callable
-    returning both; the same expressions, cached): the route itself works on the ring elements, and a
-    caller that only reads ``H_S, G_S`` never pays for the per-order sympy forms.
+    returning both; the same expressions, cached), and ``gauge`` likewise (``convert_gauge``, from the exact
+    kernel vectors): the route itself works on the ring elements, and a caller that only reads ``H_S, G_S``
+    never pays for the per-order sympy forms.
     """
 
     order: int
@@ -115,9 +116,15 @@ class OrderSolution:
     obstruction_value: object = None
     rhs: object = None
     convert: object = field(default=None, repr=False, compare=False)
+    convert_gauge: object = field(default=None, repr=False, compare=False)
 
     def _converted(self, name):
         value = self.__dict__.get("_" + name)
+        if name == "gauge":
+            if value is None and self.convert_gauge is not None:
+                value = self.__dict__["_gauge"] = self.convert_gauge()
+                self.convert_gauge = None
+            return value
         if value is None and self.convert is not None:
             self.__dict__["_corrections"], self.__dict__["_members"] = self.convert()
             self.convert = None
@@ -145,6 +152,7 @@ def _lazy(name):
 # after @dataclass: the generated __init__ assigns through the properties (defaults () stay the fields' own)
 OrderSolution.corrections = _lazy("corrections")
 OrderSolution.members = _lazy("members")
+OrderSolution.gauge = _lazy("gauge")
 
 
 @dataclass
@@ -167,6 +175,27 @@ class DirectResult:
     @property
     def failed_order(self):
         return next((o.order for o in self.orders if o.status not in ("solved", "vanishes")), None)
+
+    def has_symbol(self, symbol) -> bool:
+        """Whether ``symbol`` occurs in ``shadow()``, read off the exact data (no sympy sum is built).
+
+        The shadows are ``H^a + sum_j h^j dH^a_j`` with distinct powers of ``h`` per order, so nothing cancels: the
+        symbol occurs when it occurs in a Hamiltonian or in a correction -- as a generator of the ring (an exponent),
+        as a parameter of the coefficient field, or in a sympy correction of a non-polynomial result.
+        """
+        if any(sympy.sympify(Ha, strict=True).has(symbol) for Ha in self.system.hamiltonians):
+            return True
+        for c in self.corrections.values():
+            if not self.algebra.is_polynomial(c):
+                if sympy.sympify(c, strict=True).has(symbol):
+                    return True
+                continue
+            symbols = c.ring.symbols
+            if symbol in symbols and any(m[symbols.index(symbol)] for m in c.keys()):
+                return True
+            if symbol in getattr(c.ring.domain, "symbols", ()) and self.algebra.to_sympy(c).has(symbol):
+                return True
+        return False
 
     def shadow(self, upto=None) -> tuple:
         """``(H_S, G_S, ...)`` as sympy expressions in ``h`` and ``alpha`` through ``h^upto``."""
@@ -295,6 +324,11 @@ def _sympy_forms(alg, fam, mem_polys) -> tuple:
             tuple(tuple(alg.to_sympy(p, memo) for p in polys) for polys in mem_polys))
 
 
+def _gauge_forms(ansatz, kernel, coordinates, domain) -> list:
+    """The sympy forms of a solved order's kernel basis (:attr:`OrderSolution.gauge`), one tuple per vector."""
+    return [ansatz.expressions(v, coordinates, domain) for v in kernel]
+
+
 class _Solver:
     def __init__(self, system, comp, order, degree, max_unknowns=None, effective=None):
         self.max_unknowns = max_unknowns
@@ -322,6 +356,13 @@ class _Solver:
         self._columns: dict = {}
         self._plain = None  # the polynomial ring of the fraction-free fields (_fields_cleared)
         self._cleared: dict = {}  # id of a Hamiltonian -> (its cleared polynomial, its denominator)
+        self._jacobian_rank2 = None  # H, G algebraically independent (_psi_dim), found once per solve
+        self._cofactors: dict = {}  # slot -> the fields with x_j in that slot (_monomial_field), once per solve
+        N1, n = len(hams), self.n
+        # the determinant form of Eq. (gLiouville) (liouville_field's general case), over a field without parameters:
+        # over QQ(params) the sums of shifted cofactors would add fractions, slower than the fraction-free fields
+        self._laplace = (N1 == n - 1 and not (N1 == 1 and n % 2 == 0 and n > 2) and not (N1 == 2 and n % 3 == 0 and n > 3)
+                         and not self._cleared_ok())
 
     # -- fields ------------------------------------------------------------------
     def _cleared_ok(self):
@@ -330,6 +371,55 @@ class _Solver:
 
     def _field(self, slots):
         """``X_{slots}`` (Eq. gLiouville); over ``QQ(params)`` fraction-free (:meth:`_fields_cleared`)."""
+        fast = self._monomial_field(slots)
+        return fast if fast is not None else self._general_field(slots)
+
+    def _monomial_field(self, slots):
+        """``X_{H^1, .., x^mu, .., H^{N-1}}`` (a monomial of degree >= 2 in one slot) by Laplace expansion, or None.
+
+        The Liouville field is a determinant whose row of slot ``a`` is ``grad x^mu = sum_j mu_j x^(mu - e_j) e_j``;
+        a determinant is linear in each row over the polynomial ring, so
+
+            X_{.., x^mu, ..} = sum_j mu_j x^(mu - e_j) X_{.., x_j, ..}     (x_j in slot a),
+
+        and the ``n`` fields ``X_{.., x_j, ..}`` of a slot (the cofactors) are computed once per solve: a column of
+        the operator is then a sum of shifted copies of them -- the same ring element, without a determinant of
+        polynomials per column.  Only the determinant form of Eq. (gLiouville) (``N - 1`` slots; not the
+        canonical or triplet brackets) over a coefficient field without parameters is expanded; other slots and
+        fields go the general way (None).
+        """
+        alg, n = self.alg, self.n
+        if not self._laplace:
+            return None
+        others = [b for b, p in enumerate(slots) if p is not self.hams[b]]
+        if len(others) != 1 or len(slots[others[0]]) != 1:
+            return None
+        a = others[0]
+        ((mu, c),) = slots[a].items()
+        if c != alg.domain.one or any(mu[n:]) or sum(mu) < 2:
+            return None
+        cofactors = self._cofactors.get(a)
+        if cofactors is None:
+            cofactors = []
+            for j in range(n):
+                unit = list(slots)
+                unit[a] = alg.gens[j]
+                cofactors.append(self._general_field(unit).components)
+            self._cofactors[a] = cofactors
+        sums = [{} for _ in range(n)]
+        zero = alg.domain.zero
+        for j in range(n):
+            if not mu[j]:
+                continue
+            shift = tuple(e - (k == j) for k, e in enumerate(mu))
+            for i, comp in enumerate(cofactors[j]):
+                out = sums[i]
+                for m, v in comp.items():
+                    key = tuple(x + y for x, y in zip(m, shift))
+                    out[key] = out.get(key, zero) + mu[j] * v
+        return VectorField(alg, [alg.ring.from_dict({m: v for m, v in out.items() if v}) for out in sums])
+
+    def _general_field(self, slots):
         if self._cleared_ok():
             return self._fields_cleared([slots])
         return liouville_field(self.alg, *slots)
@@ -510,13 +600,13 @@ class _Solver:
             fam[a] = self._family(mem_polys[0][a], mem_polys[1][a], alpha)
         for a in range(self.slots):
             corrections[(a, j)] = fam[a]
-        gauge = [ansatz.expressions(v, alg.coordinates, domain) for v in kernel]
-        psi_dim = self._psi_dim(ansatz, D) if self.slots == 2 else None
+        psi_dim = self._psi_dim(ansatz, D, sol.pivots) if self.slots == 2 else None
 
         # on first access (OrderSolution); a partial of a module function, so that an unconverted solution pickles
         convert = functools.partial(_sympy_forms, alg, tuple(fam), tuple(map(tuple, mem_polys)))
-        return OrderSolution(j, "solved", degree=D, corrections=None, members=None, gauge=gauge,
-                             kernel_dim=len(kernel), psi_dim=psi_dim, rhs=rhs, convert=convert)
+        gauge = functools.partial(_gauge_forms, ansatz, tuple(kernel), alg.coordinates, domain)
+        return OrderSolution(j, "solved", degree=D, corrections=None, members=None, gauge=None,
+                             kernel_dim=len(kernel), psi_dim=psi_dim, rhs=rhs, convert=convert, convert_gauge=gauge)
 
     def _family(self, m0, m1, alpha):
         """``m0 + alpha (m1 - m0)``; over ``QQ<theta>(params)`` coefficient by coefficient over ``QQ(params)``
@@ -532,43 +622,66 @@ class _Solver:
             return m0 + (m1 - m0).mul_monom(alpha)
         return self.alg.ring.from_dict(coeffs) if coeffs else self.alg.zero
 
-    def _psi_dim(self, ansatz, D):
-        """Rank of ``{(psi_G, -psi_H) : psi = H^p G^q}`` within the ansatz (they lie in the kernel)."""
-        alg = self.alg
+    def _independent(self):
+        """``H, G`` are algebraically independent (a 2 x 2 minor of their Jacobian in the coordinates is non-zero)."""
+        if self._jacobian_rank2 is None:
+            alg = self.alg
+            grads = [[alg.diff(P, i) for i in range(self.n)] for P in self.hams]
+            self._jacobian_rank2 = any(grads[0][i] * grads[1][k] != grads[0][k] * grads[1][i]
+                                       for i in range(self.n) for k in range(i + 1, self.n))
+        return self._jacobian_rank2
+
+    def _psi_dim(self, ansatz, D, pivots):
+        """Dimension of ``span{(psi_G, -psi_H) : psi = H^p G^q}`` within the ansatz, without a second elimination.
+
+        Every such pair lies in ``ker L`` (``X_{f(H,G), G} = f_H X_{H,G}``: the bracket is a derivation in each
+        slot and alternating), and is a column vector of the ansatz exactly when each of its two components
+        ``q H^p G^(q-1)`` and ``-p H^(p-1) G^q`` (a zero one aside) has total degree ``<= D`` in the coordinates
+        and no constant generator (``alpha``) -- read off the degrees, since the coordinate degree and the
+        constant degree of a product add up over a polynomial ring (an integral domain).
+
+        Counting is the rank.  When the Jacobian of ``(H, G)`` in the coordinates has rank 2, ``H`` and ``G``
+        are algebraically independent over the coefficient field (the Jacobian criterion in characteristic 0:
+        Jacobi 1841; e.g. Ehrenborg and Rota, Eur. J. Combin. 14 (1993), 157-181, Thm. 3.2).  A relation
+        ``sum c_pq (q H^p G^(q-1), -p H^(p-1) G^q) = 0`` is ``(Psi_g(H, G), -Psi_h(H, G)) = 0`` for the
+        polynomial ``Psi(h, g) = sum c_pq h^p g^q``; independence makes ``Psi_g`` and ``Psi_h`` zero as
+        polynomials, so ``Psi`` is a constant and every ``c_pq`` with ``(p, q) != (0, 0)`` vanishes.  The
+        fitting pairs are therefore linearly independent, and their number is the rank the former second pass
+        computed (an elimination of those vectors).
+
+        Otherwise (a degenerate pair, ``X_{H,G} = 0``) the pairs are not independent; they still lie in the
+        kernel, whose basis from the elimination is the identity on its free columns (one vector per free
+        column, zero on the other free columns), so a kernel vector is the combination of the basis with its
+        own values on the free columns as coefficients: the rank of the pairs is the rank of their restriction
+        to the free columns (those outside the elimination's pivots), a matrix of ``len(kernel)`` columns.
+        """
+        alg, n = self.alg, self.n
         Hp, Gp = self.hams
-        index = ansatz.index
-        vecs = []
-        dh, dg = (max(_total_degree(Hp, self.n), 1), max(_total_degree(Gp, self.n), 1))
-        powers: dict = {}  # (k, l) -> H^k G^l, each product formed once
+        dh, dg = (_total_degree(P, n) for P in (Hp, Gp))
+        plain = [not any(any(m[n:]) for m in P.keys()) for P in (Hp, Gp)]  # no constant generator
 
-        def power(k, l):
-            value = powers.get((k, l))
-            if value is None:
-                value = alg.ring.one if k == l == 0 else (power(k - 1, l) * Hp if k else power(k, l - 1) * Gp)
-                powers[(k, l)] = value
-            return value
+        def fits(k, l):  # H^k G^l (k, l >= 0) is a combination of ansatz monomials
+            return dh * k + dg * l <= D and (k == 0 or plain[0]) and (l == 0 or plain[1])
 
-        for p in range(D + 2):
-            for q in range(D + 2):
-                # psi_G and psi_H must fit the ansatz degree: skip the products that cannot
-                if p + q == 0 or dh * p + dg * (q - 1) > D and dh * (p - 1) + dg * q > D:
-                    continue
-                dG = q * power(p, q - 1) if q else alg.zero  # d psi / dG
-                dH = p * power(p - 1, q) if p else alg.zero  # d psi / dH
-                pair = (dG, -dH)
-                vec, ok = {}, True
-                for a, poly in enumerate(pair):
-                    for m, c in poly.items():
-                        col = index.get((a, m[: self.n]))
-                        if col is None or any(m[self.n:]):
-                            ok = False
-                            break
-                        vec[col] = c
-                    if not ok:
-                        break
-                if ok and vec:
-                    vecs.append(vec)
-        return rank(vecs, len(ansatz), alg.domain) if vecs else 0
+        pairs = [(p, q) for p in range(D + 2) for q in range(D + 2)
+                 if p + q and (q == 0 or fits(p, q - 1)) and (p == 0 or fits(p - 1, q))]
+        if self._independent() or not pairs:
+            return len(pairs)
+        pivots = set(pivots)
+        place = {c: k for k, c in enumerate(c for c in range(len(ansatz)) if c not in pivots)}  # the free columns
+        index, vecs = ansatz.index, []
+        for p, q in pairs:
+            dG = q * Hp**p * Gp ** (q - 1) if q else alg.zero  # d psi / dG
+            dH = p * Hp ** (p - 1) * Gp**q if p else alg.zero  # d psi / dH
+            vec = {}
+            for a, poly in enumerate((dG, -dH)):
+                for m, c in poly.items():
+                    k = place.get(index[(a, m[:n])])
+                    if k is not None:
+                        vec[k] = c
+            if vec:
+                vecs.append(vec)
+        return rank(vecs, len(place), alg.domain) if vecs else 0
 
 
 def direct_route(system, word, order: int = 2, degree=None, max_unknowns=None, progress=None,

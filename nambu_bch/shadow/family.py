@@ -13,6 +13,7 @@ Horikoshi, Eqs. (L1), (L2), (SH12321c), (SG12321c), (Xeff3).
 
 from __future__ import annotations
 
+import functools
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 
@@ -103,9 +104,23 @@ class Corrections(Mapping):
         return repr(dict(self.items()))
 
 
+class Gauge(Corrections):
+    """``order -> [directions]`` of a direct-route family: the kernel basis of each solved order, read-only, converted to
+    sympy on first access (:attr:`~nambu_bch.shadow.direct_route.OrderSolution.gauge`); equal to the dict of the same
+    items."""
+
+    def __getitem__(self, order):
+        return self._solutions[order].gauge
+
+
 def _free_parameters(exists, shadows) -> list:
     """``["alpha"]`` when an existing family's shadows depend on ``alpha`` (Eq. Xeff3), else ``[]``."""
     return ["alpha"] if exists and any(S.has(ALPHA) for S in shadows) else []
+
+
+def _direct_shadows(result) -> tuple:
+    """The shadows of a direct-route result as sympy expressions (a module function: a pending family pickles)."""
+    return result.shadow()
 
 
 @dataclass(frozen=True)
@@ -124,9 +139,11 @@ class ShadowFamily(Printable):
     drift : dict or None -- predicted secular drift ``dH'/dt`` per Hamiltonian of a certified non-existence
     evidence : dict or None -- the existence decision as data (:meth:`~nambu_bch.shadow.existence.Existence.evidence`)
     existence : the :class:`~nambu_bch.shadow.existence.Existence` decision, or None
-    shadows : tuple -- all shadow Hamiltonians ``(H_S, G_S, ...)`` (sympy, in ``h`` and ``alpha``), or ``()``
+    shadows : tuple -- all shadow Hamiltonians ``(H_S, G_S, ...)`` (sympy, in ``h`` and ``alpha``), or ``()``; a
+        direct-route family keeps the exact corrections (``details``) and builds these sums on first access
     free_parameters : list of str -- e.g. ``["alpha"]``
-    gauge : dict ``order -> [directions]`` -- kernel bases (one correction per Hamiltonian)
+    gauge : dict ``order -> [directions]`` -- kernel bases (one correction per Hamiltonian; direct route: a read-only
+        :class:`Gauge`, converted to sympy on first access)
     corrections : mapping ``order -> tuple`` -- the family's ``dH_j, dG_j`` (direct route: a read-only
         :class:`Corrections`, converted to sympy on first access)
     degree : dict ``order -> int`` -- ansatz degrees used
@@ -172,22 +189,21 @@ class ShadowFamily(Printable):
             (:func:`existence_fields`; None: undecided); ignored when a polynomial pair was found
         max_unknowns : int or None -- the bound the route used (named in the obstruction of a refused order)
         """
-        notes, gauge, solved, degree = [], {}, {}, {}
+        notes, solved, degree = [], {}, {}
         for o in result.orders:
             if o.status == "vanishes":
                 notes.append(_vanishing_note(composition, o.order))
             elif o.status == "solved":
-                gauge[o.order] = o.gauge
                 solved[o.order] = o
                 degree[o.order] = o.degree
             else:
                 degree[o.order] = o.degree
-        corrections = Corrections(solved)
+        corrections, gauge = Corrections(solved), Gauge(solved)
         common = dict(gauge=gauge, corrections=corrections, degree=degree, notes=notes, details=result)
         if result.exists:
-            shadows = result.shadow()
-            return cls(system, composition, order, "direct", True, shadows=shadows, polynomial=True,
-                       free_parameters=_free_parameters(True, shadows), **common)
+            # the exact corrections stay the data; the sympy sums are built on first access (``shadows``)
+            return cls(system, composition, order, "direct", True, shadows=functools.partial(_direct_shadows, result),
+                       polynomial=True, free_parameters=["alpha"] if result.has_symbol(ALPHA) else [], **common)
         bad = result.orders[-1]
         if bad.status == "obstructed":
             certificate, obstruction = bad.certificate, _obstruction_text(bad, len(system.hamiltonians))
@@ -439,3 +455,20 @@ class ShadowFamily(Printable):
             else f"obstructed at h^{self.failed_order}" if self.exists is False else f"undecided at h^{self.failed_order}"
         return (f"ShadowFamily({self.system.name!r}, {self.composition.name!r}, order={self.order}, route={self.route!r}, "
                 f"{state}, free_parameters={self.free_parameters})")
+
+
+def _get_shadows(self):
+    value = self.__dict__.get("_shadows", ())
+    if callable(value):  # pending: built from the route's exact data, once
+        value = self.__dict__["_shadows"] = tuple(value())
+    return value
+
+
+def _put_shadows(self, value):
+    self.__dict__["_shadows"] = value  # the frozen dataclass's __init__ assigns through object.__setattr__
+
+
+# after @dataclass: the generated __init__ assigns through the property (the default () stays the field's own);
+# equality, hashing, repr and pickling read the property, so a pending family equals its built copy
+ShadowFamily.shadows = property(_get_shadows, _put_shadows,
+                                doc="The shadow Hamiltonians ``(H_S, G_S, ...)`` as sympy expressions (built on first access).")
