@@ -29,7 +29,7 @@ import tomllib
 
 from .errors import InvalidSystemError
 from .parsing import parse_expression
-from .systems.system import USER_NAME, check_name
+from .systems.system import USER_NAME
 
 #: Largest accepted model file, in bytes.
 MAX_FILE_SIZE = 64 * 1024
@@ -51,7 +51,7 @@ def parse_value(text, what: str):
 
 
 def load_system(path, values: dict | None = None):
-    """``(System, {name: value})`` read from the TOML file at ``path``.
+    """The :class:`~nambu_bch.systems.System` the TOML file at ``path`` defines.
 
     Parameters
     ----------
@@ -65,7 +65,17 @@ def load_system(path, values: dict | None = None):
         On a missing / unreadable / oversized file, TOML syntax errors, unknown
         keys or a malformed entry; :class:`ExpressionParseError` on a bad expression.
     """
-    from .systems import System
+    spec = load_spec(path)
+    system = spec.build()
+    if values is not None:
+        values.update(dict(spec.values))
+    return system
+
+
+def load_spec(path):
+    """The :class:`~nambu_bch.systems.spec.SystemSpec` of the TOML file at ``path`` (read and its shape checked;
+    the system itself is checked and built by :meth:`~nambu_bch.systems.spec.SystemSpec.build`)."""
+    from .systems.spec import SystemSpec
 
     shown = os.fspath(path)
     raw = _read_regular_file(shown)
@@ -104,29 +114,28 @@ def load_system(path, values: dict | None = None):
         if not all(isinstance(v, str) for v in hams):
             raise InvalidSystemError(f"--system {shown}: H and G must be strings such as \"x2^2/2 + x1^2/2\"")
     params = data.get("parameters", [])
-    names = []
+    values = {}
     if isinstance(params, dict):
-        for key, value in params.items():
-            names.append(key)
-            if values is not None:
-                values[key] = parse_value(value, f"--system {shown}: parameter {key}")
+        names = list(params)
+        values = {key: parse_value(value, f"--system {shown}: parameter {key}") for key, value in params.items()}
     else:
         names = text_list("parameters", params)
     for key in ("name", "split", "description", "citation", "bracket"):
         if key in data and not isinstance(data[key], str):
             raise InvalidSystemError(f"--system {shown}: {key} must be a string, got {data[key]!r}")
     if "name" in data:
-        name = check_name(data["name"], f"--system {shown}: name")
+        name = data["name"]
     else:  # the file's base name when it is a valid name, else 'custom'
         stem = os.path.splitext(os.path.basename(shown))[0]
         name = stem if USER_NAME.match(stem) else "custom"
-    symbols = _symbols(coordinates, names, shown)
-    parsed = [parse_expression(H, symbols, what=f"--system {shown}: {label}") for H, label in zip(hams, _labels(len(hams)))]
-    system = System(
-        coordinates, parsed, names, name=name, split=data.get("split"), bracket=data.get("bracket"),
-        description=data.get("description", ""), citation=data.get("citation", ""),
+    where = f"--system {shown}"
+    labels = {"coordinates": where, "parameters": where, "count": where, "system": where, "name": f"{where}: name"}
+    return SystemSpec(
+        hamiltonians=tuple((text, f"{where}: {label}") for text, label in zip(hams, _labels(len(hams)))),
+        coordinates=tuple(coordinates), parameters=tuple(names), values=tuple(values.items()),
+        split=data.get("split"), bracket=data.get("bracket"), name=name,
+        description=data.get("description", ""), citation=data.get("citation", ""), labels=tuple(labels.items()),
     )
-    return system
 
 
 def _read_regular_file(shown) -> bytes:
@@ -169,14 +178,3 @@ def _labels(count):
     if count == 2:
         return ["H", "G"]
     return ["H"] + [f"hamiltonians[{k}]" for k in range(1, count)]
-
-
-def _symbols(coordinates, parameters, shown):
-    import sympy
-
-    out = []
-    for n in list(coordinates) + list(parameters):
-        if not isinstance(n, str) or not n.isidentifier():
-            raise InvalidSystemError(f"--system {shown}: {n!r} is not a valid symbol name")
-        out.append(sympy.Symbol(n))
-    return out

@@ -319,3 +319,20 @@ def test_criterion_needs_orbits_that_are_curves():
     assert not R.exists
     d = decide(R, measure=False)
     assert d.outcome == "undecided" and d.exists is None and "curves" in d.reason
+
+
+def test_the_decision_is_a_list_of_strategies_in_the_documented_order(monkeypatch):
+    """decide asks STRATEGIES in order (exact averages, then the symmetry argument, then quadrature; the last
+    always answers); when the exact decomposition fails the next strategy decides, with the same orbits."""
+    from nambu_bch.shadow import existence
+
+    assert [s.__name__ for s in existence.STRATEGIES] == [
+        "_needs_curves", "_vanishing", "_exact", "_symmetry", "_numerical_certificate", "_numerical_evidence",
+        "_no_decision"]
+    R = direct_route(model("ho3"), "12321", 2, max_unknowns=1)   # the solve refused: the averages decide
+    d = decide(R, measure=False)
+    assert (d.outcome, d.method) == ("smooth", "exact") and all(a == 0 for a in d.averages)
+    monkeypatch.setattr(existence, "exact_average", lambda *args, **kwargs: None)
+    s = decide(R, measure=False)
+    assert (s.outcome, s.method) == ("smooth", "symmetry") and s.sections
+    assert [o.x0 for o in s.orbits] == [o.x0 for o in d.orbits]

@@ -9,10 +9,9 @@ errors answer without it.
 from __future__ import annotations
 
 import argparse
-import re
 
 from ..checks import MAX_ORDER as MAX_CLI_ORDER  # the API's range of orders (light module: no sympy here)
-from ..errors import MAX_MESSAGE, NambuBCHError, one_line, shown  # noqa: F401 -- re-exported to the cli modules
+from ..errors import MAX_MESSAGE, InvalidSystemError, NambuBCHError, one_line, shown  # noqa: F401 -- re-exported to the cli modules
 
 PROG = "nambu-bch"
 DEFAULT_MODEL = "ho3"
@@ -145,20 +144,13 @@ def order_value(text, flag="--order", limit=MAX_CLI_ORDER, low=0):
 
 def parse_params(items):
     """``--param NAME`` / ``--param NAME=VALUE`` -> ``(names in order, {name: exact value})``."""
-    from ..systems.system import MAX_PARAMETERS, SYMBOL_NAME
+    from ..systems.system import check_parameter_names
 
     names, values = [], {}
-    if len(items or ()) > MAX_PARAMETERS:
-        raise NambuBCHError(f"--param is given {len(items)} times; at most {MAX_PARAMETERS} parameters are accepted")
     for item in items or ():
         name, sep, value = item.partition("=")
         name = name.strip()
-        if not SYMBOL_NAME.match(name):
-            raise NambuBCHError(
-                f"--param {item!r}: {name!r} is not a parameter name; write --param m (declare) or --param m=1 (value)"
-            )
-        if name in ("h", "alpha"):
-            raise NambuBCHError(f"--param {item!r}: {name!r} is reserved (the step is --h, alpha is the family parameter)")
+        check_parameter_names([name], f"--param {shown(item)}: ")
         if name not in names:
             names.append(name)
         if sep:
@@ -179,122 +171,43 @@ def parse_x0(text, n):
 # --------------------------------------------------------------------------------------------
 # the system and the integrator from the flags
 # --------------------------------------------------------------------------------------------
-def system_from_args(args):
-    """``(system, values)``: the built-in model, TOML file or flag-defined system, and parameter values."""
-    import sympy
-
-    from ..model_file import load_system
-    from ..parsing import parse_expression
-    from ..systems import System, infer_bracket, model
-    from ..systems.system import MAX_COORDINATES, SYMBOL_NAME, check_name
+def system_spec(args):
+    """The :class:`~nambu_bch.systems.spec.SystemSpec` of the system flags (with ``--param`` values)."""
+    from ..systems.spec import SystemSpec
 
     names, values = parse_params(getattr(args, "param", None))
     user_flags = [f for f, v in (("--H", args.H), ("--G", args.G), ("--coords", args.coords)) if v is not None]
-    chosen = [f for f, v in (("--model", args.model), ("--system", args.system)) if v] + (["--H"] if user_flags else [])
-    if len(chosen) > 1:
-        raise NambuBCHError(f"{' and '.join(chosen)} both choose the system; give only one of --model, --system, --H/--G")
-    if user_flags and args.H is None:
-        raise NambuBCHError(f"{user_flags[0]} needs --H EXPR (the first Hamiltonian)")
-    if args.H is not None:
-        hams = [args.H] + list(args.G or [])
-        if len(hams) > MAX_COORDINATES - 1:  # before any parsing: the bracket of n Hamiltonians has (n+1)! terms
-            raise NambuBCHError(
-                f"--H and {len(hams) - 1} --G give {len(hams)} Hamiltonians; at most {MAX_COORDINATES - 1} are accepted "
-                f"(a system on at most {MAX_COORDINATES} coordinates)"
-            )
-        name = check_name(args.name, "--name") if args.name else "custom"
-        if args.coords:
-            coords = args.coords.replace(",", " ").split()
-        else:
-            coords = [f"x{i}" for i in range(1, (len(hams) + 1 if len(hams) > 1 else 2) + 1)]
-            _check_inferred_coordinates(hams, coords, names, args.bracket)
-        if len(coords) > MAX_COORDINATES:
-            raise NambuBCHError(f"--coords gives {len(coords)} coordinates; at most {MAX_COORDINATES} are accepted")
-        for c in coords:
-            if not SYMBOL_NAME.match(c):
-                raise NambuBCHError(f"--coords {args.coords!r}: {c!r} is not a symbol name; write e.g. --coords 'x1 x2 x3'")
-            if c in ("h", "alpha"):
-                raise NambuBCHError(f"--coords {args.coords!r}: {c!r} is reserved (the step h, the family parameter alpha)")
-        if len(coords) >= 2:
-            try:
-                infer_bracket(len(coords), len(hams), args.bracket)
-            except NambuBCHError as exc:
-                raise NambuBCHError(f"--coords {' '.join(coords)!r} with --H and {len(hams) - 1} --G: {exc}") from None
-        symbols = [sympy.Symbol(s) for s in (*coords, *names)]
-        flags = ["--H"] + ["--G"] * (len(hams) - 1)
-        parsed = [parse_expression(text, symbols, what=flag) for text, flag in zip(hams, flags)]
-        system = System(coords, parsed, names, name=name, split=args.split, bracket=args.bracket)
-        return system, values
-    if args.system:
-        file_values: dict = {}
-        system = load_system(args.system, file_values)
-        extra = [n for n in names if n not in {p.name for p in system.parameters}]
-        if extra:
-            raise NambuBCHError(
-                f"--param {extra[0]}: the system of {shown(args.system)} has parameters {names_of(system.parameters)}"
-            )
-        _refuse_declarations(names, values, f"the system of {shown(args.system)}")
-        system = _with_flags(system, args)
-        args.file_values = file_values  # numeric defaults for check / plot; not substituted symbolically
-        return system, values
-    system = model(args.model or DEFAULT_MODEL)
-    extra = [n for n in names if n not in {p.name for p in system.parameters}]
-    if extra:
-        raise NambuBCHError(f"--param {extra[0]}: model {system.name} has parameters {names_of(system.parameters)}")
-    _refuse_declarations(names, values, f"model {system.name}")
-    return _with_flags(system, args), values
+    if user_flags and args.H is None and not (args.model or args.system):
+        raise InvalidSystemError(f"{user_flags[0]} needs --H EXPR (the first Hamiltonian)")
+    texts = ([args.H] if args.H is not None else []) + list(args.G or [])
+    labels = {"model": "--model", "file": "--system", "hamiltonians": "--H", "choice": "--model, --system, --H/--G",
+              "parameters": "--param", "name": "--name", "count": f"--H and {len(texts) - 1} --G",
+              "system": f"--coords {{coords}} with --H and {len(texts) - 1} --G"}
+    coords = None
+    if args.coords is not None:
+        coords = tuple(args.coords.replace(",", " ").split())
+        labels["coordinates"] = f"--coords {shown(args.coords)}"
+    nothing_chosen = not (texts or coords is not None or args.system)
+    return SystemSpec(
+        model=args.model or (DEFAULT_MODEL if nothing_chosen else None), file=args.system,
+        hamiltonians=tuple(zip(texts, ["--H"] + ["--G"] * (len(texts) - 1))), coordinates=coords,
+        parameters=tuple(names), values=tuple(values.items()), split=args.split, bracket=args.bracket,
+        name=args.name, labels=tuple(labels.items()),
+    )
 
 
-def _refuse_declarations(names, values, source) -> None:
-    """``--param NAME`` without a value on a built-in model or a file: it would change nothing."""
-    declared = [n for n in names if n not in values]
-    if declared:
-        raise NambuBCHError(f"--param {declared[0]} without a value declares a parameter of a user system (--H); "
-                            f"{source} has it already: give a value, e.g. --param {declared[0]}=1")
+def system_from_args(args):
+    """``(system, values)``: the built-in model, TOML file or flag-defined system, and the ``--param`` values.
 
-
-_COORDINATE = re.compile(r"(?<![A-Za-z0-9_])x([1-9][0-9]*)(?![A-Za-z0-9_])", re.ASCII)
-
-
-def _check_inferred_coordinates(hams, coords, names, bracket) -> None:
-    """Without ``--coords`` the coordinates are ``x1..xN`` with N from the number of Hamiltonians (2 for one,
-    else one more than their number); refuse when the highest ``x<k>`` the expressions use is not ``xN``.
-
-    ``--H 'x2^2/2 + x1^2/2' --G 'x1^2'`` would otherwise be analysed on ``x1 x2 x3`` (a Nambu system in
-    which x3 appears nowhere), and ``--H`` using ``x3`` would be refused as an undeclared name.
+    A TOML file's own parameter values are left in ``args.file_values`` (numeric defaults for check / plot;
+    not substituted symbolically).
     """
-    from ..systems import infer_bracket
-
-    found = {f"x{m}" for text in hams for m in _COORDINATE.findall(text)} - set(names)
-    if not found:
-        return  # no coordinate-like name: the parser names whatever is undeclared
-    used = sorted(found, key=lambda name: int(name[1:]))
-    top = int(used[-1][1:])
-    if top == len(coords):
-        return
-    flags = "--H" + (f" and {len(hams) - 1} --G use" if len(hams) > 1 else " uses")
-    try:
-        kind = f", {infer_bracket(len(coords), len(hams), bracket)} bracket"
-    except NambuBCHError:
-        kind = ""
-    count = f"{len(hams)} Hamiltonians mean" if len(hams) > 1 else "one Hamiltonian means"
-    meant = f"{flags} {', '.join(used)}; without --coords, {count} a system on {' '.join(coords)} (N = {len(coords)}{kind})"
-    if top < len(coords):
-        unused = coords[top:]
-        appear = f"{unused[0]} appears" if len(unused) == 1 else f"{', '.join(unused)} appear"
-        raise NambuBCHError(
-            f"{meant}, in which {appear} in no Hamiltonian; pass --coords {' '.join(coords)!r} to analyse that system"
-        )
-    wanted = " ".join(f"x{k}" for k in range(1, top + 1))
-    raise NambuBCHError(f"{meant}; pass --coords {wanted!r} for the coordinates the expressions use "
-                        "(--param NAME declares a parameter)")
-
-
-def _with_flags(system, args):
-    """``system`` with the --bracket and --split flags applied (a new System when they change it)."""
-    if args.bracket:
-        return system.with_bracket(args.bracket, args.split)
-    return system.with_split(args.split) if args.split else system
+    spec = system_spec(args)
+    file_values: dict = {}
+    system = spec.build(file_values)
+    if spec.file:
+        args.file_values = file_values
+    return system, dict(spec.values)
 
 
 def symbolic_system(args):

@@ -24,9 +24,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..errors import InvalidRunError, InvalidSystemError, NumericalRangeError
+from ..errors import InvalidRunError, NumericalRangeError
 from ..progress import Progress, progress_wanted
-from ..systems import System, model
+from ..systems import System
 from ..checks import check_flag
 from .guards import (check_backend, check_count, check_inputs, check_out, check_range, check_result, check_stability,
                      check_work, initial_state, run_label, scan_states)
@@ -39,12 +39,11 @@ _SEGMENT_WORK = 20_000_000
 
 
 def as_system(system) -> System:
-    """A :class:`~nambu_bch.systems.System` from a System or a built-in model name."""
-    if isinstance(system, System):
-        return system
-    if isinstance(system, str):
-        return model(system)
-    raise InvalidSystemError(f"system must be a nambu_bch System or a built-in model name, got {system!r}")
+    """A :class:`~nambu_bch.systems.System` from a System, a built-in model name or a system specification
+    (:func:`nambu_bch.systems.system.as_system`, the one reading of a ``system`` argument)."""
+    from ..systems.system import as_system
+
+    return as_system(system)
 
 
 def iterate(system, word, h, steps, x0=None, params=None, every=1, *, kahan=False, dps=None,

@@ -24,13 +24,9 @@ SOLVE_UNKNOWNS = 2000
 
 
 def _system(system):
-    if isinstance(system, str):
-        from ..systems import model
+    from ..systems.system import as_system
 
-        return model(system)
-    if not hasattr(system, "hamiltonians") or not hasattr(system, "splitting"):
-        raise NambuBCHError(f"system must be a System or a built-in model name, got {system!r}")
-    return system
+    return as_system(system)
 
 
 def _decision(result, existence: bool, params):

@@ -65,6 +65,7 @@ Horikoshi, Eqs. (L2), (Xeff3).
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from functools import cached_property
 from itertools import combinations, product
 
 import numpy as np
@@ -321,6 +322,9 @@ def decide(result, params=None, points=None, orbits: int = DEFAULT_ORBITS, measu
            rtol: float = 1e-10) -> Existence:
     """Decide existence at the first order a :class:`DirectResult` did not solve polynomially.
 
+    The strategies of :data:`STRATEGIES` are asked in order; the first that decides answers.  A
+    certified non-existence is then checked by measuring the drift of the iterated integrator.
+
     Parameters
     ----------
     result : DirectResult -- with an ``"obstructed"`` or ``"refused"`` order
@@ -351,113 +355,194 @@ def decide(result, params=None, points=None, orbits: int = DEFAULT_ORBITS, measu
     rtol = finite_float(rtol, "rtol")
     if not 0 < rtol < 1:
         raise NambuBCHError(f"rtol must be a tolerance between 0 and 1, got {show(rtol)}")
-    params = _check_params(system, params)
-    gs, j = integrands(result)
-    names = _names(system)
-    n = len(system.coordinates)
-    if len(system.hamiltonians) != n - 1:
-        # the criterion needs orbits that are curves (N - 1 first integrals); canonical d >= 2 and triplet
-        # systems have invariant tori of higher dimension, whose averages are not orbit averages
-        return Existence("undecided", None, j, params=params, names=names,
-                         reason=(f"the orbit-average criterion needs N - 1 = {n - 1} Hamiltonians (orbits that are "
-                                 f"curves); {system.name} has {len(system.hamiltonians)} on N = {n}, so no decision "
-                                 "is made beyond the polynomial ansatz"))
-    if points is None:
-        pts = sample_points(n, orbits)
-    else:
-        try:
-            pts = np.asarray(points, dtype=float)
-        except (TypeError, ValueError, OverflowError):  # text, ragged or complex entries: named below
-            pts = np.zeros(0)
-        if pts.ndim != 2 or pts.shape[1] != n or not 1 <= len(pts) <= 64 or not np.all(np.isfinite(pts)):
-            raise NambuBCHError(f"points must be 1 to 64 finite points of {n} coordinates, got {show(points)}")
-    F = orbit_functions(system, gs, params, names)
-    found = [orbit_average(F, x, rtol=rtol) for x in pts]
-    closed = [o for o in found if o.closed]
-    dec = Existence("undecided", None, j, orbits=found, params=params, names=names, functions=F)
-    if all(g == 0 for g in gs):
-        dec.outcome, dec.exists, dec.method = "smooth", True, "exact"
-        dec.averages = [sympy.Integer(0)] * len(gs)
-        dec.reason = f"at h^{j} the integrands R.grad H vanish identically"
-        return dec
-    exact = [exact_average(system, g) for g in gs]
-    if all(c is not None for c in exact):
-        dec.averages = exact
-        dec.method = "exact"
-        if all(c == 0 for c in exact):
-            dec.outcome, dec.exists = "smooth", True
-            dec.reason = (f"at h^{j} every R.grad H_a is X_{{H,G}}(p_a) for a polynomial p_a: the averages vanish "
-                          "identically (conserved polynomials exist; the pair needs a function of them)")
-            return dec
-        # certified: <g> = c(H, G) on every periodic orbit; find one where c != 0
-        syms = [sympy.Symbol(s) for s in names]
-        subs = {p: v for p, v in params.items()}
-        for o in closed:
-            vals = [float(c.subs(subs).subs(dict(zip(syms, o.hamiltonians)))) for c in exact]
-            if any(abs(v) > 1e-12 for v in vals):
-                dec.certificate_orbit = o
-                break
-        if dec.certificate_orbit is None:
-            dec.reason = f"exact averages {exact} but no sampled periodic orbit where they are non-zero"
-            return dec
-        dec.outcome, dec.exists = "none", False
-        dec.drift = {nm: STEP**j * c for nm, c in zip(names, exact)}
-        dec.reason = (f"at h^{j} the orbit averages are exactly " +
-                      ", ".join(f"<R.grad {nm}> = {c}" for nm, c in zip(names, exact)) +
-                      " on every periodic orbit (g = X(p) + c(H, G)), non-zero on the certificate orbit")
-    else:
-        flips = reversing_involutions(system, gs)
-        singles = tuple(f[0] for f in flips if len(f) == 1)
-        if singles:
-            good = [o for o in closed if any(o.fix_crossings.get(i, 0) > 0 for i in singles)]
-            dec.involution = (singles[0],)
-            dec.sections = singles
-            if good:
-                dec.outcome, dec.exists, dec.method = "smooth", True, "symmetry"
-                small = all(all(o.negligible()) for o in good)
-                dec.reason = (f"at h^{j} the integrands are odd under the reversing involutions "
-                              f"{', '.join(f'x{i + 1} -> -x{i + 1}' for i in singles)}, which fix the Hamiltonians: the "
-                              f"averages vanish exactly on every orbit meeting one of their fixed planes ({len(good)} of "
-                              f"{len(closed)} sampled closed orbits do); numerically |<g>| <= "
-                              f"{max(max(abs(a) for a in o.averages) for o in good):.1e} "
-                              f"({'consistent' if small else 'INCONSISTENT'} with zero)")
-                if not small:
-                    dec.outcome, dec.exists, dec.method = "undecided", None, None
-                return dec
-        dec.method = "numerical"
-        sig = [o for o in closed if any(o.significant())]
-        if sig:
-            o = max(sig, key=lambda o: max(abs(a) / (e + 1e-300) for a, e in zip(o.averages, o.errors)))
-            dec.certificate_orbit = o
-            dec.outcome, dec.exists = "none", False
-            dec.drift = {nm: STEP**j * sympy.Float(a, 12) for nm, a in zip(names, o.averages)}
-            dec.reason = (f"at h^{j} the average " + ", ".join(f"<R.grad {nm}> = {a:.6g} (+- {e:.1e})"
-                                                              for nm, a, e in zip(names, o.averages, o.errors)) +
-                          f" on the periodic orbit through {[round(v, 6) for v in o.x0]} (numerical, error estimate from two tolerances)")
-        elif closed and all(all(o.negligible()) for o in closed):
-            worst = max(max(abs(a) / s for a, s in zip(o.averages, o.scales) if s) for o in closed)
-            dec.reason = (f"at h^{j} the averages vanish numerically on {len(closed)} orbits (|<g>|/max|g| <= {worst:.1e}): "
-                          "evidence of a smooth shadow pair, not a proof; undecided")
-            return dec
-        else:
-            dec.reason = (f"at h^{j} no decision: {len(closed)} of {len(found)} sampled orbits closed, "
-                          "averages neither clearly zero nor clearly non-zero")
-            return dec
+    ctx = _Context(result, _check_params(system, params), points, orbits, rtol)
+    dec = next(d for d in (strategy(ctx) for strategy in STRATEGIES) if d is not None)
     if measure and dec.exists is False:
-        o = dec.certificate_orbit
-        conserved = conserved_below(result, j)
-        # small enough that H' moves by <= 0.5% of its size over the run (the rate is then that of one orbit)
-        size = max(1e-3, max(abs(v) for v in o.hamiltonians))
-        rate = max(abs(a) for a in o.averages) + 1e-300
-        h1 = float(min(0.05, o.period / 100, (0.005 * size / (rate * PERIODS * o.period)) ** (1.0 / j)))
-        for h in (h1, h1 / 2):
-            try:
-                rates = measure_drift(system, result.composition, conserved, o.x0, params, h, PERIODS, o.period)
-            except NambuBCHError as exc:  # e.g. a step outside the stability interval: say so, keep the certificate
-                dec.measured.append({"h": h, "error": str(exc)})
-                continue
-            predicted = [float(h**j * (c.subs(params).subs(dict(zip([sympy.Symbol(s) for s in names], o.hamiltonians)))
-                                       if dec.method == "exact" else a))
-                         for c, a in zip(exact if dec.method == "exact" else [None] * len(names), o.averages)]
-            dec.measured.append({"h": h, "measured": dict(zip(names, rates)), "predicted": dict(zip(names, predicted))})
+        _measure(ctx, dec)
     return dec
+
+
+class _Context:
+    """What every strategy may read: the integrands at ``h^j`` and, computed on first use, the sampled orbits.
+
+    ``draft`` is the decision under construction; a strategy that passes may still record what it found
+    there (the reversing involutions), and the one that decides returns it.
+    """
+
+    def __init__(self, result, params, points, orbits, rtol):
+        self.result, self.params, self._points, self._count, self._rtol = result, params, points, orbits, rtol
+        self.system = result.system
+        self.gs, self.j = integrands(result)
+        self.names = _names(self.system)
+
+    @cached_property
+    def draft(self) -> Existence:
+        n = len(self.system.coordinates)
+        if self._points is None:
+            pts = sample_points(n, self._count)
+        else:
+            try:
+                pts = np.asarray(self._points, dtype=float)
+            except (TypeError, ValueError, OverflowError):  # text, ragged or complex entries: named below
+                pts = np.zeros(0)
+            if pts.ndim != 2 or pts.shape[1] != n or not 1 <= len(pts) <= 64 or not np.all(np.isfinite(pts)):
+                raise NambuBCHError(f"points must be 1 to 64 finite points of {n} coordinates, got {show(self._points)}")
+        F = orbit_functions(self.system, self.gs, self.params, self.names)
+        found = [orbit_average(F, x, rtol=self._rtol) for x in pts]
+        return Existence("undecided", None, self.j, orbits=found, params=self.params, names=self.names, functions=F)
+
+    @property
+    def closed(self) -> list:
+        return [o for o in self.draft.orbits if o.closed]
+
+
+def _needs_curves(ctx):
+    """Undecided at once when the orbits are not curves (fewer than N - 1 Hamiltonians)."""
+    system, j = ctx.system, ctx.j
+    n = len(system.coordinates)
+    if len(system.hamiltonians) == n - 1:
+        return None
+    # the criterion needs orbits that are curves (N - 1 first integrals); canonical d >= 2 and triplet
+    # systems have invariant tori of higher dimension, whose averages are not orbit averages
+    return Existence("undecided", None, j, params=ctx.params, names=ctx.names,
+                     reason=(f"the orbit-average criterion needs N - 1 = {n - 1} Hamiltonians (orbits that are "
+                             f"curves); {system.name} has {len(system.hamiltonians)} on N = {n}, so no decision "
+                             "is made beyond the polynomial ansatz"))
+
+
+def _vanishing(ctx):
+    """A pair when the integrands vanish identically."""
+    if not all(g == 0 for g in ctx.gs):
+        return None
+    dec = ctx.draft
+    dec.outcome, dec.exists, dec.method = "smooth", True, "exact"
+    dec.averages = [sympy.Integer(0)] * len(ctx.gs)
+    dec.reason = f"at h^{ctx.j} the integrands R.grad H vanish identically"
+    return dec
+
+
+def _exact(ctx):
+    """``g = X(p) + c(H, G)`` solved for every integrand: the averages ``c`` as formulas (passes if one fails)."""
+    dec = ctx.draft  # the orbits first: bad points are refused before the exact solve
+    exact = [exact_average(ctx.system, g) for g in ctx.gs]
+    if any(c is None for c in exact):
+        return None
+    j, names = ctx.j, ctx.names
+    dec.averages = exact
+    dec.method = "exact"
+    if all(c == 0 for c in exact):
+        dec.outcome, dec.exists = "smooth", True
+        dec.reason = (f"at h^{j} every R.grad H_a is X_{{H,G}}(p_a) for a polynomial p_a: the averages vanish "
+                      "identically (conserved polynomials exist; the pair needs a function of them)")
+        return dec
+    # certified: <g> = c(H, G) on every periodic orbit; find one where c != 0
+    syms = [sympy.Symbol(s) for s in names]
+    for o in ctx.closed:
+        vals = [float(c.subs(ctx.params).subs(dict(zip(syms, o.hamiltonians)))) for c in exact]
+        if any(abs(v) > 1e-12 for v in vals):
+            dec.certificate_orbit = o
+            break
+    if dec.certificate_orbit is None:
+        dec.reason = f"exact averages {exact} but no sampled periodic orbit where they are non-zero"
+        return dec
+    dec.outcome, dec.exists = "none", False
+    dec.drift = {nm: STEP**j * c for nm, c in zip(names, exact)}
+    dec.reason = (f"at h^{j} the orbit averages are exactly " +
+                  ", ".join(f"<R.grad {nm}> = {c}" for nm, c in zip(names, exact)) +
+                  " on every periodic orbit (g = X(p) + c(H, G)), non-zero on the certificate orbit")
+    return dec
+
+
+def _symmetry(ctx):
+    """A pair by reversibility, on the sampled orbits that meet a reversing plane ``x_i = 0``.
+
+    The single-coordinate involutions found are recorded on the draft even when no sampled orbit meets
+    their planes (the evidence lists them; :meth:`Existence.correction` needs them).
+    """
+    dec, closed = ctx.draft, ctx.closed
+    singles = tuple(f[0] for f in reversing_involutions(ctx.system, ctx.gs) if len(f) == 1)
+    if not singles:
+        return None
+    good = [o for o in closed if any(o.fix_crossings.get(i, 0) > 0 for i in singles)]
+    dec.involution = (singles[0],)
+    dec.sections = singles
+    if not good:
+        return None
+    dec.outcome, dec.exists, dec.method = "smooth", True, "symmetry"
+    small = all(all(o.negligible()) for o in good)
+    dec.reason = (f"at h^{ctx.j} the integrands are odd under the reversing involutions "
+                  f"{', '.join(f'x{i + 1} -> -x{i + 1}' for i in singles)}, which fix the Hamiltonians: the "
+                  f"averages vanish exactly on every orbit meeting one of their fixed planes ({len(good)} of "
+                  f"{len(closed)} sampled closed orbits do); numerically |<g>| <= "
+                  f"{max(max(abs(a) for a in o.averages) for o in good):.1e} "
+                  f"({'consistent' if small else 'INCONSISTENT'} with zero)")
+    if not small:
+        dec.outcome, dec.exists, dec.method = "undecided", None, None
+    return dec
+
+
+def _numerical_certificate(ctx):
+    """No pair: an orbit whose quadrature average exceeds 100 times its error estimate."""
+    sig = [o for o in ctx.closed if any(o.significant())]
+    if not sig:
+        return None
+    dec = ctx.draft
+    dec.method = "numerical"
+    o = max(sig, key=lambda o: max(abs(a) / (e + 1e-300) for a, e in zip(o.averages, o.errors)))
+    dec.certificate_orbit = o
+    dec.outcome, dec.exists = "none", False
+    dec.drift = {nm: STEP**ctx.j * sympy.Float(a, 12) for nm, a in zip(ctx.names, o.averages)}
+    dec.reason = (f"at h^{ctx.j} the average " + ", ".join(f"<R.grad {nm}> = {a:.6g} (+- {e:.1e})"
+                                                         for nm, a, e in zip(ctx.names, o.averages, o.errors)) +
+                  f" on the periodic orbit through {[round(v, 6) for v in o.x0]} (numerical, error estimate from two tolerances)")
+    return dec
+
+
+def _numerical_evidence(ctx):
+    """Undecided, with the evidence: the averages vanish numerically on every sampled closed orbit."""
+    closed = ctx.closed
+    if not (closed and all(all(o.negligible()) for o in closed)):
+        return None
+    dec = ctx.draft
+    dec.method = "numerical"
+    worst = max(max(abs(a) / s for a, s in zip(o.averages, o.scales) if s) for o in closed)
+    dec.reason = (f"at h^{ctx.j} the averages vanish numerically on {len(closed)} orbits (|<g>|/max|g| <= {worst:.1e}): "
+                  "evidence of a smooth shadow pair, not a proof; undecided")
+    return dec
+
+
+def _no_decision(ctx):
+    """Undecided: the sampled averages are neither clearly zero nor clearly non-zero (always answers)."""
+    dec = ctx.draft
+    dec.method = "numerical"
+    dec.reason = (f"at h^{ctx.j} no decision: {len(ctx.closed)} of {len(dec.orbits)} sampled orbits closed, "
+                  "averages neither clearly zero nor clearly non-zero")
+    return dec
+
+
+#: The decision procedure: each strategy takes the :class:`_Context` and returns an :class:`Existence` or None
+#: (passes); the first answer is the decision.  The order is the one the module docstring documents: exact
+#: averages before the symmetry argument before quadrature, and the last strategy always answers.
+STRATEGIES = (_needs_curves, _vanishing, _exact, _symmetry, _numerical_certificate, _numerical_evidence, _no_decision)
+
+
+def _measure(ctx, dec) -> None:
+    """Append to ``dec.measured`` the drift of ``H'`` measured on the certificate orbit at two step sizes."""
+    o, j, names, params = dec.certificate_orbit, ctx.j, ctx.names, ctx.params
+    conserved = conserved_below(ctx.result, j)
+    # small enough that H' moves by <= 0.5% of its size over the run (the rate is then that of one orbit)
+    size = max(1e-3, max(abs(v) for v in o.hamiltonians))
+    rate = max(abs(a) for a in o.averages) + 1e-300
+    h1 = float(min(0.05, o.period / 100, (0.005 * size / (rate * PERIODS * o.period)) ** (1.0 / j)))
+    syms = [sympy.Symbol(s) for s in names]
+    for h in (h1, h1 / 2):
+        try:
+            rates = measure_drift(ctx.system, ctx.result.composition, conserved, o.x0, params, h, PERIODS, o.period)
+        except NambuBCHError as exc:  # e.g. a step outside the stability interval: say so, keep the certificate
+            dec.measured.append({"h": h, "error": str(exc)})
+            continue
+        if dec.method == "exact":
+            predicted = [float(h**j * c.subs(params).subs(dict(zip(syms, o.hamiltonians)))) for c in dec.averages]
+        else:
+            predicted = [float(h**j * a) for a in o.averages]
+        dec.measured.append({"h": h, "measured": dict(zip(names, rates)), "predicted": dict(zip(names, predicted))})

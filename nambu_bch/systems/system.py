@@ -55,13 +55,18 @@ def check_name(name, what: str = "name", strict: bool = True) -> str:
 
 
 def as_system(system, what: str = "system") -> "System":
-    """``system`` itself, or the built-in model of that name; else :class:`InvalidSystemError` in one line."""
+    """``system`` itself, the built-in model of that name, or the system a :class:`~nambu_bch.systems.spec.SystemSpec`
+    builds; else :class:`InvalidSystemError` in one line.  The one reading of a ``system`` argument of the API."""
     if isinstance(system, System):
         return system
     if isinstance(system, str):
         from .catalog import model
 
         return model(system)
+    from .spec import SystemSpec
+
+    if isinstance(system, SystemSpec):
+        return system.build()
     raise InvalidSystemError(f"{what} must be a System or a built-in model name such as 'ho3', got {type(system).__name__}")
 
 #: The kinds of bracket a system may carry (see :func:`infer_bracket`).
@@ -80,7 +85,7 @@ _ACCEPTED = ("accepted: 1 Hamiltonian on N = 2d coordinates (canonical, q = the 
              "or bracket='lie-poisson' with 1 Hamiltonian on N = 3")
 
 
-def infer_bracket(n_coords: int, n_hams: int, bracket=None) -> str:
+def infer_bracket(n_coords: int, n_hams: int, bracket=None, where: str = "") -> str:
     """The bracket of a system from the number of coordinates and of Hamiltonians.
 
     * one Hamiltonian on ``N = 2d``: ``"canonical"`` (``q`` = the first ``d``
@@ -104,7 +109,18 @@ def infer_bracket(n_coords: int, n_hams: int, bracket=None) -> str:
     --------
     >>> infer_bracket(4, 1), infer_bracket(3, 2), infer_bracket(6, 2), infer_bracket(3, 1, "lie-poisson")
     ('canonical', 'nambu', 'triplets', 'lie-poisson')
+
+    ``where`` prefixes a message with the input as the caller names it (:class:`~nambu_bch.systems.spec.SystemSpec`).
     """
+    try:
+        return _infer_bracket(n_coords, n_hams, bracket)
+    except InvalidSystemError as exc:
+        if not where:
+            raise
+        raise InvalidSystemError(f"{where}{exc}") from None
+
+
+def _infer_bracket(n_coords, n_hams, bracket):
     N, k = check_int(n_coords, "n_coords", 1), check_int(n_hams, "n_hams", 1)
     if bracket is not None and (not isinstance(bracket, str) or bracket not in BRACKETS):
         raise InvalidSystemError(f"bracket {show(bracket)} is not known; accepted are {', '.join(BRACKETS)} (or None to infer)")
@@ -132,7 +148,7 @@ def infer_bracket(n_coords: int, n_hams: int, bracket=None) -> str:
         f"bracket={bracket!r} does not fit {k} Hamiltonian(s) on N = {N} coordinates (that is {inferred!r}); {_ACCEPTED}")
 
 
-def _as_symbols(names, what):
+def _as_symbols(names, what, where=""):
     if isinstance(names, str):
         names = names.replace(",", " ").split()
     if isinstance(names, sympy.Symbol):
@@ -140,26 +156,76 @@ def _as_symbols(names, what):
     try:
         names = list(names)
     except TypeError:
-        raise InvalidSystemError(f"{what}s must be a string such as 'x1 x2 x3' or a list of names/Symbols, got {names!r}") from None
+        raise InvalidSystemError(f"{where}{what}s must be a string such as 'x1 x2 x3' or a list of names/Symbols, got {names!r}") from None
     out = []
     for n in names:
         if isinstance(n, str):
-            n = sympy.Symbol(_symbol_name(n, what))
+            n = sympy.Symbol(_symbol_name(n, what, where))
         if not isinstance(n, sympy.Symbol):
-            raise InvalidSystemError(f"{what} must be symbols or names, got {n!r}")
-        _symbol_name(n.name, what)
+            raise InvalidSystemError(f"{where}{what} must be symbols or names, got {n!r}")
+        _symbol_name(n.name, what, where)
         out.append(n)
     return tuple(out)
 
 
-def _symbol_name(name, what):
+def _symbol_name(name, what, where=""):
     if not SYMBOL_NAME.match(name) or keyword.iskeyword(name):
         shown = repr(name if len(name) <= 40 else name[:37] + "...")
         raise InvalidSystemError(
-            f"{what} name {shown} is not a valid symbol name; use ASCII letters, digits and '_', "
+            f"{where}{what} name {shown} is not a valid symbol name; use ASCII letters, digits and '_', "
             "starting with a letter, at most 32 characters (e.g. x1, omega)"
         )
     return name
+
+
+def check_symbols(coordinates, parameters, where: str = "", where_parameters: str | None = None) -> tuple:
+    """``(coordinates, parameters)`` as Symbols, checked: valid distinct names, none reserved, within the size limits.
+
+    The one check of a system's symbols, for :class:`System` and for :class:`~nambu_bch.systems.spec.SystemSpec`;
+    ``where`` (``"--coords 'x1 x2': "``, ``"--system FILE: "``) and ``where_parameters`` (default ``where``)
+    prefix the message with the input as the caller names it.  Raises :class:`InvalidSystemError`.
+    """
+    wp = where if where_parameters is None else where_parameters
+    coords = _as_symbols(coordinates, "coordinate", where)
+    params = _as_symbols(parameters, "parameter", wp)
+    if len(coords) > MAX_COORDINATES:
+        raise InvalidSystemError(
+            f"{where}a system on {len(coords)} coordinates is refused: at most {MAX_COORDINATES} are accepted "
+            f"(the Nambu bracket of N - 1 Hamiltonians has N! terms)"
+        )
+    _check_parameter_count(params, wp)
+    if len(coords) < 2:
+        raise InvalidSystemError(f"{where}a system needs at least 2 coordinates, got {len(coords)}")
+    if len(set(coords)) != len(coords) or set(coords) & set(params):
+        raise InvalidSystemError(f"{where}coordinates {coords} and parameters {params} must be distinct symbols")
+    _check_reserved(coords, where)
+    _check_reserved(params, wp)
+    return coords, params
+
+
+def check_parameter_names(names, where: str = "") -> tuple:
+    """Parameter names as Symbols, checked as :func:`check_symbols` checks them (for a request on a model or file)."""
+    params = _as_symbols(names, "parameter", where)
+    _check_parameter_count(params, where)
+    _check_reserved(params, where)
+    return params
+
+
+def _check_parameter_count(params, where):
+    if len(params) > MAX_PARAMETERS:
+        raise InvalidSystemError(f"{where}a system with {len(params)} parameters is refused: at most {MAX_PARAMETERS} are accepted")
+
+
+def _check_reserved(symbols, where):
+    for s in symbols:
+        if s.name in RESERVED_SYMBOLS:
+            raise InvalidSystemError(f"{where}the symbol {s.name!r} is reserved (step / family parameter); rename it")
+
+
+def check_hamiltonian_count(count: int, where: str = "") -> None:
+    """Refuse more than ``MAX_COORDINATES - 1`` Hamiltonians before any is parsed (the bracket has N! terms)."""
+    if count > MAX_COORDINATES - 1:
+        raise InvalidSystemError(f"{where}{count} Hamiltonians are refused: at most {MAX_COORDINATES - 1} are accepted")
 
 
 @dataclass(frozen=True, eq=False)
@@ -204,8 +270,7 @@ class System:
     bracket: str | None = None
 
     def __post_init__(self):
-        coords = _as_symbols(self.coordinates, "coordinate")
-        params = _as_symbols(self.parameters, "parameter")
+        coords, params = check_symbols(self.coordinates, self.parameters)
         object.__setattr__(self, "coordinates", coords)
         object.__setattr__(self, "parameters", params)
         check_name(self.name, "system name", strict=False)
@@ -213,27 +278,12 @@ class System:
             text = getattr(self, key)
             if not isinstance(text, str) or len(text) > 500 or not text.isprintable():
                 raise InvalidSystemError(f"{key} of a system must be printable text of at most 500 characters, got {str(text)[:40]!r}")
-        if len(coords) > MAX_COORDINATES:
-            raise InvalidSystemError(
-                f"a system on {len(coords)} coordinates is refused: at most {MAX_COORDINATES} are accepted "
-                f"(the Nambu bracket of N - 1 Hamiltonians has N! terms)"
-            )
-        if len(params) > MAX_PARAMETERS:
-            raise InvalidSystemError(f"a system with {len(params)} parameters is refused: at most {MAX_PARAMETERS} are accepted")
-        if len(coords) < 2:
-            raise InvalidSystemError(f"a system needs at least 2 coordinates, got {len(coords)}")
-        if len(set(coords)) != len(coords) or set(coords) & set(params):
-            raise InvalidSystemError(f"coordinates {coords} and parameters {params} must be distinct symbols")
-        for s in coords + params:
-            if s.name in RESERVED_SYMBOLS:
-                raise InvalidSystemError(f"the symbol {s.name!r} is reserved (step / family parameter); rename it")
         hams = self.hamiltonians
         if isinstance(hams, (str, sympy.Basic)):
             hams = (hams,)
         if not isinstance(hams, (list, tuple)):
             raise InvalidSystemError(f"hamiltonians must be a list of expressions (strings or sympy), got {type(hams).__name__}")
-        if len(hams) > MAX_COORDINATES:
-            raise InvalidSystemError(f"{len(hams)} Hamiltonians are refused: at most {MAX_COORDINATES - 1} are accepted")
+        check_hamiltonian_count(len(hams))
         hams = tuple(self._parse(H) for H in hams)
         casimir = sympy.Add(*(x**2 for x in coords)) / 2
         if self.bracket == "lie-poisson" and len(hams) == 2 and sympy.expand(hams[1] - casimir) == 0:
