@@ -58,7 +58,9 @@ have.
 from __future__ import annotations
 
 import ast
+import keyword
 import math
+import re
 import numbers
 import warnings
 from decimal import Decimal, InvalidOperation
@@ -283,15 +285,23 @@ def as_expression(value, symbols, what: str = "expression") -> sympy.Expr:
     )
 
 
+#: A symbol name given as text: ASCII letters, digits and underscores (no look-alikes, no LaTeX or source syntax).
+SYMBOL_NAME = re.compile(r"[A-Za-z][A-Za-z0-9_]{0,31}\Z")
+
+
 def as_symbols(value, what: str = "coordinates", names: bool = False) -> tuple:
     """``value`` as a tuple of sympy Symbols, else one line naming ``what`` (never a sympified string).
 
     A sequence (:func:`~nambu_bch.checks.check_sequence`) of Symbols; with ``names=True`` a string item
-    is a name and becomes ``Symbol(name)`` (the name is not read as an expression).
+    is a name (:data:`SYMBOL_NAME`, not a Python keyword) and becomes ``Symbol(name)``: the name is not read
+    as an expression, and nothing that could act in LaTeX or generated source becomes a symbol.
     """
     out = []
     for item in check_sequence(value, what, "sympy Symbols"):
-        if names and isinstance(item, str) and item:
+        if names and isinstance(item, str):
+            if not SYMBOL_NAME.match(item) or keyword.iskeyword(item):
+                raise ExpressionParseError(f"{what}: {show(item)} is not a symbol name; use ASCII letters, digits and "
+                                           "'_', starting with a letter, at most 32 characters (e.g. x1, omega)")
             item = sympy.Symbol(item)
         if not isinstance(item, sympy.Symbol):
             raise ExpressionParseError(f"{what} must be sympy Symbols{' or names' if names else ''}, got {show(item)}")

@@ -176,3 +176,11 @@ def test_composed_map_takes_an_expression_as_the_step():
     forward, backward = nb.composed_map(S, "12321"), nb.composed_map(S, "12321", -h)
     assert backward == tuple(sympy.expand(e.subs(h, -h)) for e in forward)
     assert nb.composed_map(S, "12321", "-h") == backward
+
+
+@pytest.mark.parametrize("name", ["\\input{/etc/passwd}", "x}", "a b", "lambda", "x" * 40, "1x", ""])
+def test_names_given_as_text_are_symbol_names(name):
+    """A name string becomes a Symbol only if it is a plain identifier: nothing that acts in LaTeX or source."""
+    with pytest.raises(NambuBCHError) as info:
+        nb.PolynomialAlgebra(["x1", name])
+    assert "\n" not in str(info.value) and "symbol name" in str(info.value)

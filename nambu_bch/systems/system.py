@@ -12,7 +12,7 @@ import sympy
 from ..algebra import PolynomialAlgebra, VectorField, liouville_field
 from ..checks import check_int, show
 from ..errors import InvalidSystemError, NambuBCHError
-from ..parsing import as_expression
+from ..parsing import SYMBOL_NAME, as_expression
 
 #: Symbols reserved by the package: the step and the family parameter.
 RESERVED_SYMBOLS = ("h", "alpha")
@@ -21,8 +21,6 @@ RESERVED_SYMBOLS = ("h", "alpha")
 MAX_COORDINATES = 8
 #: Most parameters of a system (each is a generator of the coefficient field).
 MAX_PARAMETERS = 16
-#: A symbol name: ASCII letters, digits and underscores (no NFKC look-alikes, no LaTeX or source syntax).
-SYMBOL_NAME = re.compile(r"[A-Za-z][A-Za-z0-9_]{0,31}\Z")
 #: A name given by a user (``--name``, the TOML ``name``): LaTeX-safe and source-safe.
 USER_NAME = re.compile(r"[A-Za-z][A-Za-z0-9_-]{0,63}\Z")
 #: Any system name (also the derived ``ho3[m=1/2]``): no quote, backslash, brace, ``#``, ``$``, ``%``, ``&``, ``~``, ``^`` or newline.
