@@ -24,14 +24,15 @@ sys.path.insert(0, str(Path(__file__).parent))
 # early in the same worker instead of each computing it (the rest of their file may be stolen by the other worker).
 LONG = (
     ("test_cache_safety.py", "test_"),                                      # 15-30 s each: numba recompiles in subprocesses
-    ("test_pickle.py", "test_results_come_back_from_spawned_workers"),      # two spawned workers import and compute
     ("test_docs.py", "test_api_reference_builds_without_warnings"),         # a Sphinx build in a subprocess
+    ("test_bch_modular.py", "test_sparse_engine_equals_dense_engine"),      # 9 s at [12-12], cold: numba compile
+    ("test_pickle.py", "test_results_come_back_from_spawned_workers"),      # a spawned worker imports and computes
+    ("test_cli.py", "test_every_subcommand_runs_as_a_subprocess"),          # 14 s: nine subprocesses, two at a time
     ("test_packaging.py", "test_"),                                         # wheel and sdist built, installed, run
     ("test_fuzz_cli.py", "test_"),
-    ("test_cli.py", "test_every_subcommand_runs_as_a_subprocess"),          # 14 s: nine subprocesses, two at a time
-    ("test_elimination.py", "test_solve_affine_matches_plain_domainmatrix"),  # 12 s at QQ<2^(1/3)>(a,b)
     ("test_direct_route_fast.py", "test_rigid_body_symbolic_yoshida_family_over_base_field"),
-    ("test_bch_modular.py", "test_sparse_engine_equals_dense_engine"),      # 9 s at [12-12], cold: numba compile
+    ("test_numeric_api_arguments.py", "test_default_x0_of_every_model_runs_a_long_orbit"),
+    ("test_elimination.py", "test_solve_affine_matches_plain_domainmatrix"),  # 12 s at QQ<2^(1/3)>(a,b)
     ("test_notebooks.py", "test_notebook_executes"),                        # 3-8 s each, in a kernel process
     ("test_numeric.py", "test_exponential_flows_"),                         # 3-7 s each: Lotka-Volterra kernels, a C build
     ("test_testing.py", "test_example_suite_"),                             # two pytest subprocesses

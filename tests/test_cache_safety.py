@@ -85,26 +85,74 @@ print(json.dumps({"run": bool(np.array_equal(a, b)), "batch": bool(np.array_equa
                   "lyndon": len(words) == sum(witt_dimension(2, d) for d in range(1, 7))}))
 """
 
+#: The two cheapest compiled loops, one from each kind of cache directory: the ho/121 kernel's single-trajectory
+#: loop (``kernels/``) and the batch scan (the package's ``numba/``), each compared with its pure-Python twin.  The
+#: probes that damage cache files run this instead of :data:`RUN`: every compiled function reads its files through
+#: the same verified cache class (:func:`nambu_bch.compiled.enable_private_cache`), so recompiling two small loops
+#: over damaged files proves what recompiling all of them did, at a fraction of the compile time.
+SMALL = """
+import json
+import numpy as np
+from nambu_bch.numeric.iterate import iterate
+from nambu_bch.numeric.guards import scan_states
+from nambu_bch.numeric.scan import scan
+
+a = iterate("ho", "121", 0.125, 400, [1.0, 0.5], backend="numba", every=400)
+b = iterate("ho", "121", 0.125, 400, [1.0, 0.5], backend="numpy", every=400)
+S = np.array([[1.0, np.inf, 2.0], [0.5, 3.0, 1e-310]])
+res = np.zeros(7, dtype=np.int64)
+scan(S, res)
+twin = scan_states(S)
+print(json.dumps({"run": bool(np.array_equal(a, b)),
+                  "scan": [int(res[0]), int(res[1])] == [int(twin[0]), int(twin[1])] == [1, 1]}))
+"""
+
+#: ``check`` (whose backend choice looks into the kernel and numba caches first: a FIFO there once hung it), then
+#: :data:`SMALL`, then the ``models`` listing, in one fresh process (each step the first in it to read its files).
+CHECK_SMALL_LISTING = """
+import contextlib, io, json
+from nambu_bch.numeric.diagnostics import check
+r = check('ho', '121', 0.1, 200, [1.0, 0.0])
+print(json.dumps({"check": bool(r.max_abs_error['H'] < 1e-2)}))
+""" + SMALL + """
+from nambu_bch.cli import main
+listing = io.StringIO()
+with contextlib.redirect_stdout(listing):
+    status = main(['models', '--format', 'text'])
+print(json.dumps({"status": status, "listing": listing.getvalue()}))
+"""
+
+
+def _results(done) -> dict:
+    """The JSON lines a probe printed, merged."""
+    out = {}
+    for line in done.stdout.strip().splitlines():
+        if line.startswith("{"):
+            out.update(json.loads(line))
+    return out
+
 
 def _run_ok(env):
-    out = json.loads(_probe(RUN, env).stdout.strip().splitlines()[-1])
+    out = _results(_probe(RUN, env))
     assert out == {"run": True, "batch": True, "scan": True, "lyndon": True}, out
 
 
-LISTING = "from nambu_bch.cli import main\nimport sys\nsys.exit(main(['models', '--format', 'text']))\n"
-CHECK = ("from nambu_bch.numeric.diagnostics import check\n"
-         "r = check('ho', '121', 0.1, 200, [1.0, 0.0])\nprint(r.max_abs_error['H'] < 1e-2)\n")
+def _small_ok(env):
+    out = _results(_probe(SMALL, env))
+    assert out == {"run": True, "scan": True}, out
 
 
 @pytest.fixture(scope="module")
 def warm(tmp_path_factory):
-    """A cache root filled once by RUN, CHECK and LISTING (compiling cold costs tens of seconds on a loaded
-    machine), and the honest listing; each test works on its own copy (:func:`_copy_warm`)."""
+    """A cache root filled once by RUN, ``check`` and the listing (compiling cold costs tens of seconds on a loaded
+    machine; one process), and the honest listing; each test works on its own copy (:func:`_copy_warm`)."""
     base = tmp_path_factory.mktemp("warm")
     env = _env(base)
-    _run_ok(env)
-    assert _probe(CHECK, env).stdout.split()[-1] == "True"
-    return base / "cache", _probe(LISTING, env).stdout
+    out = _results(_probe(RUN + CHECK_SMALL_LISTING, env))
+    listing = out.pop("listing")
+    assert listing.startswith("ho") and out == {"run": True, "batch": True, "scan": True, "lyndon": True,
+                                                "check": True, "status": 0}, out
+    return base / "cache", listing
 
 
 def _copy_warm(warm, tmp_path):
@@ -178,22 +226,29 @@ def _private_index(fn, directory):
 @numba_only
 def test_private_numba_cache_unpickles_only_verified_files(tmp_path, warm):
     """In the package's own numba directories, a file without the digest the package writes (a raw pickle in
-    numba's format, a truncated entry) is compiled over and rewritten in the verified format, never unpickled."""
+    numba's format, a truncated entry) is compiled over and rewritten in the verified format, never unpickled.
+
+    Every index gets a planted pickle; the probe (:data:`SMALL`) then recompiles one loop of each directory, the
+    ho/121 kernel's ``run`` (``kernels/``) and ``scan`` (``numba/``), over their planted index and truncated data."""
     root, env = _copy_warm(warm, tmp_path)
     indexes = sorted(root.rglob("*.nbi"))
     data = sorted(root.rglob("*.nbc"))
     assert {p.relative_to(root).parts[0] for p in indexes} == {"kernels", "numba"}
     for path in indexes + data:
         assert path.read_bytes().startswith(compiled._MAGIC) and stat.S_IMODE(path.stat().st_mode) == 0o600
+    read = sorted(root.rglob("*.run-*.nbi")) + sorted((root / "numba").rglob("scan.scan-*.nbi"))
+    truncated = sorted(root.rglob("*.run-*.nbc")) + sorted((root / "numba").rglob("scan.scan-*.nbc"))
+    assert {p.relative_to(root).parts[0] for p in read} == {p.relative_to(root).parts[0] for p in truncated} \
+        == {"kernels", "numba"}
     markers = []
     for i, path in enumerate(indexes):
         markers.append(tmp_path / f"ran-{i}")
         path.write_bytes(pickle.dumps(_Marker(markers[-1])))  # numba's format: a bare pickle
-    for path in data[:2]:
+    for path in truncated:
         path.write_bytes(path.read_bytes()[:100])  # truncated
-    _run_ok(env)
+    _small_ok(env)
     assert not any(m.exists() for m in markers)
-    assert all(p.read_bytes().startswith(compiled._MAGIC) for p in indexes)  # compiled over, rewritten
+    assert all(p.read_bytes().startswith(compiled._MAGIC) for p in read + truncated)  # compiled over, rewritten
     # a planted entry *with* a valid digest is refused too once the directory is not private
     fn = next(f for f in _functions(root) if f.__name__ == "scan")
     index = _private_index(fn, _numba_dir(root, fn))
@@ -202,7 +257,7 @@ def test_private_numba_cache_unpickles_only_verified_files(tmp_path, warm):
     payload = pickle.dumps(_Marker(marker))
     index.write_bytes(compiled._MAGIC + hashlib.sha256(payload).digest() + payload)
     os.chmod(index.parent, 0o777)
-    _run_ok(env)
+    _small_ok(env)
     assert not marker.exists()
 
 
@@ -322,16 +377,16 @@ def _replace_with(path, kind, tmp_path):
 def test_special_files_in_place_of_cache_files_neither_block_nor_are_read(tmp_path, warm, kind):
     """A FIFO (which hung ``check``), a symbolic link or a directory in place of each kind of cache file: the
     kernel index and source, numba's index and data files (a kernel's and the package's), the models listing.
-    The probes finish with the right results; a planted link's target is never changed."""
+    A fresh process runs ``check``, the two small loops and the listing over them (:data:`CHECK_SMALL_LISTING`):
+    right results, nothing blocks; a planted link's target is never changed."""
     root, env = _copy_warm(warm, tmp_path)
     targets = (sorted((root / "kernels").glob("nambu_bch_*")) + sorted((root / "kernels").rglob("*.run-*.nb?"))
                + sorted((root / "numba").rglob("scan.scan-*.nb?")) + sorted((root / "cli").glob("*.txt")))
     assert {".json", ".py", ".nbi", ".nbc", ".txt"} <= {p.suffix for p in targets}
     for path in targets:
         _replace_with(path, kind, tmp_path)
-    _run_ok(env)
-    assert _probe(CHECK, env).stdout.split()[-1] == "True"
-    assert _probe(LISTING, env).stdout == warm[1]
+    out = _results(_probe(CHECK_SMALL_LISTING, env))
+    assert out == {"check": True, "run": True, "scan": True, "status": 0, "listing": warm[1]}, out
     for path in targets:
         assert not path.is_symlink() or Path(os.readlink(path)).read_text() == "planted"
 
