@@ -57,8 +57,26 @@ def check_order(order, limit: int = MAX_ORDER) -> int:
     return order
 
 
+class FieldSeries:
+    """A vector field as a series ``sum_j h^j Z_j`` (``coefficients``: the ``Z_j`` as :class:`VectorField`)."""
+
+    def __getitem__(self, j) -> VectorField:
+        return self.coefficients[j]
+
+    @property
+    def field(self) -> VectorField:
+        """``sum_j h^j Z_j`` as one field whose components are polynomials in ``h``."""
+        total = VectorField.zero(self.coefficients[0].algebra)
+        for j, Z in enumerate(self.coefficients):
+            total = total + Z.scale(H**j)
+        return total
+
+    def to_sympy(self) -> tuple:
+        return self.field.to_sympy()
+
+
 @dataclass(frozen=True, eq=False)
-class EffectiveField(Printable):
+class EffectiveField(FieldSeries, Printable):
     """``X_eff = sum_{j=0}^{order} h^j Z_j`` of a composition.
 
     Attributes
@@ -74,20 +92,6 @@ class EffectiveField(Printable):
     composition: object
     splitting: object
 
-    def __getitem__(self, j) -> VectorField:
-        return self.coefficients[j]
-
-    @property
-    def field(self) -> VectorField:
-        """``sum_j h^j Z_j`` as one field whose components are polynomials in ``h``."""
-        algebra = self.coefficients[0].algebra
-        total = VectorField.zero(algebra)
-        for j, Z in enumerate(self.coefficients):
-            total = total + Z.scale(H**j)
-        return total
-
-    def to_sympy(self) -> tuple:
-        return self.field.to_sympy()
 
     def to_latex(self) -> str:
         r"""``X_{\rm eff} &= (c_1)\partial_{x_1} + ... + h^{2}\Bigl(...\Bigr) + O(h^4)`` in an ``aligned`` block,

@@ -24,7 +24,7 @@ from dataclasses import dataclass
 import sympy
 
 from ..algebra import VectorField
-from ..bch.backward import check_order, modified_field_of_map
+from ..bch.backward import FieldSeries, check_order, modified_field_of_map
 from ..errors import InvalidCompositionError, NambuBCHError
 from ..integrators.runge_kutta import butcher_tableau
 from . import rooted_trees as T
@@ -36,7 +36,7 @@ MAX_RK_ORDER = 8
 
 
 @dataclass(frozen=True, eq=False)
-class ModifiedEquation:
+class ModifiedEquation(FieldSeries):
     """``f~ = sum_{j=0}^{order} h^j Z_j`` of a Runge--Kutta method on a system (``Z_0 = f``).
 
     Attributes
@@ -54,19 +54,6 @@ class ModifiedEquation:
     system: object
     tree_coefficients: dict
 
-    def __getitem__(self, j) -> VectorField:
-        return self.coefficients[j]
-
-    @property
-    def field(self) -> VectorField:
-        """``sum_j h^j Z_j`` as one field whose components are polynomials in ``h``."""
-        total = VectorField.zero(self.coefficients[0].algebra)
-        for j, Z in enumerate(self.coefficients):
-            total = total + Z.scale(H**j)
-        return total
-
-    def to_sympy(self) -> tuple:
-        return self.field.to_sympy()
 
     def to_text(self) -> str:
         """``f~ = Z_0 + h*Z_1 + ... + O(h^(order+1))``, one line per non-zero ``Z_j``."""
