@@ -82,15 +82,14 @@ class DesignedComposition(Composition):
     template : str            -- the template's name
     values : tuple            -- ``(unknown, exact value)`` pairs: the coefficients of *this* composition
     optimum : tuple           -- ``(unknown, value)`` of the constrained minimiser: exact algebraic numbers (real
-                                 radicals, or ``CRootOf`` of the minimal polynomial, whose isolating interval
-                                 certifies which root) when the critical-point equations were solved exactly,
-                                 else ``dps``-digit decimal strings
+    radicals, or ``CRootOf`` of the minimal polynomial, whose isolating interval certifies which root) when the
+    critical-point equations were solved exactly, else ``dps``-digit decimal strings
     lem : float               -- the error constant of *this* composition (exact, as float)
     lem_optimum : float       -- the error constant at the numerical optimum
     exact : bool              -- True: order conditions hold exactly; False: see ``error_bound``
     error_bound : float       -- largest absolute Lyndon defect of length <= order (0 when exact)
     optimal : bool            -- True: ``values`` are the minimiser itself (exactly); False: an exact solution
-                                 of the order conditions near it, or its decimals (see ``optimum``)
+    of the order conditions near it, or its decimals (see ``optimum``)
     """
 
     template: str = ""

@@ -29,7 +29,7 @@ def rk_step_function(system, method, params=None):
     system = as_system(system)
     tableau = butcher_tableau(method)
     values = parameter_values(system, params)
-    f_exprs = [sympy.sympify(e).subs(values) for e in system.vector_field.to_sympy()]
+    f_exprs = [sympy.sympify(e, strict=True).subs(values) for e in system.vector_field.to_sympy()]
     coords = system.coordinates
     jac = sympy.Matrix(f_exprs).jacobian(coords)
     f_num = sympy.lambdify(coords, f_exprs, modules="numpy")

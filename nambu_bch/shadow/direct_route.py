@@ -98,6 +98,8 @@ class OrderSolution:
     obstruction_value : sympy expression -- the certificate applied to the right-hand side
     rhs : VectorField or None -- the right-hand side of Eq. (*)
 
+    Notes
+    -----
     A solved order converts ``corrections`` and ``members`` to sympy on first access (``convert``, a callable
     returning both; the same expressions, cached), and ``gauge`` likewise (``convert_gauge``, from the exact
     kernel vectors): the route itself works on the ring elements, and a caller that only reads ``H_S, G_S``
