@@ -210,8 +210,10 @@ class DirectResult:
                                   if self.corrections.get((a, j))]
             if all(self.algebra.is_polynomial(p) for p, _ in parts):
                 out.append(sympy.Add(*[t for p, f in parts for t in self.algebra.expanded_terms(p, f)]))
-            else:  # non-polynomial pieces (the BCH series of _non_polynomial): sympy expands the sum
-                out.append(sympy.expand(sympy.Add(*[sympy.Mul(self.algebra.to_sympy(p), *f) for p, f in parts])))
+            else:  # non-polynomial pieces (the BCH series of _non_polynomial): sympy expands the sum, but not
+                # the powers of sums (a denominator (q1**2 + q2**2)**4 stays one factor instead of nine terms)
+                out.append(sympy.expand(sympy.Add(*[sympy.Mul(self.algebra.to_sympy(p), *f) for p, f in parts]),
+                                        multinomial=False))
         return tuple(out)
 
 
