@@ -158,7 +158,7 @@ def error_analysis(spec, parts: int | None = None) -> ErrorConstant:
         if not vanishes(defects):
             exact = {w: field.K.to_sympy(v) for w, v in defects.items()}
             if comp.is_complex:  # the 2-norm of a complex vector: sum |v|^2
-                squared = sympy.nsimplify(sympy.expand(sum(v * sympy.conjugate(v) for v in exact.values())))
+                squared = sympy.expand(sum(v * sympy.conjugate(v) for v in exact.values()))  # exact: no guessing
             else:
                 squared = field.K.to_sympy(sum((v * v for v in defects.values()), field.K.zero))
             return ErrorConstant(comp, parts, degree - 1, squared, exact, bound)

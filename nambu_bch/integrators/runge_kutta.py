@@ -68,7 +68,7 @@ class ButcherTableau:
 
 
 def _tableau(name, A, b, order, reference, quadratic_only=False) -> ButcherTableau:
-    A = tuple(tuple(sympy.nsimplify(a) if not isinstance(a, sympy.Basic) else a for a in row) for row in A)
+    A = tuple(tuple(sympy.sympify(a, strict=True) for a in row) for row in A)
     b = tuple(sympy.sympify(x, strict=True) for x in b)
     c = tuple(sympy.radsimp(sympy.expand(sum(row, sympy.Integer(0)))) for row in A)
     return ButcherTableau(name, A, b, c, order, reference, quadratic_only)
