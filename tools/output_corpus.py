@@ -25,6 +25,8 @@ from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT))
+from nambu_bch.atomic import write_atomic  # noqa: E402  (the package's writer: atomic, never over a non-regular file)
 
 #: (name, argv) of each request; names are unique and safe as file names.
 CORPUS: tuple[tuple[str, tuple[str, ...]], ...] = (
@@ -109,9 +111,9 @@ def main(argv: list[str] | None = None) -> int:
         args.directory.mkdir(parents=True, exist_ok=True)
         manifest = {}
         for (i, n, _), out in zip(todo, outputs):
-            (args.directory / file_name(i, n)).write_bytes(out)
+            write_atomic(args.directory / file_name(i, n), out)
             manifest[file_name(i, n)] = hashlib.sha256(out).hexdigest()
-        (args.directory / "manifest.json").write_text(json.dumps(manifest, indent=1) + "\n")
+        write_atomic(args.directory / "manifest.json", json.dumps(manifest, indent=1) + "\n")
         print(f"recorded {len(todo)} requests in {args.directory}")
         return 0
     differ = 0
