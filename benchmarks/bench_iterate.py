@@ -11,12 +11,15 @@ load average is printed with the numbers.  The contenders:
                                                      -- single trajectory and batch,
   C, the same build with -ffp-contract=off (bit for bit the numba kernels) -- single and batch,
   C with one exp per piece (hand-written; Lotka-Volterra only) -- single trajectory,
-  numba via iterate(): default (bit-reproducible) and fma=True -- single; batch into out= (both),
-      batch allocating its result, and the batch kernel alone,
+  numba via iterate(): default (bit-reproducible) and fma=True -- single; batch into out= (both) on one
+      thread, batch allocating its result, and the batch kernel alone,
+  both sides' batches split across the cores (``--threads``, default all): iterate(workers=T, out=) and the
+      default C build called on T contiguous blocks of states from T threads (ctypes releases the GIL),
   our numpy fallback                                 -- batch (vectorised) and single (scalar Python loop),
   a plain Python loop over nambu_bch.integrators.step_function,
 the ratios with the targets (one trajectory, fma=True, <= 1.05x the default C build; batch through
-iterate() into out= <= 1.5x the default C batch loop; numpy fallback <= 20x) and the kernel compile
+iterate() into out= <= 1.5x the default C batch loop, on one thread and on all; the threaded batch
+>= 1.8x faster than one thread on two cores; numpy fallback <= 20x) and the kernel compile
 time (cold: empty cache, in a subprocess) versus loading it from the disk cache.  The first compiled
 run of a fresh process is measured by bench_iterate_cold.py.
 
@@ -46,7 +49,8 @@ import numpy as np  # noqa: E402
 from nambu_bch import model  # noqa: E402
 from nambu_bch.integrators import step_function  # noqa: E402
 from nambu_bch.numeric import iterate, kernel  # noqa: E402
-from nambu_bch.numeric.kernels import NUMBA_CHUNK, numba_available  # noqa: E402
+from nambu_bch.numeric.iterate import available_threads  # noqa: E402
+from nambu_bch.numeric.kernels import NUMBA_CHUNK, column_ranges, numba_available  # noqa: E402
 from nambu_bch.numeric.samples import n_samples  # noqa: E402
 
 
@@ -103,7 +107,9 @@ LABELS = {
     "numba_single_fma": "iterate(fma=True), single",
     "c_batch": "C -O3 -march=native (gcc default, FMA), batch",
     "c_exact_batch": "C ... -ffp-contract=off, batch",
-    "numba_batch": "iterate(out=), batch",
+    "c_batch_threads": "C -O3 -march=native, batch, T threads",
+    "numba_batch": "iterate(out=, workers=1), batch",
+    "numba_batch_threads": "iterate(out=, workers=T), batch",
     "numba_batch_fma": "iterate(out=, fma=True), batch",
     "numba_batch_alloc": "iterate(), batch (allocates its result)",
     "numba_batch_kernel": "numba batch kernel alone",
@@ -116,7 +122,8 @@ LABELS = {
 RATIOS = [("numba_single_fma", "c_single", 1.05), ("numba_single", "c_exact_single", None),
           ("numba_single", "c_single", None), ("numba_single", "c_one_exp_single", 1.3),
           ("numba_single_fma", "c_one_exp_single", None),
-          ("numba_batch", "c_batch", 1.5), ("numba_batch_fma", "c_batch", None), ("numba_batch", "c_exact_batch", None),
+          ("numba_batch", "c_batch", 1.5), ("numba_batch_threads", "c_batch_threads", 1.5),
+          ("numba_batch_fma", "c_batch", None), ("numba_batch", "c_exact_batch", None),
           ("numba_batch_alloc", "c_batch", None), ("numba_batch_kernel", "c_batch", None),
           ("numpy_batch", "c_batch", 20.0), ("numpy_batch_kernel", "c_batch", None),
           ("numpy_single_python", "c_single", None), ("plain_python_loop", "c_single", None)]
@@ -130,6 +137,7 @@ def main(argv=None):
     ap.add_argument("--steps", type=int, default=10_000_000, help="steps of the single-trajectory runs")
     ap.add_argument("--batch", type=int, default=1_000_000, help="states of the batch runs")
     ap.add_argument("--batch-steps", type=int, default=50)
+    ap.add_argument("--threads", type=int, default=None, help="threads of the threaded batch rows (default: all cores)")
     ap.add_argument("--numpy-steps", type=int, default=10, help="steps of the numpy batch run")
     ap.add_argument("--python-steps", type=int, default=20_000)
     ap.add_argument("--repeats", type=int, default=7)
@@ -147,8 +155,12 @@ def main(argv=None):
     K = k.constants(args.h)
     x0 = np.full(N, 0.7)
     X0 = np.random.default_rng(0).uniform(0.5, 1.5, size=(N, args.batch))
+    threads = args.threads or available_threads()
     print(f"# {system.name} {args.word}: {len(k.program.updates)} sub-flows, ~{k.program.n_operations} flops/step; "
-          f"h = {args.h}; {args.repeats} rounds")
+          f"h = {args.h}; {args.repeats} rounds; threaded batch rows: T = {threads}")
+    from concurrent.futures import ThreadPoolExecutor
+
+    pool = ThreadPoolExecutor(max(1, threads))
     results = {}
 
     # -- compile times -------------------------------------------------------------------------------------
@@ -188,6 +200,19 @@ def main(argv=None):
         finals[f"{name}_single"], finals[f"{name}_batch"] = x.copy(), X.copy()
         work[f"{name}_single"] = (c_single, args.steps)
         work[f"{name}_batch"] = (c_batch, batch_work)
+    if "c" in builds and threads > 1:  # the same C loop on T contiguous blocks of states, one thread each
+        cref = builds["c"]
+        blocks = [(lo, hi, np.empty((N, hi - lo))) for lo, hi in column_ranges(args.batch, NUMBA_CHUNK, threads)]
+
+        def c_block(block, cref=cref):
+            lo, hi, Xb = block
+            np.copyto(Xb, X0[:, lo:hi])
+            cref.run_batch(Xb, K, args.batch_steps, NUMBA_CHUNK)
+
+        def c_batch_threads():
+            list(pool.map(c_block, blocks))
+
+        work["c_batch_threads"] = (c_batch_threads, batch_work)
 
     # Lotka-Volterra: the hand-written one-exp-per-piece C loop (the reference)
     if builds and system.name == "lotka-volterra":
@@ -212,16 +237,18 @@ def main(argv=None):
         def single(fma):
             holder["x", fma] = iterate(system, args.word, args.h, args.steps, x0, every=args.steps, fma=fma)[-1].copy()
 
-        def batch(fma):
-            holder["X", fma] = iterate(system, args.word, args.h, args.batch_steps, X0, every=args.batch_steps,
-                                       fma=fma, out=batch_out[fma])
+        def batch(fma, workers=1):
+            holder["X", fma, workers] = iterate(system, args.word, args.h, args.batch_steps, X0,
+                                                every=args.batch_steps, fma=fma, out=batch_out[fma], workers=workers)
 
         work["numba_single"] = (lambda: single(False), args.steps)
         work["numba_single_fma"] = (lambda: single(True), args.steps)
         work["numba_batch"] = (lambda: batch(False), batch_work)
         work["numba_batch_fma"] = (lambda: batch(True), batch_work)
+        if threads > 1:
+            work["numba_batch_threads"] = (lambda: batch(False, threads), batch_work)
         work["numba_batch_alloc"] = (lambda: iterate(system, args.word, args.h, args.batch_steps, X0,
-                                                     every=args.batch_steps), batch_work)
+                                                     every=args.batch_steps, workers=1), batch_work)
         out = np.empty((2, N, args.batch))
         Xk = X0.copy()
 
@@ -261,11 +288,14 @@ def main(argv=None):
           f"({args.repeats} rounds, contenders in turn)")
     if "numba_single" in work and "c_exact_single" in finals:
         same = (np.array_equal(holder["x", False], finals["c_exact_single"]),
-                np.array_equal(holder["X", False][-1], finals["c_exact_batch"]))
+                np.array_equal(holder["X", False, 1][-1], finals["c_exact_batch"]))
         print(f"iterate() == C -ffp-contract=off bit for bit: single {same[0]}, batch {same[1]}")
+    if ("X", False, threads) in holder:
+        print(f"iterate(workers={threads}) == iterate(workers=1) bit for bit: "
+              f"{np.array_equal(holder['X', False, threads], holder['X', False, 1])}")
         for what, ours, theirs in (("single", holder["x", True], finals["c_single"]),
-                                   ("batch", holder["X", True][-1], finals["c_batch"])):
-            ref = holder["x", False] if what == "single" else holder["X", False][-1]
+                                   ("batch", holder["X", True, 1][-1], finals["c_batch"])):
+            ref = holder["x", False] if what == "single" else holder["X", False, 1][-1]
             rel = float(np.max(np.abs(ours - ref) / np.maximum(np.abs(ref), 1e-300)))
             print(f"iterate(fma=True), {what}: == C default build bit for bit {np.array_equal(ours, theirs)}; "
                   f"largest relative difference to the default run {rel:.1e}")
@@ -288,11 +318,17 @@ def main(argv=None):
             ratios[f"{a}/{b}"] = (r, rm)
             verdict = "" if target is None else f"  (target <= {target:g}: {'met' if r <= target else 'MISSED'})"
             print(f"  {LABELS[a]:44s} / {LABELS[b]:46s}: {r:6.2f} ({rm:5.2f}){verdict}")
+    for ours, one in (("numba_batch_threads", "numba_batch"), ("c_batch_threads", "c_batch")):
+        if ours in ns and one in ns:
+            print(f"  speed-up on {threads} threads, {LABELS[ours]}: {ns[one][0] / ns[ours][0]:.2f}x "
+                  f"(median {ns[one][1] / ns[ours][1]:.2f}x)" + ("  (target >= 1.8 on two cores: "
+                  f"{'met' if ns[one][0] / ns[ours][0] >= 1.8 else 'MISSED'})" if ours.startswith("numba") else ""))
     if args.rows:
         print_rows(args, system, ns, ratios, results["load_average"])
     if args.json:
         print(json.dumps({"system": system.name, "word": args.word, "ns_per_step": ns,
                           "ratios": ratios, **{k2: v for k2, v in results.items()}}))
+    pool.shutdown()
     for c in closers:
         c.close()
 
@@ -314,6 +350,8 @@ def print_rows(args, system, ns, ratios, load):
         "c_exact_single")
     row(f"iteration, {system.name} {args.word}, one trajectory, default", "numba_single", "c_single")
     row(f"iteration, batch of {args.batch:.0e} x {args.batch_steps} steps, `iterate(out=)`", "numba_batch", "c_batch")
+    row(f"iteration, same batch, `iterate(out=, workers=T)` vs C on T threads (T = {args.threads or available_threads()})",
+        "numba_batch_threads", "c_batch_threads")
     row(f"iteration, same batch, `iterate()` allocating its result", "numba_batch_alloc", "c_batch")
     row(f"numpy fallback, batch of {args.batch:.0e} x {args.numpy_steps} steps", "numpy_batch", "c_batch")
     print("\n".join(rows))

@@ -81,7 +81,7 @@ def sweep(function, tasks, *, backend=None, client=None, n_jobs=None) -> list:
     if backend == "loky":
         joblib = _require("joblib", "loky")
         return list(joblib.Parallel(n_jobs=n_jobs or -1, backend="loky")(
-            joblib.delayed(_apply)(function, task) for task in tasks))
+            joblib.delayed(_apply_in_worker)(function, task) for task in tasks))
     return _dask(function, tasks, client)
 
 
@@ -92,6 +92,14 @@ def _apply(function, task):
     if isinstance(task, tuple):
         return function(*task)
     return function(task)
+
+
+def _apply_in_worker(function, task):
+    """One task in a worker of a parallel sweep: its batches run on one thread (the workers share the cores)."""
+    from .numeric.iterate import single_threaded
+
+    with single_threaded():
+        return _apply(function, task)
 
 
 def _dask(function, tasks, client):
@@ -130,7 +138,7 @@ class _Packed:
 
 
 def _run_batch(packed):
-    return [_apply(packed.function, task) for task in packed.tasks]
+    return [_apply_in_worker(packed.function, task) for task in packed.tasks]
 
 
 def _require(module, backend):

@@ -22,6 +22,10 @@ Horikoshi, Sect. 5.5: ``x^{32123}(t) = (Phi^{32123}_h)^n x(0)``, ``t = n h``.
 
 from __future__ import annotations
 
+import contextlib
+import contextvars
+import os
+
 import numpy as np
 
 from ..errors import InvalidRunError, NumericalRangeError
@@ -36,6 +40,43 @@ from .samples import MAX_SAMPLE_BYTES, n_samples, sample_steps
 
 #: Trajectory-steps per kernel call when progress is reported (a few tenths of a second compiled).
 _SEGMENT_WORK = 20_000_000
+#: ``workers=None`` splits a compiled batch across threads only with at least this many trajectory-steps
+#: per thread: starting and joining a thread costs ~0.1 ms, this much work a few ms.
+PARALLEL_WORK = 1_000_000
+#: The most threads ``workers=None`` may use in this context: :func:`single_threaded` sets it to 1 inside
+#: the tasks of a parallel sweep, whose processes already share the cores.
+_MAX_THREADS = contextvars.ContextVar("nambu_bch_batch_threads", default=None)
+
+
+@contextlib.contextmanager
+def single_threaded():
+    """Inside the block, batches of ``iterate(workers=None)`` run on one thread (for tasks of a sweep)."""
+    token = _MAX_THREADS.set(1)
+    try:
+        yield
+    finally:
+        _MAX_THREADS.reset(token)
+
+
+def available_threads() -> int:
+    """The cores this process may run on (its CPU affinity), at most ``$NUMBA_NUM_THREADS`` when that is set
+    (joblib sets it in its workers) and 1 inside :func:`single_threaded`."""
+    try:
+        cores = len(os.sched_getaffinity(0))
+    except (AttributeError, OSError):
+        cores = os.cpu_count() or 1
+    limit = os.environ.get("NUMBA_NUM_THREADS", "").strip()
+    if limit.isdigit() and int(limit) >= 1:
+        cores = min(cores, int(limit))
+    return max(1, min(cores, _MAX_THREADS.get() or cores))
+
+
+def batch_workers(workers, batch: int, steps: int) -> int:
+    """Threads for a compiled batch run: ``workers`` when given, else :func:`available_threads` limited so
+    that each thread has :data:`PARALLEL_WORK` trajectory-steps."""
+    if workers is not None:
+        return workers
+    return max(1, min(available_threads(), batch * steps // PARALLEL_WORK))
 
 
 def as_system(system) -> System:
@@ -47,7 +88,7 @@ def as_system(system) -> System:
 
 
 def iterate(system, word, h, steps, x0=None, params=None, every=1, *, kahan=False, dps=None,
-            backend="auto", progress=None, chunk=None, check_stable=True, out=None, fma=False):
+            backend="auto", progress=None, chunk=None, check_stable=True, out=None, fma=False, workers=None):
     """Iterate ``Phi_h`` of ``word`` on ``system`` ``steps`` times from ``x0``; the samples every ``every`` steps.
 
     The step is generated once from the exact sub-flows (Eqs. hX1e-hX3e for ``ho3``)
@@ -78,6 +119,11 @@ def iterate(system, word, h, steps, x0=None, params=None, every=1, *, kahan=Fals
         trajectory; docs/numerics.md).  The samples are then close to the default ones, not equal, and
         depend on the machine; the interpreter and numpy never fuse.  Default False: the same bits on
         every backend.  float64 runs only.
+    workers : int >= 1 or None -- threads advancing a batch with the compiled loop, each on its own range of
+        states (the loop releases the GIL).  The samples are the same bits for every value.  None: the
+        cores available (:func:`available_threads`), fewer for small batches (:data:`PARALLEL_WORK`
+        trajectory-steps per thread), one inside the tasks of :func:`nambu_bch.parallel.sweep`.  Ignored by
+        one trajectory, the numpy loop and mpmath runs.
 
     Returns
     -------
@@ -112,6 +158,8 @@ def iterate(system, word, h, steps, x0=None, params=None, every=1, *, kahan=Fals
     kahan, check_stable = check_flag(kahan, "kahan"), check_flag(check_stable, "check_stable")
     progress, backend = check_flag(progress, "progress", none=True), check_backend(backend)
     fma = check_flag(fma, "fma")
+    if workers is not None:
+        workers = check_count(workers, "workers", 1)
     kern = kernel(system, word)
     if dps is not None:
         dps = check_dps(dps)
@@ -153,7 +201,8 @@ def iterate(system, word, h, steps, x0=None, params=None, every=1, *, kahan=Fals
     segment = steps if not reporter.enabled else max(every, (_SEGMENT_WORK // batch) // every * every)
     if not single:
         with reporter:
-            _run_batch(kern, X, K, steps, every, out, kahan, be, chunk, segment, reporter, what, fma)
+            _run_batch(kern, X, K, steps, every, out, kahan, be, chunk, segment, reporter, what, fma,
+                       batch_workers(workers, batch, steps))
         return out
     state = X  # check_inputs made a fresh float64 copy: advanced in place
     out[0] = state
@@ -196,7 +245,7 @@ def _run_single(kern, state, K, steps, every, out, kahan, comp, be, fallback, wh
                                   ) from None
 
 
-def _run_batch(kern, X, K, steps, every, out, kahan, be, chunk, segment, reporter, what, fma=False):
+def _run_batch(kern, X, K, steps, every, out, kahan, be, chunk, segment, reporter, what, fma=False, workers=1):
     """Fill ``out`` with the samples of a batch: ``X`` (the caller's start states) is only read.
 
     The kernel copies ``X`` into ``out[0]`` while it loads each chunk, starts every later segment
@@ -213,7 +262,7 @@ def _run_batch(kern, X, K, steps, every, out, kahan, be, chunk, segment, reporte
             seg = min(segment, steps - done)
             nseg = n_samples(seg, every)
             bad = kern.run_batch(source, K, seg, every, out[j:j + nseg], kahan=kahan, comp=comp, backend=be,
-                                 chunk=chunk, start=j == 0, back=False, fma=fma)
+                                 chunk=chunk, start=j == 0, back=False, fma=fma, workers=workers)
             if bad:
                 grid = sample_steps(steps, every)
                 samples = out[1:j + nseg]

@@ -395,7 +395,7 @@ class Kernel:
             X = np.zeros((N, 1))
             out = np.zeros((2, N, 1))
             args = (X, np.zeros((N, 1))) if kahan else (X,)
-            fn(*args, K, 1, 1, out, NUMBA_CHUNK, 1, 1)
+            fn(*args, K, 1, 1, out, NUMBA_CHUNK, 1, 1, 0, 1)
         else:
             x = np.zeros(N)
             out = np.zeros((2, N))
@@ -441,23 +441,49 @@ class Kernel:
         return int(n)
 
     def run_batch(self, X, K, steps, every, out, *, kahan=False, comp=None, backend="numba", chunk=None,
-                  start=False, back=True, fma=False) -> int:
+                  start=False, back=True, fma=False, workers=1) -> int:
         """Advance states ``X`` (shape (N, batch), float64); ``out`` of shape (n, N, batch), ``out[1:]`` is filled.
 
         ``start``: also copy ``X`` into ``out[0]`` (fused with the pass that loads the states);
         ``back``: write the final states into ``X`` (in place); with ``back=False`` ``X`` is only
         read (the caller's array can be passed as it is) and the final states are ``out[-1]``.
-        ``fma`` as in :meth:`run`.  Returns 0 when every sample written is finite, a positive number otherwise.
+        ``fma`` as in :meth:`run`.  ``workers``: threads running the compiled loop on disjoint column
+        ranges (:func:`column_ranges`; the loop releases the GIL, every state is advanced by the same
+        operations, so the bits do not depend on it).  Returns 0 when every sample written is finite,
+        a positive number otherwise.
         """
         name = "run_batch_kahan" if kahan else "run_batch"
         args = (X, comp) if kahan else (X,)
         flags = (int(bool(start)), int(bool(back)))
-        if backend == "numba":
-            self.compile(kahan=kahan, batch=True, fma=fma)
-            fn = self.function(self.loop_name(kahan, True, fma))
-            return int(fn(*args, K, int(steps), int(every), out, int(chunk or NUMBA_CHUNK), *flags))
-        fn = self.function(name, "numpy")
-        return int(fn(*args, [float(k) for k in K], int(steps), int(every), out, int(chunk or NUMPY_CHUNK), *flags))
+        B = X.shape[1]
+        if backend != "numba":
+            fn = self.function(name, "numpy")
+            return int(fn(*args, [float(k) for k in K], int(steps), int(every), out, int(chunk or NUMPY_CHUNK),
+                          *flags, 0, B))
+        self.compile(kahan=kahan, batch=True, fma=fma)
+        fn = self.function(self.loop_name(kahan, True, fma))
+        chunk = int(chunk or NUMBA_CHUNK)
+        call = lambda lo, hi: int(fn(*args, K, int(steps), int(every), out, chunk, *flags, lo, hi))  # noqa: E731
+        ranges = column_ranges(B, chunk, workers)
+        if len(ranges) <= 1:
+            return call(0, B)
+        from concurrent.futures import ThreadPoolExecutor
+
+        with ThreadPoolExecutor(len(ranges)) as pool:
+            return sum(pool.map(lambda r: call(*r), ranges))
+
+
+def column_ranges(batch: int, chunk: int, workers: int) -> list:
+    """``workers`` contiguous ranges ``(lo, hi)`` covering ``range(batch)``, split at multiples of ``chunk``
+    (fewer when there are fewer chunks than workers).
+
+    >>> column_ranges(10, 4, 2), column_ranges(10, 4, 8), column_ranges(3, 4, 2)
+    ([(0, 4), (4, 10)], [(0, 4), (4, 8), (8, 10)], [(0, 3)])
+    """
+    chunks = -(-batch // chunk)
+    workers = max(1, min(workers, chunks))
+    cuts = [min(batch, (chunks * w // workers) * chunk) for w in range(workers + 1)]
+    return [(lo, hi) for lo, hi in zip(cuts, cuts[1:]) if hi > lo]
 
 
 def kernel(system, word) -> Kernel:
