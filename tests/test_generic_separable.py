@@ -169,20 +169,23 @@ def _check_against_concrete_orders(system, R, concrete, n):
         assert _same_up_to_constant(system, theirs.coeff(h, j), ours[j])
 
 
-# -- numerically: H_S^[4] drifts like h^6 --------------------------------------------------------------
-def test_substituted_h4_drifts_like_h6(verlet):
+# -- numerically: H_S^[4] drifts like h^6 (H_S^[2] like h^4) --------------------------------------------
+def test_substituted_h2_and_h4_drift_like_h4_and_h6(verlet):
     from nambu_bch.design.compare import slope
 
     system = model("henon-heiles")
     coords = system.coordinates
     series = verlet["212"].substitute_series(poisson_structure(system)[0][1], q=coords[:2], p=coords[2:])
+    H2 = sympy.lambdify([*coords, h], series[0] + h**2 * series[2], "numpy")
     H4 = sympy.lambdify([*coords, h], series[0] + h**2 * series[2] + h**4 * series[4], "numpy")
-    steps_sizes, drifts = [0.2, 0.1, 0.05], []
+    steps_sizes, drifts = [0.2, 0.1, 0.05], {2: [], 4: []}
     for step in steps_sizes:
         X = iterate(system, "212", step, int(round(4 / step)), x0=(0.0, 0.3, 0.4, 0.1))
-        values = H4(*X.T, step)
-        drifts.append(float(np.max(np.abs(values - values[0]))))
-    assert 5.5 < slope(steps_sizes, drifts) < 6.5, drifts
+        for k, H in ((2, H2), (4, H4)):
+            values = H(*X.T, step)
+            drifts[k].append(float(np.max(np.abs(values - values[0]))))
+    assert 3.5 < slope(steps_sizes, drifts[2]) < 4.5, drifts
+    assert 5.5 < slope(steps_sizes, drifts[4]) < 6.5, drifts
 
 
 # -- printing, JSON, substitution -----------------------------------------------------------------------
@@ -272,3 +275,20 @@ def test_cli_text(capsys):
 
     assert main(["shadow", "--generic-separable", "--integrator", "121", "--order", "2", "--format", "text"]) == 0
     assert "h^2: -1/24 V''(p,p) + 1/12 ∇V·∇V" in capsys.readouterr().out
+
+
+def test_json_matches_the_schema(capsys):
+    # docs/schema/nambu-bch.schema.json, $defs/generic_separable (docs/json.md); the CLI prints to_dict()
+    from pathlib import Path
+
+    jsonschema = pytest.importorskip("jsonschema")
+    from nambu_bch.cli import main
+
+    schema = json.loads((Path(__file__).resolve().parents[1] / "docs" / "schema" / "nambu-bch.schema.json").read_text())
+    validator = jsonschema.Draft202012Validator({"$schema": schema["$schema"], "$defs": schema["$defs"],
+                                                 "$ref": "#/$defs/generic_separable"})
+    assert main(["shadow", "--generic-separable", "--integrator", "12", "--order", "3", "--format", "json"]) == 0
+    data = json.loads(capsys.readouterr().out)
+    validator.validate(data)
+    assert data == json.loads(json.dumps(separable_shadow("12", 3).to_dict()))
+    assert data["dimension"] is None and data["series"]["1"]
