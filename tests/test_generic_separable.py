@@ -209,6 +209,15 @@ def test_substitute_with_default_symbols_and_a_string():
     assert sympy.expand(HS - expected) == 0
 
 
+def test_substitution_is_returned_in_the_ring_normal_form(verlet):
+    # the pendulum V = -cos q: the h^4 term as the concrete route prints it (sin/cos reduced by s^2 + c^2 = 1)
+    x1, x2 = sympy.symbols("x1 x2")
+    ours = verlet["212"].substitute_series(-sympy.cos(x1), q=["x1"], p=["x2"])
+    assert ours[4] == (x2**4 * sympy.cos(x1) / 720 - x2**2 * sympy.sin(x1)**2 / 40 + x2**2 / 60
+                       - sympy.sin(x1)**2 * sympy.cos(x1) / 240)
+    assert ours[2] == x2**2 * sympy.cos(x1) / 12 - sympy.sin(x1)**2 / 24
+
+
 @pytest.mark.parametrize("call, match", [
     (lambda: separable_shadow("123", 2), "piece"),
     (lambda: separable_shadow("212", 13), "order"),
@@ -235,6 +244,7 @@ def test_contraction_of_refuses_what_is_not_a_tree(plegs, edges):
 
 def test_result_type():
     assert isinstance(separable_shadow("TVT", 2), SeparableShadow)
+    assert repr(separable_shadow("121", 2, d=3)) == "SeparableShadow('121', order=2, d=3)"
     assert separable_shadow("TVT", 2).series == separable_shadow("121", 2).series
 
 

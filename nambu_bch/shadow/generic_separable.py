@@ -353,7 +353,7 @@ def _join_terms(pairs, latex: bool) -> str:
 # ------------------------------------------------------------------------------------------------------
 # the shadow Hamiltonian
 # ------------------------------------------------------------------------------------------------------
-@dataclass
+@dataclass(frozen=True)
 class SeparableShadow:
     """The generic ``H_S`` of a composition for ``H = p.p/2 + V(q)``: ``series[j]`` is the coefficient of ``h^j``.
 
@@ -396,6 +396,9 @@ class SeparableShadow:
     def _repr_latex_(self):
         return "$" + self.to_latex() + "$"
 
+    def __repr__(self):
+        return f"SeparableShadow({self.word!r}, order={self.order}, d={self.d})"
+
     def __str__(self):
         return self.to_text()
 
@@ -418,6 +421,12 @@ class SeparableShadow:
         d : int, optional -- default: the result's ``d``, else ``len(q)``
         q, p : sequences of ``d`` symbols or names (default ``q1..qd``, ``p1..pd``; e.g. ``["x1"]``, ``["x2"]``
             for the pendulum's coordinates)
+
+        Returns
+        -------
+        dict -- each coefficient in the normal form of the extended exact ring (:mod:`nambu_bch.algebra.extended`:
+        polynomials expanded, radicals and exp/sin/cos reduced by their relations) when the ring takes ``V``'s atoms,
+        else as the contraction sums built it (e.g. for an undefined ``V``)
         """
         q, p, V = self._inputs(V, d, q, p)
         work = sum(t.index_sums(len(q)) for s in self.series.values() for t in map(Contraction, s.terms))
@@ -437,7 +446,7 @@ class SeparableShadow:
         for j, s in sorted(self.series.items()):
             out[j] = sympy.Add(*(sympy.Rational(c.numerator, c.denominator) * t.evaluate(derivative, len(q), p)
                                  for c, t in s.items()))
-        return out
+        return _normal_forms(out, q + p, V)
 
     def substitute(self, V, d=None, q=None, p=None) -> sympy.Expr:
         """The concrete ``H_S = sum_j h^j series[j]`` for a potential ``V(q)`` (see :meth:`substitute_series`).
@@ -469,6 +478,19 @@ class SeparableShadow:
             if V.free_symbols & set(p) or not isinstance(V, sympy.Expr):
                 raise NambuBCHError(f"V must be a function of q = {', '.join(map(str, q))} only, got {V}")
         return q, p, V
+
+
+def _normal_forms(series: dict, coordinates, V) -> dict:
+    """``series`` in the extended ring's normal form, or unchanged when the ring refuses an atom of ``V``."""
+    from ..algebra.extended import extended_ring
+
+    parameters = sorted((x for x in V.free_symbols if x not in coordinates), key=str)
+    if any(not isinstance(x, sympy.Symbol) for x in parameters):
+        return series
+    ring = extended_ring(coordinates, parameters, [V, *series.values()])
+    if ring is None:
+        return series
+    return {j: ring.to_sympy(ring.convert(e)) for j, e in series.items()}
 
 
 def separable_shadow(word="212", order: int = 4, d: int | None = None) -> SeparableShadow:
