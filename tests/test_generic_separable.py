@@ -200,6 +200,12 @@ def test_text_latex_and_json(verlet):
     assert row["coefficient"] == "1/60" and row["nodes"] == [{"derivative": 2, "p": 1}] * 2 and row["edges"] == [[0, 1]]
 
 
+def test_substitute_reads_floats_as_the_decimals_written():
+    q1, p1 = sympy.symbols("q1 p1")
+    assert separable_shadow("212", 2).substitute(sympy.Float(1.5) * q1, d=1) == \
+        separable_shadow("212", 2).substitute(sympy.Rational(3, 2) * q1, d=1)
+
+
 def test_substitute_with_default_symbols_and_a_string():
     R = separable_shadow("212", 2, d=2)
     q1, q2, p1, p2 = sympy.symbols("q1 q2 p1 p2")
@@ -228,6 +234,12 @@ def test_substitution_is_returned_in_the_ring_normal_form(verlet):
     (lambda: separable_shadow("212", 2).substitute("q1", q=["q1"], p=["q1"]), "distinct"),
     (lambda: separable_shadow("212", 2).substitute("q1", q=["q 1"], p=["p1"]), "symbol name"),
     (lambda: separable_shadow("212", 4).substitute("q1^3", d=64), "index sums"),
+    (lambda: separable_shadow("212", 4).substitute("sin(sin(sin(sin(sin(sin(sin(sin(q1))))))))", d=1), "estimated"),
+    (lambda: separable_shadow("212", 2).substitute(None, d=1), "V must be"),
+    (lambda: separable_shadow("212", 2).substitute(sympy.Matrix([1]), d=1), "V must be"),
+    (lambda: separable_shadow("212", 2).substitute(sympy.zoo, d=1), "finite"),
+    (lambda: separable_shadow("212", 2).substitute(sympy.Symbol("h") * sympy.Symbol("q1"), d=1), "reserved"),
+    (lambda: separable_shadow("212", 2).substitute("q1", q=["h"], p=["p1"]), "reserved"),
 ])
 def test_bad_input_is_one_line_of_the_family(call, match):
     with pytest.raises(NambuBCHError, match=match) as info:

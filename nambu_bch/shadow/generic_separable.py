@@ -9,7 +9,7 @@ with ``[X_A, X_B] = X_{{B, A}}`` (Eq. CL1), is the shadow Hamiltonian
 
 and every nested bracket of ``T`` and ``V`` is a polynomial in ``p`` whose coefficients are full contractions
 of the derivative tensors ``V^(k)(q)`` with ``p`` and with each other, e.g. ``{T, {T, V}} = V''(p, p)``,
-``{V, {V, T}} = grad V . grad V`` (Hairer, Lubich, Wanner, Sect. IX.4; Skeel and Hardy 2001).
+``{V, {V, T}} = grad V . grad V`` (cf. Hairer, Lubich, Wanner, Sect. IX.4).
 
 A contraction is a *tree*: its vertices are the tensors ``V^(k)`` (degree ``k``) and the ``p``'s (leaves);
 an edge is a summed index.  Only trees occur: ``T`` and ``V`` are trees, and ``{A, B}`` of two trees
@@ -24,7 +24,7 @@ References
 ----------
 Horikoshi, Sect. 4 and Eqs. (CL1), (BCH1), (BCH2); Hairer, Lubich, Wanner, *Geometric Numerical
 Integration*, 2nd ed., Sects. IX.3-IX.4 (modified equations of the Stoermer-Verlet scheme); R. D. Skeel and
-D. J. Hardy, SIAM J. Sci. Comput. 23 (2001) 1172 (shadow Hamiltonians of Verlet, h^2 and h^4 terms).
+D. J. Hardy, SIAM J. Sci. Comput. 23 (2001) 1172 (modified Hamiltonians of the leapfrog/Verlet method).
 """
 
 from __future__ import annotations
@@ -44,6 +44,8 @@ MAX_INDEX_SUMS = 200_000
 # A contraction in canonical rooted form: a tensor node is ``(number of p legs, (child, child, ...))`` with the
 # children sorted; ``T_KEY`` stands for ``p.p`` (two p's joined, no tensor), so ``T = T_KEY / 2``.
 T_KEY = ("T",)
+
+_NON_FINITE = (sympy.zoo, sympy.nan, sympy.oo, -sympy.oo)
 
 
 # ------------------------------------------------------------------------------------------------------
@@ -155,7 +157,7 @@ class Contraction:
                     seen.add(c)
                     stack.append(c)
         if not plegs or len(pairs) != len(plegs) - 1 or len(seen) != len(plegs):
-            raise NambuBCHError(f"a contraction is a tree: at least one tensor, connected, one edge fewer than tensors; "
+            raise NambuBCHError("a contraction is a tree: at least one tensor, connected, one edge fewer than tensors; "
                                 f"got {len(plegs)} tensors and edges {pairs}")
         return cls(_canonical(plegs, pairs))
 
@@ -222,7 +224,10 @@ class Contraction:
         return style["V"](len(a)) + style["paren"](",".join(a))
 
     def to_text(self) -> str:
-        """Index-free text: ``V''(p,p)``, ``∇V·∇V``, ``V''(p,V''p)``, ``V^(4)(p,p,p,p)``; ``V'''(p,p,·)`` is a vector."""
+        """Index-free text: ``V''(p,p)``, ``∇V·∇V``, ``V''(p,V''p)``, ``V^(4)(p,p,p,p)``.
+
+        A tensor with one slot open is a vector: ``V''p``, ``V'''(p,p,·)``.
+        """
         return self._render(_TEXT)
 
     def to_latex(self) -> str:
@@ -459,8 +464,11 @@ class SeparableShadow:
         return sympy.Add(*(h**j * e for j, e in self.substitute_series(V, d, q, p).items()))
 
     def _inputs(self, V, d, q, p):
+        from types import SimpleNamespace
+
         from ..checks import check_int
-        from ..parsing import as_symbols, parse_expression
+        from ..parsing import as_expression, as_symbols
+        from .generic import check_work
 
         if d is None:
             d = self.d if self.d is not None else (len(q) if q is not None else None)
@@ -471,13 +479,25 @@ class SeparableShadow:
         p = tuple(sympy.symbols(f"p1:{d + 1}")) if p is None else as_symbols(p, "p", names=True)
         if len(q) != d or len(p) != d or len(set(q + p)) != 2 * d:
             raise NambuBCHError(f"substitute: q and p must be {d} distinct symbols each, got q={q}, p={p}")
-        if isinstance(V, str):
-            V = parse_expression(V, q, "V")
-        else:
-            V = sympy.sympify(V, strict=True)
-            if V.free_symbols & set(p) or not isinstance(V, sympy.Expr):
-                raise NambuBCHError(f"V must be a function of q = {', '.join(map(str, q))} only, got {V}")
+        _check_not_reserved((*q, *p))
+        V = as_expression(V, q, "V")
+        if V.has(sympy.Float):  # symbolic code never sees floats: 0.5 is read as 1/2, as System does
+            V = sympy.nsimplify(V, rational=True)
+        _check_not_reserved(V.free_symbols)
+        if V.free_symbols & set(p) or V.has(*_NON_FINITE) or getattr(V, "is_Matrix", False):
+            raise NambuBCHError(f"V must be a finite function of q = {', '.join(map(str, q))} (and parameters) only, "
+                                f"got {str(V)[:80]}")
+        # the concrete route's size estimate of the same derivatives (BCH brackets of T and V up to order + 1 letters)
+        check_work(SimpleNamespace(coordinates=q, name=f"V = {str(V)[:40]}"), 2, (V,), self.order)
         return q, p, V
+
+
+def _check_not_reserved(symbols) -> None:
+    from ..systems.system import RESERVED_SYMBOLS
+
+    clash = sorted(x.name for x in symbols if x.name in RESERVED_SYMBOLS)
+    if clash:
+        raise NambuBCHError(f"substitute: the symbol {clash[0]!r} is reserved (step / family parameter); rename it")
 
 
 def _normal_forms(series: dict, coordinates, V) -> dict:
