@@ -161,6 +161,13 @@ def test_non_symmetric_word_has_odd_powers():
     _check_against_concrete_orders(system, R, family("henon-heiles", "12", 3).H_S, 4)
 
 
+@pytest.mark.parametrize("word", ["212", "121"])
+def test_pendulum_through_h6(word):
+    R = separable_shadow(word, 6)
+    assert len(R.series[6].terms) == 10
+    _check_against_concrete_orders(model("pendulum"), R, family("pendulum", word, 6).H_S, 7)
+
+
 def _check_against_concrete_orders(system, R, concrete, n):
     d = system.N // 2
     ours = R.substitute_series(poisson_structure(system)[0][1], q=system.coordinates[:d], p=system.coordinates[d:])

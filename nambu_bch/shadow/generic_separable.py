@@ -305,6 +305,8 @@ class ContractionSum:
         return isinstance(other, ContractionSum) and self.terms == other.terms
 
     def __add__(self, other):
+        if not isinstance(other, ContractionSum):
+            return NotImplemented
         out = dict(self.terms)
         for k, c in other.terms.items():
             out[k] = out.get(k, 0) + c
@@ -315,6 +317,9 @@ class ContractionSum:
 
     def bracket(self, other) -> "ContractionSum":
         """``{self, other}`` with ``{f, g} = sum_i df/dq_i dg/dp_i - df/dp_i dg/dq_i``."""
+        from ..checks import check_type
+
+        check_type(other, ContractionSum, "other")
         out: dict = {}
         for a, ca in self.terms.items():
             for b, cb in other.terms.items():
