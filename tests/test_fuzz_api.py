@@ -61,7 +61,8 @@ RECORDS = (
     "OrderConditions", "Template", "LinearCore", "ExactFlow", "CheckResult", "DriftFit", "FigureSet", "HScan", "Kernel",
     "OrderFit", "PrecisionStudy", "StepProgram", "TruncationStudy", "DirectResult", "Existence", "FICommutator",
     "FINested", "FIOrder", "FIRepresentation", "FIResult", "OrderSolution", "Piece", "FieldBackend",
-    "ExpressionBackend", "PolynomialBackend", "ShadowTrajectory", "ButcherTableau",
+    "ExpressionBackend", "PolynomialBackend", "ShadowTrajectory", "ButcherTableau", "SeparableShadow", "ContractionSum",
+    "Contraction",
 )
 
 
@@ -174,6 +175,7 @@ def _base_table():
         "nambu_bch.shadow.double_commutator_terms": lambda v: dict(algebra=v["alg"], a=v["AC"], b=v["AC"], c=v["BD"],
                                                                    label="1AX"),
         "nambu_bch.shadow.fi_brackets": lambda v: dict(system=v["ho3"], word="12321", order=2),
+        "nambu_bch.shadow.separable_shadow": lambda v: dict(word="212", order=2, d=2),
         # exact
         "nambu_bch.F": lambda v: dict(x=0.5),
         "nambu_bch.F_series": lambda v: dict(x=v["sympy"].Symbol("z"), order=4),

@@ -76,10 +76,11 @@ SURFACE = {
         "sample_times", "shadow_along", "step_program", "truncation_study",
     ),
     "nambu_bch.shadow": (
-        "DirectResult", "Existence", "FICommutator", "FINested", "FIOrder", "FIRepresentation", "FIResult",
-        "FI_LABELS", "JetAlgebra", "LiouvilleSum", "LiouvilleTerm", "OrderSolution", "ShadowFamily",
-        "commutator_terms", "count_brackets", "decide", "direct_route", "double_commutator_terms", "fi_brackets",
-        "fi_route", "representations", "shadow_hamiltonians",
+        "Contraction", "ContractionSum", "DirectResult", "Existence", "FICommutator", "FINested", "FIOrder",
+        "FIRepresentation", "FIResult", "FI_LABELS", "JetAlgebra", "LiouvilleSum", "LiouvilleTerm", "OrderSolution",
+        "SeparableShadow", "ShadowFamily", "commutator_terms", "count_brackets", "decide", "direct_route",
+        "double_commutator_terms", "fi_brackets", "fi_route", "representations", "separable_shadow",
+        "shadow_hamiltonians",
     ),
     "nambu_bch.systems": (
         "BRACKETS", "Piece", "Splitting", "System", "canonical_split", "full_split", "infer_bracket", "is_separable",

@@ -10,7 +10,8 @@ HELP = "the shadow-Hamiltonian family of a word at an order, or the obstruction"
 EXAMPLES = ("examples:\n  nambu-bch shadow                       # alpha-family of Phi^{12321}, ho3, order 2 (Eqs. SH12321c, SG12321c)\n"
             "  nambu-bch shadow --integrator 32123 --format json\n"
             "  nambu-bch shadow --model ho --integrator TVT --order 4\n"
-            "  nambu-bch shadow --H 'x2^2/(2*m) + m*x3/2' --G 'x3 - x1^2' --param m --route fi")
+            "  nambu-bch shadow --H 'x2^2/(2*m) + m*x3/2' --G 'x3 - x1^2' --param m --route fi\n"
+            "  nambu-bch shadow --generic-separable --integrator 212 --order 4   # |p|^2/2 + V(q), V undefined")
 
 
 def register(sub) -> None:
@@ -23,11 +24,43 @@ def register(sub) -> None:
     p.add_argument("--degree", metavar="D", type=str, help="polynomial degree of the ansatz for H_S, G_S (default: the library's)")
     p.add_argument("--no-existence", dest="existence", action="store_false",
                    help="when no polynomial pair is found, do not decide existence by orbit averages (answer: undecided)")
+    generic_separable_options(p)
     output_options(p, "latex")
+
+
+# the generic answer for H = |p|^2/2 + V(q): no system, only the word, the order and optionally d
+def generic_separable_options(p) -> None:
+    p.add_argument("--generic-separable", action="store_true",
+                   help="the generic H_S for H = |p|^2/2 + V(q), V undefined, q in R^d, in tensor form "
+                        "(V''(p,p), grad V.grad V, ...); piece 1 = T, piece 2 = V; takes no system options")
+    p.add_argument("--dim", metavar="D", type=str, help="with --generic-separable: the dimension d shown (default: any d)")
+
+
+def run_generic_separable(args) -> None:
+    from ..errors import NambuBCHError
+    from ..shadow.generic_separable import separable_shadow
+    from ._options import positive_int
+
+    system_flags = (("--model", "model"), ("--system", "system"), ("--H", "H"), ("--G", "G"), ("--param", "param"),
+                    ("--degree", "degree"))
+    given = [flag for flag, key in system_flags if getattr(args, key, None) is not None]
+    given += ["--route fi"] if args.route != "direct" else []
+    if given:
+        raise NambuBCHError(f"--generic-separable is for H = |p|^2/2 + V(q) with V undefined and takes no {given[0]}")
+    d = positive_int(args.dim, "--dim", 64) if args.dim is not None else None
+    result = separable_shadow(args.integrator or "212", args.order if args.order is not None else 2, d)
+    emit(args, latex=result.to_latex, text=result.to_text, data=result.to_dict)
 
 
 def run(args):
     from ..shadow import shadow_hamiltonians
+
+    if args.generic_separable:
+        return run_generic_separable(args)
+    if args.dim is not None:
+        from ..errors import NambuBCHError
+
+        raise NambuBCHError("--dim is used with --generic-separable only")
 
     system = symbolic_system(args)
     word, comp = integrator_from_args(args, system)

@@ -6,10 +6,13 @@ from .existence import Existence, decide
 from .family import ShadowFamily
 from .fi_route import FICommutator, FINested, FIOrder, FIRepresentation, FIResult, count_brackets, fi_brackets, fi_route
 from .fundamental_identity import FI_LABELS, commutator_terms, double_commutator_terms, representations
+from .generic_separable import Contraction, ContractionSum, SeparableShadow, separable_shadow
 from .jets import JetAlgebra
 from .liouville_terms import LiouvilleSum, LiouvilleTerm
 
 __all__ = [
+    "Contraction",
+    "ContractionSum",
     "FI_LABELS",
     "DirectResult",
     "Existence",
@@ -22,6 +25,7 @@ __all__ = [
     "LiouvilleSum",
     "LiouvilleTerm",
     "OrderSolution",
+    "SeparableShadow",
     "ShadowFamily",
     "commutator_terms",
     "count_brackets",
@@ -31,5 +35,6 @@ __all__ = [
     "fi_brackets",
     "fi_route",
     "representations",
+    "separable_shadow",
     "shadow_hamiltonians",
 ]
