@@ -10,13 +10,17 @@ potential energies, gives the same values as the system's own run.
 from __future__ import annotations
 
 import json
+import os
 import pickle
+import subprocess
+import sys
 from fractions import Fraction
 
 import numpy as np
 import pytest
 
 import nambu_bch as nb
+from nambu_bch.cli import main
 from nambu_bch.errors import InvalidOrderError, InvalidRunError, InvalidSystemError, NumericalRangeError
 from nambu_bch.numeric import NumericalShadow, fit_order, numerical_shadow
 from nambu_bch.numeric.skeel_hardy import stencil
@@ -200,3 +204,32 @@ def test_one_dimensional_arrays_are_one_degree_of_freedom():
     x = nb.iterate("pendulum", "212", 0.1, 60, [0.5, 0.0])
     r = numerical_shadow(x[:, 0], x[:, 1], "pendulum", 0.1)
     assert r.values.size == 57 and r.max_abs_error["H~"] < 1e-2 * r.max_abs_error["H"]
+
+
+def test_cli_check_adds_the_numerical_shadow_in_a_subprocess():
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join(sys.path)}
+    done = subprocess.run([sys.executable, "-m", "nambu_bch", "check", "--model", "ho", "--integrator", "212",
+                           "--x0", "1,0", "--steps", "200", "--numerical-shadow", "6", "--format", "json"],
+                          capture_output=True, text=True, timeout=600, env=env)
+    assert done.returncode == 0, done.stderr
+    data = json.loads(done.stdout)
+    shadow = data["numerical_shadow"]
+    assert (shadow["order"], shadow["first_index"], shadow["last_index"], shadow["n_values"]) == (6, 3, 197, 195)
+    assert shadow["max_abs_error"]["H~"] < 1e-12 < 1e-4 < shadow["max_abs_error"]["H"]  # quadratic: conserved
+    assert set(shadow["drift"]["H~"]) == {"rate", "stderr", "intercept", "span", "drift"}
+    assert data["max_abs_error"]["H"] > 0  # the check report is unchanged around the new key
+
+
+@pytest.mark.parametrize("argv, word", [
+    (("--numerical-shadow", "5"), "one of 2, 4, 6, 8"),
+    (("--numerical-shadow", "4", "--every", "2"), "every step"),
+    (("--numerical-shadow", "4", "--model", "ho3", "--x0", "1,1,1"), "canonical"),
+    (("--numerical-shadow", "4", "--steps", "5"), "at least 6 steps"),
+])
+def test_cli_refusals_are_one_line_and_status_2(argv, word, capsys):
+    base = ("check",) if "--model" in argv else ("check", "--model", "henon-heiles", "--integrator", "212", "--x0",
+                                                  "0.1,-0.2,0.3,0.25")
+    argv = base + argv
+    assert main(list(argv)) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and word in err and "Traceback" not in err, err

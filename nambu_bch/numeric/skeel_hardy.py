@@ -119,7 +119,7 @@ class NumericalShadow:
     t : numpy.ndarray -- their times ``|h| * indices``
     values : numpy.ndarray -- ``H~_{2k}`` at those samples
     H : numpy.ndarray or None -- ``H`` at the same samples (when the system is known)
-    max_abs_error : dict -- ``max |Q_n - Q_k|`` of ``H~`` (and of ``H``)
+    max_abs_error : dict -- ``max_n |Q_n - Q_k|`` of ``H~`` (and of ``H``), from the first value, sample ``k``
     drift : dict -- ``{name: DriftFit}``, the straight line through ``(t, Q_n - Q_k)``
     """
 
@@ -154,7 +154,8 @@ class NumericalShadow:
     def __str__(self):
         lines = [f"{self.model} {self.integrator}: numerical shadow Hamiltonian of order {self.order} (Skeel-Hardy), "
                  f"h = {self.h}, samples {int(self.indices[0])}..{int(self.indices[-1])}"]
-        lines += [f"  max |{k}(t) - {k}(0)| = {v:.3e}, drift rate {self.drift[k].rate:.3e} "
+        first = int(self.indices[0])
+        lines += [f"  max |{k}_n - {k}_{first}| = {v:.3e}, drift rate {self.drift[k].rate:.3e} "
                   f"+- {self.drift[k].stderr:.1e}" for k, v in self.max_abs_error.items()]
         return "\n".join(lines)
 
