@@ -10,11 +10,11 @@ The mathematics (derived here; the references state the construction, their equa
 cited because their text was not at hand when this was written):
 
 1. **An identity for any Hamiltonian.**  Let ``E = q.d/dq + p.d/dp`` be the scaling (Euler) field.  Along a
-   solution of ``q' = H_p``, ``p' = -H_q``,
+   solution of ``q' = H_p``, ``p' = -H_q``::
 
        (1/2) (p . q' - q . p') = (1/2) (p . H_p + q . H_q) = (1/2) E(H),
 
-   so with a scalar ``beta`` carried along by ``beta' = E(H) - 2 H``,
+   so with a scalar ``beta`` carried along by ``beta' = E(H) - 2 H``::
 
        H = (1/2) (p . q' - q . p' - beta').                                            (SH)
 
@@ -33,17 +33,17 @@ cited because their text was not at hand when this was written):
    other half) ``w_i = E(H_i) - 2 H_i`` is constant along the sub-flow ``exp(tau X_{H_i})``, so that
    sub-flow adds exactly ``tau w_i(y)``: one step adds ``beta_{n+1} - beta_n = sum_s c_s h w_{i_s}(y^{(s)})``
    over its stages ``y^{(s)}``.  For velocity Verlet (word ``212``: kick, drift, kick) with a kinetic
-   energy quadratic in ``p`` (``E(T) = 2 T``, drifts add nothing) and ``w_V = q . V_q - 2 V = -q . F - 2 V``:
+   energy quadratic in ``p`` (``E(T) = 2 T``, drifts add nothing) and ``w_V = q . V_q - 2 V = -q . F - 2 V``::
 
        beta_{n+1} - beta_n = (h/2) (w_V(q_n) + w_V(q_{n+1})).                           (beta)
 
 3. **The derivatives at the samples** are the centred differences of order ``2k`` on ``2k + 1`` samples
-   (Fornberg, Math. Comp. 51 (1988) 699, Table 1):
+   (Fornberg, Math. Comp. 51 (1988) 699, Table 1)::
 
        h y~'(n h) = sum_{j=1}^{k} a_j (y_{n+j} - y_{n-j}) + O(h^{2k+1}),
        a_j = (-1)^{j+1} (k!)^2 / (j (k-j)! (k+j)!)      (k = 2: a = 2/3, -1/12),
 
-   and the estimate of order ``2k`` at sample ``n`` is (SH) with them:
+   and the estimate of order ``2k`` at sample ``n`` is (SH) with them::
 
        H~_{2k}(n) = 1/(2h) sum_j a_j [p_n . (q_{n+j} - q_{n-j}) - q_n . (p_{n+j} - p_{n-j})
                                        - (beta_{n+j} - beta_{n-j})]
