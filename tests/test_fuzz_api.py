@@ -62,7 +62,7 @@ RECORDS = (
     "OrderFit", "PrecisionStudy", "StepProgram", "TruncationStudy", "DirectResult", "Existence", "FICommutator",
     "FINested", "FIOrder", "FIRepresentation", "FIResult", "OrderSolution", "Piece", "FieldBackend",
     "ExpressionBackend", "PolynomialBackend", "ShadowTrajectory", "ButcherTableau", "SeparableShadow", "ContractionSum",
-    "Contraction",
+    "Contraction", "NumericalShadow",
 )
 
 
@@ -98,8 +98,19 @@ def valid():
         ho3=ho3, ho=model("ho"), x=(x1, x2, x3), alg=alg, split=full_split(ho3), comp=composition("12321"),
         field=VectorField(alg, [x2, -x1, 0]), H=ho3.hamiltonians[0], G=ho3.hamiltonians[1], sympy=sympy,
         piece=full_split(ho3).pieces[0], AC=ho3.splitting[1].terms[0], BD=ho3.splitting[2].terms[0],
-        lie_trotter=direct_route(ho3, "123", 1), H_S=family.H_S, G_S=family.G_S,
+        lie_trotter=direct_route(ho3, "123", 1), H_S=family.H_S, G_S=family.G_S, ho_qp=_verlet_ho(),
     )
+
+
+def _verlet_ho(h=0.1, steps=8):
+    """Velocity Verlet samples ``(q, p)`` of q'' = -q from (1, 0): a valid trajectory for ``numerical_shadow``."""
+    q, p, qs, ps = 1.0, 0.0, [1.0], [0.0]
+    for _ in range(steps):
+        p -= h / 2 * q
+        q += h * p
+        p -= h / 2 * q
+        qs.append(q), ps.append(p)
+    return qs, ps
 
 
 def _base_table():
@@ -211,6 +222,8 @@ def _base_table():
         "nambu_bch.sample_times": lambda v: dict(h=0.1, steps=10),
         "nambu_bch.shadow_along": lambda v: dict(system=v["ho3"], word="12321", trajectory=[[1.0, 1.0, 1.0]] * 4, h=0.1,
                                                  which=("H", "H_S")),
+        "nambu_bch.numeric.numerical_shadow": lambda v: dict(q=v["ho_qp"][0], p=v["ho_qp"][1], forces_or_system=v["ho"],
+                                                             h=0.1),
         "nambu_bch.paper_figures": lambda v: dict(outdir="figures", t_short=1.0, t_long=2.0, every_long=1, dpi=10),
         "nambu_bch.numeric.Progress": lambda v: dict(total=10, enabled=False),
         "nambu_bch.numeric.RunningStats": lambda v: {},

@@ -57,6 +57,9 @@ def _chunks(**kw):
     return list(numeric.iterate_chunks(**kw))
 
 
+#: A velocity Verlet run of the oscillator, a valid trajectory for ``numerical_shadow``.
+_HO = numeric.iterate("ho", "212", 0.1, 10, [1.0, 0.0])
+
 ENTRIES = {
     "iterate": (numeric.iterate, dict(system=S, word="32123", h=0.1, steps=10, x0=[1.0, 1.0, 1.0], params=None,
                                        every=1, kahan=False, dps=None, backend="auto", progress=False, chunk=None,
@@ -67,6 +70,8 @@ ENTRIES = {
                                   alpha=0.5, every=1, include=("H",), chunk_samples=None, kahan=False, backend="auto")),
     "shadow_along": (numeric.shadow_along, dict(system=S, word="12321", trajectory=[[1.0, 1.0, 1.0]] * 4, h=0.1,
                                                 order=2, alpha=0.5, params=None, t=None, which=("H",))),
+    "numerical_shadow": (numeric.numerical_shadow, dict(q=_HO[:, :1], p=_HO[:, 1:], forces_or_system="ho", h=0.1, order=4,
+                                                        word="212", potential=None, params=None, check_steps=True)),
     "rk_iterate": (numeric.rk_iterate, dict(system=S, method="midpoint", h=0.1, steps=10, x0=[1.0, 1.0, 1.0], params=None,
                                             every=1)),
     "rk_step_function": (numeric.rk_step_function, dict(system=S, method="midpoint", params=None)),

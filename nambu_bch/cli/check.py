@@ -8,7 +8,8 @@ from ._output import emit
 
 HELP = "iterate the integrator and report the conservation diagnostics"
 EXAMPLES = ("examples:\n  nambu-bch check --integrator 32123 --h 0.1 --steps 100000 --x0 1,1,1\n"
-            "  nambu-bch check --model rigid-body --param I1=1 --param I2=2 --param I3=3 --format json")
+            "  nambu-bch check --model rigid-body --param I1=1 --param I2=2 --param I3=3 --format json\n"
+            "  nambu-bch check --model henon-heiles --integrator 212 --x0 0.1,-0.2,0.3,0.25 --numerical-shadow 6")
 
 
 def register(sub) -> None:
@@ -18,6 +19,9 @@ def register(sub) -> None:
     integrator_options(p, order=True)
     numeric_options(p, {"h": 0.1, "steps": 1000, "every": 1})
     p.add_argument("--alpha", metavar="A", help="value of the family parameter alpha in H_S, G_S (default 1/2)")
+    p.add_argument("--numerical-shadow", metavar="2K", dest="numerical_shadow",
+                   help="also the Skeel-Hardy numerical shadow Hamiltonian of order 2K (2, 4, 6 or 8) along the run, "
+                        "from the trajectory alone (canonical systems; every step sampled)")
     output_options(p, "text", choices=("text", "json"))
 
 
@@ -30,6 +34,42 @@ def run(args):
     params, x0 = numeric_inputs(args, system, values)
     order = args.order if args.order is not None else 2
     alpha = finite_float(number(args.alpha, "--alpha"), "--alpha") if args.alpha is not None else 0.5
+    shadow_order = _numerical_shadow_order(args, system)
     report = check(system, word, args.h, args.steps, x0, params=params, every=args.every, order=order, alpha=alpha)
+    if shadow_order is None:
+        emit(args, text=lambda: str(report), data=report.to_dict, system=system)
+        return
+    shadow = _numerical_shadow(system, word, args.h, args.steps, x0, params, shadow_order)
+    emit(args, text=lambda: f"{report}\n{shadow}", data=lambda: {**report.to_dict(), "numerical_shadow": shadow.to_dict()},
+         system=system)
 
-    emit(args, text=lambda: str(report), data=report.to_dict, system=system)
+
+def _numerical_shadow_order(args, system):
+    """``--numerical-shadow`` as one of 2, 4, 6, 8, refused up front where the run could not give it."""
+    from ..errors import NambuBCHError
+    from ..numeric.skeel_hardy import ORDERS
+
+    text = args.numerical_shadow
+    if text is None:
+        return None
+    accepted = ", ".join(map(str, ORDERS))
+    if text.strip() not in {str(k) for k in ORDERS}:
+        raise NambuBCHError(f"--numerical-shadow {text[:40]!r} must be one of {accepted}")
+    if system.bracket != "canonical":
+        raise NambuBCHError(f"--numerical-shadow needs a canonical system (q, p halves); {system.name} has the "
+                            f"{system.bracket} bracket (the Skeel-Hardy construction uses the symplectic form)")
+    if args.every != 1:
+        raise NambuBCHError(f"--numerical-shadow needs every step of the run; --every {args.every} skips steps")
+    order = int(text)
+    if args.steps < order + 2:  # 2k + 1 samples per value and three values for the drift fit
+        raise NambuBCHError(f"--numerical-shadow {order} needs at least {order + 2} steps, got --steps {args.steps}")
+    return order
+
+
+def _numerical_shadow(system, word, h, steps, x0, params, order):
+    """The Skeel-Hardy shadow Hamiltonian along the same run (:func:`nambu_bch.numeric.numerical_shadow`)."""
+    from ..numeric import iterate, numerical_shadow
+
+    x = iterate(system, word, h, steps, x0, params=params)
+    d = system.N // 2
+    return numerical_shadow(x[:, :d], x[:, d:], system, h, order=order, word=word, params=params)

@@ -3,7 +3,8 @@
 ``iterate`` runs a scheme (numba kernels generated once from the exact sub-flows, numpy and
 mpmath fallbacks, optional Kahan summation); ``check`` measures every error the package
 predicts; ``paper_figures`` redraws Figs. 1-4; ``shadow_along``
-evaluates the shadow pair along any trajectory; the studies answer speed-versus-accuracy questions.
+evaluates the shadow pair along any trajectory, ``numerical_shadow`` the Skeel-Hardy shadow Hamiltonian
+from a canonical trajectory alone; the studies answer speed-versus-accuracy questions.
 """
 
 from ..progress import Progress
@@ -15,6 +16,7 @@ from .iterate import iterate, iterate_chunks
 from .kernels import Kernel, cache_dir, kernel, numba_available
 from .runge_kutta import rk_iterate, rk_step_function
 from .samples import n_samples, sample_steps, sample_times
+from .skeel_hardy import NumericalShadow, numerical_shadow
 from .trajectory import ShadowTrajectory, shadow_along
 from .studies import HScan, PrecisionStudy, TruncationStudy, h_scan, precision_study, truncation_study
 
@@ -24,6 +26,7 @@ __all__ = [
     "FigureSet",
     "HScan",
     "Kernel",
+    "NumericalShadow",
     "OrderFit",
     "PrecisionStudy",
     "Progress",
@@ -41,6 +44,7 @@ __all__ = [
     "kernel",
     "n_samples",
     "numba_available",
+    "numerical_shadow",
     "observed_order",
     "paper_figures",
     "precision_study",
