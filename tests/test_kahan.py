@@ -85,6 +85,18 @@ def test_rigid_body_specialisation():
         euler_top_coefficients("lotka-volterra")
 
 
+def test_general_map_equals_the_kahan_tableau():
+    """Rosenbrock form = Runge-Kutta form on a quadratic field (CMOQ 2013): the exact map of Lotka-Volterra at a
+    rational point against the float64 step of the tableau 'kahan' (Newton to round-off)."""
+    S = model("lotka-volterra")
+    K = kahan_map(S.vector_field)
+    point = dict(zip(S.coordinates, (1, sympy.Rational(1, 2), sympy.Rational(3, 4))))
+    point[h] = sympy.Rational(1, 10)
+    exact = np.array([float(v) for v in K(point)])
+    step = rk_step_function(S, "kahan")
+    assert np.max(np.abs(step(np.array([1.0, 0.5, 0.75]), 0.1) - exact)) < 1e-14
+
+
 def test_kahan_map_refusals():
     x = sympy.symbols("x1 x2")
     A = PolynomialAlgebra(x, (), (h,))
@@ -92,6 +104,11 @@ def test_kahan_map_refusals():
         kahan_map(VectorField(A, [A.convert(x[1] ** 3), A.convert(x[0])]))
     with pytest.raises(NambuBCHError, match="needs a VectorField"):
         kahan_map([1, 2])
+    K = kahan_map(model("lotka-volterra").vector_field)
+    with pytest.raises(NambuBCHError, match="a point must give exact numbers for x1, x2, x3, h"):
+        K({"x1": 1})
+    with pytest.raises(NambuBCHError, match="a point must give exact numbers"):
+        K({s: "1" for s in (*K.algebra.coordinates, h)})
 
 
 # -- the density bracket ------------------------------------------------------------------------------------------

@@ -87,3 +87,12 @@ def test_refusals():
     with pytest.raises(InvalidCompositionError, match="unknown partitioned Runge-Kutta pair 'lobatto'"):
         partitioned_tableau("lobatto")
     assert partitioned_tableau(PARTITIONED["lobatto-iiia-iiib-2"]) is PARTITIONED["lobatto-iiia-iiib-2"]
+
+
+def test_cli_refuses_the_pair_as_a_composition(capsys):
+    """The CLI takes compositions only: a partitioned pair's name is refused in one line that says where it lives."""
+    from nambu_bch.cli import main
+
+    assert main(["shadow", "--model", "ho", "--integrator", "lobatto-iiia-iiib-3"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert "\n" not in err and "'lobatto-iiia-iiib-3' is a Runge-Kutta method" in err

@@ -39,6 +39,7 @@ from dataclasses import dataclass
 import sympy
 
 from ..algebra import PolynomialAlgebra, VectorField
+from ..checks import show
 from ..errors import InvalidCompositionError, NambuBCHError
 
 H = sympy.Symbol("h")
@@ -150,18 +151,27 @@ class KahanMap:
     def __call__(self, point: dict) -> tuple:
         """The image of a point given as ``{symbol: exact number}`` for the coordinates, parameters and ``h``."""
         alg = self.algebra
-        values = [sympy.sympify(point[s], strict=True) for s in (*alg.coordinates, *alg.constants)]
-        params = {s: sympy.sympify(point[s], strict=True) for s in alg.parameters}
+        symbols = (*alg.coordinates, *alg.parameters, *alg.constants)
+        if not isinstance(point, dict) or any(s not in point for s in symbols):
+            raise NambuBCHError(f"a point must give exact numbers for {', '.join(map(str, symbols))}, got {show(point)}")
+        try:
+            values = {s: sympy.sympify(point[s], strict=True) for s in symbols}
+        except sympy.SympifyError:
+            raise NambuBCHError(f"a point must give exact numbers (int, Fraction, sympy Rational), got {show(point)}") from None
+        if not all(v.is_number for v in values.values()):
+            raise NambuBCHError(f"a point must give exact numbers, got {show(point)}")
 
         def at(p):
-            return alg.to_sympy(p).subs(params).subs(dict(zip((*alg.coordinates, *alg.constants), values)))
+            return alg.to_sympy(p).subs(values, simultaneous=True)
 
         Dl = at(self.denominator)
+        if Dl == 0:
+            raise NambuBCHError(f"Kahan's map is not defined at {show(point)}: det(I - h/2 f'(x)) = 0 there")
         return tuple(at(P) / Dl for P in self.numerators)
 
 
 def kahan_map(field: VectorField) -> KahanMap:
-    """Kahan's map of the quadratic field ``field`` (an algebra with the constant ``h``): ``x' = P/Delta``.
+    """Kahan's map of the quadratic field ``field`` as ``x' = P/Delta`` (``h`` adjoined to the algebra if absent).
 
     ``x' = x + h (I - h/2 f'(x))^{-1} f(x)`` (Celledoni--McLachlan--Owren--Quispel 2013), by Cramer's rule:
     ``Delta = det(I - h/2 f'(x))``, ``P = Delta x + h adj(I - h/2 f'(x)) f(x)``.
@@ -169,16 +179,15 @@ def kahan_map(field: VectorField) -> KahanMap:
     if not isinstance(field, VectorField):
         raise NambuBCHError(f"kahan_map needs a VectorField, got {type(field).__name__}")
     alg = field.algebra
-    if H not in alg.constants:
+    if not all(alg.is_polynomial(c) for c in field.components):
+        raise NambuBCHError(f"Kahan's method needs a polynomial field, got {field.to_sympy()}")
+    if H not in alg.constants:  # h becomes the last generator: the exponents gain a trailing 0
         alg = alg.with_constants(H)
-        field = VectorField(alg, [alg.convert(alg.to_sympy(c)) if not alg.is_polynomial(c) else
-                                  alg.ring.from_dict({m + (0,): v for m, v in c.items()}) for c in field.components])
+        field = VectorField(alg, [alg.ring.from_dict({m + (0,): v for m, v in c.items()}) for c in field.components])
     n = alg.n
     if n > MAX_KAHAN_DIMENSION:
         raise NambuBCHError(f"kahan_map expands determinants by minors; at most {MAX_KAHAN_DIMENSION} coordinates, "
                             f"got {n}")
-    if not all(alg.is_polynomial(c) for c in field.components):
-        raise NambuBCHError(f"Kahan's method needs a polynomial field, got {field.to_sympy()}")
     degree = max((_degree_in_coordinates(c, n) for c in field.components), default=0)
     if degree > 2:
         raise InvalidCompositionError(f"Kahan's method is defined here for quadratic vector fields; the field has "
