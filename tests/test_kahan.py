@@ -160,6 +160,16 @@ def test_density_bracket_admits_a_pair(density_result):
         assert not any(m[B.n] < 5 for m in (got - lifted).keys())
 
 
+def test_inverse_density_is_obstructed():
+    """rho X_{H,G} keeps dx/rho, so the bracket's density is phi, not 1/phi: with rho = 2 - phi (= 1/phi + O(h^4)) the
+    h^2 obstruction doubles (the same certificate, value twice the standard bracket's)."""
+    S = model("rigid-body")
+    I1, I2, I3 = S.parameters
+    R = density_shadow(S, "kahan", sympy.expand(2 - euler_top_density(S)), 2)
+    assert R.failed_order == 2
+    assert sympy.cancel(R.orders[1].obstruction_value + (I1 - I2) * (I1 - I3) * (I2 - I3) / (I1**2 * I2**2 * I3**2)) == 0
+
+
 def test_density_field_is_rho_times_the_nambu_field():
     S = model("rigid-body")
     A = S.algebra
