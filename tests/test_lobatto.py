@@ -87,6 +87,10 @@ def test_refusals():
     with pytest.raises(InvalidCompositionError, match="unknown partitioned Runge-Kutta pair 'lobatto'"):
         partitioned_tableau("lobatto")
     assert partitioned_tableau(PARTITIONED["lobatto-iiia-iiib-2"]) is PARTITIONED["lobatto-iiia-iiib-2"]
+    with pytest.raises(InvalidCompositionError, match="same number of stages, got 2 and 3"):
+        PartitionedTableau("x", TABLEAUX["gauss4"], TABLEAUX["gauss6"], 2, "")
+    with pytest.raises(InvalidCompositionError, match="two ButcherTableau"):
+        PartitionedTableau("x", "gauss4", TABLEAUX["gauss4"], 2, "")
 
 
 def test_cli_refuses_the_pair_as_a_composition(capsys):

@@ -129,6 +129,14 @@ class PartitionedTableau:
     order: int
     reference: str
 
+    def __post_init__(self):
+        if not (isinstance(self.q, ButcherTableau) and isinstance(self.p, ButcherTableau)):
+            raise InvalidCompositionError(f"a partitioned pair takes two ButcherTableau, got {show(self.q)} and "
+                                          f"{show(self.p)}")
+        if self.q.stages != self.p.stages:
+            raise InvalidCompositionError(f"the tableaux of a partitioned pair need the same number of stages, got "
+                                          f"{self.q.stages} and {self.p.stages}")
+
     @property
     def stages(self) -> int:
         return self.q.stages
