@@ -1,8 +1,9 @@
 """Kahan's method on the Euler top: its closed-form integrals and measure, exactly, and the density bracket.
 
 Sources: E. Celledoni, R. I. McLachlan, B. Owren, G. R. W. Quispel, *Geometric properties of Kahan's method*,
-J. Phys. A 46 (2013) 025201 (the Rosenbrock form x' = x + h (I - h/2 f'(x))^{-1} f(x) of the map, the invariant
-measure dx/phi and modified integrals of Kahan maps); R. Hirota, K. Kimura, J. Phys. Soc. Japan 69 (2000) 627 and
+J. Phys. A 46 (2013) 025201 (the Runge-Kutta and Rosenbrock forms x' = x + h (I - h/2 f'(x))^{-1} f(x) of the map;
+invariant measures of Kahan maps, proved there for constant Poisson structures -- the Euler top's measure
+dx/(D_1 D_2) was found by this package, and is checked here); R. Hirota, K. Kimura, J. Phys. Soc. Japan 69 (2000) 627 and
 M. Petrera, Y. B. Suris, arXiv:0707.4382 (the integrals of the discrete Euler top as ratios
 (a_j x_i^2 - a_i x_j^2) / (1 - h^2/4 a_i a_j x_k^2)).  The closed forms are checked against the map itself (zero by
 normal form of polynomials, denominators cleared), not against the printed equations.
@@ -64,7 +65,7 @@ def test_hirota_kimura_integrals_are_exact_invariants(closed):
 
 def test_invariant_measure_jacobian_relation(closed):
     """det DPhi(x) = phi(x')/phi(x) exactly for phi = D_1 D_2 (and D_2 D_3, D_3 D_1: D_i/D_j is a function of the
-    integrals); not for phi = 1 or a single D_k: Kahan's map keeps dx/phi, not dx (CMOQ 2013, invariant measures)."""
+    integrals); not for phi = 1 or a single D_k: Kahan's map keeps dx/phi, not dx."""
     K = closed.map
     D1, D2, D3 = (D for _, D in closed.integrals)
     assert K.keeps_measure(closed.density) and closed.density == D1 * D2

@@ -20,13 +20,18 @@ For the Euler top ``x1' = a1 x2 x3, x2' = a2 x3 x1, x3' = a3 x1 x2`` (Kahan; Hir
 three ratios ``(a_j x_i^2 - a_i x_j^2) / (1 - h^2/4 a_i a_j x_k^2)`` ((i j k) cyclic; any two are independent)
 and the measure ``dx / (D_1 D_2)`` with ``D_k = 1 - h^2/4 a_i a_j x_k^2``: :func:`euler_top_closed_forms`.
 
-The closed forms were derived here and are checked against the map itself (exactly, in the test suite), not
-against a printed page: the equation numbers of the papers below were not verified.
+The closed forms are checked against the map itself (exactly, in the test suite), not against a printed page. The
+integrals are the Hirota--Kimura ones; the measure was found here (an ansatz of products of the ``D_k``, then
+checked exactly). Celledoni--McLachlan--Owren--Quispel prove invariant measures for Kahan maps of Hamiltonian fields
+with a *constant* Poisson structure, which the Euler top's Lie--Poisson bracket is not; Celledoni et al. (2019)
+compute measures of Kahan maps by discrete Darboux polynomials.
 
 References
 ----------
 E. Celledoni, R. I. McLachlan, B. Owren, G. R. W. Quispel, *Geometric properties of Kahan's method*,
 J. Phys. A 46 (2013) 025201 (the Runge--Kutta and Rosenbrock forms, invariant measures and modified integrals);
+E. Celledoni, C. Evripidou, D. I. McLaren, B. Owren, G. R. W. Quispel, B. K. Tapley, *Detecting and determining
+preserved measures and integrals of birational maps* (arXiv:1902.04685);
 R. Hirota, K. Kimura, *Discretization of the Euler top*, J. Phys. Soc. Japan 69 (2000) 627;
 M. Petrera, Y. B. Suris, *On the Hamiltonian structure of Hirota--Kimura discretization of the Euler top*
 (arXiv:0707.4382), where the integrals of the discrete Euler top are written as such ratios.
@@ -235,9 +240,9 @@ def euler_top_closed_forms() -> EulerTopClosedForms:
 
     The map keeps ``I_k = (a_j x_i^2 - a_i x_j^2) / (1 - h^2/4 a_i a_j x_k^2)`` ((k i j) cyclic: ``I_k`` has
     ``x_k`` in its denominator; the Hirota--Kimura integrals) and the measure ``dx1 dx2 dx3 / (D_1 D_2)``,
-    ``D_k = 1 - h^2/4 a_i a_j x_k^2`` (Celledoni--McLachlan--Owren--Quispel 2013 on invariant measures of Kahan
-    maps; since ``D_1 / D_3`` is a function of the integrals, ``D_2 D_3`` and ``D_3 D_1`` serve as well).  Each
-    statement is checked exactly by :meth:`KahanMap.keeps_ratio` and :meth:`KahanMap.keeps_measure` in the tests.
+    ``D_k = 1 - h^2/4 a_i a_j x_k^2`` (found here; since ``D_1 / D_3`` is a function of the integrals, ``D_2 D_3``
+    and ``D_3 D_1`` serve as well).  Each statement is checked exactly by :meth:`KahanMap.keeps_ratio` and
+    :meth:`KahanMap.keeps_measure` in the tests.
     """
     x = sympy.symbols("x1 x2 x3")
     a = sympy.symbols("a1 a2 a3")
