@@ -98,6 +98,15 @@ def test_general_map_equals_the_kahan_tableau():
     assert np.max(np.abs(step(np.array([1.0, 0.5, 0.75]), 0.1) - exact)) < 1e-14
 
 
+def test_lotka_volterra_kahan_map_keeps_the_flow_s_measure():
+    """Kahan's map of the cyclic Lotka-Volterra field x1' = x1 (x2 - x3) (cyclic) keeps dx/(x1 x2 x3) exactly, like the
+    flow, and not dx; G = x1 x2 x3 itself is not an integral of the map."""
+    K = kahan_map(model("lotka-volterra").vector_field)
+    A = K.algebra
+    assert K.keeps_measure(A.convert("x1*x2*x3")) and not K.keeps_measure(1)
+    assert not K.keeps_ratio(A.convert("x1*x2*x3"), 1)
+
+
 def test_kahan_map_refusals():
     x = sympy.symbols("x1 x2")
     A = PolynomialAlgebra(x, (), (h,))
