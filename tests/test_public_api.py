@@ -46,8 +46,9 @@ SURFACE = {
         "tree_to_latex", "witt_dimension",
     ),
     "nambu_bch.bseries": (
-        "ModifiedEquation", "density", "elementary_weight", "graft", "modified_coefficients", "modified_equation",
-        "modified_equation_by_taylor", "order", "runge_kutta_shadow", "symmetry", "trees",
+        "EulerTopClosedForms", "KahanMap", "ModifiedEquation", "density", "elementary_weight", "euler_top_closed_forms",
+        "euler_top_coefficients", "euler_top_density", "graft", "kahan_map", "modified_coefficients",
+        "modified_equation", "modified_equation_by_taylor", "order", "runge_kutta_shadow", "symmetry", "trees",
     ),
     "nambu_bch.cli": (
         "SUBCOMMANDS", "UsageError", "build_parser", "main",
@@ -79,8 +80,8 @@ SURFACE = {
     "nambu_bch.shadow": (
         "Contraction", "ContractionSum", "DirectResult", "Existence", "FICommutator", "FINested", "FIOrder",
         "FIRepresentation", "FIResult", "FI_LABELS", "JetAlgebra", "LiouvilleSum", "LiouvilleTerm", "OrderSolution",
-        "SeparableShadow", "ShadowFamily", "commutator_terms", "count_brackets", "decide", "direct_route",
-        "double_commutator_terms", "fi_brackets", "fi_route", "representations", "separable_shadow",
+        "SeparableShadow", "ShadowFamily", "commutator_terms", "count_brackets", "decide", "density_shadow",
+        "direct_route", "double_commutator_terms", "fi_brackets", "fi_route", "representations", "separable_shadow",
         "shadow_hamiltonians",
     ),
     "nambu_bch.systems": (

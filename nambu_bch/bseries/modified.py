@@ -46,6 +46,7 @@ class ModifiedEquation(FieldSeries):
     method : the method's tableau (:class:`nambu_bch.integrators.runge_kutta.ButcherTableau`)
     system : System
     tree_coefficients : dict ``{tree: b(tree)}`` (HLW's normalisation, ``b(•) = 1``), trees up to ``order + 1`` vertices
+        (empty for a partitioned pair, whose field comes from the Taylor route)
     """
 
     coefficients: tuple
@@ -126,7 +127,9 @@ def modified_equation(system, method, order: int = 2) -> ModifiedEquation:
     ----------
     system : System or model name (a polynomial vector field)
     method : name of :data:`~nambu_bch.integrators.runge_kutta.TABLEAUX` (``"midpoint"``, ``"gauss4"``,
-        ``"kahan"`` ...) or a :class:`~nambu_bch.integrators.runge_kutta.ButcherTableau`
+        ``"kahan"`` ...) or a :class:`~nambu_bch.integrators.runge_kutta.ButcherTableau`; or a partitioned pair
+        (:data:`~nambu_bch.integrators.runge_kutta.PARTITIONED`, ``"lobatto-iiia-iiib-3"``) on a canonical system,
+        expanded by the Taylor route (:func:`modified_equation_by_taylor`; ``tree_coefficients`` is then empty)
     order : int -- the highest power of ``h`` kept, at most :data:`MAX_RK_ORDER`
 
     Examples
@@ -139,6 +142,10 @@ def modified_equation(system, method, order: int = 2) -> ModifiedEquation:
     from ..systems.system import as_system
 
     system = as_system(system)
+    pair = _partitioned(method)
+    if pair is not None:  # bi-coloured trees are not implemented: the Taylor route gives the same exact field
+        order = check_order(order, MAX_RK_ORDER)
+        return ModifiedEquation(tuple(modified_equation_by_taylor(system, pair, order)), order, pair, system, {})
     tableau = butcher_tableau(method)
     order = check_order(order, MAX_RK_ORDER)
     f = _polynomial_field(system, tableau)
@@ -169,16 +176,50 @@ def modified_equation_by_taylor(system, method, order: int = 2) -> tuple:
     (each gains one power of ``h``), the step ``y + h sum_i b_i f(Y_i)`` is read off, and
     :func:`~nambu_bch.bch.backward.modified_field_of_map` gives the field (HLW Sect. IX.1).
     Radicals of the tableau (Gauss methods) are adjoined to the coefficient field for the expansion.
+    A partitioned pair (:data:`~nambu_bch.integrators.runge_kutta.PARTITIONED`) integrates the ``q`` components
+    with its first tableau and the ``p`` components with its second (HLW Sect. II.2), on a canonical system.
     """
     from ..systems.system import as_system
 
     system = as_system(system)
-    tableau = butcher_tableau(method)
     order = check_order(order, MAX_RK_ORDER)
-    f = _polynomial_field(system, tableau)
+    pair = _partitioned(method)
+    if pair is not None:
+        d = _canonical_half(system, pair)
+        f = _polynomial_field(system, pair.q)
+        per_coordinate = [pair.q] * d + [pair.p] * d
+    else:
+        tableau = butcher_tableau(method)
+        f = _polynomial_field(system, tableau)
+        per_coordinate = [tableau] * f.algebra.n
+    return _taylor_route(f, per_coordinate, order)
+
+
+def _partitioned(method):
+    """The partitioned pair ``method`` names, or None when it names (or is) a plain tableau."""
+    from ..integrators.runge_kutta import PARTITIONED, PartitionedTableau, partitioned_tableau
+
+    if isinstance(method, PartitionedTableau) or (isinstance(method, str) and method in PARTITIONED):
+        return partitioned_tableau(method)
+    return None
+
+
+def _canonical_half(system, pair) -> int:
+    """``d`` for a canonical system on ``2d`` coordinates (``q`` the first ``d``); refuses any other system."""
+    if system.bracket != "canonical":
+        raise InvalidCompositionError(
+            f"{pair.name!r} is a partitioned method for canonical systems (q' = dH/dp, p' = -dH/dq); {system.name} "
+            f"has the {system.bracket} bracket")
+    return system.N // 2
+
+
+def _taylor_route(f, per_coordinate, order):
+    """The Taylor expansion of the step with the tableau ``per_coordinate[k]`` for component ``k``, then backward
+    error analysis (all tableaux with the same number of stages)."""
     base = f.algebra
     top = order + 1
-    numbers = [x for row in tableau.A for x in row] + list(tableau.b)
+    numbers = [x for t in set(per_coordinate) for row in t.A for x in row] + [x for t in set(per_coordinate)
+                                                                              for x in t.b]
     radicals = sorted({p for x in numbers for p in x.atoms(sympy.Pow) if not p.exp.is_integer}, key=str)
     alg = base.with_constants(extension=radicals) if radicals else base
     n = alg.n
@@ -190,17 +231,17 @@ def modified_equation_by_taylor(system, method, order: int = 2) -> tuple:
     def cut(p):
         return alg.ring.from_dict({m: c for m, c in p.items() if m[h_index] <= top}) if p else p
 
-    A = [[alg.domain.from_sympy(a) for a in row] for row in tableau.A]
-    B = [alg.domain.from_sympy(x) for x in tableau.b]
-    s = tableau.stages
+    A = [[[alg.domain.from_sympy(a) for a in row] for row in t.A] for t in per_coordinate]
+    B = [[alg.domain.from_sympy(x) for x in t.b] for t in per_coordinate]
+    s = per_coordinate[0].stages
     coords = list(gens[:n])
     Y = [list(coords) for _ in range(s)]
     for _ in range(top):
         K = [[cut(fk.compose(list(zip(coords, Yi)))) for fk in fields] for Yi in Y]
-        Y = [[cut(coords[k] + hgen * sum((A[i][j] * K[j][k] for j in range(s)), alg.zero)) for k in range(n)]
+        Y = [[cut(coords[k] + hgen * sum((A[k][i][j] * K[j][k] for j in range(s)), alg.zero)) for k in range(n)]
              for i in range(s)]
     K = [[cut(fk.compose(list(zip(coords, Yi)))) for fk in fields] for Yi in Y]
-    step = [cut(coords[k] + hgen * sum((B[i] * K[i][k] for i in range(s)), alg.zero)) for k in range(n)]
+    step = [cut(coords[k] + hgen * sum((B[k][i] * K[i][k] for i in range(s)), alg.zero)) for k in range(n)]
     pulled = []
     for p in step:
         series = [{} for _ in range(top + 1)]

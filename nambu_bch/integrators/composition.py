@@ -557,9 +557,9 @@ def _generic(text) -> Composition:
                 raise InvalidCompositionError(f"composition item {_shown(item)} of {_shown(text)} is not of the form 'piece:coefficient'")
             pairs.append((int(k), c.strip()))
         return composition(pairs)
-    from .runge_kutta import TABLEAUX
+    from .runge_kutta import PARTITIONED, TABLEAUX
 
-    if text.lower() in TABLEAUX:  # a Runge-Kutta method is no word over the pieces: say where it is available
+    if text.lower() in TABLEAUX or text.lower() in PARTITIONED:  # a Runge-Kutta method is no word over the pieces: say where it is available
         raise InvalidCompositionError(
             f"{text!r} is a Runge-Kutta method, not a composition of the pieces; its modified equation and shadow "
             "question are nambu_bch.modified_equation and nambu_bch.runge_kutta_shadow (not yet on the command line)")

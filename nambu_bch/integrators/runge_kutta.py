@@ -94,11 +94,79 @@ TABLEAUX = {
                   [R(5, 36) + _S15 / 24, R(2, 9), R(5, 36) - _S15 / 24],
                   [R(5, 36) + _S15 / 30, R(2, 9) + _S15 / 15, R(5, 36)]],
                  [R(5, 18), R(4, 9), R(5, 18)], 6, "Gauss-Legendre, s = 3; Hairer-Wanner II, Sect. IV.5"),
+        _tableau("lobatto-iiib-2", [[R(1, 2), 0], [R(1, 2), 0]], [R(1, 2), R(1, 2)], 2,
+                 "Lobatto IIIB, s = 2; Hairer-Lubich-Wanner Sect. II.2"),
+        _tableau("lobatto-iiia-3", [[0, 0, 0], [R(5, 24), R(1, 3), R(-1, 24)], [R(1, 6), R(2, 3), R(1, 6)]],
+                 [R(1, 6), R(2, 3), R(1, 6)], 4, "Lobatto IIIA, s = 3; Hairer-Lubich-Wanner Sect. II.2"),
+        _tableau("lobatto-iiib-3", [[R(1, 6), R(-1, 6), 0], [R(1, 6), R(1, 3), 0], [R(1, 6), R(5, 6), 0]],
+                 [R(1, 6), R(2, 3), R(1, 6)], 4, "Lobatto IIIB, s = 3; Hairer-Lubich-Wanner Sect. II.2"),
         _tableau("kahan", [[0, 0, 0], [R(-1, 4), 1, R(-1, 4)], [R(-1, 2), 2, R(-1, 2)]], [R(-1, 2), 2, R(-1, 2)], 2,
                  "Kahan's method on quadratic fields; Celledoni-McLachlan-Owren-Quispel, J. Phys. A 46 (2013) 025201",
                  quadratic_only=True),
     )
 }
+
+
+@dataclass(frozen=True)
+class PartitionedTableau:
+    """A partitioned Runge--Kutta pair for a canonical system ``q' = dH/dp, p' = -dH/dq`` (HLW Sect. II.2).
+
+    The stages ``Q_i = q + h sum_j a_ij K_j``, ``P_i = p + h sum_j a^_ij L_j`` with ``K_j = dH/dp(Q_j, P_j)``,
+    ``L_j = -dH/dq(Q_j, P_j)``; the step ``q1 = q + h sum_i b_i K_i``, ``p1 = p + h sum_i b^_i L_i``: the first
+    tableau integrates ``q`` (the first ``d`` coordinates), the second ``p``.
+
+    Attributes
+    ----------
+    name : str -- the key of :data:`PARTITIONED`
+    q, p : ButcherTableau -- the tableaux of the ``q`` and of the ``p`` components (same number of stages)
+    order : int
+    reference : str
+    """
+
+    name: str
+    q: ButcherTableau
+    p: ButcherTableau
+    order: int
+    reference: str
+
+    def __post_init__(self):
+        if not (isinstance(self.q, ButcherTableau) and isinstance(self.p, ButcherTableau)):
+            raise InvalidCompositionError(f"a partitioned pair takes two ButcherTableau, got {show(self.q)} and "
+                                          f"{show(self.p)}")
+        if self.q.stages != self.p.stages:
+            raise InvalidCompositionError(f"the tableaux of a partitioned pair need the same number of stages, got "
+                                          f"{self.q.stages} and {self.p.stages}")
+
+    @property
+    def stages(self) -> int:
+        return self.q.stages
+
+    def __str__(self):
+        return self.name
+
+
+#: Partitioned pairs by name: Lobatto IIIA (for ``q``) with Lobatto IIIB (for ``p``), symplectic (HLW Sect. VI.4);
+#: ``s = 2`` is the Stormer--Verlet method (HLW Sect. II.2), ``s = 3`` has order 4.
+PARTITIONED = {
+    t.name: t
+    for t in (
+        PartitionedTableau("lobatto-iiia-iiib-2", TABLEAUX["trapezoid"], TABLEAUX["lobatto-iiib-2"], 2,
+                           "Lobatto IIIA-IIIB, s = 2 (Stormer-Verlet); Hairer-Lubich-Wanner Sect. II.2"),
+        PartitionedTableau("lobatto-iiia-iiib-3", TABLEAUX["lobatto-iiia-3"], TABLEAUX["lobatto-iiib-3"], 4,
+                           "Lobatto IIIA-IIIB, s = 3; Hairer-Lubich-Wanner Sects. II.2, III.2"),
+    )
+}
+
+
+def partitioned_tableau(method) -> PartitionedTableau:
+    """The :class:`PartitionedTableau` named ``method`` (one of :data:`PARTITIONED`), or ``method`` itself."""
+    if isinstance(method, PartitionedTableau):
+        return method
+    if isinstance(method, str) and method in PARTITIONED:
+        return PARTITIONED[method]
+    raise InvalidCompositionError(
+        f"unknown partitioned Runge-Kutta pair {show(method)}; accepted are {', '.join(PARTITIONED)} or a "
+        f"PartitionedTableau")
 
 
 def butcher_tableau(method) -> ButcherTableau:

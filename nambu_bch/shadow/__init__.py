@@ -1,6 +1,7 @@
 """Shadow Hamiltonians: Liouville-term algebra, the fundamental identity, the FI and direct routes, ``ShadowFamily``."""
 
 from .api import shadow_hamiltonians
+from .density_bracket import density_shadow
 from .direct_route import DirectResult, OrderSolution, direct_route
 from .existence import Existence, decide
 from .family import ShadowFamily
@@ -30,6 +31,7 @@ __all__ = [
     "commutator_terms",
     "count_brackets",
     "decide",
+    "density_shadow",
     "direct_route",
     "double_commutator_terms",
     "fi_brackets",
