@@ -7,6 +7,8 @@ Horikoshi, Sects. 4.2 and 5.2; Eqs. (L2), (SH12321c), (SG12321c).
 
 from __future__ import annotations
 
+import sympy
+
 from ..bch.backward import check_order
 from ..checks import check_flag
 from ..errors import NambuBCHError
@@ -113,4 +115,28 @@ def _runge_kutta_family(system, tableau, order, route, degree, existence, params
         raise NambuBCHError(f"the FI route reads a composition's BCH commutators; the Runge-Kutta method {tableau.name} "
                             "has none: use route='direct'")
     R = runge_kutta_shadow(system, tableau, order, degree=degree, max_unknowns=max_unknowns)
-    return ShadowFamily.from_direct(system, tableau, order, R, _decision(R, existence, params), max_unknowns=max_unknowns)
+    decision = _divergence_decision(system, R) if existence and not R.exists else None
+    if decision is None:
+        decision = _decision(R, existence, params)
+    return ShadowFamily.from_direct(system, tableau, order, R, decision, max_unknowns=max_unknowns)
+
+
+def _divergence_decision(system, result):
+    """Certified non-existence when the modified field at the failed order has non-zero divergence, else None.
+
+    Every ``X_{H_S,G_S}`` of the package's brackets is divergence-free (Liouville), and so are the cross terms of the
+    lower, solved orders; a Runge--Kutta field need not be (implicit midpoint on the rigid body at ``h^2``,
+    docs/runge_kutta.md).  The orbit averages of :mod:`~nambu_bch.shadow.existence` see only the drift of ``H, G``,
+    which a method keeping quadratic invariants does not have, so this test comes first.
+    """
+    from .existence import Existence
+
+    j = result.orders[-1].order
+    Z = result.effective[j]
+    div = Z.divergence()
+    if Z.algebra.is_zero(div):
+        return None
+    shown = sympy.factor(Z.algebra.to_sympy(div))
+    reason = (f"at h^{j} the modified field has divergence {shown} != 0, while every X_{{H_S,G_S}} (and every cross "
+              "term of the solved orders) is divergence-free: no pair, polynomial or not")
+    return Existence("none", False, j, method="divergence", reason=reason)
