@@ -148,7 +148,7 @@ def _module(system, backend):
 
         from ..compiled import enable_private_cache
 
-        sys.modules[name + "_numba"] = module
+        sys.modules[name] = module  # numba's cache locates the functions through their module
         for fn in ("rk_field", "rk_jacobian", "rk_solve", "rk_newton", "rk_run"):  # callees first: globals of callers
             jitted = numba.njit(nogil=True, error_model="numpy")(module.__dict__[fn])
             if path.is_file():
