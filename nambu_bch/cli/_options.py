@@ -250,11 +250,11 @@ def integrator_from_args(args, system, runge_kutta=False):
 
 def runge_kutta_options(parser):
     """``--tableau FILE``: a Runge--Kutta method from a TOML tableau file (exact coefficients, claimed order checked)."""
-    from ..integrators.runge_kutta import TABLEAUX
-
+    # the help names examples only: importing the tableaux (sympy) while the parser is built would slow every command
     parser.add_argument("--tableau", metavar="FILE",
                         help="a Runge-Kutta method from a TOML file (name, order, A, b, optional c and reference; "
-                             f"coefficients as exact strings); --integrator also takes {', '.join(TABLEAUX)}")
+                             "coefficients as exact strings); --integrator also takes built-in methods such as "
+                             "midpoint, gauss4, gauss6, rk4 or kahan")
 
 
 def numeric_inputs(args, system, values):

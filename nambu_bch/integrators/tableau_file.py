@@ -123,7 +123,8 @@ def _coefficient(value, what):
     if isinstance(value, float):
         raise InvalidCompositionError(f"{what} = {value!r}: give exact coefficients as strings (\"1/3\", \"sqrt(3)/6\")")
     if not isinstance(value, (str, int)) or isinstance(value, bool) or (isinstance(value, str) and len(value) > 200):
-        raise InvalidCompositionError(f"{what} must be a string of at most 200 characters such as \"1/2\", got {str(value)[:40]!r}")
+        raise InvalidCompositionError(f"{what} must be a string of at most 200 characters such as \"1/2\", "
+                                      f"got {str(value)[:40]!r}")
     try:
         x = parse_value(value, what)
     except NambuBCHError as exc:

@@ -825,7 +825,7 @@ def source_hash(source: str) -> str:
 
 # -- Runge--Kutta steps -------------------------------------------------------------------------------------------
 #: Bump when the generated Runge--Kutta source changes meaning.
-RK_TEMPLATE_VERSION = "1"
+RK_TEMPLATE_VERSION = "2"
 
 _RK_TEMPLATE = '''
 
@@ -915,11 +915,25 @@ def rk_newton(x, h, P, A, K, Y, F, J, M, r, maxit, tol):
         it += 1
 
 
-def rk_run(x, c, compensated, linear, h, P, A, b, steps, every, out, maxit, tol, info):
+def rk_explicit(x, h, P, A, K, Y):
+    """The stages of an explicit method in order: K_i = f(x + h sum_{j<i} a_ij K_j)."""
+    s = K.shape[0]
+    n = x.shape[0]
+    for i in range(s):
+        for k in range(n):
+            acc = 0.0
+            for j in range(i):
+                acc += A[i, j] * K[j, k]
+            Y[i, k] = x[k] + h * acc
+        rk_field(Y[i], P, K[i])
+
+
+def rk_run(x, c, compensated, mode, h, P, A, b, steps, every, out, maxit, tol, info):
     """steps steps from x (updated in place); out[j] gets the state after step j*every (and the last step).
-    linear: Kahan's step x' = x + h (I - h/2 f'(x))^-1 f(x), one linear solve; else the Runge--Kutta step
-    with Newton's method.  info[0] += Newton iterations (linear: solves); on failure info[1] = 1 (singular),
-    2 (no convergence) or 3 (not finite) and info[2] = the step; returns the steps done."""
+    mode: 1 -- Kahan's step x' = x + h (I - h/2 f'(x))^-1 f(x), one linear solve; 2 -- an explicit method,
+    its stages in order; 0 -- the Runge--Kutta step with Newton's method.  info[0] += Newton iterations
+    (mode 1: solves); on failure info[1] = 1 (singular), 2 (no convergence) or 3 (not finite) and info[2] = the
+    step; returns the steps done."""
     s = b.shape[0]
     n = x.shape[0]
     m = s * n
@@ -932,7 +946,14 @@ def rk_run(x, c, compensated, linear, h, P, A, b, steps, every, out, maxit, tol,
     inc = np.zeros(n)
     j = 1
     for step in range(1, steps + 1):
-        if linear:
+        if mode == 2:
+            rk_explicit(x, h, P, A, K, Y)
+            for k in range(n):
+                acc = 0.0
+                for i in range(s):
+                    acc += b[i] * K[i, k]
+                inc[k] = h * acc
+        elif mode == 1:
             rk_field(x, P, r)
             rk_jacobian(x, P, J)
             for a in range(n):

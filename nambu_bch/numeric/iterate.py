@@ -112,7 +112,8 @@ def iterate(system, word, h, steps, x0=None, params=None, every=1, *, kahan=Fals
     tableau = runge_kutta_method(word)
     if tableau is not None:  # an implicit or explicit Runge--Kutta method: Newton's method, compiled alike
         _runge_kutta_options(tableau, dps, fma)
-        check_flag(check_stable, "check_stable"), check_flag(progress, "progress", none=True)
+        check_flag(check_stable, "check_stable")  # no stability interval to check: Newton's failure is the guard
+        check_flag(progress, "progress", none=True)
         return iterate_runge_kutta(system, tableau, h, steps, x0, params, every, kahan=kahan, backend=backend, out=out)
     x0, origin = initial_state(system, x0)
     check_work(check_count(steps, "steps", 0), x0, mpmath=dps is not None)  # from the request, before any work

@@ -104,6 +104,9 @@ def rk_iterate(system, method, h, steps, x0, params=None, every=1) -> np.ndarray
     return np.array(out)
 
 
+#: Trajectory-steps up to which ``backend="auto"`` interprets rather than compiles (a cold numba compile of the
+#: module costs seconds; the interpreter does a few thousand implicit steps per second).
+INTERPRET_STEPS = 2000
 #: Residual accepted when Newton's iteration stagnates: ``tol * (1 + max|K|)`` (round-off is far below).
 NEWTON_TOL = 1e-10
 #: ``{"newton_iterations": .., "steps": ..}`` of the last :func:`iterate_runge_kutta` run in this process (the
@@ -149,7 +152,8 @@ def _module(system, backend):
         from ..compiled import enable_private_cache
 
         sys.modules[name] = module  # numba's cache locates the functions through their module
-        for fn in ("rk_field", "rk_jacobian", "rk_solve", "rk_newton", "rk_run"):  # callees first: globals of callers
+        # callees first: the compiled callers find them as globals of the module
+        for fn in ("rk_field", "rk_jacobian", "rk_solve", "rk_newton", "rk_explicit", "rk_run"):
             jitted = numba.njit(nogil=True, error_model="numpy")(module.__dict__[fn])
             if path.is_file():
                 enable_private_cache(jitted, directory / "__pycache__")
@@ -168,7 +172,9 @@ def iterate_runge_kutta(system, method, h, steps, x0=None, params=None, every=1,
     system, h, steps, x0, params, every, out : as for :func:`~nambu_bch.numeric.iterate`
     method : a name of :data:`~nambu_bch.integrators.runge_kutta.TABLEAUX` or a ButcherTableau
     kahan : bool -- compensated summation of the increments
-    backend : ``"auto"`` | ``"numba"`` | ``"numpy"`` -- compiled, or the same generated source interpreted
+    backend : ``"auto"`` | ``"numba"`` | ``"numpy"`` -- compiled, or the same generated source interpreted (the same
+        bits); ``"auto"``: compiled, except runs of at most :data:`INTERPRET_STEPS` trajectory-steps before the module
+        is compiled in this process
     max_newton : int -- Newton iterations allowed per step
     compensation : float64 array of shape (N,), optional -- the compensated summation's carry, updated in place
         (a run continued block by block: :func:`nambu_bch.numeric.iterate_chunks`); one trajectory only
@@ -187,13 +193,14 @@ def iterate_runge_kutta(system, method, h, steps, x0=None, params=None, every=1,
     from ..systems.system import as_system
     from .guards import check_backend, check_count, check_out, initial_state, run_label
     from .kernels import resolve_backend
-    from .samples import n_samples, sample_steps
+    from .samples import n_samples
 
     system = as_system(system)
     tableau = butcher_tableau(method)
     x0, origin = initial_state(system, x0)
     kahan = check_flag(kahan, "kahan")
-    backend = resolve_backend(check_backend(backend))
+    auto = check_backend(backend) == "auto"
+    backend = resolve_backend(backend)
     max_newton = check_count(max_newton, "max_newton", 1)
     h, steps, every, X, values = check_inputs(system, h, steps, every, x0, params)
     h = float(h)
@@ -202,6 +209,10 @@ def iterate_runge_kutta(system, method, h, steps, x0=None, params=None, every=1,
         from ..bseries.modified import _polynomial_field
 
         _polynomial_field(system, tableau)  # Kahan's formula is the method only on quadratic fields: refuse others
+    mode = 1 if linear else 2 if tableau.is_explicit else 0
+    if backend == "numba" and auto and (system, "numba") not in _MODULES and steps * (1 if X.ndim == 1 else X.shape[1]) \
+            <= INTERPRET_STEPS:
+        backend = "numpy"  # compiling costs seconds; a short run is done sooner by the interpreter (the same bits)
     module = _module(system, backend)
     P = np.array([float(values[p]) for p in system.parameters], dtype=np.float64)
     A = np.array([[float(a) for a in row] for row in tableau.A], dtype=np.float64)
@@ -220,7 +231,7 @@ def iterate_runge_kutta(system, method, h, steps, x0=None, params=None, every=1,
         c = compensation if compensation is not None and single else np.zeros(system.N)
         info = np.zeros(3, dtype=np.int64)
         with np.errstate(all="ignore"):
-            done = module.rk_run(x, c, kahan, linear, h, P, A, b, steps, every, samples, max_newton, NEWTON_TOL, info)
+            done = module.rk_run(x, c, kahan, mode, h, P, A, b, steps, every, samples, max_newton, NEWTON_TOL, info)
         total += int(info[0])
         if done < steps:
             why = {1: "the Newton matrix is singular", 2: f"Newton's method did not converge in {max_newton} iterations",
@@ -232,5 +243,5 @@ def iterate_runge_kutta(system, method, h, steps, x0=None, params=None, every=1,
             out[:, :, k] = samples
     LAST_RUN.clear()
     LAST_RUN.update({"method": tableau.name, "steps": steps * batch, "newton_iterations": total,
-                     "linear_solves": total if linear else None, "samples_at": sample_steps(steps, every)[-1:]})
+                     "linear_solves": total if linear else None})
     return out
