@@ -106,3 +106,18 @@ def test_shadow_hamiltonians_of_a_tableau():
 def test_check_runs_a_runge_kutta_method():
     r = check("rigid-body", "midpoint", 0.1, 200, X0, P, include=("H", "G"))
     assert r.max_abs_error["H"] < 1e-13 and r.max_abs_error["G"] < 1e-13
+
+
+def test_compare_ranks_families_and_draws_them():
+    """compare puts compositions and Runge--Kutta methods in one table and in the curves the figure draws
+    (docs/runge_kutta.md, compare); a non-polynomial field (the pendulum) still runs, without the exact leading term."""
+    from nambu_bch.design import compare
+
+    C = compare("ho", ["121", "midpoint", "rk4", "kahan"], t_end=1.0, steps=(10, 20))
+    rows = {r["integrator"]: r for r in C.rows}
+    assert (rows["midpoint"]["leading_power"], rows["rk4"]["leading_power"]) == (2, 4)
+    assert rows["rk4"]["cost"] == 4.0 and rows["kahan"]["cost"] == 2.0 and rows["midpoint"]["cost"] >= 1.0
+    assert set(C.curves) == set(rows) and "midpoint" in C.table()
+    assert all(p["evaluations"] > 0 and p["error"] > 0 for pts in C.curves.values() for p in pts)
+    P = compare("pendulum", ["TVT", "gauss4"], t_end=1.0, steps=(10, 20))
+    assert P.rows[1]["leading_power"] is None and P.rows[1]["slope"] < -3.5

@@ -115,7 +115,8 @@ class Comparison:
         for r in self.rows:
             lem = "-" if r["error_constant"] is None else f"{r['error_constant']:.4g}"
             order = "-" if r["order"] is None else str(r["order"])
-            lines.append(f"{r['integrator']:<24} {order:>5} {r['cost']:>5} {lem:>10} {r['leading_power']:>4} "
+            power = "-" if r["leading_power"] is None else r["leading_power"]
+            lines.append(f"{r['integrator']:<24} {order:>5} {r['cost']:>5} {lem:>10} {power:>4} "
                          f"{r['leading_size']:>10.3g} {r['slope']:>7.2f} {r['best_error']:>11.2e}")
         return "\n".join(lines)
 
@@ -305,8 +306,11 @@ def _runge_kutta_row(system, tableau, label, t_end, steps, x0, params, x_ref, re
 
     s = tableau.stages
     top = min(tableau.order + 1, MAX_RK_ORDER)
-    M = modified_equation(system, tableau, top)
-    power = next((j for j in range(1, top + 1) if not M[j].is_zero()), None)
+    try:
+        M = modified_equation(system, tableau, top)
+    except NambuBCHError:  # no exact modified field (e.g. a non-polynomial field): the runs alone are compared
+        M = None
+    power = None if M is None else next((j for j in range(1, top + 1) if not M[j].is_zero()), None)
     size = float("nan") if power is None else field_size(M[power].to_sympy(), system, box, samples, params, 0)
     pts, per_steps = [], []
     for N in steps:
