@@ -132,3 +132,14 @@ def test_divergence_certifies_no_pair():
     F = shadow_hamiltonians("rigid-body", "midpoint", order=2)
     assert F.exists is False and F.evidence["method"] == "divergence"
     assert "x1*x2*x3*(I1 - I2)*(I1 - I3)*(I2 - I3)/(2*I1**2*I2**2*I3**2)" in F.evidence["reason"]
+
+
+def test_check_tableau_and_latex_in_process(tmp_path, capsys):
+    """check --tableau runs the file's method; shadow --format latex prints the family of a Runge--Kutta method."""
+    path = _file(tmp_path, LOBATTO)
+    assert main(["check", "--model", "ho", "--tableau", str(path), "--steps", "50", "--format", "json"]) == 0
+    data = json.loads(capsys.readouterr().out)
+    assert data["integrator"] == "lobatto3c" and data["max_abs_error"]["H"] > 0
+    assert main(["shadow", "--model", "lotka-volterra", "--integrator", "midpoint", "--format", "latex"]) == 0
+    out = capsys.readouterr().out
+    assert "H_{S} &= H + h^{2}" in out and "O(h^{4})" in out

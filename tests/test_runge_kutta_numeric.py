@@ -121,3 +121,11 @@ def test_compare_ranks_families_and_draws_them():
     assert all(p["evaluations"] > 0 and p["error"] > 0 for pts in C.curves.values() for p in pts)
     P = compare("pendulum", ["TVT", "gauss4"], t_end=1.0, steps=(10, 20))
     assert P.rows[1]["leading_power"] is None and P.rows[1]["slope"] < -3.5
+
+
+def test_long_runge_kutta_run_is_refused_up_front():
+    from nambu_bch.errors import ResourceLimitError
+    from nambu_bch.numeric.runge_kutta import MAX_RK_STEPS
+
+    with pytest.raises(ResourceLimitError, match="trajectory-steps of gauss4"):
+        iterate("rigid-body", "gauss4", 0.1, MAX_RK_STEPS // 2, np.ones((3, 3)), P, backend="numpy")

@@ -23,7 +23,7 @@ from __future__ import annotations
 import numpy as np
 import sympy
 
-from ..errors import InvalidRunError, NumericalRangeError
+from ..errors import InvalidRunError, NumericalRangeError, ResourceLimitError
 from ..integrators.runge_kutta import TABLEAUX, butcher_tableau
 from .guards import check_inputs
 
@@ -107,6 +107,9 @@ def rk_iterate(system, method, h, steps, x0, params=None, every=1) -> np.ndarray
 #: Trajectory-steps up to which ``backend="auto"`` interprets rather than compiles (a cold numba compile of the
 #: module costs seconds; the interpreter does a few thousand implicit steps per second).
 INTERPRET_STEPS = 2000
+#: Most trajectory-steps of one Runge--Kutta run (an implicit step costs 10-100 splitting steps; the interpreter
+#: about 1e4 times more): refused up front above this, compiled or not.
+MAX_RK_STEPS = 10**8
 #: Residual accepted when Newton's iteration stagnates: ``tol * (1 + max|K|)`` (round-off is far below).
 NEWTON_TOL = 1e-10
 #: ``{"newton_iterations": .., "steps": ..}`` of the last :func:`iterate_runge_kutta` run in this process (the
@@ -183,6 +186,7 @@ def iterate_runge_kutta(system, method, h, steps, x0=None, params=None, every=1,
     ------
     NumericalRangeError -- Newton's method did not converge, or its matrix was singular, at step ``k`` (the
         message names ``h`` and ``k``; lower ``h``), or the state left the float64 range.
+    ResourceLimitError -- more than :data:`MAX_RK_STEPS` trajectory-steps, before any work
 
     References
     ----------
@@ -193,7 +197,7 @@ def iterate_runge_kutta(system, method, h, steps, x0=None, params=None, every=1,
     from ..systems.system import as_system
     from .guards import check_backend, check_count, check_out, initial_state, run_label
     from .kernels import resolve_backend
-    from .samples import n_samples
+    from .samples import MAX_SAMPLE_BYTES, n_samples
 
     system = as_system(system)
     tableau = butcher_tableau(method)
@@ -204,14 +208,17 @@ def iterate_runge_kutta(system, method, h, steps, x0=None, params=None, every=1,
     max_newton = check_count(max_newton, "max_newton", 1)
     h, steps, every, X, values = check_inputs(system, h, steps, every, x0, params)
     h = float(h)
+    work = steps * (1 if X.ndim == 1 else X.shape[1])
+    if work > MAX_RK_STEPS:
+        raise ResourceLimitError(f"{work} trajectory-steps of {tableau.name} are more than the {MAX_RK_STEPS:.0e} one "
+                                 "Runge-Kutta run accepts; split the run or take a larger h")
     linear = is_linearly_implicit(tableau)
     if linear:
         from ..bseries.modified import _polynomial_field
 
         _polynomial_field(system, tableau)  # Kahan's formula is the method only on quadratic fields: refuse others
     mode = 1 if linear else 2 if tableau.is_explicit else 0
-    if backend == "numba" and auto and (system, "numba") not in _MODULES and steps * (1 if X.ndim == 1 else X.shape[1]) \
-            <= INTERPRET_STEPS:
+    if backend == "numba" and auto and (system, "numba") not in _MODULES and work <= INTERPRET_STEPS:
         backend = "numpy"  # compiling costs seconds; a short run is done sooner by the interpreter (the same bits)
     module = _module(system, backend)
     P = np.array([float(values[p]) for p in system.parameters], dtype=np.float64)
@@ -221,7 +228,14 @@ def iterate_runge_kutta(system, method, h, steps, x0=None, params=None, every=1,
     batch = 1 if single else X.shape[1]
     count = n_samples(steps, every)
     shape = (count, system.N) if single else (count, system.N, batch)
-    out = check_out(out, shape, x0, X) if out is not None else np.empty(shape, dtype=np.float64)
+    if out is not None:
+        out = check_out(out, shape, x0, X)
+    else:
+        nbytes = count * system.N * batch * 8
+        if nbytes > MAX_SAMPLE_BYTES:
+            raise InvalidRunError(f"{count} samples of {system.N} x {batch} states need {nbytes / 2**30:.1f} GiB "
+                                  f"(limit {MAX_SAMPLE_BYTES / 2**30:.0f} GiB); sample less often (larger every)")
+        out = np.empty(shape, dtype=np.float64)
     columns = [X] if single else [np.ascontiguousarray(X[:, k]) for k in range(batch)]
     what = run_label(system, tableau.name, h, X, origin)
     total = 0
