@@ -2,9 +2,9 @@
 
 The generated Newton iteration (:func:`nambu_bch.numeric.runge_kutta.iterate_runge_kutta`) against the plain numpy
 reference ``rk_iterate``; compiled and interpreted runs bit for bit; Kahan's linearly implicit step
-``x' = x + h (I - h/2 f'(x))^-1 f(x)`` (Celledoni, McLachlan, Owren, Quispel, J. Phys. A 46 (2013) 025201, Eq. (3))
+``x' = x + h (I - h/2 f'(x))^-1 f(x)`` (Celledoni, McLachlan, Owren, Quispel, J. Phys. A 46 (2013) 025201)
 equal to the three-stage tableau on the rigid body; the invariants the methods keep (implicit midpoint and the Gauss
-methods keep quadratic invariants, HLW Thm. IV.2.1: on the rigid body H and G) confirmed by iteration; the one entry
+methods keep quadratic invariants, HLW Sect. IV.2: on the rigid body H and G) confirmed by iteration; the one entry
 point ``shadow_hamiltonians`` returning a family for the tableaux (docs/runge_kutta.md, "The shadow question").
 """
 
@@ -111,7 +111,7 @@ def test_check_runs_a_runge_kutta_method():
 def test_compare_ranks_families_and_draws_them():
     """compare puts compositions and Runge--Kutta methods in one table and in the curves the figure draws
     (docs/runge_kutta.md, compare); a non-polynomial field (the pendulum) still runs, without the exact leading term."""
-    from nambu_bch.design import compare
+    from nambu_bch.design.compare import compare
 
     C = compare("ho", ["121", "midpoint", "rk4", "kahan"], t_end=1.0, steps=(10, 20))
     rows = {r["integrator"]: r for r in C.rows}

@@ -65,8 +65,8 @@ class ButcherTableau:
 
     @property
     def symmetric(self) -> bool:
-        """``b_i = b_{s+1-i}`` and ``a_ij + a_{s+1-i,s+1-j} = b_j``: the method is symmetric (HLW Thm. V.2.3), so its
-        modified field has only even powers of ``h`` (HLW Thm. IX.2.2).  Sufficient, decided exactly."""
+        """``b_i = b_{s+1-i}`` and ``a_ij + a_{s+1-i,s+1-j} = b_j``: the method is symmetric (HLW Sect. V.2), so its
+        modified field has only even powers of ``h`` (HLW Sect. IX.2).  Sufficient, decided exactly."""
         s, A, b = self.stages, self.A, self.b
         return all(sympy.expand(b[i] - b[s - 1 - i]) == 0 for i in range(s)) and all(
             sympy.expand(A[i][j] + A[s - 1 - i][s - 1 - j] - b[j]) == 0 for i in range(s) for j in range(s))

@@ -14,7 +14,8 @@ validated exact field, then fixed loops with their own Gaussian elimination), co
 (machine code in the package's private, verified cache, :func:`nambu_bch.compiled.enable_private_cache`)
 or run by the interpreter (``backend="numpy"``: the same source, the same operations in the same order).
 Kahan's method on a quadratic field is linearly implicit, ``x' = x + h (I - h/2 f'(x))^{-1} f(x)``
-(Celledoni, McLachlan, Owren, Quispel, J. Phys. A 46 (2013) 025201, Eq. (3)): one linear solve per step,
+(Celledoni, McLachlan, Owren, Quispel, J. Phys. A 46 (2013) 025201; equation number not checked, the equality
+with the tableau is tested): one linear solve per step,
 no Newton iteration.  The work of a run is reported as Newton iterations (:data:`LAST_RUN`).
 """
 
