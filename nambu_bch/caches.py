@@ -61,6 +61,7 @@ CACHES = (
     ("nambu_bch.numeric.kernels", "_kernel_for_word"),
     ("nambu_bch.numeric.kernels", "_kernel"),
     ("nambu_bch.numeric.precision", "clear_cache"),     # _MPMATH
+    ("nambu_bch.numeric.runge_kutta", "_MODULES"),
     ("nambu_bch.shadow.fi_route", "clear_cache"),       # _RAW_OPS, _FORMS, _MONOMIAL_COLUMNS, _EVALUATORS, _OPERATOR
     ("nambu_bch.shadow.fundamental_identity", "_MEMO"),
     ("nambu_bch.shadow.liouville_terms", "clear_cache"),  # _CONTEXTS, canonical_key, _dependent

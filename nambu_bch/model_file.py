@@ -138,26 +138,27 @@ def load_spec(path):
     )
 
 
-def _read_regular_file(shown) -> bytes:
+def _read_regular_file(shown, flag="--system", error=InvalidSystemError) -> bytes:
     """The bytes of the regular file ``shown``, at most :data:`MAX_FILE_SIZE`; devices, FIFOs, directories refused.
 
     The size is checked on the open file (``fstat``) and enforced while reading, so
-    ``/dev/zero`` or a file that grows while it is read cannot exhaust memory.
+    ``/dev/zero`` or a file that grows while it is read cannot exhaust memory.  ``flag`` names the option in the
+    messages, ``error`` is the exception raised (the tableau files of :mod:`nambu_bch.integrators.tableau_file`).
     """
     flags = os.O_RDONLY | getattr(os, "O_NONBLOCK", 0) | getattr(os, "O_CLOEXEC", 0)
     try:
         fd = os.open(shown, flags)  # O_NONBLOCK: opening a FIFO does not wait for a writer
     except ValueError:  # an embedded NUL
-        raise InvalidSystemError(f"--system {shown[:40]!r}: not a usable file name") from None
+        raise error(f"{flag} {shown[:40]!r}: not a usable file name") from None
     except OSError as exc:
-        raise InvalidSystemError(f"--system {shown}: cannot read the file ({exc.strerror or exc})") from None
+        raise error(f"{flag} {shown}: cannot read the file ({exc.strerror or exc})") from None
     try:
         info = os.fstat(fd)
         if not stat.S_ISREG(info.st_mode):
             kind = "a directory" if stat.S_ISDIR(info.st_mode) else "not a regular file (device, FIFO or socket)"
-            raise InvalidSystemError(f"--system {shown}: {kind}; give a TOML file")
+            raise error(f"{flag} {shown}: {kind}; give a TOML file")
         if info.st_size > MAX_FILE_SIZE:
-            raise InvalidSystemError(f"--system {shown}: file is {info.st_size} bytes; at most {MAX_FILE_SIZE} are accepted")
+            raise error(f"{flag} {shown}: file is {info.st_size} bytes; at most {MAX_FILE_SIZE} are accepted")
         chunks, total = [], 0
         while True:
             chunk = os.read(fd, 65536)
@@ -165,11 +166,11 @@ def _read_regular_file(shown) -> bytes:
                 break
             total += len(chunk)
             if total > MAX_FILE_SIZE:
-                raise InvalidSystemError(f"--system {shown}: file is larger than {MAX_FILE_SIZE} bytes, the most accepted")
+                raise error(f"{flag} {shown}: file is larger than {MAX_FILE_SIZE} bytes, the most accepted")
             chunks.append(chunk)
         return b"".join(chunks)
     except OSError as exc:
-        raise InvalidSystemError(f"--system {shown}: cannot read the file ({exc.strerror or exc})") from None
+        raise error(f"{flag} {shown}: cannot read the file ({exc.strerror or exc})") from None
     finally:
         os.close(fd)
 

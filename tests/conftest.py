@@ -53,6 +53,7 @@ LONG = (
     ("test_any_system.py", "test_lie_poisson_bch_member_with_casimir_kept"),
     ("test_shadow.py", "test_n4_full_split_is_obstructed"),
     ("test_numeric.py", "test_series_pair_is_accurate"),
+    ("test_runge_kutta_numeric.py", "test_compiled_equals_interpreted_bit_for_bit"),  # cold: numba compiles the RK loops
 )
 
 

@@ -264,12 +264,13 @@ def test_rk_iterate_refuses_blow_up():
 
 @pytest.mark.parametrize("name", ["midpoint", "gauss4", "gauss6", "kahan"])
 def test_cli_refuses_runge_kutta_names_in_one_line(name, capsys):
-    """The CLI takes compositions only: an RK name is refused with exit 2 and one line saying where it is available."""
+    """The subcommands of compositions only (bch): an RK name is refused with exit 2 and one line saying where it is
+    available (shadow, check and compare take it: tests/test_runge_kutta_cli.py)."""
     from nambu_bch.cli import main
 
-    assert main(["shadow", "--model", "rigid-body", "--integrator", name]) == 2
+    assert main(["bch", "--model", "rigid-body", "--integrator", name]) == 2
     err = capsys.readouterr().err.strip()
-    assert "\n" not in err and f"{name!r} is a Runge-Kutta method" in err and "runge_kutta_shadow" in err
+    assert "\n" not in err and f"{name!r} is a Runge-Kutta method" in err and "shadow_hamiltonians" in err
 
 
 def test_wrong_arguments_are_one_line():

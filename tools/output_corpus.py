@@ -79,6 +79,10 @@ CORPUS: tuple[tuple[str, tuple[str, ...]], ...] = (
     ("check-ho3", ("check", "--steps", "200")),
     ("check-rigid-body-json", ("check", "--model", "rigid-body", "--order", "4", "--steps", "200", "--format", "json")),
     ("models", ("models",)),
+    # Runge-Kutta and Kahan methods: the direct route on the modified field
+    ("shadow-rigid-body-gauss4-h4-json", ("shadow", "--integrator", "gauss4", "--model", "rigid-body", "--order", "4",
+                                          "--format", "json")),
+    ("shadow-rigid-body-midpoint-text", ("shadow", "--integrator", "midpoint", "--model", "rigid-body", "--format", "text")),
 )
 
 

@@ -221,12 +221,40 @@ def names_of(symbols) -> str:
     return ", ".join(str(s) for s in symbols) or "none"
 
 
-def integrator_from_args(args, system):
-    """``(word, Composition)`` checked against the system's splitting (:func:`~nambu_bch.integrators.composition_for`)."""
+def integrator_from_args(args, system, runge_kutta=False):
+    """``(word, Composition)`` checked against the system's splitting (:func:`~nambu_bch.integrators.composition_for`).
+
+    ``runge_kutta``: the subcommand also takes Runge--Kutta methods -- ``--integrator midpoint|gauss4|..|kahan`` or
+    ``--tableau FILE.toml`` (:func:`~nambu_bch.integrators.tableau_file.load_tableau`) -- returned as
+    ``(name, ButcherTableau)``.
+    """
     from ..integrators.composition import composition_for, strang_word
 
+    if runge_kutta:
+        from ..integrators.runge_kutta import runge_kutta_method
+
+        tableau_file = getattr(args, "tableau", None)
+        if tableau_file is not None:
+            if args.integrator is not None:
+                raise NambuBCHError("give either --integrator or --tableau, not both")
+            from ..integrators.tableau_file import load_tableau
+
+            tableau = load_tableau(tableau_file)
+            return tableau.name, tableau
+        tableau = runge_kutta_method(args.integrator)
+        if tableau is not None:
+            return tableau.name, tableau
     word = args.integrator or strang_word(len(system.splitting))
     return word, composition_for(word, system)
+
+
+def runge_kutta_options(parser):
+    """``--tableau FILE``: a Runge--Kutta method from a TOML tableau file (exact coefficients, claimed order checked)."""
+    # the help names examples only: importing the tableaux (sympy) while the parser is built would slow every command
+    parser.add_argument("--tableau", metavar="FILE",
+                        help="a Runge-Kutta method from a TOML file (name, order, A, b, optional c and reference; "
+                             "coefficients as exact strings); --integrator also takes built-in methods such as "
+                             "midpoint, gauss4, gauss6, rk4 or kahan")
 
 
 def numeric_inputs(args, system, values):

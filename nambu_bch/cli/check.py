@@ -3,13 +3,14 @@
 from __future__ import annotations
 
 from ._options import (add_subcommand, integrator_from_args, integrator_options, number, numeric_inputs, numeric_options,
-                       output_options, progress_option, system_from_args, system_options)
+                       output_options, progress_option, runge_kutta_options, system_from_args, system_options)
 from ._output import emit
 
 HELP = "iterate the integrator and report the conservation diagnostics"
 EXAMPLES = ("examples:\n  nambu-bch check --integrator 32123 --h 0.1 --steps 100000 --x0 1,1,1\n"
             "  nambu-bch check --model rigid-body --param I1=1 --param I2=2 --param I3=3 --format json\n"
-            "  nambu-bch check --model henon-heiles --integrator 212 --x0 0.1,-0.2,0.3,0.25 --numerical-shadow 6")
+            "  nambu-bch check --model henon-heiles --integrator 212 --x0 0.1,-0.2,0.3,0.25 --numerical-shadow 6\n"
+            "  nambu-bch check --model rigid-body --integrator midpoint --h 0.1 --steps 2000   # Newton, compiled")
 
 
 def register(sub) -> None:
@@ -17,6 +18,7 @@ def register(sub) -> None:
     progress_option(p)
     system_options(p)
     integrator_options(p, order=True)
+    runge_kutta_options(p)
     numeric_options(p, {"h": 0.1, "steps": 1000, "every": 1})
     p.add_argument("--alpha", metavar="A", help="value of the family parameter alpha in H_S, G_S (default 1/2)")
     p.add_argument("--numerical-shadow", metavar="2K", dest="numerical_shadow",
@@ -30,12 +32,13 @@ def run(args):
     from ..numeric.diagnostics import check
 
     system, values = system_from_args(args)
-    word, comp = integrator_from_args(args, system)
+    word, comp = integrator_from_args(args, system, runge_kutta=True)
     params, x0 = numeric_inputs(args, system, values)
     order = args.order if args.order is not None else 2
     alpha = finite_float(number(args.alpha, "--alpha"), "--alpha") if args.alpha is not None else 0.5
+    method = comp if args.tableau else word  # a tableau file's method is its tableau, not a name
     shadow_order = _numerical_shadow_order(args, system)
-    report = check(system, word, args.h, args.steps, x0, params=params, every=args.every, order=order, alpha=alpha)
+    report = check(system, method, args.h, args.steps, x0, params=params, every=args.every, order=order, alpha=alpha)
     if shadow_order is None:
         emit(args, text=lambda: str(report), data=report.to_dict, system=system)
         return

@@ -20,7 +20,9 @@ EXAMPLES = (
     "\n"
     "integrators: digit words, aliases (strang, lie-trotter, forest-ruth, yoshida:WORD, suzuki[:WORD],\n"
     "kahan-li[:WORD], yoshida6[:WORD], blanes-moan) or 'piece:coeff,...'; cost = sub-flow evaluations per\n"
-    "step after merging equal neighbours (also across steps); the slope of log(error) vs log(evaluations)\n"
+    "step after merging equal neighbours (also across steps); Runge-Kutta methods (midpoint, gauss4, rk4,\n"
+    "kahan, ... or --tableau FILE): field evaluations per step, measured (s per Newton iteration); the\n"
+    "slope of log(error) vs log(evaluations)\n"
     "is -order. The reference solution is the 6th-order Kahan-Li composition at h_min/8."
 )
 MAX_INTEGRATORS = 12
@@ -31,6 +33,8 @@ def register(sub) -> None:
     system_options(p)
     p.add_argument("--integrator", dest="integrators", metavar="WORD", action="append",
                    help="an integrator to compare; repeat (default: the Strang word, its triple jump and Suzuki 5-jump)")
+    p.add_argument("--tableau", dest="tableaux", metavar="FILE", action="append",
+                   help="a Runge-Kutta method from a TOML tableau file (as for shadow --tableau); repeatable")
     p.add_argument("--t-end", metavar="T", default="10", help="final time T of the runs (default 10)")
     p.add_argument("--step-counts", metavar="N,N,...", default="20,40,80,160,320,640",
                    help="numbers of steps N (h = T/N), at least two (default 20,40,80,160,320,640)")
@@ -58,11 +62,18 @@ def run(args):
     system, values = system_from_args(args)
     params, x0 = numeric_inputs(args, system, values)
     words = args.integrators
-    if not words:
+    tableaux = []
+    if args.tableaux:
+        from ..integrators.tableau_file import load_tableau
+
+        tableaux = [load_tableau(path) for path in args.tableaux]
+    if not words and not tableaux:
         strang = strang_word(len(system.splitting))
         words = [strang, f"triple-jump:{strang}", f"suzuki:{strang}"] if len(strang) > 1 else [strang]
-    if len(words) > MAX_INTEGRATORS:
-        raise NambuBCHError(f"--integrator given {len(words)} times; compare accepts at most {MAX_INTEGRATORS}")
+    words = list(words or [])
+    if len(words) + len(tableaux) > MAX_INTEGRATORS:
+        raise NambuBCHError(f"--integrator/--tableau given {len(words) + len(tableaux)} times; compare accepts at most "
+                            f"{MAX_INTEGRATORS}")
     for w in words:
         if not w.strip() or len(w) > 200:
             raise NambuBCHError(f"--integrator {w[:40]!r} must be a non-empty string of at most 200 characters")
@@ -72,7 +83,7 @@ def run(args):
     if t_end > 1e5:
         raise NambuBCHError(f"--t-end {args.t_end!r} must be at most 1e5")
     counts = _step_counts(args.step_counts)
-    result = compare(system, words, t_end=t_end, steps=counts, x0=x0, params=params)
+    result = compare(system, words + tableaux, t_end=t_end, steps=counts, x0=x0, params=params)
     if args.figure:
         try:
             result.figure(args.figure)

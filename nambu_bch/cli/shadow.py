@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from ._options import (add_subcommand, integrator_from_args, integrator_options, output_options, progress_option,
-                       symbolic_system, system_options)
+                       runge_kutta_options, symbolic_system, system_options)
 from ._output import emit
 
 HELP = "the shadow-Hamiltonian family of a word at an order, or the obstruction"
@@ -11,7 +11,8 @@ EXAMPLES = ("examples:\n  nambu-bch shadow                       # alpha-family 
             "  nambu-bch shadow --integrator 32123 --format json\n"
             "  nambu-bch shadow --model ho --integrator TVT --order 4\n"
             "  nambu-bch shadow --H 'x2^2/(2*m) + m*x3/2' --G 'x3 - x1^2' --param m --route fi\n"
-            "  nambu-bch shadow --generic-separable --integrator 212 --order 4   # |p|^2/2 + V(q), V undefined")
+            "  nambu-bch shadow --generic-separable --integrator 212 --order 4   # |p|^2/2 + V(q), V undefined\n"
+            "  nambu-bch shadow --model rigid-body --integrator gauss4 --order 4   # Runge-Kutta: its modified field")
 
 
 def register(sub) -> None:
@@ -19,6 +20,8 @@ def register(sub) -> None:
     progress_option(p)
     system_options(p)
     integrator_options(p, order=True)
+    # Runge-Kutta and Kahan methods (the direct route on the modified field)
+    runge_kutta_options(p)
     p.add_argument("--route", choices=("direct", "fi"), default="direct",
                    help="direct: order-by-order linear solve; fi: fundamental-identity representations (default direct)")
     p.add_argument("--degree", metavar="D", type=str, help="polynomial degree of the ansatz for H_S, G_S (default: the library's)")
@@ -63,7 +66,7 @@ def run(args):
         raise NambuBCHError("--dim is used with --generic-separable only")
 
     system = symbolic_system(args)
-    word, comp = integrator_from_args(args, system)
+    word, comp = integrator_from_args(args, system, runge_kutta=True)
     order = args.order if args.order is not None else 2
     kwargs = {"order": order, "route": args.route, "existence": args.existence}
     if args.degree is not None:

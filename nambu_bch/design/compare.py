@@ -14,6 +14,14 @@ Per word:
   against the evaluations ``N cost (+1)``, and the least-squares slope of
   ``log(error)`` against ``log(evaluations)`` over the points above round-off: ``-order``.
 
+Runge--Kutta and Kahan methods (a name of :data:`~nambu_bch.integrators.runge_kutta.TABLEAUX` or a
+``ButcherTableau``) are compared on the same runs: ``order`` is the tableau's, ``error_constant`` None,
+``leading_power`` / ``leading_size`` those of the first non-zero ``h^j Z_j`` of the modified field
+(:func:`~nambu_bch.bseries.modified_equation`), and ``cost`` the *measured* field evaluations per step:
+an explicit method pays its ``s`` stages; an implicit one pays ``s`` evaluations at the start of each step and
+``s`` per Newton iteration, averaged over the runs (Jacobian evaluations and the linear solves are not counted);
+Kahan's method, linearly implicit, pays one field and one Jacobian evaluation (counted 2) and one linear solve.
+
 The reference ``x_ref(T)`` is the sixth-order Kahan-Li composition of the system's Strang
 step (:mod:`nambu_bch.design.catalog`) with a step ``h_min / 8``; its error is checked
 against the same run at ``h_min / 4`` and reported (``reference_error``).
@@ -37,6 +45,7 @@ from ..atomic import write_atomic
 from ..checks import check_type, finite_float, is_int, show
 from ..errors import InvalidCompositionError, InvalidRunError, NambuBCHError
 from ..integrators.composition import Composition, composition as make_composition, composition_for
+from ..integrators.runge_kutta import runge_kutta_method
 from ..integrators.step import parameter_values
 from ..numeric import iterate
 from ..numeric.figures import MAX_DPI
@@ -106,7 +115,8 @@ class Comparison:
         for r in self.rows:
             lem = "-" if r["error_constant"] is None else f"{r['error_constant']:.4g}"
             order = "-" if r["order"] is None else str(r["order"])
-            lines.append(f"{r['integrator']:<24} {order:>5} {r['cost']:>5} {lem:>10} {r['leading_power']:>4} "
+            power = "-" if r["leading_power"] is None else r["leading_power"]
+            lines.append(f"{r['integrator']:<24} {order:>5} {r['cost']:>5} {lem:>10} {power:>4} "
                          f"{r['leading_size']:>10.3g} {r['slope']:>7.2f} {r['best_error']:>11.2e}")
         return "\n".join(lines)
 
@@ -166,7 +176,9 @@ def _words(words) -> list:
     """The integrators to compare as a non-empty list (a single word or Composition is a list of one)."""
     from ..integrators.composition import Composition
 
-    if isinstance(words, (str, Composition)):
+    from ..integrators.runge_kutta import ButcherTableau
+
+    if isinstance(words, (str, Composition, ButcherTableau)):
         return [words]
     try:
         out = list(words)
@@ -178,8 +190,9 @@ def _words(words) -> list:
     if len(out) > MAX_WORDS:
         raise InvalidRunError(f"compare takes at most {MAX_WORDS} integrators, got {len(out)}")
     for w in out:
-        if not isinstance(w, (str, Composition)):
-            raise InvalidCompositionError(f"each integrator must be a word, alias or Composition, got {show(w)}")
+        if not isinstance(w, (str, Composition, ButcherTableau)):
+            raise InvalidCompositionError(f"each integrator must be a word, alias, Composition, Runge-Kutta method name "
+                                          f"or ButcherTableau, got {show(w)}")
     return out
 
 
@@ -246,6 +259,12 @@ def compare(system, words, t_end: float = 10.0, steps=(20, 40, 80, 160, 320, 640
     ref_err = float(np.linalg.norm(x_ref - x_half)) / 63.0  # order 6: error(h) ~ (error(2h) - error(h)) / (2^6 - 1)
     rows, curves = [], {}
     for word in words:
+        tableau = runge_kutta_method(word)
+        if tableau is not None:
+            label = word if isinstance(word, str) else tableau.name
+            rows.append(_runge_kutta_row(system, tableau, label, t_end, steps, x0, params, x_ref, ref_err, box, samples))
+            curves[label] = rows[-1].pop("points")
+            continue
         comp = composition_for(word, system.splitting)
         label = word if isinstance(word, str) else comp.name
         try:
@@ -276,3 +295,46 @@ def compare(system, words, t_end: float = 10.0, steps=(20, 40, 80, 160, 320, 640
         })
         curves[label] = pts
     return Comparison(system.name, t_end, x0, params, rows, curves, ref_name, ref_err)
+
+
+def _runge_kutta_row(system, tableau, label, t_end, steps, x0, params, x_ref, ref_err, box, samples) -> dict:
+    """The row of a Runge--Kutta method (module docstring): measured cost, error, and the modified field's leading term."""
+    from ..bseries import modified_equation
+    from ..bseries.modified import MAX_RK_ORDER
+    from ..numeric.runge_kutta import LAST_RUN, is_linearly_implicit
+    from .system_error import field_size
+
+    s = tableau.stages
+    top = min(tableau.order + 1, MAX_RK_ORDER)
+    try:
+        M = modified_equation(system, tableau, top)
+    except NambuBCHError:  # no exact modified field (e.g. a non-polynomial field): the runs alone are compared
+        M = None
+    power = None if M is None else next((j for j in range(1, top + 1) if not M[j].is_zero()), None)
+    size = float("nan") if power is None else field_size(M[power].to_sympy(), system, box, samples, params, 0)
+    pts, per_steps = [], []
+    for N in steps:
+        h = t_end / N
+        try:
+            err = float(np.linalg.norm(_final(system, tableau, h, N, x0, params) - x_ref))
+        except NambuBCHError as exc:
+            pts.append({"steps": N, "h": h, "evaluations": float("nan"), "error": float("nan"), "note": str(exc)})
+            continue
+        if is_linearly_implicit(tableau):
+            per_step = 2.0
+        elif tableau.is_explicit:
+            per_step = float(s)
+        else:
+            per_step = s * (1.0 + LAST_RUN["newton_iterations"] / max(N, 1))
+        per_steps.append(per_step)
+        pts.append({"steps": N, "h": h, "evaluations": N * per_step, "error": err})
+    good = [p for p in pts if np.isfinite(p["error"]) and p["error"] > max(FLOOR, 100 * ref_err)]
+    return {
+        "integrator": label, "name": tableau.name, "order": tableau.order, "error_constant": None,
+        "cost": round(float(np.mean(per_steps)), 2) if per_steps else float("nan"), "fsal_extra": 0,
+        "leading_power": power, "leading_size": size,
+        "slope": slope([p["evaluations"] for p in good], [p["error"] for p in good]),
+        "slope_points": len(good),
+        "best_error": min((p["error"] for p in pts if np.isfinite(p["error"])), default=float("nan")),
+        "citation": tableau.reference, "points": pts,
+    }

@@ -561,8 +561,8 @@ def _generic(text) -> Composition:
 
     if text.lower() in TABLEAUX or text.lower() in PARTITIONED:  # a Runge-Kutta method is no word over the pieces: say where it is available
         raise InvalidCompositionError(
-            f"{text!r} is a Runge-Kutta method, not a composition of the pieces; its modified equation and shadow "
-            "question are nambu_bch.modified_equation and nambu_bch.runge_kutta_shadow (not yet on the command line)")
+            f"{text!r} is a Runge-Kutta method, not a composition of the pieces; shadow_hamiltonians, check, iterate "
+            "and compare accept it; the composition routes (BCH, FI, exact) do not")
     if not text.isdigit() or "0" in text:
         raise InvalidCompositionError(
             f"unknown composition {text!r}{did_you_mean(text, _NAMES) if not text.isdigit() else ''}; "

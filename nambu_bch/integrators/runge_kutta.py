@@ -63,6 +63,18 @@ class ButcherTableau:
     def is_explicit(self) -> bool:
         return all(self.A[i][j] == 0 for i in range(self.stages) for j in range(i, self.stages))
 
+    @property
+    def symmetric(self) -> bool:
+        """``b_i = b_{s+1-i}`` and ``a_ij + a_{s+1-i,s+1-j} = b_j``: the method is symmetric (HLW Sect. V.2), so its
+        modified field has only even powers of ``h`` (HLW Sect. IX.2).  Sufficient, decided exactly."""
+        s, A, b = self.stages, self.A, self.b
+        return all(sympy.expand(b[i] - b[s - 1 - i]) == 0 for i in range(s)) and all(
+            sympy.expand(A[i][j] + A[s - 1 - i][s - 1 - j] - b[j]) == 0 for i in range(s) for j in range(s))
+
+    def remainder_power(self, order: int) -> int:
+        """The first power of ``h`` after ``h**order`` the modified field can contain (skips odd ones if symmetric)."""
+        return order + 2 if self.symmetric and order % 2 == 0 else order + 1
+
     def __str__(self):
         return self.name
 
@@ -181,3 +193,18 @@ def butcher_tableau(method) -> ButcherTableau:
         return TABLEAUX[method]
     raise InvalidCompositionError(
         f"unknown Runge-Kutta method {show(method)}; accepted are {', '.join(TABLEAUX)} or a ButcherTableau")
+
+
+def runge_kutta_method(method):
+    """The :class:`ButcherTableau` if ``method`` is one (or names one of :data:`TABLEAUX`, any case), else None.
+
+    The one test the entry points use to tell a Runge--Kutta method from a composition.
+
+    >>> runge_kutta_method("Gauss4").name, runge_kutta_method("12321")
+    ('gauss4', None)
+    """
+    if isinstance(method, ButcherTableau):
+        return method
+    if isinstance(method, str) and method.strip().lower() in TABLEAUX:
+        return TABLEAUX[method.strip().lower()]
+    return None

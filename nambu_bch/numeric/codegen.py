@@ -820,3 +820,217 @@ def describe(program: StepProgram) -> str:
 def source_hash(source: str) -> str:
     """A short stable key of a generated source (the kernel cache file name)."""
     return hashlib.sha256((TEMPLATE_VERSION + source).encode()).hexdigest()[:20]
+
+
+# -- Runge--Kutta steps -------------------------------------------------------------------------------------------
+#: Bump when the generated Runge--Kutta source changes meaning.
+RK_TEMPLATE_VERSION = "2"
+
+_RK_TEMPLATE = '''
+
+def rk_solve(M, r, m):
+    """Gaussian elimination with partial pivoting: r <- M^-1 r (M is overwritten); False if M is singular."""
+    for k in range(m):
+        p = k
+        big = abs(M[k, k])
+        for i in range(k + 1, m):
+            if abs(M[i, k]) > big:
+                big = abs(M[i, k])
+                p = i
+        if not (big > 0.0 and big < _INF):
+            return False
+        if p != k:
+            for j in range(m):
+                t = M[k, j]
+                M[k, j] = M[p, j]
+                M[p, j] = t
+            t = r[k]
+            r[k] = r[p]
+            r[p] = t
+        for i in range(k + 1, m):
+            q = M[i, k] / M[k, k]
+            if q != 0.0:
+                for j in range(k + 1, m):
+                    M[i, j] -= q * M[k, j]
+                r[i] -= q * r[k]
+    for k in range(m - 1, -1, -1):
+        t = r[k]
+        for j in range(k + 1, m):
+            t -= M[k, j] * r[j]
+        r[k] = t / M[k, k]
+    return True
+
+
+def rk_newton(x, h, P, A, K, Y, F, J, M, r, maxit, tol):
+    """The stages K_i = f(x + h sum_j a_ij K_j) by Newton's method, from K_i = f(x), until the residual no
+    longer shrinks (round-off); the iterations used, -1 when the Newton matrix is singular, -2 when the
+    residual did not reach tol * (1 + max|K|) within maxit iterations."""
+    s = K.shape[0]
+    n = x.shape[0]
+    m = s * n
+    rk_field(x, P, F[0])
+    for i in range(s):
+        for k in range(n):
+            K[i, k] = F[0, k]
+    best = _INF
+    it = 0
+    while True:
+        for i in range(s):
+            for k in range(n):
+                acc = 0.0
+                for j in range(s):
+                    acc += A[i, j] * K[j, k]
+                Y[i, k] = x[k] + h * acc
+            rk_field(Y[i], P, F[i])
+        size = 0.0
+        scale = 0.0
+        for i in range(s):
+            for k in range(n):
+                d = K[i, k] - F[i, k]
+                r[i * n + k] = d
+                if abs(d) > size:
+                    size = abs(d)
+                if abs(K[i, k]) > scale:
+                    scale = abs(K[i, k])
+        if not (size < _INF):
+            return -2
+        if size <= 4.0 * 2.220446049250313e-16 * scale or (size >= best and best <= tol * (1.0 + scale)):
+            return it
+        if size >= best or it >= maxit:
+            return -2
+        best = size
+        for i in range(s):
+            rk_jacobian(Y[i], P, J)
+            for a in range(n):
+                for j in range(s):
+                    q = h * A[i, j]
+                    for c in range(n):
+                        M[i * n + a, j * n + c] = (1.0 if (i == j and a == c) else 0.0) - q * J[a, c]
+        if not rk_solve(M, r, m):
+            return -1
+        for i in range(s):
+            for k in range(n):
+                K[i, k] -= r[i * n + k]
+        it += 1
+
+
+def rk_explicit(x, h, P, A, K, Y):
+    """The stages of an explicit method in order: K_i = f(x + h sum_{j<i} a_ij K_j)."""
+    s = K.shape[0]
+    n = x.shape[0]
+    for i in range(s):
+        for k in range(n):
+            acc = 0.0
+            for j in range(i):
+                acc += A[i, j] * K[j, k]
+            Y[i, k] = x[k] + h * acc
+        rk_field(Y[i], P, K[i])
+
+
+def rk_run(x, c, compensated, mode, h, P, A, b, steps, every, out, maxit, tol, info):
+    """steps steps from x (updated in place); out[j] gets the state after step j*every (and the last step).
+    mode: 1 -- Kahan's step x' = x + h (I - h/2 f'(x))^-1 f(x), one linear solve; 2 -- an explicit method,
+    its stages in order; 0 -- the Runge--Kutta step with Newton's method.  info[0] += Newton iterations
+    (mode 1: solves); on failure info[1] = 1 (singular), 2 (no convergence) or 3 (not finite) and info[2] = the
+    step; returns the steps done."""
+    s = b.shape[0]
+    n = x.shape[0]
+    m = s * n
+    K = np.zeros((s, n))
+    Y = np.zeros((s, n))
+    F = np.zeros((s, n))
+    J = np.zeros((n, n))
+    M = np.zeros((m, m))
+    r = np.zeros(m)
+    inc = np.zeros(n)
+    j = 1
+    for step in range(1, steps + 1):
+        if mode == 2:
+            rk_explicit(x, h, P, A, K, Y)
+            for k in range(n):
+                acc = 0.0
+                for i in range(s):
+                    acc += b[i] * K[i, k]
+                inc[k] = h * acc
+        elif mode == 1:
+            rk_field(x, P, r)
+            rk_jacobian(x, P, J)
+            for a in range(n):
+                for e in range(n):
+                    M[a, e] = (1.0 if a == e else 0.0) - 0.5 * h * J[a, e]
+            if not rk_solve(M, r, n):
+                info[1] = 1
+                info[2] = step
+                return step - 1
+            info[0] += 1
+            for k in range(n):
+                inc[k] = h * r[k]
+        else:
+            it = rk_newton(x, h, P, A, K, Y, F, J, M, r, maxit, tol)
+            if it < 0:
+                info[1] = 1 if it == -1 else 2
+                info[2] = step
+                return step - 1
+            info[0] += it
+            for k in range(n):
+                acc = 0.0
+                for i in range(s):
+                    acc += b[i] * K[i, k]
+                inc[k] = h * acc
+        finite = True
+        for k in range(n):
+            if compensated:
+                y = inc[k] - c[k]
+                t = x[k] + y
+                c[k] = (t - x[k]) - y
+                x[k] = t
+            else:
+                x[k] = x[k] + inc[k]
+            if not _isfinite(x[k]):
+                finite = False
+        if not finite:
+            info[1] = 3
+            info[2] = step
+            return step - 1
+        if step % every == 0 or step == steps:
+            for k in range(n):
+                out[j, k] = x[k]
+            j += 1
+    return steps
+'''
+
+
+def runge_kutta_source(system) -> str:
+    """The generated module of the Runge--Kutta steps on ``system``: ``rk_field(y, P, out)`` and
+    ``rk_jacobian(y, P, J)`` printed from the system's (validated) vector field, then the fixed Newton and
+    linear-solve loops (:data:`_RK_TEMPLATE`).  Coordinates enter as ``y[i]``, parameters as ``P[i]``: no name a
+    user chose reaches the source; the field may use only them and :data:`ALLOWED_FUNCTIONS`, and must be finite.
+    """
+    coords, params = list(system.coordinates), list(system.parameters)
+    s = [sympy.Symbol(f"s{i}") for i in range(len(coords))]
+    p = [sympy.Symbol(f"p{i}") for i in range(len(params))]
+    rename = dict(zip(coords + params, s + p))
+    field = [sympy.sympify(e, strict=True) for e in system.vector_field.to_sympy()]
+    jac = sympy.Matrix(field).jacobian(coords)
+    allowed = set(s) | set(p)
+    singular = (sympy.zoo, sympy.nan, sympy.oo, -sympy.oo)
+
+    def checked(expr, where):
+        expr = expr.xreplace(rename)
+        if any(expr.has(z) for z in singular):
+            raise InvalidSystemError(f"{where} of {system.name} is singular ({expr}); check the parameters of the model")
+        stray = expr.free_symbols - allowed
+        if stray:
+            raise InvalidSystemError(f"{where} of {system.name} uses unknown symbols {sorted(map(str, stray))}")
+        for f in expr.atoms(sympy.Function):
+            if type(f).__name__ not in ALLOWED_FUNCTIONS:
+                raise InvalidSystemError(f"{where} of {system.name} calls {type(f).__name__}, which numeric kernels "
+                                         f"do not support (supported: {', '.join(sorted(ALLOWED_FUNCTIONS))})")
+        return print_python(expr, "_")
+
+    load = [f"    s{i} = y[{i}]" for i in range(len(s))] + [f"    p{i} = P[{i}]" for i in range(len(p))]
+    lines = [_HEADER.format(version="rk" + RK_TEMPLATE_VERSION), "", "def rk_field(y, P, out):", *load]
+    lines += [f"    out[{i}] = {checked(e, 'the vector field')}" for i, e in enumerate(field)]
+    lines += ["", "", "def rk_jacobian(y, P, J):", *load]
+    lines += [f"    J[{i}, {k}] = {checked(jac[i, k], 'the Jacobian')}" for i in range(len(s)) for k in range(len(s))]
+    return "\n".join(lines) + "\n" + _RK_TEMPLATE

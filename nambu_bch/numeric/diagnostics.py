@@ -396,7 +396,9 @@ def check(system, word, h, steps, x0=None, params=None, *, order=2, alpha=0.5, e
 
     start = time.perf_counter()
     system = as_system(system)
-    comp = make_composition(word, len(system.splitting))
+    from ..integrators.runge_kutta import runge_kutta_method
+
+    comp = runge_kutta_method(word) or make_composition(word, len(system.splitting))  # a Runge-Kutta method runs too
     name = word if isinstance(word, str) else str(comp)
     alpha = finite_float(alpha, "alpha")
     order = check_order(order)

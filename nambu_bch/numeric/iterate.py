@@ -36,6 +36,8 @@ from .guards import (check_backend, check_count, check_inputs, check_out, check_
                      check_work, initial_state, run_label, scan_states)
 from .kernels import kernel, resolve_backend
 from .precision import check_dps, run_mpmath
+from .runge_kutta import iterate_runge_kutta
+from ..integrators.runge_kutta import runge_kutta_method
 from .samples import MAX_SAMPLE_BYTES, n_samples, sample_steps
 
 #: Trajectory-steps per kernel call when progress is reported (a few tenths of a second compiled).
@@ -153,6 +155,12 @@ def iterate(system, word, h, steps, x0=None, params=None, every=1, *, kahan=Fals
     (5, 2, 2)
     """
     system = as_system(system)
+    tableau = runge_kutta_method(word)
+    if tableau is not None:  # an implicit or explicit Runge--Kutta method: Newton's method, compiled alike
+        _runge_kutta_options(tableau, dps, fma)
+        check_flag(check_stable, "check_stable")  # no stability interval to check: Newton's failure is the guard
+        check_flag(progress, "progress", none=True)
+        return iterate_runge_kutta(system, tableau, h, steps, x0, params, every, kahan=kahan, backend=backend, out=out)
     x0, origin = initial_state(system, x0)
     check_work(check_count(steps, "steps", 0), x0, mpmath=dps is not None)  # from the request, before any work
     kahan, check_stable = check_flag(kahan, "kahan"), check_flag(check_stable, "check_stable")
@@ -377,6 +385,10 @@ def iterate_chunks(system, word, h, steps, x0=None, params=None, every=1, *, kah
     NumericalRangeError -- at the first block with a non-finite sample (the blocks before it were yielded).
     """
     system = as_system(system)
+    tableau = runge_kutta_method(word)
+    if tableau is not None:
+        yield from _runge_kutta_chunks(system, tableau, h, steps, x0, params, every, kahan, backend, chunk_samples)
+        return
     x0, origin = initial_state(system, x0)
     check_work(check_count(steps, "steps", 0), x0)  # from the request, before any work
     kahan, check_stable = check_flag(kahan, "kahan"), check_flag(check_stable, "check_stable")
@@ -409,6 +421,41 @@ def iterate_chunks(system, word, h, steps, x0=None, params=None, every=1, *, kah
             check_result(out, numbers, what)
             done += seg
             yield numbers[1:], out[1:]
+
+
+def _runge_kutta_options(tableau, dps, fma) -> None:
+    """Refuse, in one line, the options of :func:`iterate` that only the splitting kernels have."""
+    if dps is not None:
+        raise InvalidRunError(f"dps= (an mpmath run) is available for compositions; the Runge-Kutta method "
+                              f"{tableau.name} runs in float64 only")
+    if check_flag(fma, "fma"):
+        raise InvalidRunError(f"fma=True applies to the compiled splitting kernels, not to the Runge-Kutta method {tableau.name}")
+
+
+def _runge_kutta_chunks(system, tableau, h, steps, x0, params, every, kahan, backend, chunk_samples):
+    """:func:`iterate_chunks` for a Runge--Kutta method: blocks of :func:`iterate_runge_kutta` runs, the state and
+    the compensation carried from block to block (the same samples as one run)."""
+    x0, _ = initial_state(system, x0)
+    steps = check_count(steps, "steps", 0)
+    chunk_samples = _count(chunk_samples, "chunk_samples", 2)
+    if chunk_samples * system.N * 8 > MAX_SAMPLE_BYTES:
+        raise InvalidRunError(f"chunk_samples = {chunk_samples} blocks of {system.N} coordinates need more than "
+                              f"{MAX_SAMPLE_BYTES / 2**30:.0f} GiB; take fewer samples per block")
+    first = iterate_runge_kutta(system, tableau, h, 0, x0, params, 1, backend=backend)  # validates the run
+    if first.ndim != 2:
+        raise InvalidRunError(f"iterate_chunks takes one initial state of shape ({system.N},), got shape {first.shape[1:]}")
+    every = min(check_count(every, "every", 1), max(steps, 1))
+    state, comp = first[0].copy(), np.zeros(system.N)
+    yield np.zeros(1, dtype=np.int64), first.copy()
+    block = (chunk_samples - 1) * every
+    done = 0
+    while done < steps:
+        seg = min(block, steps - done)
+        out = iterate_runge_kutta(system, tableau, h, seg, state, params, every, kahan=kahan, backend=backend,
+                                  compensation=comp)
+        state = out[-1].copy()
+        yield done + sample_steps(seg, every)[1:], out[1:]
+        done += seg
 
 
 def _count(value, what, minimum):

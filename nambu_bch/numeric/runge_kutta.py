@@ -6,6 +6,17 @@ from ``K_i = f(y)`` and stopped when a correction no longer shrinks the residual
 (round-off reached) or after :data:`MAX_NEWTON` iterations; the step is
 ``y + h sum_i b_i K_i``.  This is the plain, uncompiled reference the exact modified
 equations (:mod:`nambu_bch.bseries`) are checked against.
+
+:func:`iterate_runge_kutta` is the driver :func:`nambu_bch.numeric.iterate` hands a Runge--Kutta method to:
+the same Newton iteration, generated once per system as a Python module
+(:func:`~nambu_bch.numeric.codegen.runge_kutta_source`: the field and its Jacobian printed from the
+validated exact field, then fixed loops with their own Gaussian elimination), compiled with numba
+(machine code in the package's private, verified cache, :func:`nambu_bch.compiled.enable_private_cache`)
+or run by the interpreter (``backend="numpy"``: the same source, the same operations in the same order).
+Kahan's method on a quadratic field is linearly implicit, ``x' = x + h (I - h/2 f'(x))^{-1} f(x)``
+(Celledoni, McLachlan, Owren, Quispel, J. Phys. A 46 (2013) 025201; equation number not checked, the equality
+with the tableau is tested): one linear solve per step,
+no Newton iteration.  The work of a run is reported as Newton iterations (:data:`LAST_RUN`).
 """
 
 from __future__ import annotations
@@ -13,8 +24,8 @@ from __future__ import annotations
 import numpy as np
 import sympy
 
-from ..errors import InvalidRunError, NumericalRangeError
-from ..integrators.runge_kutta import butcher_tableau
+from ..errors import InvalidRunError, NumericalRangeError, ResourceLimitError
+from ..integrators.runge_kutta import TABLEAUX, butcher_tableau
 from .guards import check_inputs
 
 #: Newton iterations allowed per step before the step is refused.
@@ -92,3 +103,160 @@ def rk_iterate(system, method, h, steps, x0, params=None, every=1) -> np.ndarray
         if k % every == 0:
             out.append(y.copy())
     return np.array(out)
+
+
+#: Trajectory-steps up to which ``backend="auto"`` interprets rather than compiles (a cold numba compile of the
+#: module costs seconds; the interpreter does a few thousand implicit steps per second).
+INTERPRET_STEPS = 2000
+#: Most trajectory-steps of one Runge--Kutta run (an implicit step costs 10-100 splitting steps; the interpreter
+#: about 1e4 times more): refused up front above this, compiled or not.
+MAX_RK_STEPS = 10**8
+#: Residual accepted when Newton's iteration stagnates: ``tol * (1 + max|K|)`` (round-off is far below).
+NEWTON_TOL = 1e-10
+#: ``{"newton_iterations": .., "steps": ..}`` of the last :func:`iterate_runge_kutta` run in this process (the
+#: cost measure of :func:`nambu_bch.design.compare`).
+LAST_RUN: dict = {}
+_MODULES: dict = {}
+
+
+def is_linearly_implicit(tableau) -> bool:
+    """Kahan's tableau (``TABLEAUX["kahan"]``, by its exact coefficients): stepped by one linear solve."""
+    kahan = TABLEAUX["kahan"]
+    return tableau.quadratic_only and tableau.A == kahan.A and tableau.b == kahan.b
+
+
+def _module(system, backend):
+    """The generated Runge--Kutta module of ``system``: interpreted, or with its functions compiled by numba."""
+    from ..systems.system import as_system
+    from .codegen import runge_kutta_source, source_hash
+    from .kernels import _write_file, cache_dir
+
+    system = as_system(system)
+    key = (system, backend)
+    module = _MODULES.get(key)
+    if module is not None:
+        return module
+    import sys
+    import types
+
+    source = runge_kutta_source(system)
+    directory = cache_dir()
+    name = f"nambu_bch_rk_{source_hash(source)}"
+    path = directory / f"{name}.py"
+    try:  # numba keeps machine code next to a source file; the module itself runs from memory, never read back
+        _write_file(path, source.encode("utf-8"))
+    except OSError:
+        pass
+    module = types.ModuleType(name)
+    module.__file__ = str(path)
+    exec(compile(source, str(path), "exec"), module.__dict__)  # noqa: S102 - generated from validated exact data
+    if backend == "numba":
+        import numba
+
+        from ..compiled import enable_private_cache
+
+        sys.modules[name] = module  # numba's cache locates the functions through their module
+        # callees first: the compiled callers find them as globals of the module
+        for fn in ("rk_field", "rk_jacobian", "rk_solve", "rk_newton", "rk_explicit", "rk_run"):
+            jitted = numba.njit(nogil=True, error_model="numpy")(module.__dict__[fn])
+            if path.is_file():
+                enable_private_cache(jitted, directory / "__pycache__")
+            module.__dict__[fn] = jitted
+    _MODULES[key] = module
+    return module
+
+
+def iterate_runge_kutta(system, method, h, steps, x0=None, params=None, every=1, *, kahan=False, backend="auto",
+                        out=None, max_newton=MAX_NEWTON, compensation=None):
+    """``steps`` steps of the Runge--Kutta ``method`` (implicit ones by Newton's method), sampled like
+    :func:`nambu_bch.numeric.iterate` (shape ``(n_samples, N)`` or ``(n_samples, N, batch)``).
+
+    Parameters
+    ----------
+    system, h, steps, x0, params, every, out : as for :func:`~nambu_bch.numeric.iterate`
+    method : a name of :data:`~nambu_bch.integrators.runge_kutta.TABLEAUX` or a ButcherTableau
+    kahan : bool -- compensated summation of the increments
+    backend : ``"auto"`` | ``"numba"`` | ``"numpy"`` -- compiled, or the same generated source interpreted (the same
+        bits); ``"auto"``: compiled, except runs of at most :data:`INTERPRET_STEPS` trajectory-steps before the module
+        is compiled in this process
+    max_newton : int -- Newton iterations allowed per step
+    compensation : float64 array of shape (N,), optional -- the compensated summation's carry, updated in place
+        (a run continued block by block: :func:`nambu_bch.numeric.iterate_chunks`); one trajectory only
+
+    Raises
+    ------
+    NumericalRangeError -- Newton's method did not converge, or its matrix was singular, at step ``k`` (the
+        message names ``h`` and ``k``; lower ``h``), or the state left the float64 range.
+    ResourceLimitError -- more than :data:`MAX_RK_STEPS` trajectory-steps, before any work
+
+    References
+    ----------
+    Hairer, Norsett, Wanner, *Solving ODEs I*, Sect. II.7; Hairer, Wanner, *Solving ODEs II*, Sect. IV.8
+    (Newton's method for the stage equations).
+    """
+    from ..checks import check_flag
+    from ..systems.system import as_system
+    from .guards import check_backend, check_count, check_out, initial_state, run_label
+    from .kernels import resolve_backend
+    from .samples import MAX_SAMPLE_BYTES, n_samples
+
+    system = as_system(system)
+    tableau = butcher_tableau(method)
+    x0, origin = initial_state(system, x0)
+    kahan = check_flag(kahan, "kahan")
+    auto = check_backend(backend) == "auto"
+    backend = resolve_backend(backend)
+    max_newton = check_count(max_newton, "max_newton", 1)
+    h, steps, every, X, values = check_inputs(system, h, steps, every, x0, params)
+    h = float(h)
+    work = steps * (1 if X.ndim == 1 else X.shape[1])
+    if work > MAX_RK_STEPS:
+        raise ResourceLimitError(f"{work} trajectory-steps of {tableau.name} are more than the {MAX_RK_STEPS:.0e} one "
+                                 "Runge-Kutta run accepts; split the run or take a larger h")
+    linear = is_linearly_implicit(tableau)
+    if linear:
+        from ..bseries.modified import _polynomial_field
+
+        _polynomial_field(system, tableau)  # Kahan's formula is the method only on quadratic fields: refuse others
+    mode = 1 if linear else 2 if tableau.is_explicit else 0
+    if backend == "numba" and auto and (system, "numba") not in _MODULES and work <= INTERPRET_STEPS:
+        backend = "numpy"  # compiling costs seconds; a short run is done sooner by the interpreter (the same bits)
+    module = _module(system, backend)
+    P = np.array([float(values[p]) for p in system.parameters], dtype=np.float64)
+    A = np.array([[float(a) for a in row] for row in tableau.A], dtype=np.float64)
+    b = np.array([float(x) for x in tableau.b], dtype=np.float64)
+    single = X.ndim == 1
+    batch = 1 if single else X.shape[1]
+    count = n_samples(steps, every)
+    shape = (count, system.N) if single else (count, system.N, batch)
+    if out is not None:
+        out = check_out(out, shape, x0, X)
+    else:
+        nbytes = count * system.N * batch * 8
+        if nbytes > MAX_SAMPLE_BYTES:
+            raise InvalidRunError(f"{count} samples of {system.N} x {batch} states need {nbytes / 2**30:.1f} GiB "
+                                  f"(limit {MAX_SAMPLE_BYTES / 2**30:.0f} GiB); sample less often (larger every)")
+        out = np.empty(shape, dtype=np.float64)
+    columns = [X] if single else [np.ascontiguousarray(X[:, k]) for k in range(batch)]
+    what = run_label(system, tableau.name, h, X, origin)
+    total = 0
+    for k, x in enumerate(columns):
+        samples = np.empty((count, system.N))
+        samples[0] = x
+        c = compensation if compensation is not None and single else np.zeros(system.N)
+        info = np.zeros(3, dtype=np.int64)
+        with np.errstate(all="ignore"):
+            done = module.rk_run(x, c, kahan, mode, h, P, A, b, steps, every, samples, max_newton, NEWTON_TOL, info)
+        total += int(info[0])
+        if done < steps:
+            why = {1: "the Newton matrix is singular", 2: f"Newton's method did not converge in {max_newton} iterations",
+                   3: "the state left the float64 range"}[int(info[1])]
+            raise NumericalRangeError(f"{tableau.name} on {what}: {why} at step {int(info[2])} (h = {h:g}); lower h")
+        if single:
+            out[...] = samples
+        else:
+            out[:, :, k] = samples
+    LAST_RUN.clear()
+    LAST_RUN.update({"method": tableau.name, "steps": steps * batch, "newton_iterations": total,
+                     "linear_solves": total if linear else None})
+    return out

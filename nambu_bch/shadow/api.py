@@ -7,10 +7,13 @@ Horikoshi, Sects. 4.2 and 5.2; Eqs. (L2), (SH12321c), (SG12321c).
 
 from __future__ import annotations
 
+import sympy
+
 from ..bch.backward import check_order
 from ..checks import check_flag
 from ..errors import NambuBCHError
 from ..integrators.composition import composition_for
+from ..integrators.runge_kutta import runge_kutta_method
 from .direct_route import direct_route
 from .family import ShadowFamily
 from .fi_route import fi_route
@@ -45,7 +48,11 @@ def shadow_hamiltonians(system, word, order: int = 2, route: str = "direct", deg
     Parameters
     ----------
     system : System or built-in model name
-    word : composition spec (``"12321"``, ``"TVT"``, ``"lie-trotter"``, ...)
+    word : composition spec (``"12321"``, ``"TVT"``, ``"lie-trotter"``, ...), or a Runge--Kutta method: a name of
+        :data:`~nambu_bch.integrators.runge_kutta.TABLEAUX` (``"midpoint"``, ``"gauss4"``, ``"kahan"`` ...) or a
+        :class:`~nambu_bch.integrators.runge_kutta.ButcherTableau`; the direct route then runs on the method's
+        modified field (:func:`~nambu_bch.bseries.runge_kutta_shadow`, HLW Sect. IX.9), and the family's
+        ``composition`` is the tableau
     order : int -- highest power of ``h`` kept in ``H_S, G_S``
     route : ``"direct"`` (order-by-order linear solve, any order) or ``"fi"``
         (affine hulls of the representations of the BCH commutators by the fundamental identity,
@@ -85,6 +92,9 @@ def shadow_hamiltonians(system, word, order: int = 2, route: str = "direct", deg
         raise NambuBCHError(
             f"the FI route needs the Nambu bracket (N - 1 Hamiltonians, the fundamental identity); {system.name} has the "
             f"{system.bracket} bracket on N = {system.N}: use route='direct'")
+    tableau = runge_kutta_method(word)
+    if tableau is not None:
+        return _runge_kutta_family(system, tableau, order, route, degree, existence, params, max_unknowns)
     comp = composition_for(word, system.splitting)
     if route == "direct":
         R = direct_route(system, comp, order, degree, max_unknowns, progress=progress)
@@ -95,3 +105,38 @@ def shadow_hamiltonians(system, word, order: int = 2, route: str = "direct", deg
     # the FI ansatz failing is no certificate: the direct route and the orbit averages decide
     D = direct_route(system, comp, order, None, max_unknowns) if existence and not R.exists else None
     return ShadowFamily.from_fi(system, comp, order, R, _decision(D, existence, params), direct=D)
+
+
+def _runge_kutta_family(system, tableau, order, route, degree, existence, params, max_unknowns) -> ShadowFamily:
+    """The family of a Runge--Kutta method: the direct route on its modified field (the same solver and decision)."""
+    from ..bseries import runge_kutta_shadow
+
+    if route != "direct":
+        raise NambuBCHError(f"the FI route reads a composition's BCH commutators; the Runge-Kutta method {tableau.name} "
+                            "has none: use route='direct'")
+    R = runge_kutta_shadow(system, tableau, order, degree=degree, max_unknowns=max_unknowns)
+    decision = _divergence_decision(system, R) if existence and not R.exists else None
+    if decision is None:
+        decision = _decision(R, existence, params)
+    return ShadowFamily.from_direct(system, tableau, order, R, decision, max_unknowns=max_unknowns)
+
+
+def _divergence_decision(system, result):
+    """Certified non-existence when the modified field at the failed order has non-zero divergence, else None.
+
+    Every ``X_{H_S,G_S}`` of the package's brackets is divergence-free (Liouville), and so are the cross terms of the
+    lower, solved orders; a Runge--Kutta field need not be (implicit midpoint on the rigid body at ``h^2``,
+    docs/runge_kutta.md).  The orbit averages of :mod:`~nambu_bch.shadow.existence` see only the drift of ``H, G``,
+    which a method keeping quadratic invariants does not have, so this test comes first.
+    """
+    from .existence import Existence
+
+    j = result.orders[-1].order
+    Z = result.effective[j]
+    div = Z.divergence()
+    if Z.algebra.is_zero(div):
+        return None
+    shown = sympy.factor(Z.algebra.to_sympy(div))
+    reason = (f"at h^{j} the modified field has divergence {shown} != 0, while every X_{{H_S,G_S}} (and every cross "
+              "term of the solved orders) is divergence-free: no pair, polynomial or not")
+    return Existence("none", False, j, method="divergence", reason=reason)
