@@ -187,6 +187,7 @@ def _base_table():
                                                                    label="1AX"),
         "nambu_bch.shadow.fi_brackets": lambda v: dict(system=v["ho3"], word="12321", order=2),
         "nambu_bch.shadow.separable_shadow": lambda v: dict(word="212", order=2, d=2),
+        "nambu_bch.shadow.density_shadow": lambda v: dict(system=v["ho3"], method="midpoint", density=1, order=2),
         # exact
         "nambu_bch.F": lambda v: dict(x=0.5),
         "nambu_bch.F_series": lambda v: dict(x=v["sympy"].Symbol("z"), order=4),

@@ -125,7 +125,7 @@ def iterate(system, word, h, steps, x0=None, params=None, every=1, *, kahan=Fals
         states (the loop releases the GIL).  The samples are the same bits for every value.  None: the
         cores available (:func:`available_threads`), fewer for small batches (:data:`PARALLEL_WORK`
         trajectory-steps per thread), one inside the tasks of :func:`nambu_bch.parallel.sweep`.  Ignored by
-        one trajectory, the numpy loop and mpmath runs.
+        one trajectory, the numpy loop, mpmath runs and Runge--Kutta methods.
 
     Returns
     -------
@@ -155,6 +155,8 @@ def iterate(system, word, h, steps, x0=None, params=None, every=1, *, kahan=Fals
     (5, 2, 2)
     """
     system = as_system(system)
+    if workers is not None:
+        workers = check_count(workers, "workers", 1)
     tableau = runge_kutta_method(word)
     if tableau is not None:  # an implicit or explicit Runge--Kutta method: Newton's method, compiled alike
         _runge_kutta_options(tableau, dps, fma)
@@ -166,8 +168,6 @@ def iterate(system, word, h, steps, x0=None, params=None, every=1, *, kahan=Fals
     kahan, check_stable = check_flag(kahan, "kahan"), check_flag(check_stable, "check_stable")
     progress, backend = check_flag(progress, "progress", none=True), check_backend(backend)
     fma = check_flag(fma, "fma")
-    if workers is not None:
-        workers = check_count(workers, "workers", 1)
     kern = kernel(system, word)
     if dps is not None:
         dps = check_dps(dps)
