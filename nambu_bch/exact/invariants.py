@@ -57,6 +57,7 @@ from ..integrators import composed_map, composition_for
 from ..integrators.flows import exact_flow
 from ..parsing import as_expression
 from ..printing import Printable, aligned, series_text, series_tokens
+from ..values import ValueEquality
 
 H_STEP = sympy.Symbol("h")
 #: Most candidate pivot sets (r-subsets of monomials, in graded order) tried by the normalisation.
@@ -276,7 +277,7 @@ def _clean(expr, coords=()):
 
 
 @dataclass(frozen=True, eq=False)
-class ConservedQuantities(Printable):
+class ConservedQuantities(Printable, ValueEquality):
     """Exact polynomial invariants of a composed map, normalised to the Hamiltonians.
 
     Attributes
@@ -298,6 +299,10 @@ class ConservedQuantities(Printable):
     system: object = field(repr=False)
     word: str = ""
     hamiltonians_c: tuple = ()
+
+    def _value(self) -> tuple:
+        """The exact data (``==``, ``hash``): the invariants (expanded), the degree, the system and word."""
+        return self.H_c, self.G_c, self.quantities, self.degree, self.system, self.word, self.hamiltonians_c
 
     def to_dict(self) -> dict:
         """``{"H_c": str, "G_c": str, "series": {"H_c": {"0": str, "2": str}, ...}}`` (``sympy.sympify`` reads them back;

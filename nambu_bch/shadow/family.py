@@ -23,6 +23,7 @@ from ..algebra.ansatz import Ansatz
 from ..parsing import as_expression
 from ..printing import Printable, aligned, h_coefficients, latex_text, series_text, series_tokens
 from ..symbols import ALPHA, STEP
+from ..values import ValueEquality
 
 
 def existence_fields(decision, failed_order) -> dict:
@@ -123,8 +124,8 @@ def _direct_shadows(result) -> tuple:
     return result.shadow()
 
 
-@dataclass(frozen=True)
-class ShadowFamily(Printable):
+@dataclass(frozen=True, eq=False)
+class ShadowFamily(Printable, ValueEquality):
     """Shadow Hamiltonians of a composition on a system, as a family.
 
     A family is immutable; it is built by :meth:`from_direct`, :meth:`from_fi` or :meth:`unperturbed`.
@@ -270,6 +271,19 @@ class ShadowFamily(Printable):
         return cls(system, composition, order, route, True, shadows=shadows, free_parameters=_free_parameters(True, shadows),
                    notes=["h^1: the correction vanishes (symmetric word)"], polynomial=polynomial,
                    fi_span=[] if route == "fi" else None)
+
+    def _value(self) -> tuple:
+        """The exact data that determine the family (``==``, ``hash``): a direct-route family's ring elements
+        ``(slot, order) -> dH`` and per-order status, never its sympy sums; an FI-route family's expressions."""
+        details = self.details
+        if self.route == "direct" and details is not None:
+            exact = (sorted(details.corrections.items(), key=lambda kv: kv[0]),
+                     [(o.order, o.status, o.degree, o.kernel_dim, o.psi_dim, o.obstruction_value) for o in details.orders])
+        else:
+            exact = (self.shadows, dict(self.corrections), dict(self.gauge))
+        return (self.system, self.composition, self.order, self.route, self.exists, self.polynomial, self.failed_order,
+                self.degree, self.notes, self.free_parameters, exact, self.certificate, self.obstruction, self.existence,
+                self.fi_span)
 
     def _outcome_headline(self) -> str:
         """The existence outcome of a family without a polynomial pair (pair / certified non-existence / undecided)."""
