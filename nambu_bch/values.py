@@ -85,6 +85,9 @@ class ValueEquality:
     Results are immutable, so the key is computed once and kept (it is not part of the pickle).
     """
 
+    #: attributes derived from the exact data on demand, left out of the pickle
+    _TRANSIENT = ("_value_cache",)
+
     def _value(self) -> tuple:  # pragma: no cover - each result type defines its own
         raise NotImplementedError
 
@@ -104,7 +107,8 @@ class ValueEquality:
 
     def __getstate__(self):
         state = dict(self.__dict__)
-        state.pop("_value_cache", None)
+        for name in self._TRANSIENT:
+            state.pop(name, None)
         return state
 
     def __setstate__(self, state):
