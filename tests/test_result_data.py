@@ -69,3 +69,15 @@ def test_layouts_are_not_pickled():
     F.to_text()
     copy = pickle.loads(pickle.dumps(F))
     assert "_layouts" not in copy.__dict__ and copy.to_text() == F.to_text() and copy == F
+
+
+def test_conserved_quantities_keep_their_ring_elements():
+    """The invariants are the exact ring elements the search found; H_c, G_c, ... are their sympy forms, converted on
+    first access, left out of the pickle, and the same after a round trip (Eqs. CQ12321H, CQ12321G)."""
+    cq = nb.conserved_quantities(nb.model("ho3"), "12321")
+    quantities, normalised = cq.exact
+    assert len(normalised) == 2 and all(q.ring == quantities[0].ring for q in (*quantities, *normalised))
+    assert "_sympy" not in cq.__dict__ and cq == pickle.loads(pickle.dumps(cq))  # equality reads the ring elements
+    assert str(cq.G_c) == "h**2*x2**2/(4*m**2) - x1**2 + x3" and cq.hamiltonians_c == (cq.H_c, cq.G_c)
+    copy = pickle.loads(pickle.dumps(cq))
+    assert "_sympy" not in copy.__dict__ and copy.exact == cq.exact and copy.to_dict() == cq.to_dict()
