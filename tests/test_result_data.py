@@ -39,10 +39,12 @@ def families():
         "lotka-volterra 12321 h^2": nb.shadow_hamiltonians(nb.model("lotka-volterra"), "12321", order=2),
         "ho 121 h^4 fi": nb.shadow_hamiltonians(nb.model("ho"), "121", order=4, route="fi"),
         "ho3 32123 h^2": nb.shadow_hamiltonians(nb.model("ho3"), "32123", order=2),
+        "pendulum 121 h^2": nb.shadow_hamiltonians(nb.model("pendulum"), "121", order=2),  # not polynomial: the sums
     }
 
 
-@pytest.mark.parametrize("case", ["ho3 12321 h^4", "lotka-volterra 12321 h^2", "ho 121 h^4 fi", "ho3 32123 h^2"])
+@pytest.mark.parametrize("case", ["ho3 12321 h^4", "lotka-volterra 12321 h^2", "ho 121 h^4 fi", "ho3 32123 h^2",
+                                  "pendulum 121 h^2"])
 def test_outputs_are_the_layout_of_the_sums(families, case):
     F = families[case]
     assert _outputs(F) == _by_sums(F)

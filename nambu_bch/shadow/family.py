@@ -319,6 +319,12 @@ class ShadowFamily(Printable, ValueEquality):
             layouts[key] = value
         return layouts[key]
 
+    def _printed(self, slot: int):
+        """``(expression, layout)`` arguments of ``series_text``/``series_tokens`` for shadow ``slot``: the layout when
+        the shadow is polynomial in ``h`` (the expression is then not needed), else the sympy sum for their fallback."""
+        layout = self._layout(slot)
+        return (self.shadows[slot], None) if layout is None else (None, layout)
+
     def _value(self) -> tuple:
         """The exact data that determine the family (``==``, ``hash``): a direct-route family's ring elements
         ``(slot, order) -> dH`` and per-order status, never its sympy sums; an FI-route family's expressions."""
@@ -388,8 +394,8 @@ class ShadowFamily(Printable, ValueEquality):
         coords = self.system.coordinates
         rows = []
         for slot, ((name, _), base) in enumerate(zip(self._names(), self.system.hamiltonians)):
-            rows.append((f"{name}_{{S}}", "=", series_tokens(name, None, base, coords, power,
-                                                                coefficients=self._layout(slot))))
+            expr, layout = self._printed(slot)
+            rows.append((f"{name}_{{S}}", "=", series_tokens(name, expr, base, coords, power, coefficients=layout)))
         for (name, _), base in zip(self._names(), self.system.hamiltonians):
             rows.append((name, "=", series_tokens("0", base, 0, coords)))
         for row in rows[:-1]:
@@ -442,8 +448,10 @@ class ShadowFamily(Printable, ValueEquality):
             return f"{self.composition.name} on {self.system.name}: {self._outcome_text()}"
         power = self.composition.remainder_power(self.order)
         coords = self.system.coordinates
-        lines = [f"{name}_S = " + series_text(name, None, base, coords, power, coefficients=self._layout(slot))
-                 for slot, ((_, name), base) in enumerate(zip(self._names(), self.system.hamiltonians))]
+        lines = []
+        for slot, ((_, name), base) in enumerate(zip(self._names(), self.system.hamiltonians)):
+            expr, layout = self._printed(slot)
+            lines.append(f"{name}_S = " + series_text(name, expr, base, coords, power, coefficients=layout))
         lines.append(", ".join(f"{name} = {base}" for (_, name), base in zip(self._names(), self.system.hamiltonians)))
         if self.free_parameters:
             lines.append("free parameters: " + ", ".join(self.free_parameters))
