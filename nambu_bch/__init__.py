@@ -9,24 +9,37 @@ from .errors import NambuBCHError
 
 # The public names are imported on first use (PEP 562), so that ``nambu-bch --help`` and argument
 # errors answer without importing sympy, numpy and numba; ``from nambu_bch import X`` works as before.
+# ``__all__`` is the curated set a session needs: systems, the shadow Hamiltonians, the exact results, the
+# effective field and formal series, numerics, design, the result types and the errors.
 _LAZY = {
-    ".algebra": ("PolynomialAlgebra", "VectorField", "is_symplectic", "lie_bracket", "liouville_field", "nambu_bracket",
-                 "poisson_bracket", "satisfies_nambu_condition"),
-    ".bseries": ("modified_equation", "runge_kutta_shadow"),
+    ".bch": ("EffectiveField", "FormalBCH", "effective_field", "formal_bch"),
+    ".bseries": ("ModifiedEquation", "modified_equation", "runge_kutta_shadow"),
     ".design": ("compare", "composition_order", "error_constant", "leading_error", "optimize_composition",
                 "order_conditions"),
-    ".bch": ("EffectiveField", "FormalBCH", "effective_field", "effective_field_bch", "expand_terms", "formal_bch"),
-    ".exact": ("F", "ConservedQuantities", "ExactShadow", "F_series", "ModifiedSolution", "conserved_quantities",
-               "exact_shadow_hamiltonians", "is_invariant", "modified_equations", "modified_solution"),
-    ".integrators": ("PAPER_WORDS", "ButcherTableau", "Composition", "butcher_tableau", "composed_map", "composition",
-                     "exact_flow", "step_function"),
-    ".numeric": ("check", "iterate", "paper_figures", "sample_times", "shadow_along", "ShadowTrajectory"),
-    ".shadow": ("LiouvilleSum", "LiouvilleTerm", "ShadowFamily", "direct_route", "fi_route", "representations",
-                "shadow_hamiltonians"),
+    ".exact": ("ConservedQuantities", "ExactShadow", "ModifiedSolution", "conserved_quantities",
+               "exact_shadow_hamiltonians", "modified_solution"),
+    ".integrators": ("PAPER_WORDS", "Composition", "composition"),
+    ".numeric": ("ShadowTrajectory", "check", "iterate", "paper_figures", "shadow_along"),
     ".parallel": ("sweep",),
-    ".systems": ("Splitting", "System", "full_split", "model", "model_names", "separate", "single_split"),
+    ".shadow": ("ShadowFamily", "shadow_hamiltonians"),
+    ".systems": ("System", "model", "model_names"),
 }
 _WHERE = {name: module for module, names in _LAZY.items() for name in names}
+
+# Route-level and building-block names of the earlier, wider top level: their home is the subpackage
+# (``nambu_bch.shadow.direct_route``, ...); they still resolve here so that existing code keeps working, but are
+# not in ``__all__`` or ``dir()``.
+_MOVED = {
+    ".algebra": ("PolynomialAlgebra", "VectorField", "is_symplectic", "lie_bracket", "liouville_field", "nambu_bracket",
+                 "poisson_bracket", "satisfies_nambu_condition"),
+    ".bch": ("effective_field_bch", "expand_terms"),
+    ".exact": ("F", "F_series", "is_invariant", "modified_equations"),
+    ".integrators": ("ButcherTableau", "butcher_tableau", "composed_map", "exact_flow", "step_function"),
+    ".numeric": ("sample_times",),
+    ".shadow": ("LiouvilleSum", "LiouvilleTerm", "direct_route", "fi_route", "representations"),
+    ".systems": ("Splitting", "full_split", "separate", "single_split"),
+}
+_MOVED_WHERE = {name: module for module, names in _MOVED.items() for name in names}
 
 
 def __getattr__(name):
@@ -34,12 +47,16 @@ def __getattr__(name):
         globals()[name] = value = _version()
         return value
     module = _WHERE.get(name)
+    moved = module is None
+    if moved:
+        module = _MOVED_WHERE.get(name)
     if module is None:
         raise AttributeError(f"module 'nambu_bch' has no attribute {name!r}")
     from importlib import import_module
 
     value = getattr(import_module(module, __name__), name)
-    globals()[name] = value
+    if not moved:  # a moved name is not cached here, so that it stays out of dir()
+        globals()[name] = value
     return value
 
 

@@ -36,7 +36,8 @@ import sympy
 from .symbols import STEP
 
 __all__ = [
-    "Printable", "HSeries", "bracket_sum", "WIDTH", "h_coefficients", "series_tokens", "series_text", "sum_tokens", "signed",
+    "Printable", "HSeries", "bracket_sum", "WIDTH", "h_coefficients", "laid_out", "series_tokens", "series_text", "sum_tokens",
+    "signed",
     "aligned", "latex_text", "display", "standalone", "flatten",
 ]
 
@@ -126,6 +127,18 @@ def h_coefficients(expr, base, coordinates, step=STEP):
     return sorted(((m[0], _by_monomial(c, coordinates)) for m, c in coefficients), key=lambda item: item[0])
 
 
+def laid_out(by_power: dict, coordinates) -> list:
+    """``[(k, c_k)]`` of :func:`h_coefficients` from the powers of ``h`` already separated: ``by_power`` maps
+    ``k`` to the expanded sympy form of ``c_k`` (an exact result's own per-order data), so the sum is never expanded
+    and regrouped; each ``c_k`` is laid out by monomials with factored coefficients, zero ones left out.
+
+    >>> x, m = sympy.symbols("x m")
+    >>> laid_out({2: x**2/(4*m)}, [x])
+    [(2, x**2/(4*m))]
+    """
+    return [(k, _by_monomial(c, coordinates)) for k, c in sorted(by_power.items()) if c != 0]
+
+
 def signed(term, first=False) -> str:
     """``+ t`` / ``- t`` LaTeX of one term (``first``: no ``+``), as sympy's Add printer writes signs."""
     term = sympy.sympify(term, strict=True)
@@ -178,13 +191,15 @@ def sum_tokens(expr, first=True) -> list:
     return [tok for i, t in enumerate(terms) for tok in _term_tokens(t, first and i == 0)]
 
 
-def series_tokens(base_latex, expr, base, coordinates, remainder=None, step=STEP) -> list:
+def series_tokens(base_latex, expr, base, coordinates, remainder=None, step=STEP, coefficients=None) -> list:
     r"""Tokens of ``base + h^k (c_k) + ... + O(h^remainder)``; ``\Bigl( \Bigr)`` may span line breaks.
 
     Falls back to ``base + (expr - base)`` term by term when the difference is not
     polynomial in ``h`` (conserved quantities of triple-jump words are rational in ``h``).
+    ``coefficients``: the ``[(k, c_k)]`` of :func:`h_coefficients` when the caller has them (:func:`laid_out`).
     """
-    coefficients = h_coefficients(expr, base, coordinates, step)
+    if coefficients is None:
+        coefficients = h_coefficients(expr, base, coordinates, step)
     tokens = [base_latex]
     if coefficients is None:  # rational in h: by monomials of the coordinates, coefficients factored
         tokens += sum_tokens(_by_monomial(sympy.expand(sympy.sympify(expr, strict=True) - sympy.sympify(base, strict=True)), coordinates), first=False)
@@ -210,14 +225,15 @@ def series_tokens(base_latex, expr, base, coordinates, remainder=None, step=STEP
     return tokens
 
 
-def series_text(base_text, expr, base, coordinates, remainder=None, step=STEP) -> str:
+def series_text(base_text, expr, base, coordinates, remainder=None, step=STEP, coefficients=None) -> str:
     """Plain-text twin of :func:`series_tokens`: ``H + h**2*(...) - h**4*x1**2/12 + O(h^4)``.
 
     >>> x, h = sympy.symbols("x h")
     >>> series_text("H", x**2/2 - h**2*x**2/8 + h**4*(x + x**2), x**2/2, [x], 6)
     'H - h**2*x**2/8 + h**4*(x**2 + x) + O(h^6)'
     """
-    coefficients = h_coefficients(expr, base, coordinates, step)
+    if coefficients is None:
+        coefficients = h_coefficients(expr, base, coordinates, step)
     text = base_text
     if coefficients is None:
         text += f" + ({sympy.expand(sympy.sympify(expr, strict=True) - sympy.sympify(base, strict=True))})"

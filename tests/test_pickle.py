@@ -7,12 +7,11 @@ fields inside them pickle as a plain exact description (:mod:`nambu_bch.algebra.
 from __future__ import annotations
 
 import dataclasses
+import functools
 import importlib
 import inspect
 import json
-import multiprocessing
 import pickle
-from concurrent.futures import ProcessPoolExecutor
 
 import numpy as np
 import pytest
@@ -32,6 +31,7 @@ def _fi_route():
     return fi_route(_ho3(), "12321", order=2)
 
 
+@functools.lru_cache(maxsize=None)  # the numerical decision (a few seconds), shared by the tests that read it
 def _existence():
     return nb.shadow_hamiltonians(nb.model("rigid-body"), "123", order=2).existence
 
@@ -92,6 +92,7 @@ BUILDERS = {
     "LiouvilleTerm": lambda: nb.LiouvilleTerm((sympy.Symbol("x3"), sympy.Symbol("x2") ** 2), 2),
     "OrderSolution": lambda: nb.shadow_hamiltonians(_ho3(), "12321", order=4).corrections._solutions[2],
     "ShadowFamily": lambda: nb.shadow_hamiltonians(_ho3(), "12321", order=4),
+    "ModifiedEquation": lambda: nb.modified_equation(nb.model("ho"), "gauss4", order=2),
     "Piece": lambda: _ho3().splitting.pieces[0],
     "Splitting": lambda: _ho3().splitting,
     "System": lambda: _ho3(),
@@ -210,6 +211,57 @@ def test_more_results_round_trip(name):
     _round_trip(EXTRA[name]())
 
 
+#: the result types that compare by value (``==`` and ``hash`` on their exact data, :mod:`nambu_bch.values`)
+VALUE_TYPES = ("ShadowFamily", "EffectiveField", "FormalBCH", "ConservedQuantities", "ExactShadow", "ModifiedSolution",
+               "ShadowTrajectory", "Existence", "ModifiedEquation")
+
+
+@pytest.mark.parametrize("name", VALUE_TYPES)
+def test_copy_is_equal(name):
+    """``pickle.loads(pickle.dumps(r)) == r`` with the same hash: equality on the exact data, not on identity."""
+    result = BUILDERS[name]()
+    copy = pickle.loads(pickle.dumps(result))
+    assert copy == result and result == copy and hash(copy) == hash(result)
+    assert copy != object() and (copy == None) is False  # noqa: E711  (NotImplemented, then identity)
+    assert pickle.loads(pickle.dumps(copy)) == result  # a copy's key, computed for ==, is not pickled stale
+
+
+@pytest.mark.parametrize("name", ["FormalBCH triple jump", "EffectiveField triple jump (cube root of 2)"])
+def test_copy_is_equal_over_an_algebraic_field(name):
+    """Coefficients in QQ<2^(1/3)> (the triple jump) compare and hash as exact field elements after a round trip."""
+    result = {"FormalBCH triple jump": lambda: nb.formal_bch("triple-jump:121", 3), **EXTRA}[name]()
+    copy = pickle.loads(pickle.dumps(result))
+    assert copy == result and hash(copy) == hash(result)
+
+
+def test_different_results_differ():
+    """Results of different requests compare unequal (the key is not too coarse)."""
+    ho3 = _ho3()
+    pairs = [
+        (nb.shadow_hamiltonians(ho3, "12321", order=4), nb.shadow_hamiltonians(ho3, "32123", order=4)),
+        (nb.shadow_hamiltonians(ho3, "12321", order=4), nb.shadow_hamiltonians(ho3, "12321", order=2)),
+        (nb.shadow_hamiltonians(nb.model("ho"), "121", order=4, route="fi"),
+         nb.shadow_hamiltonians(nb.model("ho"), "121", order=4)),
+        (nb.effective_field(ho3.splitting, "12321", order=4), nb.effective_field(ho3.splitting, "32123", order=4)),
+        (nb.formal_bch("12321", 3), nb.formal_bch("121", 3)),
+        (nb.conserved_quantities(ho3, "32123"), nb.conserved_quantities(ho3, "12321")),
+        (nb.modified_equation(nb.model("ho"), "gauss4", order=2),
+         nb.modified_equation(nb.model("ho"), "midpoint", order=2)),
+    ]
+    for a, b in pairs:
+        assert a != b and not a == b, type(a).__name__
+    # the same request twice: equal although every object inside (the systems too) is a new one
+    assert nb.shadow_hamiltonians(nb.model("ho"), "121", order=2) == nb.shadow_hamiltonians(nb.model("ho"), "121", order=2)
+
+
+def test_equality_keeps_the_sympy_sums_unbuilt():
+    """Comparing direct-route families reads the exact corrections: the sympy shadows stay pending."""
+    a = nb.shadow_hamiltonians(_ho3(), "12321", order=4)
+    b = pickle.loads(pickle.dumps(a))
+    assert a == b and hash(a) == hash(b)
+    assert callable(a.__dict__["_shadows"]) and callable(b.__dict__["_shadows"])
+
+
 def test_exact_data_survive():
     """The copy's exact polynomials are the original's: same sympy forms, same ring elements, same classes."""
     fam = nb.shadow_hamiltonians(_ho3(), "12321", order=4)
@@ -283,7 +335,8 @@ def test_sympy_rings_are_untouched():
 #: over the same parameter field QQ(I1, I2, I3) as at h^4, whose printing alone costs ~12 s of CPU per process (the
 #: h^4 family crosses the processes in "ho3 12321 h^4").
 WORKER_CASES = ("ho3 12321 h^4", "rigid-body 12321 h^2", "ho3 conserved 32123", "ho3 exact 12321",
-                "ho 121 h^4 fi", "ho3 effective field h^4", "rigid-body 123 none", "rigid-body algebra")
+                "ho 121 h^4 fi", "ho3 effective field h^4", "rigid-body 123 none", "rigid-body algebra",
+                "ho3 formal bch", "ho modified solution", "ho3 trajectory", "ho modified equation")
 
 
 def _compute(case: str):
@@ -297,25 +350,32 @@ def _compute(case: str):
         return nb.effective_field(S.splitting, "12321", order=4)
     if what == "algebra":
         return S.algebra
+    if what == "formal bch":
+        return nb.formal_bch("12321", 3)
+    if what == "modified solution":
+        return nb.modified_solution(S, "121", "o")
+    if what == "trajectory":
+        return nb.shadow_along(S, "12321", nb.iterate(S, "12321", 0.1, 20, (1, 1, 1)), 0.1)
+    if what == "modified equation":
+        return nb.modified_equation(S, "gauss4", order=2)
     if what == "123 none":
         return nb.shadow_hamiltonians(S, "123", order=2)
     word, order, *route = what.split()
     return nb.shadow_hamiltonians(S, word, order=int(order[2:]), route=route[0] if route else "direct")
 
 
-def _compute_all(cases):
-    return [_compute(case) for case in cases]
+def test_results_come_back_from_loky_workers():
+    """Every case computed in joblib/loky workers (one pool of two for this module, through
+    :func:`nambu_bch.parallel.sweep`) and sent back by pickle: each equals, hashes and prints as the same case
+    computed here."""
+    pytest.importorskip("joblib")
+    from nambu_bch.parallel import sweep
 
-
-def test_results_come_back_from_spawned_workers():
-    """Every case computed in one spawned worker (one task: one interpreter start and import, not one per case) and
-    sent back by pickle: each prints as the same case computed here."""
-    context = multiprocessing.get_context("spawn")
-    with ProcessPoolExecutor(max_workers=1, mp_context=context) as pool:
-        remote = pool.submit(_compute_all, WORKER_CASES).result()
+    remote = sweep(_compute, WORKER_CASES, backend="loky", n_jobs=2)
     for case, result in zip(WORKER_CASES, remote):
         local = _compute(case)
         assert type(result) is type(local), case
+        assert result == local and hash(result) == hash(local), case
         assert _views(result) == _views(local), case
     # an algebra from another process equals, and hashes like, this process's: content-keyed caches hit
     algebra = remote[WORKER_CASES.index("rigid-body algebra")]

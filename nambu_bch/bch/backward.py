@@ -29,6 +29,7 @@ from ..checks import MAX_ORDER, check_flag, check_int, show
 from ..errors import InvalidOrderError
 from ..integrators.composition import composition_for
 from ..printing import Printable, aligned
+from ..values import ValueEquality
 
 H = sympy.Symbol("h")
 
@@ -76,7 +77,7 @@ class FieldSeries:
 
 
 @dataclass(frozen=True, eq=False)
-class EffectiveField(FieldSeries, Printable):
+class EffectiveField(FieldSeries, Printable, ValueEquality):
     """``X_eff = sum_{j=0}^{order} h^j Z_j`` of a composition.
 
     Attributes
@@ -92,6 +93,9 @@ class EffectiveField(FieldSeries, Printable):
     composition: object
     splitting: object
 
+    def _value(self) -> tuple:
+        """The exact data (``==``, ``hash``): the ``Z_j`` as ring elements, the composition, the splitting."""
+        return self.coefficients, self.order, self.composition, self.splitting
 
     def to_latex(self) -> str:
         r"""``X_{\rm eff} &= (c_1)\partial_{x_1} + ... + h^{2}\Bigl(...\Bigr) + O(h^4)`` in an ``aligned`` block,

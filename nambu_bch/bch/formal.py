@@ -60,6 +60,7 @@ from ..integrators.composition import Composition
 from ..integrators.composition import composition as make_composition
 from ..compiled import numba_available
 from ..printing import Printable, bracket_sum
+from ..values import ValueEquality
 from .lyndon import (
     divisors,
     lyndon_expansion,
@@ -442,7 +443,7 @@ def _lyndon_coordinates(vector, d: int, g: int):
 
 
 @dataclass(frozen=True, eq=False)
-class FormalBCH(Printable):
+class FormalBCH(Printable, ValueEquality):
     """``log(exp(c_1 X_{k_1}) ... exp(c_s X_{k_s}))`` through ``max_degree`` in the Lyndon basis.
 
     Attributes
@@ -461,6 +462,10 @@ class FormalBCH(Printable):
     _domain: object = None  # None: QQ; else the algebraic field of the coefficients
     _sympy: dict = field(default_factory=dict)  # degree -> ((sympy coefficient, tree), ...), filled lazily
     _cache: dict = field(default_factory=dict)
+
+    def _value(self) -> tuple:
+        """The exact data (``==``, ``hash``): per degree the common denominator and ``(numerator, tree)`` pairs."""
+        return self.composition, self.generators, self.max_degree, self._scaled, str(self.domain)
 
     def scaled_terms(self, degree: int):
         """``(D, [(n, tree), ...])`` with coefficients ``n / D``: ``n`` a Python int (rational series) or an

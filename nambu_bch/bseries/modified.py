@@ -25,6 +25,7 @@ import sympy
 
 from ..algebra import VectorField
 from ..bch.backward import FieldSeries, check_order, modified_field_of_map
+from ..values import ValueEquality
 from ..errors import InvalidCompositionError, NambuBCHError
 from ..integrators.runge_kutta import butcher_tableau
 from . import rooted_trees as T
@@ -36,7 +37,7 @@ MAX_RK_ORDER = 8
 
 
 @dataclass(frozen=True, eq=False)
-class ModifiedEquation(FieldSeries):
+class ModifiedEquation(FieldSeries, ValueEquality):
     """``f~ = sum_{j=0}^{order} h^j Z_j`` of a Runge--Kutta method on a system (``Z_0 = f``).
 
     Attributes
@@ -54,6 +55,10 @@ class ModifiedEquation(FieldSeries):
     method: object
     system: object
     tree_coefficients: dict
+
+    def _value(self) -> tuple:
+        """The exact data (``==``, ``hash``): the ``Z_j`` as ring elements, the tableau, the system, the ``b(tree)``."""
+        return self.coefficients, self.order, self.method, self.system, self.tree_coefficients
 
 
     def to_text(self) -> str:

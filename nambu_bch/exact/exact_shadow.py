@@ -41,6 +41,7 @@ from .factor import F, F_series
 from .invariants import ConservedQuantities, conserved_quantities
 from .linear_core import linear_core
 from ..printing import Printable, aligned, series_text, series_tokens
+from ..values import ValueEquality
 from ..symbols import ALPHA, STEP
 
 OMEGA = sympy.Symbol("omega")
@@ -72,7 +73,7 @@ def factor_power_series(exponent, order: int, x=None):
 
 
 @dataclass(frozen=True, eq=False)
-class ExactShadow(Printable):
+class ExactShadow(Printable, ValueEquality):
     """The alpha-family of exact shadow Hamiltonians of a linear oscillator.
 
     Attributes
@@ -94,6 +95,11 @@ class ExactShadow(Printable):
     verified_order: int = CHECK_ORDER
     frequency: object = OMEGA
     alpha: sympy.Symbol = ALPHA
+
+    def _value(self) -> tuple:
+        """The exact data (``==``, ``hash``): the conserved quantities, the frequency and the verified order
+        determine the closed forms ``F^alpha H_c``, ``F^(1-alpha) G_c``."""
+        return self.conserved, self.frequency, self.verified_order, self.G_S is None, self.alpha
 
     @property
     def H_c(self):

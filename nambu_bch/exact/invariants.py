@@ -57,6 +57,7 @@ from ..integrators import composed_map, composition_for
 from ..integrators.flows import exact_flow
 from ..parsing import as_expression
 from ..printing import Printable, aligned, series_text, series_tokens
+from ..values import ValueEquality
 
 H_STEP = sympy.Symbol("h")
 #: Most candidate pivot sets (r-subsets of monomials, in graded order) tried by the normalisation.
@@ -276,7 +277,7 @@ def _clean(expr, coords=()):
 
 
 @dataclass(frozen=True, eq=False)
-class ConservedQuantities(Printable):
+class ConservedQuantities(Printable, ValueEquality):
     """Exact polynomial invariants of a composed map, normalised to the Hamiltonians.
 
     Attributes
@@ -289,6 +290,9 @@ class ConservedQuantities(Printable):
         (constants excluded), starting with the normalised ones
     degree : int, the ansatz degree
     system, word : what they were computed for
+    exact : ``(quantities, normalised)`` as elements of the exact ring ``QQ<ext>(parameters, h)[coordinates]``
+        (``normalised``: one per Hamiltonian, ``None`` where none tends to it), or None; when given, the sympy
+        forms above are converted from them on first access (:func:`_sympy_forms`)
     """
 
     H_c: object
@@ -298,6 +302,24 @@ class ConservedQuantities(Printable):
     system: object = field(repr=False)
     word: str = ""
     hamiltonians_c: tuple = ()
+    exact: tuple | None = field(default=None, repr=False)
+
+    #: the sympy forms, converted from ``exact`` on first access and not pickled
+    _TRANSIENT = ("_value_cache", "_sympy")
+
+    def _value(self) -> tuple:
+        """The exact data (``==``, ``hash``): the ring elements when there are, else the invariants (expanded); the
+        degree, the system and the word."""
+        if self.exact is not None:
+            return self.exact, self.degree, self.system, self.word
+        return self.H_c, self.G_c, self.quantities, self.degree, self.system, self.word, self.hamiltonians_c
+
+    def _forms(self) -> tuple:
+        """``(quantities, hamiltonians_c)`` as sympy expressions, converted from :attr:`exact` once."""
+        forms = self.__dict__.get("_sympy")
+        if forms is None:
+            forms = self.__dict__["_sympy"] = _sympy_forms(*self.exact, self.system.coordinates)
+        return forms
 
     def to_dict(self) -> dict:
         """``{"H_c": str, "G_c": str, "series": {"H_c": {"0": str, "2": str}, ...}}`` (``sympy.sympify`` reads them back;
@@ -442,12 +464,36 @@ def _conserved(system, name, comp, degree, auto):
     for b in basis:
         if _rank(setup, quantities + [b]) > len(quantities):
             quantities.append(_primitive(b))
-    coords = system.coordinates
-    exprs = tuple(_clean(q.as_expr(), coords) for q in quantities)
-    hams = tuple(None if I is None else _clean(I.as_expr(), coords) for I in normalised)
-    H_c = hams[0]
-    G_c = hams[1] if len(hams) > 1 else None
-    return ConservedQuantities(H_c, G_c, exprs, degree, system, name, hams)
+    # the ring elements are the result; H_c, G_c, ... are their sympy forms, converted on first access
+    return ConservedQuantities(None, None, (), degree, system, name, (), exact=(tuple(quantities), normalised))
+
+
+def _sympy_forms(quantities, normalised, coordinates) -> tuple:
+    """``(quantities, hamiltonians_c)``: the expanded sympy forms of exact invariants (:func:`_clean`)."""
+    return (tuple(_clean(q.as_expr(), coordinates) for q in quantities),
+            tuple(None if I is None else _clean(I.as_expr(), coordinates) for I in normalised))
+
+
+def _form(name):
+    """A field of :class:`ConservedQuantities` read from the sympy forms of its exact data when it has them."""
+
+    def get(self):
+        if self.__dict__.get("exact") is None:
+            return self.__dict__["_" + name]
+        quantities, hams = self._forms()
+        return {"quantities": quantities, "hamiltonians_c": hams, "H_c": hams[0],
+                "G_c": hams[1] if len(hams) > 1 else None}[name]
+
+    def put(self, value):
+        self.__dict__["_" + name] = value  # the frozen dataclass's __init__ assigns through object.__setattr__
+
+    return property(get, put, doc=f"``{name}`` as sympy expressions (from :attr:`ConservedQuantities.exact`)")
+
+
+# after @dataclass: the generated __init__ assigns through the properties (the defaults stay the fields' own)
+for _name in ("H_c", "G_c", "quantities", "hamiltonians_c"):
+    setattr(ConservedQuantities, _name, _form(_name))
+del _name
 
 
 def _rank(setup, polys) -> int:

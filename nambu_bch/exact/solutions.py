@@ -46,6 +46,7 @@ from .exact_shadow import OMEGA, exact_shadow_hamiltonians, frequency
 from .invariants import conserved_quantities
 from .linear_core import linear_core
 from ..symbols import STEP
+from ..values import ValueEquality
 
 TIME = sympy.Symbol("t")
 KINDS = ("o", "c", "s")
@@ -155,7 +156,7 @@ def _closed_form(system, rhs, t):
 
 
 @dataclass(frozen=True, eq=False)
-class ModifiedSolution:
+class ModifiedSolution(ValueEquality):
     """The exact solution of the modified Nambu equations of one ``kind``.
 
     Attributes
@@ -178,6 +179,11 @@ class ModifiedSolution:
     system: object = field(repr=False)
     time: sympy.Symbol = TIME
     step_frequency: object = OMEGA
+
+    def _value(self) -> tuple:
+        """The exact data (``==``, ``hash``): the closed-form solution, its frequency, equations, kind, word, system."""
+        return (self.expressions, self.initial_symbols, self.frequency, self.equations, self.kind, self.word, self.system,
+                self.time, self.step_frequency)
 
     def numeric(self, params=None, h=0.1):
         """``f(t, x0) -> array (N, len(t))``, the solution lambdified once for float ``t`` arrays.

@@ -33,13 +33,14 @@ from ..integrators.step import parameter_values
 from .diagnostics import QUANTITY_NAMES, _json_float, _names, drift_rate, numpy_function, quantities
 from .guards import finite_array
 from .iterate import as_system
+from ..values import ValueEquality
 
 #: Quantities evaluated when ``which`` is not given (those a system and word do not have are left out).
 DEFAULT_QUANTITIES = ("H", "G", "H_S", "G_S")
 
 
-@dataclass
-class ShadowTrajectory:
+@dataclass(eq=False)
+class ShadowTrajectory(ValueEquality):
     """``H``, ``G``, ``H_S``, ``G_S`` (and any other requested quantity) along one trajectory.
 
     Attributes
@@ -68,6 +69,11 @@ class ShadowTrajectory:
     drift: dict = field(default_factory=dict)
     skipped: dict = field(default_factory=dict)
     system: object = field(default=None, repr=False, compare=False)  # for the JSON head (coordinates, parameters)
+
+    def _value(self) -> tuple:
+        """The samples as data (``==``, ``hash``): arrays by dtype, shape and bytes, the system by its definition."""
+        return (self.model, self.integrator, self.h, self.order, self.alpha, self.params, self.t, self.values,
+                self.max_abs_error, self.drift, self.skipped, self.system)
 
     @property
     def n_samples(self) -> int:

@@ -78,6 +78,7 @@ from ..errors import NambuBCHError
 from ..parsing import as_expression
 from .averaging import orbit_average, orbit_functions, sample_points, section_integral
 from ..symbols import ALPHA, STEP
+from ..values import ValueEquality
 
 MAX_EXACT_UNKNOWNS = 400  # the exact decomposition g = X(p) + c(H, G) is refused above this size
 DEFAULT_ORBITS = 6
@@ -85,8 +86,8 @@ PERIODS = 6.0  # length of the drift measurement, in orbit periods
 SLACK = 2  # extra degree of p in the exact decomposition (the fields are not homogeneous)
 
 
-@dataclass
-class Existence:
+@dataclass(eq=False)
+class Existence(ValueEquality):
     """The decision at the first order the polynomial ansatz did not solve.
 
     Attributes
@@ -121,6 +122,11 @@ class Existence:
     names: tuple = ()
     functions: object = field(default=None, repr=False)
     sections: tuple = ()
+
+    def _value(self) -> tuple:
+        """The decision as data (``==``, ``hash``); ``functions``, the numerical integrands, are rebuilt from it."""
+        return (self.outcome, self.exists, self.order, self.method, self.averages, self.involution, self.orbits,
+                self.certificate_orbit, self.drift, self.measured, self.reason, self.params, self.names, self.sections)
 
     def correction(self, x, index=None) -> np.ndarray:
         """The smooth corrections ``(a_H, a_G)`` at ``x``: ``H + h^j a_H`` and ``G + h^j a_G`` are conserved to ``O(h^{j+1})``.

@@ -21,8 +21,9 @@ import sympy
 
 from ..algebra.ansatz import Ansatz
 from ..parsing import as_expression
-from ..printing import Printable, aligned, h_coefficients, latex_text, series_text, series_tokens
+from ..printing import Printable, aligned, h_coefficients, laid_out, latex_text, series_text, series_tokens
 from ..symbols import ALPHA, STEP
+from ..values import ValueEquality
 
 
 def existence_fields(decision, failed_order) -> dict:
@@ -123,8 +124,30 @@ def _direct_shadows(result) -> tuple:
     return result.shadow()
 
 
-@dataclass(frozen=True)
-class ShadowFamily(Printable):
+def _exact_layout(result, slot: int, hamiltonian, coordinates, with_base: bool):
+    """``[(k, c_k)]`` of the shadow ``H^slot + sum_k h^k dH_k`` (:func:`~nambu_bch.printing.h_coefficients` with base
+    ``0`` when ``with_base``, else the Hamiltonian) from the direct route's exact per-order corrections.
+
+    Each correction is converted on its own (``PolynomialAlgebra.expanded_terms``, the terms ``sympy.expand``
+    gives), so the shadow's whole sum is neither expanded nor regrouped by powers of ``h``.  None when a piece is not
+    a polynomial or the system's Hamiltonian is not the ring's own expanded form (the caller then lays out the sum).
+    """
+    alg = result.algebra
+    Ha = result.hamiltonians[slot]
+    parts = {k: result.corrections[(slot, k)] for k in range(1, result.order + 1) if result.corrections.get((slot, k))}
+    if not all(alg.is_polynomial(p) for p in (Ha, *parts.values())):
+        return None
+    base = sympy.Add(*alg.expanded_terms(Ha, ()))
+    if base != sympy.expand(hamiltonian):
+        return None
+    by_power = {k: sympy.Add(*alg.expanded_terms(p, ())) for k, p in parts.items()}
+    if with_base:
+        by_power[0] = base
+    return laid_out(by_power, coordinates)
+
+
+@dataclass(frozen=True, eq=False)
+class ShadowFamily(Printable, ValueEquality):
     """Shadow Hamiltonians of a composition on a system, as a family.
 
     A family is immutable; it is built by :meth:`from_direct`, :meth:`from_fi` or :meth:`unperturbed`.
@@ -271,6 +294,50 @@ class ShadowFamily(Printable):
                    notes=["h^1: the correction vanishes (symmetric word)"], polynomial=polynomial,
                    fi_span=[] if route == "fi" else None)
 
+    #: derived data kept after the first output and not pickled (the copy derives them again from the exact data)
+    _TRANSIENT = ("_value_cache", "_layouts")
+
+    def _n_shadows(self) -> int:
+        """How many shadow Hamiltonians the family has, without building a pending family's sympy sums."""
+        value = self.__dict__.get("_shadows", ())
+        return len(self.system.hamiltonians) if callable(value) else len(value)
+
+    def _layout(self, slot: int, with_base: bool = False):
+        """``[(k, c_k)]`` of the shadow ``slot`` by powers of ``h`` (:func:`~nambu_bch.printing.h_coefficients`, base
+        ``0`` when ``with_base``, else the Hamiltonian), each ``c_k`` by monomials with factored coefficients; computed
+        once and shared by the text, LaTeX and JSON outputs.  A direct-route family lays out its exact per-order
+        corrections (:func:`_exact_layout`) instead of expanding and regrouping the sympy sum."""
+        layouts = self.__dict__.setdefault("_layouts", {})
+        key = (slot, with_base)
+        if key not in layouts:
+            coords, hamiltonian = self.system.coordinates, self.system.hamiltonians[slot]
+            value = None
+            if self.route == "direct" and self.exists and self.details is not None:
+                value = _exact_layout(self.details, slot, hamiltonian, coords, with_base)
+            if value is None:
+                value = h_coefficients(self.shadows[slot], 0 if with_base else hamiltonian, coords)
+            layouts[key] = value
+        return layouts[key]
+
+    def _printed(self, slot: int):
+        """``(expression, layout)`` arguments of ``series_text``/``series_tokens`` for shadow ``slot``: the layout when
+        the shadow is polynomial in ``h`` (the expression is then not needed), else the sympy sum for their fallback."""
+        layout = self._layout(slot)
+        return (self.shadows[slot], None) if layout is None else (None, layout)
+
+    def _value(self) -> tuple:
+        """The exact data that determine the family (``==``, ``hash``): a direct-route family's ring elements
+        ``(slot, order) -> dH`` and per-order status, never its sympy sums; an FI-route family's expressions."""
+        details = self.details
+        if self.route == "direct" and details is not None:
+            exact = (sorted(details.corrections.items(), key=lambda kv: kv[0]),
+                     [(o.order, o.status, o.degree, o.kernel_dim, o.psi_dim, o.obstruction_value) for o in details.orders])
+        else:
+            exact = (self.shadows, dict(self.corrections), dict(self.gauge))
+        return (self.system, self.composition, self.order, self.route, self.exists, self.polynomial, self.failed_order,
+                self.degree, self.notes, self.free_parameters, exact, self.certificate, self.obstruction, self.existence,
+                self.fi_span)
+
     def _outcome_headline(self) -> str:
         """The existence outcome of a family without a polynomial pair (pair / certified non-existence / undecided)."""
         return {True: "shadow Hamiltonians exist in smooth functions but are not polynomial",
@@ -318,7 +385,7 @@ class ShadowFamily(Printable):
         H &= \frac{m \omega^{2} x_{1}^{2}}{2} + \frac{x_{2}^{2}}{2 m}
         \end{aligned}
         """
-        if not self.shadows:
+        if not self._n_shadows():
             rows = self._obstruction_rows()
             if self.evidence is not None:
                 rows.insert(0, ("", "", [latex_text(self._outcome_headline())]))
@@ -326,8 +393,9 @@ class ShadowFamily(Printable):
         power = self.composition.remainder_power(self.order)
         coords = self.system.coordinates
         rows = []
-        for (name, _), S, base in zip(self._names(), self.shadows, self.system.hamiltonians):
-            rows.append((f"{name}_{{S}}", "=", series_tokens(name, S, base, coords, power)))
+        for slot, ((name, _), base) in enumerate(zip(self._names(), self.system.hamiltonians)):
+            expr, layout = self._printed(slot)
+            rows.append((f"{name}_{{S}}", "=", series_tokens(name, expr, base, coords, power, coefficients=layout)))
         for (name, _), base in zip(self._names(), self.system.hamiltonians):
             rows.append((name, "=", series_tokens("0", base, 0, coords)))
         for row in rows[:-1]:
@@ -374,14 +442,16 @@ class ShadowFamily(Printable):
         H = m*omega**2*x1**2/2 + x2**2/(2*m)
         h^1: the correction vanishes (odd order of a symmetric word)
         """
-        if not self.shadows:
+        if not self._n_shadows():
             if self.evidence is None:
                 return f"no polynomial shadow Hamiltonians for {self.composition.name} on {self.system.name}: {self.obstruction}"
             return f"{self.composition.name} on {self.system.name}: {self._outcome_text()}"
         power = self.composition.remainder_power(self.order)
         coords = self.system.coordinates
-        lines = [f"{name}_S = " + series_text(name, S, base, coords, power)
-                 for (_, name), S, base in zip(self._names(), self.shadows, self.system.hamiltonians)]
+        lines = []
+        for slot, ((_, name), base) in enumerate(zip(self._names(), self.system.hamiltonians)):
+            expr, layout = self._printed(slot)
+            lines.append(f"{name}_S = " + series_text(name, expr, base, coords, power, coefficients=layout))
         lines.append(", ".join(f"{name} = {base}" for (_, name), base in zip(self._names(), self.system.hamiltonians)))
         if self.free_parameters:
             lines.append("free parameters: " + ", ".join(self.free_parameters))
@@ -391,8 +461,8 @@ class ShadowFamily(Printable):
     def series(self) -> dict:
         """``{"H_S": {k: c_k}, "G_S": {...}}``: the coefficient of ``h^k`` of each shadow Hamiltonian (k = 0 is H)."""
         out = {}
-        for (_, name), S in zip(self._names(), self.shadows):
-            coefficients = h_coefficients(S, 0, self.system.coordinates) or []
+        for slot, (_, name) in enumerate(self._names()[:self._n_shadows()]):
+            coefficients = self._layout(slot, with_base=True) or []
             out[f"{name}_S"] = {k: sympy.expand(c) for k, c in coefficients}
         return out
 
