@@ -54,6 +54,8 @@ def test_rkn_ideal_contains_the_relation_and_annihilator_is_its_complement():
 @pytest.mark.parametrize("name, general, rkn", [
     ("bm-srkn6", 4, 4),     # Table 3, SRKN_6^b
     ("bm-srkn11", 4, 6),    # Table 3, SRKN_11^b: order 6 only for RKN problems
+    ("bm-srkn14", 4, 6),    # Table 3, SRKN_14^a
+    ("mclachlan-sb3a4", 4, 4),  # McLachlan (1995), SB3A with 4 stages
     ("pefrl", 4, 4),        # PEFRL
     ("blanes-moan", 4, 4),  # Table 2, S6 (a general method)
 ])

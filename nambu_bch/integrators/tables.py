@@ -107,6 +107,41 @@ BM_SRKN11 = MethodTable("bm-srkn11", f"{_BM} (SRKN_11^b)", 6, 11, True, "ab",
 PEFRL = MethodTable("pefrl", "Omelyan, Mryglod & Folk, Comput. Phys. Commun. 146 (2002) 188, Eq. (20) (PEFRL)", 4, 4,
                     True, "ab", (("0.1786178958448091", "-0.06626458266981849"), ("0.7123418310626054",)),
                     takes_word=False)
+#: SRKN_14^a: drifts a_1..a_7 (middle a_8 = 1 - 2 sum) and kicks b_1..b_6 (middle pair b_7 = 1/2 - sum); the digits
+#: as transcribed in Principia's integrators/methods.hpp (BlanesMoan2002SRKN14A).
+BM_SRKN14 = MethodTable("bm-srkn14", f"{_BM} (SRKN_14^a)", 6, 14, True, "ab",
+                        (("0.0378593198406116", "0.102635633102435", "-0.0258678882665587", "0.314241403071447",
+                          "-0.130144459517415", "0.106417700369543", "-0.00879424312851058"),
+                         ("0.09171915262446165", "0.183983170005006", "-0.05653436583288827", "0.004914688774712854",
+                          "0.143761127168358", "0.328567693746804")),
+                        takes_word=False, structure="rkn")
+_McL = "McLachlan, SIAM J. Sci. Comput. 16 (1995) 151"
+#: SB3A_4: drifts a_1, a_2 (middle 1 - 2 sum = 2/3), kicks 1 then the pair -1/2; 20 digits as transcribed in
+#: Principia's integrators/methods.hpp (McLachlan1995SB3A4).
+MCLACHLAN_SB3A4 = MethodTable("mclachlan-sb3a4", f"{_McL} (SB3A, 4 stages)", 4, 4, True, "ab",
+                              (("0.18819521776883821787", "-0.021528551102171551201"), ("1",)),
+                              takes_word=False, structure="rkn")
+
+# General two-part methods (any splitting).
+#: Blanes-Moan S10: a_1..a_5 (middle 1 - 2 sum) and b_1..b_4 (middle pair 1/2 - sum), as in blanes-moan (S6).
+BLANES_MOAN_S10 = MethodTable("blanes-moan-s10", "Blanes & Moan, J. Comput. Appl. Math. 142 (2002) 313, Table 2 (S10)",
+                              6, 10, True, "ab",
+                              (("0.0502627644003922", "0.413514300428344", "0.0450798897943977", "-0.188054853819569",
+                                "0.541960678450780"),
+                               ("0.148816447901042", "-0.132385865767784", "0.067307604692185", "0.432666402578175")),
+                              takes_word=False)
+#: McLachlan's S2 = A(b) B(1/2) A(1 - 2b) B(1/2) A(b), b = 0.19318332750378357396 (the minimum-norm 2-stage
+#: method; 20 digits as transcribed in Principia's integrators/methods.hpp, McLachlan1995S2).
+MCLACHLAN_S2 = MethodTable("mclachlan-s2", f"{_McL} (S2, 2 stages)", 2, 2, True, "ab",
+                           (("0.19318332750378357396",), ()), takes_word=False)
+#: McLachlan's S4 (4 stages, order 4): A outer b_1, b_2 (middle 1 - 2 sum); B outer 6/11 (middle pair -1/22).
+MCLACHLAN_S4 = MethodTable("mclachlan-s4", f"{_McL} (S4, 4 stages)", 4, 4, True, "ab",
+                           (("0.16913927992207204518", "-0.29918620390405079951"), ("0.54545454545454545455",)),
+                           takes_word=False)
+#: McLachlan's S5 (5 stages, order 4): A outer b_1, b_2 (middle pair 1/2 - sum); B outer 0.4, -0.1 (middle 0.4).
+MCLACHLAN_S5 = MethodTable("mclachlan-s5", f"{_McL} (S5, 5 stages)", 4, 5, True, "ab",
+                           (("0.089269454226475244887", "-0.097336042636895508015"), ("0.4", "-0.1")),
+                           takes_word=False)
 
 # Near-integrable methods for A + eps B (piece 1 = A): nodes and weights of Gauss (SABA) and Lobatto (SBAB)
 # quadrature, exact; Laskar & Robutel give the generalised order (2n, 2).
@@ -125,7 +160,8 @@ SBAB3 = MethodTable("sbab3", f"{_LR} (SBAB_3)", 2, 3, True, "ab", (("1/12",), ("
                     takes_word=False, first=2, structure="near-integrable", generalized=(6, 2), exact=True)
 
 #: Every table by name.
-TABLES = {t.name: t for t in (TRIPLE_JUMP, SUZUKI, KAHAN_LI, YOSHIDA6, BLANES_MOAN, BM_SRKN6, BM_SRKN11, PEFRL,
+TABLES = {t.name: t for t in (TRIPLE_JUMP, SUZUKI, KAHAN_LI, YOSHIDA6, BLANES_MOAN, BLANES_MOAN_S10, MCLACHLAN_S2,
+                              MCLACHLAN_S4, MCLACHLAN_S5, BM_SRKN6, BM_SRKN11, BM_SRKN14, MCLACHLAN_SB3A4, PEFRL,
                               SABA2, SABA3, SABA4, SBAB2, SBAB3)}
 #: The tables built by :mod:`.methods` (published decimals, or exact formulas); the jumps are built in :mod:`.composition`.
 DECIMAL = tuple(name for name, t in TABLES.items() if t.kind != "jump")
