@@ -134,3 +134,24 @@ def test_generalized_order_refuses_bad_input():
         generalized_order("121", powers=0)
     with pytest.raises(InvalidCompositionError, match="two pieces"):
         generalized_order("12321")
+
+
+def test_srkn11_is_sixth_order_on_the_pendulum_numerically():
+    """Independent of the algebra: on H = p^2/2 - cos q (T quadratic) the global error of SRKN_11^b falls as h^6, and
+    that of a general fourth-order method (Blanes-Moan S6) as h^4."""
+    import math
+
+    def run(name, h, t_end=2.0, q=1.0, p=0.0):
+        factors = [(k, float(c)) for k, c in nb.composition(name).factors()]
+        for _ in range(round(t_end / h)):
+            for k, c in factors:
+                if k == 1:
+                    q += c * h * p
+                else:
+                    p -= c * h * math.sin(q)
+        return q, p
+
+    reference = run("bm-srkn11", 0.01)
+    for name, slope in (("bm-srkn11", 6), ("blanes-moan", 4)):
+        errors = [math.hypot(*(a - b for a, b in zip(run(name, h), reference))) for h in (0.4, 0.2)]
+        assert math.log2(errors[0] / errors[1]) == pytest.approx(slope, abs=0.4)
