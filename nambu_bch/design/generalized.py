@@ -264,9 +264,9 @@ class EffectiveOrder:
     kernel : Composition or GradientComposition
     order : int             -- the effective order ``p``
     squared : sympy number  -- the squared effective error constant (degree ``p + 1``, module docstring), exact
-    processor : dict        -- ``{q: coordinates of Z_q on the Lyndon brackets P_u}``: the processor's log ``Z = sum
-                               h^q Z_q``, degree by degree (one choice: ``Z_q`` is determined up to the kernel of
-                               ``ad_X``, multiples of ``X`` at ``q = 1``)
+    processor : dict        -- ``{q: coordinates of Z_q on the Lyndon brackets P_u}``: the processor's log
+                               ``Z = sum h^q Z_q``, degree by degree (one choice: ``Z_q`` is determined up to the
+                               kernel of ``ad_X``, multiples of ``X`` at ``q = 1``)
     structure : str
     """
 
@@ -404,7 +404,7 @@ def _gradient_spec(spec) -> GradientComposition:
         return gradient_composition(spec)
     from ..integrators.composition import composition as make_composition
 
-    comp = make_composition(spec)
+    comp = make_composition(spec, 2)
     if set(comp.pieces) != {1, 2}:
         raise InvalidCompositionError(f"composition {comp.name!r} must use exactly the pieces 1 and 2, got {sorted(set(comp.pieces))}")
     return GradientComposition(tuple((k, c, sympy.Integer(0)) for k, c in comp.factors()), comp.name, comp.order,

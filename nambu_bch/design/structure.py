@@ -189,14 +189,15 @@ def structured_analysis(spec, structure="rkn"):
     Blanes, Casas & Murua, Acta Numerica 33 (2024), Sect. 3; Blanes & Moan, J. Comput. Appl. Math. 142 (2002) 313.
     """
     from ..integrators.composition import composition as make_composition
-    from .conditions import ErrorConstant, _Exact
+    from .conditions import ErrorConstant, _check_work, _Exact
 
     structure = check_structure(structure)
-    comp = make_composition(spec)
+    comp = make_composition(spec, 2)
     _check_two_pieces(comp, f"structure {structure!r}")
     field = _Exact(comp)
     bound = float(getattr(comp, "error_bound", 0.0) or 0.0)
     for degree in range(1, MAX_STRUCTURED_DEGREE + 1):
+        _check_work(2, degree, len(comp.pieces), f"{structure} order of {comp.name!r}")
         pairs = _log_vectors(field, degree)
         exact = [field.K.to_sympy(v) for _, v in pairs]
         residual = _residual(exact, degree, structure)
@@ -299,13 +300,13 @@ def generalized_order(spec, powers: int = 2, max_degree: int = 9) -> Generalized
     """
     from ..checks import is_int
     from ..integrators.composition import composition as make_composition
-    from .conditions import _Exact
+    from .conditions import _check_work, _Exact
 
     if not is_int(powers, 1, 8):
         raise InvalidOrderError(f"powers must be an integer in 1..8 (powers of eps), got {powers!r}")
     if not is_int(max_degree, 2, MAX_NEAR_INTEGRABLE_DEGREE):
         raise InvalidOrderError(f"max_degree must be an integer in 2..{MAX_NEAR_INTEGRABLE_DEGREE}, got {max_degree!r}")
-    comp = make_composition(spec)
+    comp = make_composition(spec, 2)
     _check_two_pieces(comp, "a near-integrable splitting A + eps B")
     field = _Exact(comp)
     bound = float(getattr(comp, "error_bound", 0.0) or 0.0)
@@ -316,6 +317,7 @@ def generalized_order(spec, powers: int = 2, max_degree: int = 9) -> Generalized
             break
         if comp.symmetric and degree % 2 == 0:
             continue
+        _check_work(2, degree, len(comp.pieces), f"generalised order of {comp.name!r}")
         by_power: dict = {}
         for w, v in _log_vectors(field, degree):
             by_power.setdefault(w.count(2), []).append(field.K.to_sympy(v))
