@@ -66,6 +66,14 @@ def test_published_rkn_orders(name, general, rkn):
     assert R.to_dict()["structure"] == "rkn" and "structure" not in E.to_dict()
 
 
+def test_rkn_method_on_three_parts_keeps_a_tight_bound():
+    """CheckMethods' ABC rule on an RKN method: its RKN order says nothing about three general parts, so the stated
+    bound covers the general conditions only (not the order-6 defects, which would pass for order 6)."""
+    E = error_analysis("bm-srkn11", 3)
+    assert E.order == 4 and 0 < E.tolerance < 1e-14
+    assert nb.composition("bm-srkn11").structure == "rkn" and nb.composition("blanes-moan").structure == ""
+
+
 def test_rkn_constant_of_a_general_low_order_method_is_its_lem():
     """Below degree 4 the ideal is empty: the RKN constant of Strang (order 2, degree 3) is its LEM, exactly."""
     R = error_analysis("121", structure="rkn")

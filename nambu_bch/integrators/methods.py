@@ -26,9 +26,11 @@ NAMES = DECIMAL
 
 @dataclass(frozen=True)
 class CatalogComposition(Composition):
-    """A literature composition with decimal coefficients: ``error_bound`` is its largest order-condition defect."""
+    """A literature composition with decimal coefficients: ``error_bound`` is its largest order-condition defect;
+    ``structure`` the problem class its published order needs (``""`` any splitting, ``"rkn"``)."""
 
     error_bound: float = 0.0
+    structure: str = ""
 
 
 def _palindrome(outer):
@@ -65,7 +67,7 @@ def with_error_bound(comp: Composition, parts: int, structure: str = "") -> Cata
         bound = max(bound, structured_bound(comp, comp.order, structure))
     return CatalogComposition(comp.pieces, comp.coefficients, comp.name,
                               comp.order, comp.citation + f"; decimals as exact rationals, order conditions to {bound:.1e}",
-                              bound)
+                              bound, structure)
 
 
 def _base(word: str | None, n_pieces, name):
