@@ -5,9 +5,9 @@ Published values pinned here:
   RKN problems (``bm-srkn6``, ``bm-srkn11``);
 * Omelyan, Mryglod & Folk, Comput. Phys. Commun. 146 (2002) 188, PEFRL: order 4;
 * Laskar & Robutel, Celest. Mech. Dyn. Astr. 80 (2001) 39, Sect. 3: SABA_n and SBAB_n have generalised order (2n, 2);
-* Blanes, Casas & Murua, arXiv:0812.0377 (Bol. Soc. Esp. Mat. Apl. 45 (2008) 89), Sect. 3 and Acta Numerica 33
-  (2024), Sect. 3: the numbers of independent order conditions, 2, 1, 2, 3, 6, 9, 18, 30, 56 in general and
-  2, 1, 2, 2, 4, 5, 10, 15, 26 for RKN problems.
+* the numbers of independent order conditions per degree: Witt's 2, 1, 2, 3, 6, 9, 18, 30, 56 in general, and
+  2, 1, 2, 2, 4, 5, 10, 15 for RKN problems (Blanes, Casas & Murua, Acta Numerica 33 (2024), Sect. 3; the 26 at
+  degree 9 is this computation's).
 """
 
 from __future__ import annotations

@@ -127,7 +127,8 @@ def condition_counts(max_degree: int, structure=None) -> tuple:
     """The number of independent order conditions at degrees ``1..max_degree`` of a two-part splitting.
 
     ``structure=None``: the Witt dimensions 2, 1, 2, 3, 6, 9, 18, 30, ...; ``"rkn"``: ``dim L_q - dim I_q``,
-    2, 1, 2, 2, 4, 5, 10, 15, ... (Blanes, Casas & Murua 2008, Table 1; Acta Numerica 2024, Sect. 3).
+    2, 1, 2, 2, 4, 5, 10, 15, ... (16 conditions for order 6 against 23 in general; the counts of the RKN Lie
+    algebra, Blanes, Casas & Murua, Acta Numerica 33 (2024), Sect. 3), computed here from the ideal.
     """
     if not isinstance(max_degree, int) or isinstance(max_degree, bool) or not 1 <= max_degree <= MAX_STRUCTURED_DEGREE:
         raise InvalidOrderError(f"max_degree must be an integer in 1..{MAX_STRUCTURED_DEGREE}, got {max_degree!r}")
