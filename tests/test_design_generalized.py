@@ -3,7 +3,8 @@
 Published values pinned here:
 * Chin, Phys. Lett. A 226 (1997) 344, algorithm 4A: order 4 with B~ = B + (h^2/48)[B,[A,B]];
 * Takahashi & Imada, J. Phys. Soc. Jpn. 53 (1984) 3765: the kernel A(1/2) B~ A(1/2), B~ = B + (h^2/24)[B,[A,B]],
-  has effective order 4 (Blanes, Casas & Ros, SIAM J. Sci. Comput. 21 (1999) 711, Sect. 5).
+  has effective order 4 with a processor (the processed kernel of Takahashi & Imada; Blanes, Casas & Ros,
+  SIAM J. Sci. Comput. 21 (1999) 711, on processing).
 """
 
 from __future__ import annotations

@@ -30,8 +30,7 @@ References
 ----------
 Chin, *Symplectic integrators from composite operator factorizations*, Phys. Lett. A 226 (1997) 344 (4A);
 Takahashi & Imada, J. Phys. Soc. Jpn. 53 (1984) 3765 (the processed kernel with ``V + (h^2/24) |grad V|^2``);
-Blanes, Casas & Ros, *Symplectic integration with processing: a general study*, SIAM J. Sci. Comput. 21 (1999) 711,
-and *Processed symplectic integrators for Runge-Kutta-Nystrom problems*, Appl. Numer. Math. 39 (2001) 281;
+Blanes, Casas & Ros, *Symplectic integration with processing: a general study*, SIAM J. Sci. Comput. 21 (1999) 711;
 Blanes, Casas & Murua, Acta Numerica 33 (2024), Sects. 3-4.
 """
 
@@ -303,7 +302,7 @@ def effective_order(kernel, structure=None, max_degree: int = 7) -> EffectiveOrd
 
     References
     ----------
-    Blanes, Casas & Ros, SIAM J. Sci. Comput. 21 (1999) 711; Appl. Numer. Math. 39 (2001) 281.
+    Blanes, Casas & Ros, SIAM J. Sci. Comput. 21 (1999) 711.
 
     Examples
     --------

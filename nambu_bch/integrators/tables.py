@@ -104,7 +104,7 @@ BM_SRKN11 = MethodTable("bm-srkn11", f"{_BM} (SRKN_11^b)", 6, 11, True, "ab",
                         takes_word=False, first=2, structure="rkn")
 #: PEFRL: drifts xi, chi (middle 1 - 2(xi + chi)); kicks (1 - 2 lambda)/2 = 1/2 - lambda, then the pair lambda.
 #: xi = 0.1786178958448091, lambda = -0.2123418310626054, chi = -0.06626458266981849 as published.
-PEFRL = MethodTable("pefrl", "Omelyan, Mryglod & Folk, Comput. Phys. Commun. 146 (2002) 188, Eq. (20) (PEFRL)", 4, 4,
+PEFRL = MethodTable("pefrl", "Omelyan, Mryglod & Folk, Comput. Phys. Commun. 146 (2002) 188 (PEFRL)", 4, 4,
                     True, "ab", (("0.1786178958448091", "-0.06626458266981849"), ("0.7123418310626054",)),
                     takes_word=False)
 #: SRKN_14^a: drifts a_1..a_7 (middle a_8 = 1 - 2 sum) and kicks b_1..b_6 (middle pair b_7 = 1/2 - sum); the digits
