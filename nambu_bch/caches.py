@@ -48,6 +48,8 @@ CACHES = (
     ("nambu_bch.bseries.rooted_trees", "symmetry"),
     ("nambu_bch.bseries.rooted_trees", "density"),
     ("nambu_bch.bseries.rooted_trees", "trees"),
+    ("nambu_bch.design.structure", "rkn_ideal"),
+    ("nambu_bch.design.structure", "rkn_annihilator"),
     ("nambu_bch.exact.exact_shadow", "_exact_shadow"),
     ("nambu_bch.exact.invariants", "_conserved"),
     ("nambu_bch.exact.solutions", "_lambdify"),

@@ -40,6 +40,7 @@ def test_three_parts_rule_on_small_words():
     ("121", 2, 1.20),                  # row "Strang"
     ("forest-ruth", 4, 26.04),         # row "Y 4-4"
     ("blanes-moan", 4, 0.11),          # row "Emb 4/3 BM PRK/A" (its 4th-order method, Blanes & Moan 2002, S6)
+    ("blanes-moan-s10", 6, 0.45),      # row "BM 11-6 PRK" (Blanes & Moan 2002, Table 2, S10)
     ("yoshida6:121", 6, 90.86),        # row "Y 8-6"
     ("kahan-li:121", 6, 10.70),        # row "KL 10-6"
 ])
@@ -160,3 +161,16 @@ def test_complex_formal_bch_agrees_with_the_defects():
 def test_complex_coefficients_refused_on_a_system():
     with pytest.raises(InvalidCompositionError, match="complex coefficients.*not yet on a system"):
         nb.effective_field(nb.model("ho").splitting, "1:1/2+I/2,2:1,1:1/2-I/2", order=2)
+
+
+def test_ab_column_of_blanes_moan_s10():
+    """CheckMethods.ipynb, first table, row "BM 11-6 PRK", columns ``AB p`` and ``AB LEM``: 6 and 0.05."""
+    E = error_analysis("blanes-moan-s10", 2)
+    assert E.order == 6 and round(E.value, 2) == 0.05 and 0 < E.tolerance < 1e-14
+
+
+@pytest.mark.parametrize("name, order, stages", [("mclachlan-s2", 2, 2), ("mclachlan-s4", 4, 4), ("mclachlan-s5", 4, 5)])
+def test_mclachlan_1995_methods(name, order, stages):
+    """McLachlan, SIAM J. Sci. Comput. 16 (1995) 151: S2, S4, S5 with their published orders and stages."""
+    comp = nb.composition(name)
+    assert error_analysis(comp, 2).order == order and comp.pieces.count(2) == stages and comp.symmetric

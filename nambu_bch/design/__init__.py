@@ -6,7 +6,11 @@
 * :func:`optimize_composition` -- the template solution with the smallest error constant (:mod:`.optimize`);
 * :func:`leading_error` -- the system's own leading error term and its size (:mod:`.system_error`);
 * :func:`compare` -- work-precision comparison on a system (:mod:`.compare`);
-* :mod:`.catalog` -- literature methods (Suzuki, Kahan-Li, Yoshida 6, Blanes-Moan) by name.
+* :mod:`.catalog` -- literature methods (Suzuki, Kahan-Li, Yoshida 6, Blanes-Moan, McLachlan, SRKN, PEFRL,
+  SABA/SBAB) by name;
+* :mod:`.structure` -- order and error constants on the RKN quotient (``structure="rkn"``) and the generalised
+  order of near-integrable splittings ``A + eps B``;
+* :mod:`.generalized` -- force-gradient factors and processed kernels (effective order).
 """
 
 from .catalog import CatalogComposition, methods

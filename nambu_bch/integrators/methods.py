@@ -26,9 +26,11 @@ NAMES = DECIMAL
 
 @dataclass(frozen=True)
 class CatalogComposition(Composition):
-    """A literature composition with decimal coefficients: ``error_bound`` is its largest order-condition defect."""
+    """A literature composition with decimal coefficients: ``error_bound`` is its largest order-condition defect;
+    ``structure`` the problem class its published order needs (``""`` any splitting, ``"rkn"``)."""
 
     error_bound: float = 0.0
+    structure: str = ""
 
 
 def _palindrome(outer):
@@ -48,17 +50,24 @@ def _stages(base: Composition, gammas, name, order, citation, cls=Composition, *
     return cls(tuple(k for k, _ in factors), tuple(c for _, c in factors), name, order, citation, **extra)
 
 
-def with_error_bound(comp: Composition, parts: int) -> CatalogComposition:
+def with_error_bound(comp: Composition, parts: int, structure: str = "") -> CatalogComposition:
     """``comp`` as a :class:`CatalogComposition` whose ``error_bound`` is its largest absolute Lyndon defect of
-    length ``<= comp.order`` for ``parts`` pieces, computed exactly."""
+    length ``<= comp.order`` for ``parts`` pieces, computed exactly; with ``structure="rkn"`` the largest residual
+    modulo the RKN ideal (:func:`nambu_bch.design.structure.structured_bound`), where the published order holds."""
     from ..design.conditions import _Exact  # the Lyndon defects live with the order conditions
 
     field = _Exact(comp)
-    bound = max(abs(float(field.K.to_sympy(v))) for q in range(1, comp.order + 1)
-                for v in field.defects(parts, q).values())
+    # Below degree 4 the RKN quotient is the free Lie algebra, and a symmetric method has E_4 = 0 exactly: there the
+    # defects of the general order conditions measure only the rounding of the decimals, and count in the bound.
+    general = comp.order if structure != "rkn" else min(comp.order, 4 if comp.symmetric else 3)
+    bound = max(abs(float(field.K.to_sympy(v))) for q in range(1, general + 1) for v in field.defects(parts, q).values())
+    if structure == "rkn":
+        from ..design.structure import structured_bound
+
+        bound = max(bound, structured_bound(comp, comp.order, structure))
     return CatalogComposition(comp.pieces, comp.coefficients, comp.name,
                               comp.order, comp.citation + f"; decimals as exact rationals, order conditions to {bound:.1e}",
-                              bound)
+                              bound, structure)
 
 
 def _base(word: str | None, n_pieces, name):
@@ -73,19 +82,37 @@ def _base(word: str | None, n_pieces, name):
     return base
 
 
+def _number(text: str, exact: bool):
+    """A table entry: a published decimal as the rational it denotes, or an exact formula read by the package's
+    whitelist parser (numbers, + - * / ** and sqrt)."""
+    if not exact:
+        return sympy.Rational(text)
+    from ..parsing import parse_expression
+
+    return parse_expression(text, {}, what="table coefficient")
+
+
 def _ab(table) -> Composition:
-    """The palindromic two-part method ``A(a_1) B(b_1) ... B(b_1) A(a_1)`` of an ``"ab"`` table."""
-    a_outer, b_outer = ([sympy.Rational(x) for x in row] for row in table.values)
-    a = a_outer + [1 - 2 * sum(a_outer)] + a_outer[::-1]
-    b = b_outer + [sympy.Rational(1, 2) - sum(b_outer)]
-    b = b + b[::-1]
+    """The palindromic two-part method ``X(x_1) Y(y_1) X(x_2) ... Y(y_1) X(x_1)`` of an ``"ab"`` table, ``X`` the
+    piece ``table.first``; the piece with the middle factor gets ``1 - 2 sum``, the other a middle pair ``1/2 - sum``."""
+    x_outer, y_outer = ([_number(v, table.exact) for v in row] for row in table.values)
+    x_middle = len(x_outer) == len(y_outer) + 1
+
+    def full(outer, middle):
+        if middle:
+            return outer + [sympy.expand(1 - 2 * sum(outer))] + outer[::-1]
+        half = outer + [sympy.expand(sympy.Rational(1, 2) - sum(outer))]
+        return half + half[::-1]
+
+    x, y = full(x_outer, x_middle), full(y_outer, not x_middle)
+    other = 3 - table.first
     pieces, coeffs = [], []
-    for i, ai in enumerate(a):
-        pieces.append(1)
-        coeffs.append(ai)
-        if i < len(b):
-            pieces.append(2)
-            coeffs.append(b[i])
+    for i, xi in enumerate(x):
+        pieces.append(table.first)
+        coeffs.append(xi)
+        if i < len(y):
+            pieces.append(other)
+            coeffs.append(y[i])
     return Composition(tuple(pieces), tuple(coeffs), table.name, table.order, table.reference)
 
 
@@ -93,7 +120,7 @@ def _ab(table) -> Composition:
 def _build(kind: str, word, n_pieces):
     table = TABLES[kind]
     if table.kind == "ab":
-        return with_error_bound(_ab(table), 2)
+        return _ab(table) if table.exact else with_error_bound(_ab(table), 2, table.structure)
     base = _base(word, n_pieces, kind)
     comp = _stages(base, _palindrome(table.values), f"{kind}:{base.name}", table.order, table.reference)
     return with_error_bound(comp, base.n_pieces)

@@ -15,9 +15,18 @@ Kinds
     ``gamma_1 h, ..., gamma_k h, gamma_mid h, gamma_k h, ..., gamma_1 h``; ``values`` are ``gamma_1 .. gamma_k``
     (outermost first) and ``gamma_mid = 1 - 2 (gamma_1 + ... + gamma_k)``;
 ``"ab"``
-    a palindromic two-part method ``A(a_1) B(b_1) A(a_2) ... B(b_1) A(a_1)``; ``values`` are ``(a_1, a_2, ...)`` and
-    ``(b_1, b_2, ...)`` up to the middle, whose coefficients are the complements (``a_mid = 1 - 2 sum a``,
-    ``b_mid = 1/2 - sum b``).
+    a palindromic two-part method alternating the pieces, starting with piece ``first`` (1 unless stated):
+    ``A(a_1) B(b_1) A(a_2) ... B(b_1) A(a_1)``; ``values`` are the outer coefficients of the first piece and of the
+    other one up to the middle.  The piece with an odd number of factors has the middle factor
+    ``1 - 2 sum(outer)``; the other has a middle pair ``1/2 - sum(outer)`` each (so ``len(values[0]) ==
+    len(values[1]) + 1`` when the first piece has the middle factor, equal lengths when the other one has it).
+    ``stages`` counts the factors of piece 2 (force evaluations), one less when piece 2 is outermost (first same as
+    last).
+
+Structure.  ``structure`` names the problem class on which the published order holds: ``""`` every splitting,
+``"rkn"`` ``T(p) + V(q)`` with ``T`` quadratic (piece 1 = ``T``, piece 2 = ``V``; :mod:`nambu_bch.design.structure`),
+``"near-integrable"`` ``A + eps B`` (piece 1 = ``A``), with the published generalised order in ``generalized``.
+``exact`` tables give their coefficients as exact formulas (trusted internal text, read by ``sympify(strict=True)``).
 """
 
 from __future__ import annotations
@@ -39,6 +48,10 @@ class MethodTable:
     kind : str         -- ``"jump"``, ``"stages"`` or ``"ab"`` (module docstring)
     values : tuple     -- published decimals as strings (empty for exact formulas)
     takes_word : bool  -- composes a base word given as ``name:WORD`` (else it is a method of fixed pieces)
+    first : int        -- ``"ab"``: the piece of the outermost factors
+    structure : str    -- ``""``, ``"rkn"`` or ``"near-integrable"`` (module docstring)
+    generalized : tuple -- published generalised order ``(r_1, r_2, ...)`` of a near-integrable method
+    exact : bool       -- ``values`` are exact formulas rather than decimals
     """
 
     name: str
@@ -49,6 +62,10 @@ class MethodTable:
     kind: str
     values: tuple = ()
     takes_word: bool = True
+    first: int = 1
+    structure: str = ""
+    generalized: tuple = ()
+    exact: bool = False
 
 
 TRIPLE_JUMP = MethodTable("triple-jump", "Yoshida, Phys. Lett. A 150 (1990) 262; Forest & Ruth, Physica D 43 (1990) 105",
@@ -70,7 +87,81 @@ BLANES_MOAN = MethodTable("blanes-moan", "Blanes & Moan, J. Comput. Appl. Math. 
                            ("0.209515106613362", "-0.143851773179818")),
                           takes_word=False)
 
+
+# Runge-Kutta-Nystrom methods: piece 1 = T(p) (drift), piece 2 = V(q) (kick); orders hold for T quadratic in p.
+_BM = "Blanes & Moan, J. Comput. Appl. Math. 142 (2002) 313, Table 3"
+#: SRKN_6^b: kicks b_1, b_2, b_3 (b_4 = 1 - 2 sum, the middle) and drifts a_1, a_2 (a_3 = 1/2 - a_1 - a_2).
+BM_SRKN6 = MethodTable("bm-srkn6", f"{_BM} (SRKN_6^b)", 4, 6, True, "ab",
+                       (("0.0829844064174052", "0.396309801498368", "-0.0390563049223486"),
+                        ("0.245298957184271", "0.604872665711080")),
+                       takes_word=False, first=2, structure="rkn")
+#: SRKN_11^b: kicks b_1..b_5 (middle pair b_6 = 1/2 - sum) and drifts a_1..a_5 (middle a_6 = 1 - 2 sum).
+BM_SRKN11 = MethodTable("bm-srkn11", f"{_BM} (SRKN_11^b)", 6, 11, True, "ab",
+                        (("0.0414649985182624", "0.198128671918067", "-0.0400061921041533", "0.0752539843015807",
+                          "-0.0115113874206879"),
+                         ("0.123229775946271", "0.290553797799558", "-0.127049212625417", "-0.246331761062075",
+                          "0.357208872795928")),
+                        takes_word=False, first=2, structure="rkn")
+#: PEFRL: drifts xi, chi (middle 1 - 2(xi + chi)); kicks (1 - 2 lambda)/2 = 1/2 - lambda, then the pair lambda.
+#: xi = 0.1786178958448091, lambda = -0.2123418310626054, chi = -0.06626458266981849 as published.
+PEFRL = MethodTable("pefrl", "Omelyan, Mryglod & Folk, Comput. Phys. Commun. 146 (2002) 188 (PEFRL)", 4, 4,
+                    True, "ab", (("0.1786178958448091", "-0.06626458266981849"), ("0.7123418310626054",)),
+                    takes_word=False)
+#: SRKN_14^a: drifts a_1..a_7 (middle a_8 = 1 - 2 sum) and kicks b_1..b_6 (middle pair b_7 = 1/2 - sum); the digits
+#: as transcribed in Principia's integrators/methods.hpp (BlanesMoan2002SRKN14A).
+BM_SRKN14 = MethodTable("bm-srkn14", f"{_BM} (SRKN_14^a)", 6, 14, True, "ab",
+                        (("0.0378593198406116", "0.102635633102435", "-0.0258678882665587", "0.314241403071447",
+                          "-0.130144459517415", "0.106417700369543", "-0.00879424312851058"),
+                         ("0.09171915262446165", "0.183983170005006", "-0.05653436583288827", "0.004914688774712854",
+                          "0.143761127168358", "0.328567693746804")),
+                        takes_word=False, structure="rkn")
+_McL = "McLachlan, SIAM J. Sci. Comput. 16 (1995) 151"
+#: SB3A_4: drifts a_1, a_2 (middle 1 - 2 sum = 2/3), kicks 1 then the pair -1/2; 20 digits as transcribed in
+#: Principia's integrators/methods.hpp (McLachlan1995SB3A4).
+MCLACHLAN_SB3A4 = MethodTable("mclachlan-sb3a4", f"{_McL} (SB3A, 4 stages)", 4, 4, True, "ab",
+                              (("0.18819521776883821787", "-0.021528551102171551201"), ("1",)),
+                              takes_word=False, structure="rkn")
+
+# General two-part methods (any splitting).
+#: Blanes-Moan S10: a_1..a_5 (middle 1 - 2 sum) and b_1..b_4 (middle pair 1/2 - sum), as in blanes-moan (S6).
+BLANES_MOAN_S10 = MethodTable("blanes-moan-s10", "Blanes & Moan, J. Comput. Appl. Math. 142 (2002) 313, Table 2 (S10)",
+                              6, 10, True, "ab",
+                              (("0.0502627644003922", "0.413514300428344", "0.0450798897943977", "-0.188054853819569",
+                                "0.541960678450780"),
+                               ("0.148816447901042", "-0.132385865767784", "0.067307604692185", "0.432666402578175")),
+                              takes_word=False)
+#: McLachlan's S2 = A(b) B(1/2) A(1 - 2b) B(1/2) A(b), b = 0.19318332750378357396 (the minimum-norm 2-stage
+#: method; 20 digits as transcribed in Principia's integrators/methods.hpp, McLachlan1995S2).
+MCLACHLAN_S2 = MethodTable("mclachlan-s2", f"{_McL} (S2, 2 stages)", 2, 2, True, "ab",
+                           (("0.19318332750378357396",), ()), takes_word=False)
+#: McLachlan's S4 (4 stages, order 4): A outer b_1, b_2 (middle 1 - 2 sum); B outer 6/11 (middle pair -1/22).
+MCLACHLAN_S4 = MethodTable("mclachlan-s4", f"{_McL} (S4, 4 stages)", 4, 4, True, "ab",
+                           (("0.16913927992207204518", "-0.29918620390405079951"), ("0.54545454545454545455",)),
+                           takes_word=False)
+#: McLachlan's S5 (5 stages, order 4): A outer b_1, b_2 (middle pair 1/2 - sum); B outer 0.4, -0.1 (middle 0.4).
+MCLACHLAN_S5 = MethodTable("mclachlan-s5", f"{_McL} (S5, 5 stages)", 4, 5, True, "ab",
+                           (("0.089269454226475244887", "-0.097336042636895508015"), ("0.4", "-0.1")),
+                           takes_word=False)
+
+# Near-integrable methods for A + eps B (piece 1 = A): nodes and weights of Gauss (SABA) and Lobatto (SBAB)
+# quadrature, exact; Laskar & Robutel give the generalised order (2n, 2).
+_LR = "Laskar & Robutel, Celest. Mech. Dyn. Astr. 80 (2001) 39, Sect. 3"
+SABA2 = MethodTable("saba2", f"{_LR} (SABA_2)", 2, 2, True, "ab", (("1/2 - sqrt(3)/6",), ()), takes_word=False,
+                    structure="near-integrable", generalized=(4, 2), exact=True)
+SABA3 = MethodTable("saba3", f"{_LR} (SABA_3)", 2, 3, True, "ab", (("1/2 - sqrt(15)/10",), ("5/18",)),
+                    takes_word=False, structure="near-integrable", generalized=(6, 2), exact=True)
+SABA4 = MethodTable("saba4", f"{_LR} (SABA_4)", 2, 4, True, "ab",
+                    (("1/2 - sqrt(525 + 70*sqrt(30))/70", "(sqrt(525 + 70*sqrt(30)) - sqrt(525 - 70*sqrt(30)))/70"),
+                     ("1/4 - sqrt(30)/72",)),
+                    takes_word=False, structure="near-integrable", generalized=(8, 2), exact=True)
+SBAB2 = MethodTable("sbab2", f"{_LR} (SBAB_2)", 2, 2, True, "ab", (("1/6",), ()), takes_word=False, first=2,
+                    structure="near-integrable", generalized=(4, 2), exact=True)
+SBAB3 = MethodTable("sbab3", f"{_LR} (SBAB_3)", 2, 3, True, "ab", (("1/12",), ("1/2 - sqrt(5)/10",)),
+                    takes_word=False, first=2, structure="near-integrable", generalized=(6, 2), exact=True)
+
 #: Every table by name.
-TABLES = {t.name: t for t in (TRIPLE_JUMP, SUZUKI, KAHAN_LI, YOSHIDA6, BLANES_MOAN)}
-#: The tables with published decimals (built by :mod:`.methods`); the jumps are built in :mod:`.composition`.
+TABLES = {t.name: t for t in (TRIPLE_JUMP, SUZUKI, KAHAN_LI, YOSHIDA6, BLANES_MOAN, BLANES_MOAN_S10, MCLACHLAN_S2,
+                              MCLACHLAN_S4, MCLACHLAN_S5, BM_SRKN6, BM_SRKN11, BM_SRKN14, MCLACHLAN_SB3A4, PEFRL,
+                              SABA2, SABA3, SABA4, SBAB2, SBAB3)}
+#: The tables built by :mod:`.methods` (published decimals, or exact formulas); the jumps are built in :mod:`.composition`.
 DECIMAL = tuple(name for name, t in TABLES.items() if t.kind != "jump")
