@@ -301,7 +301,7 @@ def _runge_kutta_row(system, tableau, label, t_end, steps, x0, params, x_ref, re
     """The row of a Runge--Kutta method (module docstring): measured cost, error, and the modified field's leading term."""
     from ..bseries import modified_equation
     from ..bseries.modified import MAX_RK_ORDER
-    from ..numeric.runge_kutta import LAST_RUN, is_linearly_implicit
+    from ..numeric.runge_kutta import is_linearly_implicit, iterate_runge_kutta
     from .system_error import field_size
 
     s = tableau.stages
@@ -316,7 +316,9 @@ def _runge_kutta_row(system, tableau, label, t_end, steps, x0, params, x_ref, re
     for N in steps:
         h = t_end / N
         try:
-            err = float(np.linalg.norm(_final(system, tableau, h, N, x0, params) - x_ref))
+            stats = {}
+            final = iterate_runge_kutta(system, tableau, h, N, x0, params, every=N, stats=stats)[-1]
+            err = float(np.linalg.norm(np.asarray(final, float) - x_ref))
         except NambuBCHError as exc:
             pts.append({"steps": N, "h": h, "evaluations": float("nan"), "error": float("nan"), "note": str(exc)})
             continue
@@ -325,7 +327,7 @@ def _runge_kutta_row(system, tableau, label, t_end, steps, x0, params, x_ref, re
         elif tableau.is_explicit:
             per_step = float(s)
         else:
-            per_step = s * (1.0 + LAST_RUN["newton_iterations"] / max(N, 1))
+            per_step = s * (1.0 + stats["newton_iterations"] / max(N, 1))
         per_steps.append(per_step)
         pts.append({"steps": N, "h": h, "evaluations": N * per_step, "error": err})
     good = [p for p in pts if np.isfinite(p["error"]) and p["error"] > max(FLOOR, 100 * ref_err)]

@@ -16,7 +16,7 @@ or run by the interpreter (``backend="numpy"``: the same source, the same operat
 Kahan's method on a quadratic field is linearly implicit, ``x' = x + h (I - h/2 f'(x))^{-1} f(x)``
 (Celledoni, McLachlan, Owren, Quispel, J. Phys. A 46 (2013) 025201; equation number not checked, the equality
 with the tableau is tested): one linear solve per step,
-no Newton iteration.  The work of a run is reported as Newton iterations (:data:`LAST_RUN`).
+no Newton iteration.  The work of a run is reported as Newton iterations (``stats=``).
 """
 
 from __future__ import annotations
@@ -113,9 +113,6 @@ INTERPRET_STEPS = 2000
 MAX_RK_STEPS = 10**8
 #: Residual accepted when Newton's iteration stagnates: ``tol * (1 + max|K|)`` (round-off is far below).
 NEWTON_TOL = 1e-10
-#: ``{"newton_iterations": .., "steps": ..}`` of the last :func:`iterate_runge_kutta` run in this process (the
-#: cost measure of :func:`nambu_bch.design.compare`).
-LAST_RUN: dict = {}
 _MODULES: dict = {}
 
 
@@ -167,7 +164,7 @@ def _module(system, backend):
 
 
 def iterate_runge_kutta(system, method, h, steps, x0=None, params=None, every=1, *, kahan=False, backend="auto",
-                        out=None, max_newton=MAX_NEWTON, compensation=None):
+                        out=None, max_newton=MAX_NEWTON, compensation=None, stats=None):
     """``steps`` steps of the Runge--Kutta ``method`` (implicit ones by Newton's method), sampled like
     :func:`nambu_bch.numeric.iterate` (shape ``(n_samples, N)`` or ``(n_samples, N, batch)``).
 
@@ -182,6 +179,9 @@ def iterate_runge_kutta(system, method, h, steps, x0=None, params=None, every=1,
     max_newton : int -- Newton iterations allowed per step
     compensation : float64 array of shape (N,), optional -- the compensated summation's carry, updated in place
         (a run continued block by block: :func:`nambu_bch.numeric.iterate_chunks`); one trajectory only
+    stats : dict, optional -- receives the run's work: ``method``, ``steps`` (trajectory-steps),
+        ``newton_iterations`` and ``linear_solves`` (Kahan's method; None otherwise), the cost measure of
+        :func:`nambu_bch.design.compare`
 
     Raises
     ------
@@ -200,6 +200,8 @@ def iterate_runge_kutta(system, method, h, steps, x0=None, params=None, every=1,
     from .kernels import resolve_backend
     from .samples import MAX_SAMPLE_BYTES, n_samples
 
+    if stats is not None and not isinstance(stats, dict):
+        raise InvalidRunError(f"stats must be a dict to receive the run's work, got {type(stats).__name__}")
     system = as_system(system)
     tableau = butcher_tableau(method)
     x0, origin = initial_state(system, x0)
@@ -256,7 +258,7 @@ def iterate_runge_kutta(system, method, h, steps, x0=None, params=None, every=1,
             out[...] = samples
         else:
             out[:, :, k] = samples
-    LAST_RUN.clear()
-    LAST_RUN.update({"method": tableau.name, "steps": steps * batch, "newton_iterations": total,
-                     "linear_solves": total if linear else None})
+    if stats is not None:
+        stats.update({"method": tableau.name, "steps": steps * batch, "newton_iterations": total,
+                      "linear_solves": total if linear else None})
     return out
