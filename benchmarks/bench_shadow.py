@@ -310,7 +310,7 @@ def _timed_run(args, queue):
     """One call in a fresh process: ``(CPU s, wall s, peak RSS in MB, members)`` of ours, or of the plain baseline."""
     import resource
 
-    side, name, word, order = args
+    side, name, word, order, *verify = args
     system = make_system(name)
     t, w = time.process_time(), time.perf_counter()
     if side == "ours":  # the family and its shadows as sympy expressions (what the baseline returns)
@@ -322,6 +322,8 @@ def _timed_run(args, queue):
     rss = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024  # kB on Linux
     if side == "ours":
         members = [tuple(map(str, fam.member(alpha=a))) for a in (0, 1)]
+        if verify:  # outside the timed part: X_{H_S,G_S} = X_eff through h^order for both members (exact ring)
+            members = all(check_solution(system, word, order, fam.member(alpha=a)) for a in (0, 1))
     else:  # checked outside the timed part (exact ring arithmetic, the package's X_eff)
         members = out is not None and check_solution(system, word, order, out)
     queue.put((cpu_s, wall_s, rss, members))
@@ -382,10 +384,12 @@ def targets(limit: float = 600.0, only=None):
         print(line + f"  [{_load()}]", flush=True)
     if not only or "c" in only:
         stopped: dict = {}
-        n4 = _child(_timed_run, ("ours", "n4-single", "1234321", 8), limit, stopped)
+        n4 = _child(_timed_run, ("ours", "n4-single", "1234321", 8, True), limit, stopped)
         line = f"c: N = 4 single split, 1234321, h^8: {_shown(n4, limit)}"
         if n4:
-            line += f" (finishes; goal peak RSS < 1 GB: {'met' if n4[2] < 1024 else 'not met'})"
+            line += (f" (finishes; goal peak RSS < 1 GB: {'met' if n4[2] < 1024 else 'not met'}; "
+                     f"X_(H_S,G_S) = X_eff through h^8 for alpha = 0, 1: {n4[3]})")
+            ok = ok and n4[3] is True
         elif stopped.get("rss") is not None:
             line += f", peak RSS {stopped['rss']:.0f} MB when stopped (goal: finishes, < 1 GB: not met)"
         print(line + f"  [{_load()}]", flush=True)

@@ -208,3 +208,19 @@ def test_cross_terms_fraction_free_equal_liouville_field():
     ours = solver._field(slots)
     plain = liouville_field(solver.alg, *slots)
     assert ours.components == plain.components and any(ours.components)
+
+
+def test_default_bound_admits_the_n4_single_split_at_h8():
+    """``shadow_hamiltonians``' default ``max_unknowns`` is the direct route's own up-front limit: the N = 4 single
+    split (H = sum x_i^2/2, G = x1^2/2 + x2^2 + 3 x3^2/2 + 2 x4^2, K = x1 + .. + x4; issue benchmark, row c) at h^8 has
+    an ansatz of degree 10 in three slots, 3003 unknowns, and is solved exactly (elimination estimate 1.2e9, within
+    ``SOLVE_COST``) instead of being handed to the generic route."""
+    import inspect
+
+    from nambu_bch.algebra.ansatz import Ansatz
+    from nambu_bch.shadow import shadow_hamiltonians
+    from nambu_bch.shadow.direct_route import MAX_UNKNOWNS
+
+    default = inspect.signature(shadow_hamiltonians).parameters["max_unknowns"].default
+    assert default == MAX_UNKNOWNS
+    assert Ansatz.size(4, 10, 3) == 3003 <= default

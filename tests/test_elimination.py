@@ -245,3 +245,31 @@ def test_elimination_cost_counts_blocks_and_weights_parameter_fields():
     blocks = E._blocks(rows, 4)
     assert sorted(map(sorted, blocks.values())) == [[0, 1, 2], [3]]
 
+
+
+# -- the one sparse matrix type ----------------------------------------------------------------------------------
+
+@settings(max_examples=25, deadline=None)
+@given(st.lists(st.dictionaries(st.integers(0, 4), st.integers(-3, 3), max_size=4), min_size=1, max_size=5),
+       st.dictionaries(st.integers(0, 4), st.integers(-3, 3), max_size=3))
+def test_sparse_matrix_gives_what_the_bare_shapes_give(cols, b):
+    """``SparseMatrix`` (from columns or from rows) in ``solve_affine``, ``nullspace`` and ``rank`` gives the same
+    result as the three bare-dict shapes (columns; ``{row: {col: v}}`` with shape; row vectors)."""
+    cols = [{i: QQ(v) for i, v in c.items()} for c in cols]
+    b = {i: QQ(v) for i, v in b.items()}
+    M = E.SparseMatrix.from_columns(cols, 5, QQ)
+    assert M.ncols == len(cols) and all(v for r in M.rows.values() for v in r.values())
+    assert E.SparseMatrix.from_rows([M.rows.get(i, {}) for i in range(5)], len(cols), QQ).rows == M.rows
+    assert E.solve_affine(M, [b]) == E.solve_affine(cols, [b], 5, QQ)
+    assert E.nullspace(M) == E.nullspace(M.rows, 5, len(cols), QQ)
+    assert E.rank(M) == E.rank([M.rows.get(i, {}) for i in range(5)], len(cols), QQ)
+    assert [{i: v for i, v in c.items() if v} for c in M.columns()] == [{i: v for i, v in c.items() if v} for c in cols]
+
+
+@pytest.mark.parametrize("args,fragment", [(({0: {0: QQ(1)}}, 0, 1), "row index 0 outside"),
+                                           (({0: {3: QQ(1)}}, 1, 2), "column index 3 (row 0) outside 0..1"),
+                                           (({}, -1, 2), "nrows must be a non-negative integer"),
+                                           (({}, 1, True), "ncols must be a non-negative integer")])
+def test_sparse_matrix_refuses_entries_outside_its_shape(args, fragment):
+    with pytest.raises(E.NambuBCHError, match=fragment.replace("(", r"\(").replace(")", r"\)")):
+        E.SparseMatrix(*args, QQ)

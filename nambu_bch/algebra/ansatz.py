@@ -82,7 +82,7 @@ import sympy
 
 from ..checks import is_int
 from ..errors import NambuBCHError, ResourceLimitError
-from .elimination import normal_form, solve_affine
+from .elimination import SparseMatrix, normal_form, solve_affine
 
 #: The monomial orders of :class:`Ansatz`.
 ORDERS = ("lex", "graded")
@@ -256,7 +256,7 @@ class Ansatz:
         order = list(reversed(priority))
         if sorted(order) != list(range(len(columns))):
             raise NambuBCHError(f"the priority must list each of the {len(columns)} columns once")
-        res = solve_affine([columns[c] for c in order], rhs, nrows, domain, certificate=certificate)
+        res = solve_affine(SparseMatrix.from_columns([columns[c] for c in order], nrows, domain), rhs, certificate=certificate)
 
         def back(vec):
             return {order[c]: v for c, v in vec.items()}

@@ -53,6 +53,8 @@ from sympy.polys.domains import QQ
 from sympy.polys.matrices import DomainMatrix
 from sympy.polys.matrices.sdm import SDM
 
+from ..errors import NambuBCHError
+
 
 @dataclass(frozen=True)
 class AffineSolution:
@@ -76,6 +78,73 @@ class AffineSolution:
     certificate: dict | None
     failing_rhs: int | None
     pivots: tuple
+
+
+@dataclass(frozen=True)
+class SparseMatrix:
+    """A sparse matrix over a field, the one shape :func:`solve_affine`, :func:`nullspace` and :func:`rank` take.
+
+    Attributes
+    ----------
+    rows : dict ``{row: {column: value}}`` -- the non-zero entries (zero values and empty rows left out)
+    nrows, ncols : int -- the shape; every row index lies in ``range(nrows)``, every column in ``range(ncols)``
+    domain : sympy domain -- the field of the values (``QQ``, ``QQ(params)``, ``QQ<theta>`` ..)
+
+    Build it from row vectors (:meth:`from_rows`) or from column vectors (:meth:`from_columns`, the unknowns of
+    an ansatz); the constructor checks the shape, so an index outside it fails here, in one line, and not
+    inside an elimination.
+
+    >>> M = SparseMatrix.from_columns([{0: QQ(1)}, {0: QQ(2), 1: QQ(0)}], 2, QQ)
+    >>> M.rows, M.nrows, M.ncols
+    ({0: {0: 1, 1: 2}}, 2, 2)
+    >>> rank(M)
+    1
+    """
+
+    rows: dict
+    nrows: int
+    ncols: int
+    domain: object
+
+    def __post_init__(self):
+        for name in ("nrows", "ncols"):
+            value = getattr(self, name)
+            if isinstance(value, bool) or not isinstance(value, int) or value < 0:
+                raise NambuBCHError(f"SparseMatrix: {name} must be a non-negative integer, got {value!r}")
+        clean = {}
+        for i, row in self.rows.items():
+            if not (isinstance(i, int) and 0 <= i < self.nrows):
+                raise NambuBCHError(f"SparseMatrix: row index {i!r} outside 0..{self.nrows - 1}")
+            kept = {j: v for j, v in row.items() if v}
+            if any(not (isinstance(j, int) and 0 <= j < self.ncols) for j in kept):
+                bad = next(j for j in kept if not (isinstance(j, int) and 0 <= j < self.ncols))
+                raise NambuBCHError(f"SparseMatrix: column index {bad!r} (row {i}) outside 0..{self.ncols - 1}")
+            if kept:
+                clean[i] = kept
+        object.__setattr__(self, "rows", clean)
+
+    @classmethod
+    def from_rows(cls, vectors, ncols: int, domain) -> "SparseMatrix":
+        """The matrix whose ``r``-th row is ``vectors[r]`` (a sparse dict ``{column: value}``)."""
+        return cls(dict(enumerate(vectors)), len(vectors), ncols, domain)
+
+    @classmethod
+    def from_columns(cls, columns, nrows: int, domain) -> "SparseMatrix":
+        """The matrix whose ``j``-th column is ``columns[j]`` (a sparse dict ``{row: value}``)."""
+        rows: dict = {}
+        for j, col in enumerate(columns):
+            for i, v in col.items():
+                if v:
+                    rows.setdefault(i, {})[j] = v
+        return cls(rows, nrows, len(columns), domain)
+
+    def columns(self) -> list:
+        """The columns as sparse dicts ``{row: value}``, one per column."""
+        cols = [{} for _ in range(self.ncols)]
+        for i, row in self.rows.items():
+            for j, v in row.items():
+                cols[j][i] = v
+        return cols
 
 
 def _sdm(rows: dict, nrows: int, ncols: int, domain) -> DomainMatrix:
@@ -453,17 +522,17 @@ def _kernel(R, pivots, ncols: int, domain) -> list:
     return kernel
 
 
-def solve_affine(columns: list, rhs: list, nrows: int, domain, *, certificate: bool = True) -> AffineSolution:
-    """Solve ``L x = b_k`` for every ``k`` exactly; ``L`` given by sparse columns.
+def solve_affine(columns, rhs: list, nrows: int | None = None, domain=None, *, certificate: bool = True) -> AffineSolution:
+    """Solve ``L x = b_k`` for every ``k`` exactly; ``L`` a :class:`SparseMatrix` or given by sparse columns.
 
     Parameters
     ----------
-    columns : list of dict ``{row: value}``
-        The columns of ``L`` (values in ``domain``).
+    columns : SparseMatrix, or list of dict ``{row: value}``
+        ``L``, or its columns (values in ``domain``; then ``nrows`` and ``domain`` are given too).
     rhs : list of dict ``{row: value}``
         The right-hand sides ``b_k``.
-    nrows : int
-    domain : sympy domain (``QQ`` or ``QQ(params)``)
+    nrows : int -- with columns only (a :class:`SparseMatrix` carries its shape)
+    domain : sympy domain (``QQ`` or ``QQ(params)``) -- with columns only
     certificate : bool
         Look for a left null vector when inconsistent (a second elimination, of ``L^T``);
         with ``False`` the result's ``certificate`` is ``None``.
@@ -481,12 +550,18 @@ def solve_affine(columns: list, rhs: list, nrows: int, domain, *, certificate: b
     >>> {r: int(v) for r, v in solve_affine([{0: QQ(1)}], [{1: QQ(1)}], 2, QQ).certificate.items()}
     {1: 1}
     """
-    ncols = len(columns)
-    rows: dict = {}
-    for j, col in enumerate(columns):
-        for i, v in col.items():
-            if v:
-                rows.setdefault(i, {})[j] = v
+    if isinstance(columns, SparseMatrix):
+        matrix = columns
+        nrows, domain, ncols = matrix.nrows, matrix.domain, matrix.ncols
+        rows = {i: dict(r) for i, r in matrix.rows.items()}
+        columns = matrix.columns()
+    else:
+        ncols = len(columns)
+        rows = {}
+        for j, col in enumerate(columns):
+            for i, v in col.items():
+                if v:
+                    rows.setdefault(i, {})[j] = v
     split = _AlgebraicSplit.of(domain) if FAST_PATHS else None
     if split is not None:
         out = _solve_split(split, rows, columns, rhs, nrows, certificate)
@@ -615,20 +690,24 @@ def kernel_rref(kernel: list, priority: list, domain) -> list:
     return [{priority[c]: v for c, v in R.get(r, {}).items()} for r in range(len(pivots))]
 
 
-def rank(vectors: list, ncols: int, domain) -> int:
-    """Rank of sparse row vectors ``{column: value}`` (columns ``0..ncols-1``).
+def rank(vectors, ncols: int | None = None, domain=None) -> int:
+    """Rank of a :class:`SparseMatrix`, or of sparse row vectors ``{column: value}`` (columns ``0..ncols-1``).
 
     >>> from sympy.polys.domains import QQ
     >>> rank([{0: QQ(1), 1: QQ(2)}, {0: QQ(2), 1: QQ(4)}, {2: QQ(1)}], 3, QQ)
     2
     """
-    if not vectors:
+    if isinstance(vectors, SparseMatrix):
+        rows, nrows, ncols, domain = vectors.rows, vectors.nrows, vectors.ncols, vectors.domain
+    else:
+        rows = {r: {c: v for c, v in vec.items() if v} for r, vec in enumerate(vectors)}
+        nrows = len(vectors)
+    if not nrows:
         return 0
-    rows = {r: {c: v for c, v in vec.items() if v} for r, vec in enumerate(vectors)}
-    full = _full_rank_at_a_point(rows, len(vectors), ncols, domain) if FAST_PATHS else None
+    full = _full_rank_at_a_point(rows, nrows, ncols, domain) if FAST_PATHS else None
     if full is not None:
         return full
-    return len(_rref(rows, len(vectors), ncols, domain, lift=False)[1])
+    return len(_rref(rows, nrows, ncols, domain, lift=False)[1])
 
 
 #: The points tried by :func:`_full_rank_at_a_point` (parameter values, one tuple per try).
@@ -669,8 +748,9 @@ def _full_rank_at_a_point(rows: dict, nrows: int, ncols: int, domain):
     return None
 
 
-def nullspace(rows: dict, nrows: int, ncols: int, domain) -> list:
-    """A basis of ``{x : M x = 0}`` for the sparse matrix ``M = {row: {column: value}}``, one vector per free column.
+def nullspace(rows, nrows: int | None = None, ncols: int | None = None, domain=None) -> list:
+    """A basis of ``{x : M x = 0}`` for a :class:`SparseMatrix` ``M`` (or ``M = {row: {column: value}}`` with its
+    shape and domain), one vector per free column.
 
     The vector of free column ``f`` is ``1`` at ``f``, zero at the other free
     columns and minus the reduced echelon entries at the pivots (Gauss-Jordan over the field).
@@ -679,6 +759,8 @@ def nullspace(rows: dict, nrows: int, ncols: int, domain) -> list:
     >>> [{c: int(v) for c, v in k.items()} for k in nullspace({0: {0: QQ(1), 1: QQ(1)}}, 1, 3, QQ)]
     [{1: 1, 0: -1}, {2: 1}]
     """
+    if isinstance(rows, SparseMatrix):
+        rows, nrows, ncols, domain = rows.rows, rows.nrows, rows.ncols, rows.domain
     R, pivots = _rref(rows, nrows, ncols, domain)
     return _kernel(R, pivots, ncols, domain)
 

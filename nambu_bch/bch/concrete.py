@@ -80,7 +80,9 @@ def effective_field_by_cost(splitting, comp, order: int = 2) -> EffectiveField:
     (:func:`~nambu_bch.bch.backward.effective_field`): the formal series would run in the
     dense engine with field elements of ``QQ(2^(1/3))`` on all ``g^d`` words and evaluate
     thousands of brackets with algebraic coefficients (ho3 ``yoshida:12321`` to
-    ``h^8`` over 100 s by BCH, 0.45 s backward).  Rational compositions keep the BCH route
+    ``h^8`` over 100 s by BCH, 0.45 s backward).  Rational compositions take backward error analysis
+    too when it needs fewer Lie derivatives than the BCH route has Lyndon brackets (:func:`_backward_cheaper`:
+    five-stage words in three pieces from ``h^4`` on); short series in two pieces keep the BCH route
     (:func:`effective_field_bch`), whose Lyndon brackets are shared across compositions.
 
     Examples
@@ -91,9 +93,28 @@ def effective_field_by_cost(splitting, comp, order: int = 2) -> EffectiveField:
     True
     """
     comp = composition_for(comp, splitting)
-    if comp.extension:
+    if comp.extension or _backward_cheaper(comp, order):
         return effective_field(splitting, comp, order)
     return effective_field_bch(splitting, comp, order)
+
+
+def _backward_cheaper(comp, order: int) -> bool:
+    """Backward error analysis needs fewer Lie derivatives than the BCH route has brackets to evaluate.
+
+    Per coordinate, backward error analysis applies a field to a function about ``s t (t + 1) / 2`` times
+    for the ``s`` exact sub-flows (Lie series to ``h^t``, ``t = order + 1``) and ``t^3 / 6`` times for
+    the modified field; the BCH route evaluates one bracket, about two such applications per coordinate,
+    per Lyndon word of length ``2 .. t`` in the ``g`` distinct pieces, ``sum_d dim L_d(g)`` (Witt's formula),
+    which grows like ``g^t / t``.  Short series in two pieces stay on the BCH route (FPU at ``h^6``: 0.07 s
+    against 0.19 s backward); three or more pieces at high order go backward (ho3, 12321, ``h^12``: 4.9 s
+    and 300 MB by BCH, 0.02 s backward; the N = 4 single split, 1234321, ``h^8``: 33 s and 1.5 GB by BCH,
+    1.2 s and 80 MB backward; measured under load 10, docs/performance.md).
+    """
+    from .lyndon import witt_dimension
+
+    top, letters = order + 1, len(set(comp.pieces))
+    brackets = sum(witt_dimension(letters, d) for d in range(2, top + 1))
+    return len(comp.pieces) * top * (top + 1) / 2 + top**3 / 6 < 2 * brackets
 
 
 # Bracket values are shared by every composition on a splitting (the Lyndon trees of the six paper

@@ -21,9 +21,12 @@ from .fi_route import fi_route
 ROUTES = ("direct", "fi")
 #: Default ``max_unknowns``: above this many unknowns per order, or above the elimination cost budget
 #: ``direct_route.SOLVE_COST`` (estimated from the block structure of the matrix), the exact solve is skipped and
-#: existence decided by averages.  2000 admits the N = 4 single split at h^6 (1485 unknowns, 0.5 s of
-#: elimination without python-flint: :mod:`nambu_bch.algebra.modular_rref`); the cost budget refuses what would hang.
-SOLVE_UNKNOWNS = 2000
+#: existence decided by averages.  The bound is the direct route's own up-front limit
+#: (``direct_route.MAX_UNKNOWNS``); below it the estimate from the built matrix decides --
+#: its cost budget refuses what would hang, and the blocks it counts are the dense matrices the elimination
+#: holds (at most ``elimination.FLINT_DENSE_LIMIT`` entries each).  The N = 4 single split at h^8 (3003 unknowns,
+#: estimate 1.2e9, largest block 1140 x 792) is solved within 200 MB of peak RSS.
+SOLVE_UNKNOWNS = 4000
 
 
 def _system(system):

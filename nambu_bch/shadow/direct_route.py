@@ -67,7 +67,7 @@ import sympy
 from ..algebra import PolynomialAlgebra, VectorField, liouville_field
 from ..algebra.ansatz import Ansatz, Rows
 from ..algebra import elimination, frac_rref
-from ..algebra.elimination import elimination_cost, rank, signed_sums
+from ..algebra.elimination import SparseMatrix, elimination_cost, rank, signed_sums
 from ..bch.backward import check_order
 from ..checks import check_flag, show
 from ..bch.concrete import effective_field_by_cost
@@ -685,7 +685,7 @@ class _Solver:
                         vec[k] = c
             if vec:
                 vecs.append(vec)
-        return rank(vecs, len(place), alg.domain) if vecs else 0
+        return rank(SparseMatrix.from_rows(vecs, len(place), alg.domain)) if vecs else 0
 
 
 def direct_route(system, word, order: int = 2, degree=None, max_unknowns=None, progress=None,

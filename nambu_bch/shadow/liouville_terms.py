@@ -39,7 +39,7 @@ from sympy.polys.rings import PolyElement
 
 from ..algebra import PolynomialAlgebra, VectorField, liouville_field
 from ..algebra.brackets import permutation_sign
-from ..algebra.elimination import rank
+from ..algebra.elimination import SparseMatrix, rank
 from ..checks import check_sequence, check_type, is_int, show
 from ..errors import NambuBCHError
 from ..parsing import as_expression
@@ -122,7 +122,7 @@ def _dependent(exponents: tuple) -> bool:
     if not exponents:
         return False
     rows = [{c: QQ(v) for c, v in enumerate(e) if v} for e in exponents]
-    return rank(rows, len(exponents[0]), QQ) < len(rows)
+    return rank(SparseMatrix.from_rows(rows, len(exponents[0]), QQ)) < len(rows)
 
 
 @lru_cache(maxsize=None)
