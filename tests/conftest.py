@@ -176,6 +176,8 @@ DEEP = (
     # tests and the no-code-execution check of the same callable stay in the fast tier
     ("test_fuzz_api.py", "test_public_callable_raises_only_the_family",
      lambda pid: pid != "nambu_bch.paper_figures"),
+    # a long run (t = 10^3 from every model's default x0); the fast tier checks the defaults' size and use
+    ("test_numeric_api_arguments.py", "test_default_x0_of_every_model_runs_a_long_orbit", ()),
     # Eqs. (1AX)-(2BY) for generic functions (jets); the fast tier checks them on the models (test_fi_route's h^2 hull)
     ("test_shadow.py", "test_eight_representations_for_generic_functions", ()),
 )
