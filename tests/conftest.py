@@ -246,6 +246,9 @@ _FULL_SETTINGS: dict = {}
 
 def pytest_collection_modifyitems(session, config, items):
     deep = _deep_run(config)
+    # every collected (file, test name) before selection, for tests/test_suite_tiers.py's check of DEEP
+    config.nambu_bch_collected = {(item.path.name, item.name) for item in items}
+    config.nambu_bch_deep = DEEP
     for item in items:
         if _in_deep_tier(item):
             item.add_marker(pytest.mark.deep)
