@@ -7,12 +7,21 @@ Why this balances: ``--dist worksteal`` (pyproject ``addopts``) hands each of th
 the collection, and a worker that runs dry steals the *last* half of the other's queue.  With the long tests at the
 front they all start early in the first worker's queue, and what is stolen and run at the end are short tests, so
 both workers finish within seconds of each other (measured: docs/suite_time.md).
+
+It is also the one place where the suite is split into two tiers (docs/suite_time.md, "Two tiers"): the tests named
+in :data:`DEEP` carry the marker ``deep``, which ``pyproject.toml`` deselects by default (``-m "not deep"``); the
+*fast tier* (the README's test command) runs the rest, and ``pytest -m deep`` runs the *deep tier*.  The hypothesis
+tests run in both: in the fast tier at a quarter of their example counts, in the deep tier at the full counts.
 """
 
 from __future__ import annotations
 
+import math
 import sys
+import zlib
 from pathlib import Path
+
+import pytest
 
 # the suite's shared helpers (reference_fields.py, strategies.py) are imported by name from this directory; with
 # ``--import-mode=importlib`` pytest does not put it on sys.path itself
@@ -57,6 +66,123 @@ LONG = (
 )
 
 
+#: The fast tier runs ``ceil(n / HYPOTHESIS_FAST_DIVISOR)`` of a hypothesis test's ``n`` examples; the deep tier all ``n``.
+HYPOTHESIS_FAST_DIVISOR = 4
+
+
+def _diagonal(values: int):
+    """Keep one of ``values`` cases per row of a table whose ids end in ``-k`` (``k`` the column, 0 <= k < values):
+    the column chosen by a checksum of the row's id, so every row is run once and every column about equally often."""
+    def keep(pid: str) -> bool:
+        row, _, col = pid.rpartition("-")
+        return col == str(zlib.crc32(row.encode()) % values)
+    return keep
+
+
+#: The deep tier: (file, test name, cases kept in the fast tier).  A whole test is deep when the third field is
+#: empty; otherwise the cases named there (parameter ids, or a predicate on the id) stay in the fast tier and the other
+#: cases of the table are deep.  A test belongs here when it repeats a concern the fast tier already checks, at greater
+#: depth or cost (docs/suite_time.md, "Two tiers"): another notebook, a build (Sphinx, wheel), another pdflatex run,
+#: another cache-damage probe in subprocesses, an order of h^6 or more, another row of a large table, another process
+#: start.  Nothing else is moved: the fast tier keeps a case of every table, every module and every subcommand.
+DEEP = (
+    # one notebook in the fast tier; a kernel process each, 5-12 s
+    ("test_notebooks.py", "test_notebook_executes", ("01_hamiltonian_warmup",)),
+    # the three probes that recompile numba's loops in subprocesses after damaging the warm cache (7-20 s each); the
+    # fast tier keeps the verified read, the listing cache and test_hardening_numeric's kernel- and numba-cache probes
+    ("test_cache_safety.py", "test_special_files_in_place_of_cache_files_neither_block_nor_are_read", ()),
+    ("test_cache_safety.py", "test_pickles_planted_under_numba_cache_dir_are_never_loaded", ()),
+    ("test_cache_safety.py", "test_private_numba_cache_unpickles_only_verified_files", ()),
+    # builds: Sphinx (12 s), the wheel and sdist (twine, an installed wheel); the fast tier keeps the page index
+    # check, the version and the citation
+    ("test_docs.py", "test_api_reference_builds_without_warnings", ()),
+    ("test_packaging.py", "test_wheel_and_sdist_pass_twine_check", ()),
+    ("test_packaging.py", "test_wheel_holds_only_the_package", ()),
+    ("test_packaging.py", "test_sdist_holds_the_sources_and_the_licence", ()),
+    ("test_packaging.py", "test_installed_wheel_runs_the_readme_first_command", ()),
+    # pdflatex: one compile per subcommand in the fast tier, the other outputs in the deep tier
+    ("test_latex_compile.py", "test_cli_latex_compiles",
+     ("shadow", "conserved", "exact --order 4", "bch", "fi", "models --format latex")),
+    # another process start for what the fast tier checks once: the example suite with the plugin named explicitly
+    # (the entry-point run stays), the dask cluster (loky stays), the spawned pickle worker (the in-process round trips
+    # stay)
+    ("test_testing.py", "test_example_suite_with_explicit_plugin", ()),
+    ("test_parallel.py", "test_dask_local_cluster_equals_serial", ()),
+    ("test_pickle.py", "test_results_come_back_from_spawned_workers", ()),
+    # hostile text: every subcommand and every option once in the fast tier, all 105 pairs in the deep tier
+    ("test_hardening_input.py", "test_hostile_text_every_subcommand_and_option",
+     ("models--model", "bch--system", "fi--H", "shadow--G", "conserved--coords", "exact--param", "check--name",
+      "plot--split", "models--format", "bch--integrator", "shadow--order", "shadow--route", "conserved--degree",
+      "check--h", "plot--steps", "check--x0", "plot--every", "check--alpha", "plot--short-steps", "plot--dpi",
+      "plot--fig-format")),
+    # the numeric argument table: every (entry, argument) row with one of its 19 bad values in the fast tier
+    ("test_numeric_api_arguments.py", "test_bad_argument_gives_one_nambu_error_line", _diagonal(19)),
+    # the exact linear algebra over every field and backend: QQ for each backend and one algebraic field in the fast
+    # tier, the parametric and algebraic-parametric fields (1-7 s each) in the deep tier
+    ("test_elimination.py", "test_solve_affine_matches_plain_domainmatrix",
+     ("flint-QQ", "modular-QQ", "sympy-only-QQ", "flint-QQ<2^(1/3)>")),
+    ("test_elimination.py", "test_rank_nullspace_normal_form_match_plain",
+     ("flint-QQ", "modular-QQ", "sympy-only-QQ", "flint-QQ(a,b)")),
+    ("test_elimination.py", "test_rigid_body_shadows_match_plain_path",
+     ("flint-values0-yoshida:12321-2", "modular-values0-yoshida:12321-2", "sympy-only-values0-yoshida:12321-2",
+      "flint-values1-yoshida:12321-4")),
+    # the sparse BCH engine against the dense one: degrees <= 9 in the fast tier; degree 11-12 (a 15 s cold compile)
+    ("test_bch_modular.py", "test_sparse_engine_equals_dense_engine",
+     ("12321-9", "123-8", "21-8", "3:1/2,1:1,3:1/2-8", "1234321-6", "1:1/3,2:1/2,1:2/3,3:1,2:1/2-7",
+      "1:999/7,2:1,1:-992/7-8")),
+    # high orders (h^6 and more) and the large symbolic cases; each has a lower-order case in the fast tier
+    ("test_direct_route_fast.py", "test_rigid_body_symbolic_yoshida_family_over_base_field", ()),
+    ("test_design.py", "test_optimize_finds_yoshidas_sixth_order_solution", ()),
+    ("test_exact_shadow.py", "test_alpha_family_reproduces_X_eff_to_h8", ("12321",)),
+    ("test_direct_route_gauge.py", "test_psi_dim_equals_second_elimination",
+     ("degrees-ho3-6_0", "free-columns-ho3-6_0", "degrees-lotka-volterra-6")),
+    ("test_direct_route_flint.py", "test_solves_identical_with_and_without_flint",
+     ("n3-params-12321-4-True", "n3-params-123-2-True")),
+    ("test_shadow.py", "test_shadow_pair_reproduces_effective_field",
+     ("ho3-12321-2", "ho3-13231-2", "ho3-31213-2", "ho3-21312-2", "ho3-23132-2", "ho3-32123-2", "ho-121-4", "ho-12-3",
+      "lotka-volterra-12321-4", "lotka-volterra-123-2", "ho3-composite-121-4", "ho3-composite-12-2")),
+    ("test_fi_route.py", "test_hull_members_have_the_brackets_field", ("ho3-12321-4", "lotka-volterra-12321-4")),
+    ("test_fi_route.py", "test_h4_hull_equals_brute_force_enumeration", ("ho3-12321", "ho3-21312")),
+    # tables: a sample of rows in the fast tier
+    ("test_exact_solutions.py", "test_solutions_solve_the_equations",
+     ("o-ho3-12321", "o-ho-121", "o-ho-12", "c-ho-121", "s-ho-121")),
+    ("test_integrators.py", "test_condition1_every_composition",
+     ("ho-121", "ho-212", "ho-12", "ho-21", "ho-forest-ruth", "ho3-12321", "ho3-13231", "ho3-31213", "ho3-21312",
+      "ho3-23132", "ho3-32123", "ho3-123", "ho3-321", "ho3-composite-121", "ho3-composite-212", "ho3-composite-12",
+      "lotka-volterra-123", "rigid-body-123")),
+    ("test_exact_solutions.py", "test_shadow_solution_at_t_equal_h_is_the_map", ("ho3-12321", "ho3-31213", "ho-121")),
+    ("test_integrators.py", "test_condition1_rigid_body_all_words", ("12321", "31213")),
+    ("test_bseries.py", "test_bseries_equals_taylor_backward_analysis",
+     ("euler-ho", "implicit-euler-rigid-body", "midpoint-lotka-volterra", "trapezoid-ho3", "rk4-ho", "kahan-ho3")),
+    ("test_any_system.py", "test_generic_nambu_no_universal_shadow_pair_at_h2", ("12321",)),
+    ("test_extended_ring.py", "test_ring_check_agrees_with_the_expression_check",
+     ("pendulum-121-4", "exp-well-212-4", "henon-heiles-121-4")),
+    ("test_design_methods.py", "test_complex_rows_of_check_methods",
+     ("2:1/4-sqrt(3)*I/12,1:1/2-sqrt(3)*I/6,2:1/2,1:1/2+sqrt(3)*I/6,2:1/4+sqrt(3)*I/12-3-0.36-1.49",)),
+    ("test_pickle.py", "test_more_results_round_trip",
+     ("EffectiveField triple jump (cube root of 2)", "ShadowFamily ho h^4 fi", "ShadowFamily none")),
+    # high orders and degrees beyond the fast tier's: gauss6, BCH degree 7-9 and 16 against the exact references
+    ("test_bseries.py", "test_gauss_modified_field_starts_at_its_order", ("gauss4",)),
+    ("test_bch_formal.py", "test_matrix_check_detects_a_wrong_high_degree_coefficient", ()),
+    ("test_bch_formal.py", "test_against_free_associative_log",
+     ("12-6", "1:1/3,2:1,3:1,1:2/3-6", "2:1/3,1:1/2,2:2/3,1:1/2-6")),
+    ("test_bch_modular.py", "test_bernoulli_coefficients_of_ad_powers", ("13",)),
+    ("test_modular_rref.py", "test_n4_single_split_h4_same_with_modular_and_flint", ()),
+    # sweeps against a reference at many points: the Lotka-Volterra exponential flows in both ranges (the fast tier
+    # keeps test_exponential_flows_use_expm1 and _agree_across_backends), the expm1 pair against mpmath
+    ("test_numeric.py", "test_exponential_flows_agree_bitwise_in_the_series_range", ()),
+    ("test_numeric.py", "test_exponential_flows_mix_series_and_library_ranges", ()),
+    ("test_numeric.py", "test_series_pair_is_accurate", ()),
+    # the adversarial calls of paper_figures (drawing every figure, 4 s); test_hardening_numeric's paper_figures
+    # tests and the no-code-execution check of the same callable stay in the fast tier
+    ("test_fuzz_api.py", "test_public_callable_raises_only_the_family",
+     lambda pid: pid != "nambu_bch.paper_figures"),
+    # a long run (t = 10^3 from every model's default x0); the fast tier checks the defaults' size and use
+    ("test_numeric_api_arguments.py", "test_default_x0_of_every_model_runs_a_long_orbit", ()),
+    # Eqs. (1AX)-(2BY) for generic functions (jets); the fast tier checks them on the models (test_fi_route's h^2 hull)
+    ("test_shadow.py", "test_eight_representations_for_generic_functions", ()),
+)
+
 #: Plugin distributions whose modules pytest marks for assertion rewriting (every module of a distribution with a
 #: ``pytest11`` entry point).  None of them has an ``assert`` the suite relies on (the package has none at all), but
 #: every pytest process re-parsed and rewrote ~150 of their modules as they were imported, ~0.7 s of CPU per process,
@@ -80,7 +206,57 @@ def pytest_configure(config):
         cache.clear()
 
 
+def _deep_run(config) -> bool:
+    """Whether this run's ``-m`` expression selects the deep tier (true for a test marked ``deep`` alone)."""
+    expr = config.getoption("markexpr", "") or ""
+    if not expr:
+        return False
+    try:
+        from _pytest.mark.expression import Expression
+
+        return bool(Expression.compile(expr).evaluate(lambda name, **kwargs: name == "deep" and not kwargs))
+    except Exception:  # pytest's private parser changed: fall back to the words themselves
+        return "deep" in expr.split() and "not" not in expr.split()
+
+
+def _in_deep_tier(item) -> bool:
+    for f, n, keep in DEEP:
+        if item.path.name == f and (item.name == n or item.name.startswith(n + "[")):
+            pid = item.name[len(n) + 1:-1] if item.name != n else ""
+            return not (keep(pid) if callable(keep) else pid in keep)
+    return False
+
+
+def _scale_hypothesis(item, deep: bool) -> None:
+    """A fast-tier hypothesis test draws ``ceil(n / HYPOTHESIS_FAST_DIVISOR)`` of its ``n`` examples."""
+    test = getattr(item, "obj", None)
+    test = getattr(test, "__func__", test)  # a method's function carries the settings
+    current = getattr(test, "_hypothesis_internal_use_settings", None)
+    if deep or current is None or not getattr(test, "is_hypothesis_test", False):
+        return
+    from hypothesis import settings
+
+    full = _FULL_SETTINGS.setdefault(test, current)  # the parametrised cases of one test share its function
+    fast = max(1, math.ceil(full.max_examples / HYPOTHESIS_FAST_DIVISOR))
+    # the attribute @given reads its settings from when the test runs (hypothesis 6); absent, nothing changes
+    test._hypothesis_internal_use_settings = settings(full, max_examples=fast)
+
+
+_FULL_SETTINGS: dict = {}
+
+
 def pytest_collection_modifyitems(session, config, items):
+    deep = _deep_run(config)
+    # every collected (file, test name) before selection, for tests/test_suite_tiers.py's check of DEEP
+    config.nambu_bch_collected = {(item.path.name, item.name) for item in items}
+    config.nambu_bch_deep = DEEP
+    for item in items:
+        if _in_deep_tier(item):
+            item.add_marker(pytest.mark.deep)
+        elif deep and getattr(getattr(item, "obj", None), "is_hypothesis_test", False):
+            item.add_marker(pytest.mark.deep)  # the deep tier runs the hypothesis tests again, at full counts
+        _scale_hypothesis(item, deep)
+
     def rank(item) -> int:
         for i, (f, n) in enumerate(LONG):
             if item.path.name == f and item.name.startswith(n):

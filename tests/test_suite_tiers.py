@@ -1,0 +1,46 @@
+"""The two tiers of the suite (tests/conftest.py ``DEEP``; docs/suite_time.md): every entry names tests that exist.
+
+A renamed test or parameter would otherwise move a whole table to the deep tier (a case kept by name that no longer
+exists keeps nothing) or leave a deep entry matching nothing, without any test failing.
+"""
+
+from __future__ import annotations
+
+import pytest
+
+
+def _cases(collected, f, n):
+    return {name[len(n) + 1:-1] if name != n else "" for file, name in collected
+            if file == f and (name == n or name.startswith(n + "["))}
+
+
+def test_every_deep_entry_and_kept_case_exists(request):
+    collected = getattr(request.config, "nambu_bch_collected", None)
+    deep = getattr(request.config, "nambu_bch_deep", None)
+    if collected is None or deep is None:
+        pytest.skip("tests/conftest.py did not record the collection")
+    files = {f for f, _ in collected}
+    checked = 0
+    for f, n, keep in deep:
+        if f not in files:  # a run of some files only
+            continue
+        cases = _cases(collected, f, n)
+        if not cases:  # the file was collected in part (a node id, or -k before collection)
+            continue
+        checked += 1
+        if not callable(keep):
+            missing = [k for k in keep if k not in cases]
+            assert not missing, f"tests/conftest.py DEEP keeps {missing} of {f}::{n}, which has no such case"
+        else:
+            assert any(keep(c) for c in cases), f"tests/conftest.py DEEP keeps no case of {f}::{n}"
+    if not checked:
+        pytest.skip("none of the files DEEP names was collected")
+
+
+def test_diagonal_keeps_one_case_per_row():
+    from conftest import _diagonal  # the helper only: a pure function of the id
+
+    keep = _diagonal(19)
+    rows = ["iterate-h", "check-x0", "ModifiedSolution.numeric()(t, x0)-t", "shadow_along-word"]
+    for row in rows:
+        assert sum(keep(f"{row}-{k}") for k in range(19)) == 1, row
