@@ -45,13 +45,13 @@ Gerhard, *Modern Computer Algebra*, ch. 5 (the modular route); Horikoshi, Sect. 
 
 from __future__ import annotations
 
-import importlib
-import os
 from dataclasses import dataclass
 
 from sympy.polys.domains import QQ
 from sympy.polys.matrices import DomainMatrix
 from sympy.polys.matrices.sdm import SDM
+
+from . import _flint
 
 
 @dataclass(frozen=True)
@@ -95,33 +95,23 @@ MODULAR_MIN = 24
 #: reference path the tests compare the faster routes with).
 FAST_PATHS = True
 
-_FLINT: list = []
-
-
 def flint_available() -> bool:
     """python-flint is installed and not disabled by ``NAMBU_BCH_DISABLE_FLINT=1`` (read at every call).
 
     python-flint is a dependency; when it is missing or switched off every elimination runs on the
     package's multi-modular RREF or sympy's ``DomainMatrix``, with the same results (both paths are tested).
     """
-    if os.environ.get("NAMBU_BCH_DISABLE_FLINT", "").strip().lower() in ("1", "true", "yes", "on"):
-        return False
-    if not _FLINT:
-        try:
-            _FLINT.append(importlib.import_module("flint"))
-        except ImportError:
-            _FLINT.append(None)
-    return _FLINT[0] is not None and hasattr(_FLINT[0], "fmpq_mat")
+    return _flint.available()
 
 
 def _rref_flint_qq(rows: dict, nrows: int, ncols: int):
     """Reduced echelon form over ``QQ`` with flint's dense ``fmpq_mat.rref`` (exact, fraction-free inside)."""
-    flint = _FLINT[0]
-    native = QQ.dtype is flint.fmpq  # sympy's ground types are flint: no conversion
-    M = flint.fmpq_mat(nrows, ncols)
+    native = _flint.qq_is_fmpq(QQ.dtype)  # sympy's ground types are flint: no conversion
+    fmpq = _flint.fmpq
+    M = _flint.fmpq_mat(nrows, ncols)
     for i, row in rows.items():
         for j, v in row.items():
-            M[i, j] = v if native else flint.fmpq(int(v.numerator), int(v.denominator))
+            M[i, j] = v if native else fmpq(v)
     R, rank = M.rref()
     entries = R.entries()
     out, pivots = {}, []

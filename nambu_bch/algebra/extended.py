@@ -36,11 +36,10 @@ simplification.  Inputs outside these conditions raise :class:`~nambu_bch.errors
 
 from __future__ import annotations
 
-import importlib
-
 import sympy
 
 from ..errors import NoExactResultError
+from . import _flint
 
 #: The functions the ring accepts as atoms (everything else is refused).
 _TRIG = (sympy.sin, sympy.cos)
@@ -177,7 +176,6 @@ class ExtendedRing:
         self.parameters = tuple(parameters)
         self.n = len(self.coordinates)
         exprs = [sympy.sympify(e, strict=True) for e in expressions]
-        self._flint = importlib.import_module("flint")
         self._discover(exprs)
         self._build()
         #: no exp, sin, cos or square root: the elements are rational functions
@@ -256,7 +254,7 @@ class ExtendedRing:
         names = ([f"C{k}" for k in range(len(trig))] + [f"u{k}" for k in range(len(self._radicands))]
                  + [str(x) for x in self.coordinates] + [f"S{k}" for k in range(len(trig))]
                  + [f"E{k}" for k in range(len(exps))] + [str(p) for p in self.parameters])
-        ctx = self._ctx = self._flint.fmpq_mpoly_ctx.get(tuple(f"v{i}" for i in range(len(names))), "lex")
+        ctx = self._ctx = _flint.fmpq_mpoly_context(len(names))
         self.names = tuple(names)
         gens = ctx.gens()
         nt, nr, n = len(trig), len(self._radicands), self.n
@@ -412,7 +410,7 @@ class ExtendedRing:
         if e.is_Symbol:
             out = self._x[self.coordinates.index(e)] if e in self.coordinates else self._p[self.parameters.index(e)]
         elif e.is_Rational:
-            out = self._one_poly * self._flint.fmpq(int(e.p), int(e.q))
+            out = self._one_poly * _flint.fmpq(int(e.p), int(e.q))
         elif e.is_Add:
             out = self._zero_poly
             for a in e.args:
@@ -469,15 +467,12 @@ class ExtendedRing:
 
     def scalar(self, value):
         """An exact rational as a flint ``fmpq`` (the scalars of the ring)."""
-        fmpq = self._flint.fmpq
-        if isinstance(value, fmpq):
-            return value
-        if isinstance(value, int):
-            return fmpq(value)
+        if isinstance(value, int) or _flint.is_fmpq(value):
+            return _flint.fmpq(value)
         value = sympy.sympify(value, strict=True)
         if not value.is_Rational:
             raise NoExactResultError(f"{value} is not a rational number (the ring's scalars are rational)")
-        return fmpq(int(value.p), int(value.q))
+        return _flint.fmpq(int(value.p), int(value.q))
 
     def constant(self, value) -> Element:
         return Element(self, self._one_poly * self.scalar(value), self._zero_den)
@@ -673,9 +668,7 @@ class ExtendedRing:
 def extended_ring(coordinates, parameters, expressions):
     """The :class:`ExtendedRing` of ``expressions``, or ``None`` when one of their atoms is refused or python-flint
     is missing or switched off (``NAMBU_BCH_DISABLE_FLINT=1``): the callers then work in sympy expressions."""
-    from .elimination import flint_available
-
-    if not flint_available():
+    if not _flint.available():
         return None
     try:
         return ExtendedRing(coordinates, parameters, expressions)

@@ -16,14 +16,10 @@ Horikoshi, Eq. (gLiouville); FLINT ``fmpq_mpoly``.
 
 from __future__ import annotations
 
-import importlib
 from types import SimpleNamespace
 
-
-def exponents(p) -> list:
-    """The exponent tuples of a flint polynomial's terms as Python ints (flint returns ``fmpz`` exponents, which
-    must not leak into sympy's rings), in the order of ``p.coeffs()``."""
-    return [tuple(map(int, m)) for m in p.monoms()]
+from . import _flint
+from ._flint import exponents
 
 
 class FlintRing:
@@ -39,10 +35,7 @@ class FlintRing:
 
     def __init__(self, names, n: int):
         self.names = tuple(names)
-        flint = importlib.import_module("flint")
-        # flint names are cosmetic and ASCII-only (a generator may be called ``ω``): v0, v1, .. in the given order
-        self.ctx = flint.fmpq_mpoly_ctx.get(tuple(f"v{i}" for i in range(len(tuple(names)))), "lex")
-        self._fmpq = flint.fmpq
+        self.ctx = _flint.fmpq_mpoly_context(len(self.names))  # generators v0, v1, .. in the order of ``names``
         self.n = n
         self.gens = tuple(self.ctx.gens())
         self.zero = self.ctx.from_dict({})
@@ -60,9 +53,8 @@ class FlintRing:
 
     def from_terms(self, terms: dict):
         """The polynomial ``sum c x^e`` of ``{exponent tuple: rational}`` (sympy ``QQ`` elements or flint ``fmpq``)."""
-        fmpq = self._fmpq
-        return self.ctx.from_dict({e: c if isinstance(c, fmpq) else fmpq(int(c.numerator), int(c.denominator))
-                                   for e, c in terms.items()})
+        fmpq = _flint.fmpq
+        return self.ctx.from_dict({e: fmpq(c) for e, c in terms.items()})
 
     @staticmethod
     def terms(p) -> dict:
