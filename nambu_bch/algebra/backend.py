@@ -60,6 +60,7 @@ from ..checks import check_type
 from ..errors import NambuBCHError
 from . import _flint
 from ._flint import exponents
+from .fields import CoefficientField
 from .flint_ring import FlintRing
 from .vector_field import VectorField
 
@@ -207,7 +208,7 @@ class PolynomialBackend:
     @classmethod
     def _laurent(cls, algebra, fields):
         params = algebra.parameters
-        base = algebra.domain.field.domain if params else algebra.domain
+        base = CoefficientField.of(algebra.domain).ground
         names = [str(s) for s in algebra.coordinates + algebra.constants]
         for p in params:
             names += [str(p), f"{p}_inv"]

@@ -52,6 +52,7 @@ from sympy.polys.matrices import DomainMatrix
 from sympy.polys.matrices.sdm import SDM
 
 from . import _flint
+from .fields import CoefficientField
 
 
 @dataclass(frozen=True)
@@ -142,11 +143,10 @@ class _AlgebraicSplit:
 
     @classmethod
     def of(cls, domain):
-        if domain.is_AlgebraicField:
-            return cls(domain, domain, QQ)
-        if getattr(domain, "is_FractionField", False) and domain.domain.is_AlgebraicField:
-            return cls(domain, domain.domain, QQ.frac_field(*domain.symbols))
-        return None
+        field = CoefficientField.recognise(domain)
+        if field is None or not field.is_algebraic:
+            return None
+        return cls(domain, field.ground, QQ.frac_field(*field.parameters) if field.parameters else QQ)
 
     def split(self, v):
         """``[b_0, .., b_{k-1}]`` in ``B`` with ``v = sum_i theta^i b_i``, or ``None`` (denominator not in ``B``)."""
@@ -295,8 +295,8 @@ def elimination_cost(columns: list, nrows: int, domain=QQ) -> int:
     for members in _blocks(rows, len(columns)).values():
         r, c = len(members), len({j for i in members for j in rows[i]})
         total += r * c * min(r, c)
-    over_qq = domain.is_QQ or domain.is_AlgebraicField
-    return total if over_qq else total * FIELD_WEIGHT
+    field = CoefficientField.recognise(domain)
+    return total if field is not None and field.is_number_field else total * FIELD_WEIGHT
 
 
 def signed_sums(sums: dict, domain) -> dict | None:
@@ -633,7 +633,8 @@ def _full_rank_at_a_point(rows: dict, nrows: int, ncols: int, domain):
     is that bound.  A smaller rank at the point proves nothing (the caller eliminates over the field).
     The rank at the point is an elimination over ``QQ`` (no polynomial gcds).
     """
-    if not (getattr(domain, "is_FractionField", False) and domain.domain.is_QQ) or len(domain.symbols) > 8:
+    field = CoefficientField.recognise(domain)
+    if field is None or not field.is_rational_functions or len(field.parameters) > 8:
         return None
     bound = min(nrows, ncols)
     for point in _RANK_POINTS:

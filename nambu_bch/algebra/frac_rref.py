@@ -27,17 +27,14 @@ from __future__ import annotations
 
 from . import _flint
 from ._flint import exponents
+from .fields import CoefficientField
 
 
 def context(domain):
     """The flint ``fmpz_mpoly_ctx`` of the parameters of ``domain = QQ(params)`` (lexicographic, same order),
     or ``None`` when ``domain`` is not a fraction field over ``QQ`` with the lexicographic order."""
-    if not (getattr(domain, "is_FractionField", False) and domain.domain.is_QQ):
-        return None
-    ring = domain.field.ring
-    if str(ring.order) != "lex":
-        return None
-    return generic_context(len(ring.symbols))
+    field = CoefficientField.recognise(domain)
+    return field.flint_context() if field is not None else None
 
 
 def generic_context(nvars: int):

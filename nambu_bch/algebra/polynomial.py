@@ -29,6 +29,7 @@ from sympy.polys.rings import PolyElement, PolyRing
 from ..checks import check_sequence
 from ..errors import InvalidSystemError
 from ..parsing import as_expression, as_symbols
+from .fields import CoefficientField
 from .zero import is_zero
 
 _CONVERSION_ERRORS = (CoercionFailed, GeneratorsError, PolynomialError, ValueError, TypeError)
@@ -455,6 +456,12 @@ class PolynomialAlgebra:
     def to_sympy_expanded(self, value, factors=()) -> sympy.Expr:
         """``sympy.expand(to_sympy(value) * prod(factors))``, identical, from :meth:`expanded_terms` (no ``expand``)."""
         return sympy.Add(*self.expanded_terms(value, factors))
+
+    @cached_property
+    def coefficient_field(self) -> CoefficientField:
+        """The field of the coefficients, ``QQ``, ``QQ(parameters)``, ``QQ(theta)`` or ``QQ(theta)(parameters)``
+        (:class:`~nambu_bch.algebra.fields.CoefficientField`)."""
+        return CoefficientField.of(self.domain)
 
     @cached_property
     def zero(self):
