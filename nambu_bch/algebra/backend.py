@@ -61,7 +61,7 @@ from ..errors import NambuBCHError
 from . import _flint
 from ._flint import exponents
 from .fields import CoefficientField
-from .flint_ring import FlintRing
+from .ring import check_ring
 from .vector_field import VectorField
 
 
@@ -658,9 +658,7 @@ def field_backend(algebra, fields: dict, laurent: bool = True) -> FieldBackend:
     >>> type(B).__name__, B.laurent
     ('PolynomialBackend', True)
     """
-    from .polynomial import PolynomialAlgebra
-
-    check_type(algebra, (PolynomialAlgebra, FlintRing), "algebra")
+    check_ring(algebra, "algebra")
     check_type(fields, dict, "fields")
     backend = PolynomialBackend.build(algebra, fields, laurent)
     if backend is not None:

@@ -40,6 +40,7 @@ import sympy
 
 from ..errors import NoExactResultError
 from . import _flint
+from .ring import declare
 
 #: The functions the ring accepts as atoms (everything else is refused).
 _TRIG = (sympy.sin, sympy.cos)
@@ -146,6 +147,7 @@ class Element:
         return f"Element({self.ring.to_sympy(self)})"
 
 
+@declare(vector_fields=False)
 class ExtendedRing:
     """The exact ring of the atoms of ``expressions`` over ``QQ[coordinates, parameters]`` (module docstring).
 
@@ -474,11 +476,34 @@ class ExtendedRing:
             raise NoExactResultError(f"{value} is not a rational number (the ring's scalars are rational)")
         return _flint.fmpq(int(value.p), int(value.q))
 
+    # -- the ring protocol (nambu_bch.algebra.ring.ExactRing) -------------------------------
+    @property
+    def gens(self) -> tuple:
+        """The generators as elements: the coordinates first, then ``C``, ``u``, ``S``, ``E`` and the parameters."""
+        return tuple(self._atom(g) for g in (*self._x, *self._C, *self._u, *self._S, *self._E, *self._p))
+
+    def common(self, *values) -> tuple:
+        """The values as elements (every value of this ring is one)."""
+        return tuple(v if isinstance(v, Element) else self.convert(v) for v in values)
+
+    @staticmethod
+    def is_zero(value) -> bool:
+        """Zero on the normal form: the numerator is the zero polynomial."""
+        return not value
+
+    @staticmethod
+    def is_polynomial(value) -> bool:
+        """Every element is a ring element (no general sympy expressions here)."""
+        return isinstance(value, Element)
+
     def constant(self, value) -> Element:
         return Element(self, self._one_poly * self.scalar(value), self._zero_den)
 
     def convert(self, expr) -> Element:
-        """A sympy expression in the ring's atoms as an :class:`Element` (refused when it has other atoms)."""
+        """A sympy expression in the ring's atoms as an :class:`Element` (refused when it has other atoms); an element of
+        this ring unchanged."""
+        if isinstance(expr, Element) and expr.ring is self:
+            return expr
         return self._element_of(sympy.sympify(expr, strict=True))
 
     def _element_of(self, e):

@@ -20,8 +20,10 @@ from types import SimpleNamespace
 
 from . import _flint
 from ._flint import exponents
+from .ring import declare
 
 
+@declare()
 class FlintRing:
     """``QQ[names]`` on flint ``fmpq_mpoly`` (lexicographic, generators in the order of ``names``), the first ``n``
     generators the coordinates.

@@ -30,6 +30,7 @@ from ..checks import check_sequence
 from ..errors import InvalidSystemError
 from ..parsing import as_expression, as_symbols
 from .fields import CoefficientField
+from .ring import declare
 from .zero import is_zero
 
 _CONVERSION_ERRORS = (CoercionFailed, GeneratorsError, PolynomialError, ValueError, TypeError)
@@ -264,6 +265,7 @@ def _picklable_field(field):
     return field if isinstance(field, _PicklableField) else _PicklableField(field.symbols, field.domain, field.order)
 
 
+@declare()
 class PolynomialAlgebra:
     """Polynomials in ``coordinates`` (and ``constants``) over ``QQ(parameters)``.
 
