@@ -29,6 +29,7 @@ from sympy.polys.rings import PolyElement, PolyRing
 from ..checks import check_sequence
 from ..errors import InvalidSystemError
 from ..parsing import as_expression, as_symbols
+from .backend import ExpressionBackend, PolynomialBackend
 from .fields import CoefficientField
 from .ring import declare
 from .zero import is_zero
@@ -486,15 +487,11 @@ class PolynomialAlgebra:
     def ring_backend(self):
         """The :class:`~nambu_bch.algebra.backend.PolynomialBackend` on this ring (``diff`` as derivative):
         the arithmetic behind :class:`~nambu_bch.algebra.VectorField` for polynomial components."""
-        from .backend import PolynomialBackend
-
         return PolynomialBackend.on_ring(self)
 
     @cached_property
     def expression_backend(self):
         """The :class:`~nambu_bch.algebra.backend.ExpressionBackend` on these coordinates (sympy components)."""
-        from .backend import ExpressionBackend
-
         return ExpressionBackend(self)
 
     def common(self, *values):
