@@ -171,9 +171,29 @@ def test_check_ring_refuses_other_objects():
     from nambu_bch.algebra.ring import check_ring
     from nambu_bch.errors import NambuBCHError
 
-    with pytest.raises(NambuBCHError, match=r"^algebra must be an exact ring \(a PolynomialAlgebra or FlintRing\), got"):
+    with pytest.raises(NambuBCHError, match=r"^algebra must be an exact ring \(a PolynomialAlgebra or FlintRing\), "):
         VectorField("not a ring", [x])
     with pytest.raises(NambuBCHError, match="exact ring"):
         liouville_field(object(), x)
     R = PolynomialAlgebra([x, y])
     assert check_ring(R, "algebra") is R
+
+
+def test_polynomial_ring_is_the_same_ring_with_and_without_flint():
+    """The direct route's fraction-free ring QQ[x, constants]: FlintRing or PolynomialAlgebra behind one factory,
+    the same Liouville field (Eq. gLiouville) term by term through ``from_terms``/``terms``."""
+    from nambu_bch.algebra import liouville_field
+    from nambu_bch.algebra.flint_ring import FlintRing, polynomial_ring
+
+    q, p, c = sympy.symbols("q p c")
+    H = {(0, 2, 0): QQ(1, 2), (2, 0, 1): QQ(3)}  # p^2/2 + 3 c q^2
+    fields = []
+    for flint in ((False, True) if _flint._import() is not None else (False,)):
+        R = polynomial_ring([q, p], [c], flint)
+        assert isinstance(R, FlintRing) == flint and R.n == 2
+        X = liouville_field(R, R.from_terms(H))
+        fields.append([{m: QQ(int(v.numerator), int(v.denominator)) for m, v in R.terms(comp).items()}
+                       for comp in X.components])
+        assert R.is_zero(R.from_terms({})) and R.terms(R.from_terms({})) == {}
+    assert fields[0] == [{(0, 1, 0): QQ(1)}, {(1, 0, 1): QQ(-6)}]  # X_H = (dH/dp, -dH/dq)
+    assert all(f == fields[0] for f in fields)

@@ -500,8 +500,8 @@ class ExtendedRing:
         return Element(self, self._one_poly * self.scalar(value), self._zero_den)
 
     def convert(self, expr) -> Element:
-        """A sympy expression in the ring's atoms as an :class:`Element` (refused when it has other atoms); an element of
-        this ring unchanged."""
+        """A sympy expression in the ring's atoms as an :class:`Element` (refused when it has other atoms); an
+        element of this ring unchanged."""
         if isinstance(expr, Element) and expr.ring is self:
             return expr
         return self._element_of(sympy.sympify(expr, strict=True))

@@ -68,7 +68,7 @@ class CoefficientField:
 
     @classmethod
     def recognise(cls, domain):
-        """:meth:`of`, or ``None`` when ``domain`` is none of the four fields (sympy's ``EX``, a polynomial ring ...)."""
+        """:meth:`of`, or ``None`` when ``domain`` is none of the four fields (sympy's ``EX``, a polynomial ring)."""
         if isinstance(domain, cls):
             return domain
         ground = domain.domain if getattr(domain, "is_FractionField", False) else domain

@@ -20,6 +20,7 @@ from types import SimpleNamespace
 
 from . import _flint
 from ._flint import exponents
+from .polynomial import PolynomialAlgebra
 from .ring import declare
 
 
@@ -80,3 +81,13 @@ class FlintRing:
     @staticmethod
     def is_polynomial(value) -> bool:
         return True
+
+
+def polynomial_ring(coordinates, constants, flint: bool):
+    """``QQ[coordinates, constants]`` with the coordinates as the ring protocol's derivation variables: a
+    :class:`FlintRing` when ``flint`` (python-flint chosen by the caller, :func:`nambu_bch.algebra._flint.available`),
+    else a :class:`~nambu_bch.algebra.polynomial.PolynomialAlgebra` over ``QQ`` -- the same polynomials, exponent
+    tuples in the same order (coordinates, then constants), with ``from_terms``/``terms`` on both."""
+    if flint:
+        return FlintRing([str(s) for s in (*coordinates, *constants)], len(coordinates))
+    return PolynomialAlgebra(coordinates, (), constants)

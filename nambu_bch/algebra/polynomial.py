@@ -494,6 +494,15 @@ class PolynomialAlgebra:
         """The :class:`~nambu_bch.algebra.backend.ExpressionBackend` on these coordinates (sympy components)."""
         return ExpressionBackend(self)
 
+    def from_terms(self, terms: dict):
+        """The polynomial ``sum c x^e`` of ``{exponent tuple: coefficient}`` (exponents over all generators)."""
+        return self.ring.from_dict(terms) if terms else self.zero
+
+    @staticmethod
+    def terms(value) -> dict:
+        """``{exponent tuple: coefficient}`` of a polynomial (sympy's polynomials are such dicts already)."""
+        return value
+
     def common(self, *values):
         """The values in one representation: all ring elements if possible, else all sympy."""
         if all(isinstance(v, PolyElement) for v in values):

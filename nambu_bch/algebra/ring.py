@@ -100,6 +100,7 @@ def check_ring(value, what: str, vector_fields: bool = True):
     """``value`` if it is an instance of a declared exact ring (one carrying vector fields, with ``vector_fields``),
     else one line naming ``what`` and the accepted rings."""
     if not isinstance(value, declared_rings(vector_fields)):
-        kinds = "a PolynomialAlgebra or FlintRing" if vector_fields else "a PolynomialAlgebra, FlintRing or ExtendedRing"
+        kinds = "a PolynomialAlgebra or FlintRing" if vector_fields else \
+            "a PolynomialAlgebra, FlintRing or ExtendedRing"
         raise InvalidRunError(f"{what} must be an exact ring ({kinds}), got {show(value)}")
     return value
