@@ -75,6 +75,8 @@ BUILDERS = {
         "ho3", "32123", h=0.1, steps=200, every=10, mp_steps=50, dps=20, repeats=1, timing_steps=100, x0=(1, 1, 1)),
     "ShadowTrajectory": lambda: nb.shadow_along(_ho3(), "12321", nb.iterate(_ho3(), "12321", 0.1, 20, (1, 1, 1)), 0.1),
     "RunningStats": lambda: importlib.import_module("nambu_bch.numeric").RunningStats(),
+    "CoefficientField": lambda: importlib.import_module("nambu_bch.algebra").PolynomialAlgebra(
+        sympy.symbols("x1 x2"), [sympy.Symbol("m")], extension=[sympy.cbrt(2)]).coefficient_field,
     "DirectResult": lambda: importlib.import_module("nambu_bch.shadow").direct_route(_ho3(), "12321", order=4),
     "Existence": _existence,
     "FIResult": _fi_route,
@@ -99,6 +101,7 @@ BUILDERS = {
 NOT_RESULTS = {
     "ExpressionBackend": "arithmetic engine of an algebra, rebuilt from it",
     "FieldBackend": "arithmetic engine of an algebra, rebuilt from it",
+    "ExactRing": "the declared ring protocol (a typing.Protocol, no instances of its own)",
     "PolynomialBackend": "arithmetic engine of an algebra, rebuilt from it",
     "BracketEvaluator": "a memo of bracket values during one computation",
     "JetAlgebra": "the arithmetic of the non-polynomial route, rebuilt from the system",

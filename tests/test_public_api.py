@@ -35,7 +35,8 @@ SURFACE = {
         "shadow_along", "shadow_hamiltonians", "single_split", "step_function", "sweep",
     ),
     "nambu_bch.algebra": (
-        "ExpressionBackend", "FieldBackend", "PolynomialAlgebra", "PolynomialBackend", "VectorField",
+        "CoefficientField", "ExactRing", "ExpressionBackend", "FieldBackend", "PolynomialAlgebra", "PolynomialBackend",
+        "VectorField",
         "field_backend", "is_symplectic", "jacobian", "lie_bracket", "liouville_field",
         "nambu_bracket", "poisson_bracket", "satisfies_nambu_condition",
     ),

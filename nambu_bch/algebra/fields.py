@@ -3,7 +3,7 @@
 Every exact ring of the package (:class:`~nambu_bch.algebra.polynomial.PolynomialAlgebra`, the jet ring, the
 backends' rings, the matrices of the elimination) has its coefficients in one of four fields:
 
-* ``QQ`` -- the rationals (sympy's ``QQ``; flint's ``fmpq`` when python-flint is available);
+* ``QQ`` -- the rationals (sympy's ``QQ``; python-flint's ``fmpq`` on the flint paths);
 * ``QQ(p_1, .., p_k)`` -- rational functions in the parameters (masses, moments of inertia), each element a
   reduced fraction ``n / d`` with ``n, d`` in ``ZZ[p]`` coprime and ``lc(d) > 0`` (lexicographic order):
   sympy's ``FracField``, and flint's ``fmpz_mpoly`` pairs in :mod:`nambu_bch.algebra.frac_rref`;

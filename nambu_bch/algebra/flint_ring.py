@@ -56,8 +56,8 @@ class FlintRing:
 
     def from_terms(self, terms: dict):
         """The polynomial ``sum c x^e`` of ``{exponent tuple: rational}`` (sympy ``QQ`` elements or flint ``fmpq``)."""
-        fmpq = _flint.fmpq
-        return self.ctx.from_dict({e: fmpq(c) for e, c in terms.items()})
+        fmpq, native = _flint.fmpq, _flint.module().fmpq  # flint's own rationals pass without a call
+        return self.ctx.from_dict({e: c if isinstance(c, native) else fmpq(c) for e, c in terms.items()})
 
     @staticmethod
     def terms(p) -> dict:
