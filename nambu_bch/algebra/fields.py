@@ -25,6 +25,7 @@ Algebraic Number Theory*, Sect. 4.2 (a number field as ``QQ[X] / (minimal polyno
 
 from __future__ import annotations
 
+from ..errors import InvalidRunError
 from . import _flint
 
 __all__ = ["CoefficientField"]
@@ -51,7 +52,8 @@ class CoefficientField:
         fraction = bool(getattr(domain, "is_FractionField", False))
         ground = domain.domain if fraction else domain
         if not (ground.is_QQ or ground.is_ZZ or ground.is_AlgebraicField):
-            raise TypeError(f"{domain} is not QQ, QQ(parameters) or an algebraic number field (over parameters)")
+            raise InvalidRunError(f"coefficient domain {domain} is not QQ, QQ(parameters), an algebraic number field "
+                                  "QQ(theta) or QQ(theta)(parameters)")
         #: the sympy domain
         self.domain = domain
         #: ``QQ`` (or ``ZZ`` for a ring of integral polynomials) or ``QQ<theta>``: the field without parameters
