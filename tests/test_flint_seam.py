@@ -49,14 +49,21 @@ def test_detector_sees_every_spelling():
     assert _imports_flint(ast.parse("from . import _flint\nfrom ._flint import exponents\nimport flintlock\n")) == []
 
 
-def test_only_the_seam_imports_flint():
+@pytest.fixture(scope="module")
+def package_trees() -> dict:
+    """``{path: AST}`` of every module of the package, parsed once for the tests that walk them."""
+    return {path: ast.parse(path.read_text(encoding="utf-8"), filename=str(path))
+            for path in sorted(PACKAGE.rglob("*.py"))}
+
+
+def test_only_the_seam_imports_flint(package_trees):
     offenders = {}
-    for path in sorted(PACKAGE.rglob("*.py")):
-        hits = _imports_flint(ast.parse(path.read_text(encoding="utf-8"), filename=str(path)))
+    for path, tree in package_trees.items():
+        hits = _imports_flint(tree)
         if hits and path != SEAM:
             offenders[str(path.relative_to(PACKAGE))] = hits
     assert offenders == {}
-    assert _imports_flint(ast.parse(SEAM.read_text(encoding="utf-8")))  # the seam itself does
+    assert _imports_flint(package_trees[SEAM])  # the seam itself does
 
 
 def test_switch_is_read_at_every_call(monkeypatch):
@@ -120,10 +127,10 @@ def _import_cycles_tool():
     return tool
 
 
-def test_the_arithmetic_layer_has_no_import_cycle():
+def test_the_arithmetic_layer_has_no_import_cycle(package_trees):
     """No cycle through nambu_bch.algebra, counting imports inside functions (a deferred import that breaks a cycle
     is still one); the detector itself finds a planted cycle."""
     tool = _import_cycles_tool()
-    found = tool.cycles(tool.graph(PACKAGE, deferred=True))
+    found = tool.cycles(tool.graph(PACKAGE, deferred=True, trees=package_trees))
     assert [c for c in found if any(m.startswith("nambu_bch.algebra") for m in c)] == []
     assert tool.cycles({"a": {"b"}, "b": {"c"}, "c": {"a"}, "d": {"a"}}) == [["a", "b", "c"]]

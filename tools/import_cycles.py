@@ -48,12 +48,13 @@ def _targets(name: str, is_package: bool, node, known) -> list:
     return [t for t in names if t in known]
 
 
-def graph(package: Path, deferred: bool = True) -> dict:
-    """``{module: set of modules it imports}`` (module-level imports only unless ``deferred``)."""
+def graph(package: Path, deferred: bool = True, trees: dict | None = None) -> dict:
+    """``{module: set of modules it imports}`` (module-level imports only unless ``deferred``); ``trees`` may hold
+    the modules' ASTs already parsed (``{path: ast.Module}``)."""
     known = modules(package)
     edges = {}
     for name, (path, is_package) in known.items():
-        tree = ast.parse(path.read_text(encoding="utf-8"), filename=str(path))
+        tree = (trees or {}).get(path) or ast.parse(path.read_text(encoding="utf-8"), filename=str(path))
         nodes = ast.walk(tree) if deferred else tree.body
         targets = set()
         for node in nodes:
