@@ -23,8 +23,9 @@ import sys
 #: ``(module, attribute)``: an ``lru_cache`` function (``cache_clear``), a module's ``clear_cache()``,
 #: or a dict / ``WeakKeyDictionary`` (``clear``).  Modules not imported yet hold nothing and are skipped.
 CACHES = (
-    ("nambu_bch.algebra.frac_rref", "_CONTEXTS"),
-    ("nambu_bch.algebra.frac_rref", "_FLINT_QQ"),
+    ("nambu_bch.algebra._flint", "_FMPZ_CONTEXTS"),
+    ("nambu_bch.algebra._flint", "_FMPQ_CONTEXTS"),
+    ("nambu_bch.algebra._flint", "_QQ_IS_FMPQ"),
     ("nambu_bch.bch.concrete", "clear_cache"),          # _EVALUATORS
     ("nambu_bch.compiled", "_NUMBA_DIRS"),
     ("nambu_bch.bch.formal", "clear_cache"),            # _PATTERN_CACHE

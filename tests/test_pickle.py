@@ -77,6 +77,8 @@ BUILDERS = {
     "NumericalShadow": lambda: importlib.import_module("nambu_bch.numeric").numerical_shadow(
         *np.hsplit(nb.iterate("ho", "212", 0.1, 20, (1.0, 0.0)), 2), "ho", 0.1),
     "RunningStats": lambda: importlib.import_module("nambu_bch.numeric").RunningStats(),
+    "CoefficientField": lambda: importlib.import_module("nambu_bch.algebra").PolynomialAlgebra(
+        sympy.symbols("x1 x2"), [sympy.Symbol("m")], extension=[sympy.cbrt(2)]).coefficient_field,
     "DirectResult": lambda: importlib.import_module("nambu_bch.shadow").direct_route(_ho3(), "12321", order=4),
     "Existence": _existence,
     "FIResult": _fi_route,
@@ -105,6 +107,7 @@ BUILDERS = {
 NOT_RESULTS = {
     "ExpressionBackend": "arithmetic engine of an algebra, rebuilt from it",
     "FieldBackend": "arithmetic engine of an algebra, rebuilt from it",
+    "ExactRing": "the declared ring protocol (a typing.Protocol, no instances of its own)",
     "PolynomialBackend": "arithmetic engine of an algebra, rebuilt from it",
     "BracketEvaluator": "a memo of bracket values during one computation",
     "JetAlgebra": "the arithmetic of the non-polynomial route, rebuilt from the system",

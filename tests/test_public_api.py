@@ -28,7 +28,8 @@ SURFACE = {
         "paper_figures", "runge_kutta_shadow", "shadow_along", "shadow_hamiltonians", "sweep",
     ),
     "nambu_bch.algebra": (
-        "ExpressionBackend", "FieldBackend", "PolynomialAlgebra", "PolynomialBackend", "VectorField",
+        "CoefficientField", "ExactRing", "ExpressionBackend", "FieldBackend", "PolynomialAlgebra", "PolynomialBackend",
+        "VectorField",
         "field_backend", "is_symplectic", "jacobian", "lie_bracket", "liouville_field",
         "nambu_bracket", "poisson_bracket", "satisfies_nambu_condition",
     ),

@@ -2,11 +2,15 @@
 
 from .backend import ExpressionBackend, FieldBackend, PolynomialBackend, field_backend
 from .brackets import liouville_field, nambu_bracket, poisson_bracket
+from .fields import CoefficientField
 from .polynomial import PolynomialAlgebra
+from .ring import ExactRing
 from .structure import is_symplectic, jacobian, satisfies_nambu_condition
 from .vector_field import VectorField, lie_bracket
 
 __all__ = [
+    "CoefficientField",
+    "ExactRing",
     "ExpressionBackend",
     "FieldBackend",
     "PolynomialAlgebra",

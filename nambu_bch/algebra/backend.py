@@ -58,7 +58,10 @@ from sympy.polys.rings import PolyElement, ring
 
 from ..checks import check_type
 from ..errors import NambuBCHError
-from .flint_ring import FlintRing, exponents
+from . import _flint
+from ._flint import exponents
+from .fields import CoefficientField
+from .ring import check_ring
 from .vector_field import VectorField
 
 
@@ -205,7 +208,7 @@ class PolynomialBackend:
     @classmethod
     def _laurent(cls, algebra, fields):
         params = algebra.parameters
-        base = algebra.domain.field.domain if params else algebra.domain
+        base = CoefficientField.of(algebra.domain).ground
         names = [str(s) for s in algebra.coordinates + algebra.constants]
         for p in params:
             names += [str(p), f"{p}_inv"]
@@ -296,12 +299,10 @@ class PolynomialBackend:
         """Brackets over ``ZZ`` (the integral Laurent ring) on flint's ``fmpz_mpoly`` when python-flint is available and
         the elimination's fast paths are on (``NAMBU_BCH_DISABLE_FLINT=1`` keeps sympy's ring): the same polynomials,
         products in C."""
-        from .elimination import FAST_PATHS, flint_available
+        from .elimination import FAST_PATHS
 
-        if self._integral and FAST_PATHS and flint_available():
-            from .frac_rref import generic_context
-
-            self.flint = generic_context(len(self.bracket_ring.symbols))  # the bracket ring's generators, in order
+        if self._integral and FAST_PATHS and _flint.available():
+            self.flint = _flint.fmpz_mpoly_context(len(self.bracket_ring.symbols))  # the bracket ring's generators
 
     def to_flint(self, X: _Field) -> tuple:
         """The components of ``X`` as ``fmpz_mpoly`` (kept with ``X``)."""
@@ -657,9 +658,7 @@ def field_backend(algebra, fields: dict, laurent: bool = True) -> FieldBackend:
     >>> type(B).__name__, B.laurent
     ('PolynomialBackend', True)
     """
-    from .polynomial import PolynomialAlgebra
-
-    check_type(algebra, (PolynomialAlgebra, FlintRing), "algebra")
+    check_ring(algebra, "algebra")
     check_type(fields, dict, "fields")
     backend = PolynomialBackend.build(algebra, fields, laurent)
     if backend is not None:

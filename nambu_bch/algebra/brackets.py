@@ -21,10 +21,10 @@ from itertools import permutations
 
 import sympy
 
-from ..checks import check_type
 from ..errors import NambuBCHError
 from .polynomial import PolynomialAlgebra
-from .vector_field import ALGEBRAS, VectorField
+from .ring import check_ring
+from .vector_field import VectorField
 
 
 def permutation_sign(perm) -> int:
@@ -76,7 +76,7 @@ def nambu_bracket(algebra: PolynomialAlgebra, *functions):
     >>> A.to_sympy(nambu_bracket(A, x[0], x[1], x[2]))
     1
     """
-    check_type(algebra, ALGEBRAS, "algebra")
+    check_ring(algebra, "algebra")
     if len(functions) != algebra.n:
         raise NambuBCHError(f"the Nambu bracket on {algebra.n} coordinates takes {algebra.n} functions, got {len(functions)}")
     return _determinant(algebra, [_gradient(algebra, f) for f in functions])
@@ -93,7 +93,7 @@ def poisson_bracket(algebra: PolynomialAlgebra, A, B):
     >>> alg.to_sympy(poisson_bracket(alg, q, p))
     1
     """
-    check_type(algebra, ALGEBRAS, "algebra")
+    check_ring(algebra, "algebra")
     if algebra.n % 2:
         raise NambuBCHError(f"the Poisson bracket needs an even number of coordinates, got {algebra.n}")
     n = algebra.n // 2
@@ -117,7 +117,7 @@ def liouville_field(algebra: PolynomialAlgebra, *hamiltonians) -> VectorField:
     >>> liouville_field(A, x2**2/(2*m), x3).to_sympy()   # X_{A,C}, Eq. hX1
     (x2/m, 0, 0)
     """
-    check_type(algebra, ALGEBRAS, "algebra")
+    check_ring(algebra, "algebra")
     if len(hamiltonians) == 1 and algebra.n % 2 == 0 and algebra.n > 2:
         H = hamiltonians[0]
         return VectorField(algebra, [poisson_bracket(algebra, x, H) for x in algebra.gens[: algebra.n]])

@@ -45,8 +45,6 @@ Gerhard, *Modern Computer Algebra*, ch. 5 (the modular route); Horikoshi, Sect. 
 
 from __future__ import annotations
 
-import importlib
-import os
 from dataclasses import dataclass
 
 from sympy.polys.domains import QQ
@@ -54,6 +52,8 @@ from sympy.polys.matrices import DomainMatrix
 from sympy.polys.matrices.sdm import SDM
 
 from ..errors import NambuBCHError
+from . import _flint
+from .fields import CoefficientField
 
 
 @dataclass(frozen=True)
@@ -164,33 +164,23 @@ MODULAR_MIN = 24
 #: reference path the tests compare the faster routes with).
 FAST_PATHS = True
 
-_FLINT: list = []
-
-
 def flint_available() -> bool:
     """python-flint is installed and not disabled by ``NAMBU_BCH_DISABLE_FLINT=1`` (read at every call).
 
     python-flint is a dependency; when it is missing or switched off every elimination runs on the
     package's multi-modular RREF or sympy's ``DomainMatrix``, with the same results (both paths are tested).
     """
-    if os.environ.get("NAMBU_BCH_DISABLE_FLINT", "").strip().lower() in ("1", "true", "yes", "on"):
-        return False
-    if not _FLINT:
-        try:
-            _FLINT.append(importlib.import_module("flint"))
-        except ImportError:
-            _FLINT.append(None)
-    return _FLINT[0] is not None and hasattr(_FLINT[0], "fmpq_mat")
+    return _flint.available()
 
 
 def _rref_flint_qq(rows: dict, nrows: int, ncols: int):
     """Reduced echelon form over ``QQ`` with flint's dense ``fmpq_mat.rref`` (exact, fraction-free inside)."""
-    flint = _FLINT[0]
-    native = QQ.dtype is flint.fmpq  # sympy's ground types are flint: no conversion
-    M = flint.fmpq_mat(nrows, ncols)
+    native = _flint.qq_is_fmpq(QQ.dtype)  # sympy's ground types are flint: no conversion
+    fmpq = _flint.fmpq
+    M = _flint.fmpq_mat(nrows, ncols)
     for i, row in rows.items():
         for j, v in row.items():
-            M[i, j] = v if native else flint.fmpq(int(v.numerator), int(v.denominator))
+            M[i, j] = v if native else fmpq(v)
     R, rank = M.rref()
     entries = R.entries()
     out, pivots = {}, []
@@ -221,11 +211,10 @@ class _AlgebraicSplit:
 
     @classmethod
     def of(cls, domain):
-        if domain.is_AlgebraicField:
-            return cls(domain, domain, QQ)
-        if getattr(domain, "is_FractionField", False) and domain.domain.is_AlgebraicField:
-            return cls(domain, domain.domain, QQ.frac_field(*domain.symbols))
-        return None
+        field = CoefficientField.recognise(domain)
+        if field is None or not field.is_algebraic:
+            return None
+        return cls(domain, field.ground, QQ.frac_field(*field.parameters) if field.parameters else QQ)
 
     def split(self, v):
         """``[b_0, .., b_{k-1}]`` in ``B`` with ``v = sum_i theta^i b_i``, or ``None`` (denominator not in ``B``)."""
@@ -374,8 +363,8 @@ def elimination_cost(columns: list, nrows: int, domain=QQ) -> int:
     for members in _blocks(rows, len(columns)).values():
         r, c = len(members), len({j for i in members for j in rows[i]})
         total += r * c * min(r, c)
-    over_qq = domain.is_QQ or domain.is_AlgebraicField
-    return total if over_qq else total * FIELD_WEIGHT
+    field = CoefficientField.recognise(domain)
+    return total if field is not None and field.is_number_field else total * FIELD_WEIGHT
 
 
 def signed_sums(sums: dict, domain) -> dict | None:
@@ -722,7 +711,8 @@ def _full_rank_at_a_point(rows: dict, nrows: int, ncols: int, domain):
     is that bound.  A smaller rank at the point proves nothing (the caller eliminates over the field).
     The rank at the point is an elimination over ``QQ`` (no polynomial gcds).
     """
-    if not (getattr(domain, "is_FractionField", False) and domain.domain.is_QQ) or len(domain.symbols) > 8:
+    field = CoefficientField.recognise(domain)
+    if field is None or not field.is_rational_functions or len(field.parameters) > 8:
         return None
     bound = min(nrows, ncols)
     for point in _RANK_POINTS:

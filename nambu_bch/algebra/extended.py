@@ -36,11 +36,11 @@ simplification.  Inputs outside these conditions raise :class:`~nambu_bch.errors
 
 from __future__ import annotations
 
-import importlib
-
 import sympy
 
 from ..errors import NoExactResultError
+from . import _flint
+from .ring import declare
 
 #: The functions the ring accepts as atoms (everything else is refused).
 _TRIG = (sympy.sin, sympy.cos)
@@ -147,6 +147,7 @@ class Element:
         return f"Element({self.ring.to_sympy(self)})"
 
 
+@declare(vector_fields=False)
 class ExtendedRing:
     """The exact ring of the atoms of ``expressions`` over ``QQ[coordinates, parameters]`` (module docstring).
 
@@ -177,7 +178,6 @@ class ExtendedRing:
         self.parameters = tuple(parameters)
         self.n = len(self.coordinates)
         exprs = [sympy.sympify(e, strict=True) for e in expressions]
-        self._flint = importlib.import_module("flint")
         self._discover(exprs)
         self._build()
         #: no exp, sin, cos or square root: the elements are rational functions
@@ -256,7 +256,7 @@ class ExtendedRing:
         names = ([f"C{k}" for k in range(len(trig))] + [f"u{k}" for k in range(len(self._radicands))]
                  + [str(x) for x in self.coordinates] + [f"S{k}" for k in range(len(trig))]
                  + [f"E{k}" for k in range(len(exps))] + [str(p) for p in self.parameters])
-        ctx = self._ctx = self._flint.fmpq_mpoly_ctx.get(tuple(f"v{i}" for i in range(len(names))), "lex")
+        ctx = self._ctx = _flint.fmpq_mpoly_context(len(names))
         self.names = tuple(names)
         gens = ctx.gens()
         nt, nr, n = len(trig), len(self._radicands), self.n
@@ -412,7 +412,7 @@ class ExtendedRing:
         if e.is_Symbol:
             out = self._x[self.coordinates.index(e)] if e in self.coordinates else self._p[self.parameters.index(e)]
         elif e.is_Rational:
-            out = self._one_poly * self._flint.fmpq(int(e.p), int(e.q))
+            out = self._one_poly * _flint.fmpq(int(e.p), int(e.q))
         elif e.is_Add:
             out = self._zero_poly
             for a in e.args:
@@ -469,21 +469,41 @@ class ExtendedRing:
 
     def scalar(self, value):
         """An exact rational as a flint ``fmpq`` (the scalars of the ring)."""
-        fmpq = self._flint.fmpq
-        if isinstance(value, fmpq):
-            return value
-        if isinstance(value, int):
-            return fmpq(value)
+        if isinstance(value, int) or _flint.is_fmpq(value):
+            return _flint.fmpq(value)
         value = sympy.sympify(value, strict=True)
         if not value.is_Rational:
             raise NoExactResultError(f"{value} is not a rational number (the ring's scalars are rational)")
-        return fmpq(int(value.p), int(value.q))
+        return _flint.fmpq(int(value.p), int(value.q))
+
+    # -- the ring protocol (nambu_bch.algebra.ring.ExactRing) -------------------------------
+    @property
+    def gens(self) -> tuple:
+        """The generators as elements: the coordinates first, then ``C``, ``u``, ``S``, ``E`` and the parameters."""
+        return tuple(self._atom(g) for g in (*self._x, *self._C, *self._u, *self._S, *self._E, *self._p))
+
+    def common(self, *values) -> tuple:
+        """The values as elements (every value of this ring is one)."""
+        return tuple(v if isinstance(v, Element) else self.convert(v) for v in values)
+
+    @staticmethod
+    def is_zero(value) -> bool:
+        """Zero on the normal form: the numerator is the zero polynomial."""
+        return not value
+
+    @staticmethod
+    def is_polynomial(value) -> bool:
+        """Every element is a ring element (no general sympy expressions here)."""
+        return isinstance(value, Element)
 
     def constant(self, value) -> Element:
         return Element(self, self._one_poly * self.scalar(value), self._zero_den)
 
     def convert(self, expr) -> Element:
-        """A sympy expression in the ring's atoms as an :class:`Element` (refused when it has other atoms)."""
+        """A sympy expression in the ring's atoms as an :class:`Element` (refused when it has other atoms); an
+        element of this ring unchanged."""
+        if isinstance(expr, Element) and expr.ring is self:
+            return expr
         return self._element_of(sympy.sympify(expr, strict=True))
 
     def _element_of(self, e):
@@ -673,9 +693,7 @@ class ExtendedRing:
 def extended_ring(coordinates, parameters, expressions):
     """The :class:`ExtendedRing` of ``expressions``, or ``None`` when one of their atoms is refused or python-flint
     is missing or switched off (``NAMBU_BCH_DISABLE_FLINT=1``): the callers then work in sympy expressions."""
-    from .elimination import flint_available
-
-    if not flint_available():
+    if not _flint.available():
         return None
     try:
         return ExtendedRing(coordinates, parameters, expressions)

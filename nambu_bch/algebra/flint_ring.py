@@ -16,16 +16,15 @@ Horikoshi, Eq. (gLiouville); FLINT ``fmpq_mpoly``.
 
 from __future__ import annotations
 
-import importlib
 from types import SimpleNamespace
 
+from . import _flint
+from ._flint import exponents
+from .polynomial import PolynomialAlgebra
+from .ring import declare
 
-def exponents(p) -> list:
-    """The exponent tuples of a flint polynomial's terms as Python ints (flint returns ``fmpz`` exponents, which
-    must not leak into sympy's rings), in the order of ``p.coeffs()``."""
-    return [tuple(map(int, m)) for m in p.monoms()]
 
-
+@declare()
 class FlintRing:
     """``QQ[names]`` on flint ``fmpq_mpoly`` (lexicographic, generators in the order of ``names``), the first ``n``
     generators the coordinates.
@@ -39,10 +38,7 @@ class FlintRing:
 
     def __init__(self, names, n: int):
         self.names = tuple(names)
-        flint = importlib.import_module("flint")
-        # flint names are cosmetic and ASCII-only (a generator may be called ``ω``): v0, v1, .. in the given order
-        self.ctx = flint.fmpq_mpoly_ctx.get(tuple(f"v{i}" for i in range(len(tuple(names)))), "lex")
-        self._fmpq = flint.fmpq
+        self.ctx = _flint.fmpq_mpoly_context(len(self.names))  # generators v0, v1, .. in the order of ``names``
         self.n = n
         self.gens = tuple(self.ctx.gens())
         self.zero = self.ctx.from_dict({})
@@ -60,9 +56,8 @@ class FlintRing:
 
     def from_terms(self, terms: dict):
         """The polynomial ``sum c x^e`` of ``{exponent tuple: rational}`` (sympy ``QQ`` elements or flint ``fmpq``)."""
-        fmpq = self._fmpq
-        return self.ctx.from_dict({e: c if isinstance(c, fmpq) else fmpq(int(c.numerator), int(c.denominator))
-                                   for e, c in terms.items()})
+        fmpq, native = _flint.fmpq, _flint.module().fmpq  # flint's own rationals pass without a call
+        return self.ctx.from_dict({e: c if isinstance(c, native) else fmpq(c) for e, c in terms.items()})
 
     @staticmethod
     def terms(p) -> dict:
@@ -86,3 +81,13 @@ class FlintRing:
     @staticmethod
     def is_polynomial(value) -> bool:
         return True
+
+
+def polynomial_ring(coordinates, constants, flint: bool):
+    """``QQ[coordinates, constants]`` with the coordinates as the ring protocol's derivation variables: a
+    :class:`FlintRing` when ``flint`` (python-flint chosen by the caller, :func:`nambu_bch.algebra._flint.available`),
+    else a :class:`~nambu_bch.algebra.polynomial.PolynomialAlgebra` over ``QQ`` -- the same polynomials, exponent
+    tuples in the same order (coordinates, then constants), with ``from_terms``/``terms`` on both."""
+    if flint:
+        return FlintRing([str(s) for s in (*coordinates, *constants)], len(coordinates))
+    return PolynomialAlgebra(coordinates, (), constants)

@@ -25,36 +25,22 @@ Knuth, *The Art of Computer Programming*, vol. 2, Sect. 4.5.1 (rational arithmet
 
 from __future__ import annotations
 
-import importlib
-
-from .flint_ring import exponents
-
-_CONTEXTS: dict = {}
-_FLINT_QQ: dict = {}  # QQ's element type -> is it flint's fmpq
-
-
-def _flint():
-    return importlib.import_module("flint")
+from . import _flint
+from ._flint import exponents
+from .fields import CoefficientField
 
 
 def context(domain):
     """The flint ``fmpz_mpoly_ctx`` of the parameters of ``domain = QQ(params)`` (lexicographic, same order),
     or ``None`` when ``domain`` is not a fraction field over ``QQ`` with the lexicographic order."""
-    if not (getattr(domain, "is_FractionField", False) and domain.domain.is_QQ):
-        return None
-    ring = domain.field.ring
-    if str(ring.order) != "lex":
-        return None
-    return generic_context(len(ring.symbols))
+    field = CoefficientField.recognise(domain)
+    return field.flint_context() if field is not None else None
 
 
 def generic_context(nvars: int):
     """flint's ``fmpz_mpoly_ctx`` in ``nvars`` variables (lexicographic); the variables are named ``v0, v1, ..``:
     only their order matters, and flint accepts ASCII names only (a parameter may be called ``ω``)."""
-    ctx = _CONTEXTS.get(nvars)
-    if ctx is None:
-        ctx = _CONTEXTS[nvars] = _flint().fmpz_mpoly_ctx.get(tuple(f"v{i}" for i in range(nvars)), "lex")
-    return ctx
+    return _flint.fmpz_mpoly_context(nvars)
 
 
 def _integer_poly(p, ctx):
@@ -122,11 +108,10 @@ def to_field(pair, domain):
     n, d = pair
     field = domain.field
     make, coeff = field.ring.dtype, domain.domain.dtype  # PolyElement from (monomial, coefficient) pairs; QQ's type
-    if _FLINT_QQ.get(coeff) is None:
-        _FLINT_QQ[coeff] = coeff is _flint().fmpq  # flint ground types: fmpz coefficients convert directly
+    native = _flint.qq_is_fmpq(coeff)  # flint ground types: fmpz coefficients convert directly
 
     def poly(p):
-        cs = p.coeffs() if _FLINT_QQ[coeff] else [int(c) for c in p.coeffs()]
+        cs = p.coeffs() if native else [int(c) for c in p.coeffs()]
         return make(zip(exponents(p), map(coeff, cs)))
 
     return field.raw_new(poly(n), poly(d))

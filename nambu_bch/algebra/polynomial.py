@@ -29,6 +29,9 @@ from sympy.polys.rings import PolyElement, PolyRing
 from ..checks import check_sequence
 from ..errors import InvalidSystemError
 from ..parsing import as_expression, as_symbols
+from .backend import ExpressionBackend, PolynomialBackend
+from .fields import CoefficientField
+from .ring import declare
 from .zero import is_zero
 
 _CONVERSION_ERRORS = (CoercionFailed, GeneratorsError, PolynomialError, ValueError, TypeError)
@@ -263,6 +266,7 @@ def _picklable_field(field):
     return field if isinstance(field, _PicklableField) else _PicklableField(field.symbols, field.domain, field.order)
 
 
+@declare()
 class PolynomialAlgebra:
     """Polynomials in ``coordinates`` (and ``constants``) over ``QQ(parameters)``.
 
@@ -457,6 +461,12 @@ class PolynomialAlgebra:
         return sympy.Add(*self.expanded_terms(value, factors))
 
     @cached_property
+    def coefficient_field(self) -> CoefficientField:
+        """The field of the coefficients, ``QQ``, ``QQ(parameters)``, ``QQ(theta)`` or ``QQ(theta)(parameters)``
+        (:class:`~nambu_bch.algebra.fields.CoefficientField`)."""
+        return CoefficientField.of(self.domain)
+
+    @cached_property
     def zero(self):
         return self.ring.zero
 
@@ -477,16 +487,21 @@ class PolynomialAlgebra:
     def ring_backend(self):
         """The :class:`~nambu_bch.algebra.backend.PolynomialBackend` on this ring (``diff`` as derivative):
         the arithmetic behind :class:`~nambu_bch.algebra.VectorField` for polynomial components."""
-        from .backend import PolynomialBackend
-
         return PolynomialBackend.on_ring(self)
 
     @cached_property
     def expression_backend(self):
         """The :class:`~nambu_bch.algebra.backend.ExpressionBackend` on these coordinates (sympy components)."""
-        from .backend import ExpressionBackend
-
         return ExpressionBackend(self)
+
+    def from_terms(self, terms: dict):
+        """The polynomial ``sum c x^e`` of ``{exponent tuple: coefficient}`` (exponents over all generators)."""
+        return self.ring.from_dict(terms) if terms else self.zero
+
+    @staticmethod
+    def terms(value) -> dict:
+        """``{exponent tuple: coefficient}`` of a polynomial (sympy's polynomials are such dicts already)."""
+        return value
 
     def common(self, *values):
         """The values in one representation: all ring elements if possible, else all sympy."""

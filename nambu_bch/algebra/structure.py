@@ -16,6 +16,8 @@ import sympy
 from ..checks import check_sequence
 from ..errors import NambuBCHError
 from ..parsing import as_expression, as_symbols
+from .brackets import nambu_bracket
+from .polynomial import PolynomialAlgebra
 from .zero import is_zero
 
 
@@ -51,9 +53,6 @@ def _ring_condition(map_components, coordinates):
     (Eq. NB), so the condition is ``{P_1, ..., P_N} = prod D_i`` in ``QQ[x, parameters]`` -- no rational
     function arithmetic, which is what makes the sympy determinant slow.
     """
-    from .brackets import nambu_bracket
-    from .polynomial import PolynomialAlgebra
-
     ys = _components(map_components, coordinates)
     others = sorted(set().union(*(y.free_symbols for y in ys)) - set(coordinates), key=str)
     try:

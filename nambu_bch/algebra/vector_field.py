@@ -16,11 +16,7 @@ import sympy
 
 from ..checks import check_type, show
 from ..errors import NambuBCHError
-from .flint_ring import FlintRing
-from .polynomial import PolynomialAlgebra
-
-#: The algebras a field, a bracket or a Liouville field lives in (what an ``algebra`` argument is checked against).
-ALGEBRAS = (PolynomialAlgebra, FlintRing)
+from .ring import ExactRing, check_ring
 
 
 class VectorField:
@@ -28,7 +24,7 @@ class VectorField:
 
     Parameters
     ----------
-    algebra : PolynomialAlgebra
+    algebra : PolynomialAlgebra or FlintRing
     components : sequence
         ``X^i``, one per coordinate, as sympy expressions or ring elements.
 
@@ -36,6 +32,7 @@ class VectorField:
     --------
     >>> import sympy
     >>> x1, x2 = sympy.symbols("x1 x2")
+    >>> from nambu_bch.algebra import PolynomialAlgebra
     >>> A = PolynomialAlgebra([x1, x2])
     >>> X = VectorField(A, [x2, 0]); Y = VectorField(A, [0, -x1])
     >>> X.bracket(Y).to_sympy()
@@ -44,8 +41,8 @@ class VectorField:
 
     __slots__ = ("algebra", "components")
 
-    def __init__(self, algebra: PolynomialAlgebra, components):
-        check_type(algebra, ALGEBRAS, "algebra")
+    def __init__(self, algebra: ExactRing, components):
+        check_ring(algebra, "algebra")
         if isinstance(components, (str, bytes, dict)) or not hasattr(components, "__iter__"):
             raise NambuBCHError(f"the components of a vector field are a sequence of expressions, got {show(components)}")
         components = tuple(components)
@@ -61,7 +58,7 @@ class VectorField:
         return _vector_field_from, (self.algebra, self.components)
 
     @classmethod
-    def zero(cls, algebra: PolynomialAlgebra) -> "VectorField":
+    def zero(cls, algebra: ExactRing) -> "VectorField":
         return cls(algebra, [algebra.zero] * algebra.n)
 
     # -- action ---------------------------------------------------------------------

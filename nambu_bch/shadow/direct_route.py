@@ -64,10 +64,11 @@ from itertools import product
 
 import sympy
 
-from ..algebra import PolynomialAlgebra, VectorField, liouville_field
+from ..algebra import VectorField, liouville_field
 from ..algebra.ansatz import Ansatz, Rows
 from ..algebra import elimination, frac_rref
 from ..algebra.elimination import SparseMatrix, elimination_cost, rank, signed_sums
+from ..algebra.flint_ring import polynomial_ring
 from ..bch.backward import check_order
 from ..checks import check_flag, show
 from ..bch.concrete import effective_field_by_cost
@@ -447,8 +448,7 @@ class _Solver:
         width = len(alg.gens)
         pad = (0,) * width
         plain = self._plain_ring()
-        flint = not isinstance(plain, PolynomialAlgebra)
-        make = plain.from_terms if flint else (lambda t: plain.ring.from_dict(t) if t else plain.zero)
+        make = plain.from_terms
         parts = []
         for slots in assignments:
             cleared, total = [], field.ring.one
@@ -482,7 +482,7 @@ class _Solver:
         components = []
         for comp in sums:
             groups: dict = {}
-            for m, q in (plain.terms(comp) if flint else comp).items():
+            for m, q in plain.terms(comp).items():
                 groups.setdefault(m[:width], {})[m[width:]] = q
             components.append(alg.ring.from_dict(_divided(groups, T, alg.domain)) if groups else alg.zero)
         return VectorField(alg, components)
@@ -491,12 +491,7 @@ class _Solver:
         """``QQ[coordinates, constants, parameters]`` of :meth:`_fields_cleared`: flint's when available, else sympy's."""
         if self._plain is None:
             alg = self.alg
-            if _flint_on():
-                from ..algebra.flint_ring import FlintRing
-
-                self._plain = FlintRing([str(s) for s in alg.coordinates + alg.constants + alg.parameters], alg.n)
-            else:
-                self._plain = PolynomialAlgebra(alg.coordinates, (), alg.constants + alg.parameters)
+            self._plain = polynomial_ring(alg.coordinates, alg.constants + alg.parameters, _flint_on())
         return self._plain
 
     def _cross(self, j, corrections):

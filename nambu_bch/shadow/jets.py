@@ -29,6 +29,7 @@ from sympy.polys.domains import QQ
 from sympy.polys.rings import PolyElement, ring
 
 from ..algebra import PolynomialAlgebra
+from ..algebra.ring import declare
 from ..checks import check_int, check_type
 from ..errors import InvalidSystemError, NambuBCHError, ResourceLimitError
 from ..parsing import as_expression, as_symbols
@@ -49,6 +50,7 @@ def _multi_indices(n: int, order: int):
             yield (first, *rest)
 
 
+@declare()
 class JetAlgebra(PolynomialAlgebra):
     """Polynomials in coordinates and jets ``d^alpha F`` (``|alpha| <= max_order``) of named functions.
 
