@@ -71,7 +71,7 @@ class GradientComposition:
 
     @property
     def is_complex(self) -> bool:
-        return any(not sympy.sympify(x).is_real for _, b, c in self.factors for x in (b, c))
+        return any(not sympy.sympify(x, strict=True).is_real for _, b, c in self.factors for x in (b, c))
 
     def __str__(self):
         return self.name or ",".join(f"{k}:{b}" + (f"+{c}C" if c else "") for k, b, c in self.factors)

@@ -122,20 +122,21 @@ def is_linearly_implicit(tableau) -> bool:
     return tableau.quadratic_only and tableau.A == kahan.A and tableau.b == kahan.b
 
 
+#: The functions of the generated Runge--Kutta module, callees first.
+_RK_FUNCTIONS = ("rk_field", "rk_jacobian", "rk_solve", "rk_newton", "rk_explicit", "rk_run")
+
+
 def _module(system, backend):
     """The generated Runge--Kutta module of ``system``: interpreted, or with its functions compiled by numba."""
     from ..systems.system import as_system
     from .codegen import runge_kutta_source, source_hash
-    from .kernels import _write_file, cache_dir
+    from .kernels import _load_module, _write_file, cache_dir
 
     system = as_system(system)
     key = (system, backend)
     module = _MODULES.get(key)
     if module is not None:
         return module
-    import sys
-    import types
-
     source = runge_kutta_source(system)
     directory = cache_dir()
     name = f"nambu_bch_rk_{source_hash(source)}"
@@ -144,17 +145,18 @@ def _module(system, backend):
         _write_file(path, source.encode("utf-8"))
     except OSError:
         pass
-    module = types.ModuleType(name)
-    module.__file__ = str(path)
-    exec(compile(source, str(path), "exec"), module.__dict__)  # noqa: S102 - generated from validated exact data
+    module = _load_module(name, path, source, _RK_FUNCTIONS)
     if backend == "numba":
+        import sys
+
         import numba
 
         from ..compiled import enable_private_cache
 
-        sys.modules[name] = module  # numba's cache locates the functions through their module
+        sys.modules[name] = module  # numba's cache locates the functions through their module (not the numpy twin)
+
         # callees first: the compiled callers find them as globals of the module
-        for fn in ("rk_field", "rk_jacobian", "rk_solve", "rk_newton", "rk_explicit", "rk_run"):
+        for fn in _RK_FUNCTIONS:
             jitted = numba.njit(nogil=True, error_model="numpy")(module.__dict__[fn])
             if path.is_file():
                 enable_private_cache(jitted, directory / "__pycache__")
