@@ -181,6 +181,11 @@ DEEP = (
     ("test_numeric_api_arguments.py", "test_default_x0_of_every_model_runs_a_long_orbit", ()),
     # Eqs. (1AX)-(2BY) for generic functions (jets); the fast tier checks them on the models (test_fi_route's h^2 hull)
     ("test_shadow.py", "test_eight_representations_for_generic_functions", ()),
+    # threaded batches: the oscillator's kernels in the fast tier; the exponential flows' (a 4-8 s compile of the
+    # Lotka-Volterra batch loops) in the deep tier
+    ("test_numeric_parallel.py", "test_threads_give_the_one_thread_bits", ("False-ho3-32123", "True-ho3-32123")),
+    # the generic T|V answer against the concrete systems: d = 1 and 2 in the fast tier, the d = 3 quartic (4-6 s)
+    ("test_generic_separable.py", "test_substituted_equals_the_concrete_shadow_hamiltonian_d3", ()),
 )
 
 #: Plugin distributions whose modules pytest marks for assertion rewriting (every module of a distribution with a
