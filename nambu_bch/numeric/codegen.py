@@ -209,6 +209,20 @@ def _pair_expm1(raw, start):
 ALLOWED_FUNCTIONS = frozenset(_FUNCTIONS)
 
 
+def check_kernel_expression(expr, symbols, where: str) -> None:
+    """Refuse, in one line naming ``where``, an expression a generated kernel must not hold: a singular value
+    (``zoo``, ``nan``, ``oo``), a symbol outside ``symbols``, or a function outside :data:`ALLOWED_FUNCTIONS`."""
+    if any(expr.has(z) for z in (sympy.zoo, sympy.nan, sympy.oo, -sympy.oo)):
+        raise InvalidSystemError(f"{where} is singular ({expr}); check the parameters of the model")
+    stray = expr.free_symbols - symbols
+    if stray:
+        raise InvalidSystemError(f"{where} uses unknown symbols {sorted(map(str, stray))}")
+    for f in expr.atoms(sympy.Function):
+        if type(f).__name__ not in ALLOWED_FUNCTIONS:
+            raise InvalidSystemError(f"{where} calls {type(f).__name__}, which numeric kernels "
+                                     f"do not support (supported: {', '.join(sorted(ALLOWED_FUNCTIONS))})")
+
+
 def _validate(program, system):
     """Refuse a program whose printed source could contain anything but internal names and numbers.
 
@@ -221,18 +235,9 @@ def _validate(program, system):
     for u in program.updates:
         allowed |= {sym for pair in u.pairs for sym in pair[1:3]}
     params = set(program.parameters) | {STEP}
-    singular = (sympy.zoo, sympy.nan, sympy.oo, -sympy.oo)
 
     def check(expr, symbols, where):
-        if any(expr.has(z) for z in singular):
-            raise InvalidSystemError(f"{where} of {system.name} is singular ({expr}); check the parameters of the model")
-        stray = expr.free_symbols - symbols
-        if stray:
-            raise InvalidSystemError(f"{where} of {system.name} uses unknown symbols {sorted(map(str, stray))}")
-        for f in expr.atoms(sympy.Function):
-            if type(f).__name__ not in ALLOWED_FUNCTIONS:
-                raise InvalidSystemError(f"{where} of {system.name} calls {type(f).__name__}, which numeric kernels "
-                                         f"do not support (supported: {', '.join(sorted(ALLOWED_FUNCTIONS))})")
+        check_kernel_expression(expr, symbols, f"{where} of {system.name}")
 
     for u in program.updates:
         for _, d in u.increments:
@@ -1013,19 +1018,10 @@ def runge_kutta_source(system) -> str:
     field = [sympy.sympify(e, strict=True) for e in system.vector_field.to_sympy()]
     jac = sympy.Matrix(field).jacobian(coords)
     allowed = set(s) | set(p)
-    singular = (sympy.zoo, sympy.nan, sympy.oo, -sympy.oo)
 
     def checked(expr, where):
         expr = expr.xreplace(rename)
-        if any(expr.has(z) for z in singular):
-            raise InvalidSystemError(f"{where} of {system.name} is singular ({expr}); check the parameters of the model")
-        stray = expr.free_symbols - allowed
-        if stray:
-            raise InvalidSystemError(f"{where} of {system.name} uses unknown symbols {sorted(map(str, stray))}")
-        for f in expr.atoms(sympy.Function):
-            if type(f).__name__ not in ALLOWED_FUNCTIONS:
-                raise InvalidSystemError(f"{where} of {system.name} calls {type(f).__name__}, which numeric kernels "
-                                         f"do not support (supported: {', '.join(sorted(ALLOWED_FUNCTIONS))})")
+        check_kernel_expression(expr, allowed, f"{where} of {system.name}")
         return print_python(expr, "_")
 
     load = [f"    s{i} = y[{i}]" for i in range(len(s))] + [f"    p{i} = P[{i}]" for i in range(len(p))]

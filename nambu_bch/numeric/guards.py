@@ -186,6 +186,22 @@ def check_inputs(system, h, steps, every, x0, params=None, exact=False, scan=Non
     return h, steps, every, arr, values
 
 
+def sample_array(out, shape, *inputs) -> np.ndarray:
+    """Where a run writes its samples of ``shape``: the caller's ``out`` (its layout checked by :func:`check_out`),
+    else a new float64 array, not zeroed (the loops write every sample), refused in one line above
+    :data:`~nambu_bch.numeric.samples.MAX_SAMPLE_BYTES`."""
+    from .samples import MAX_SAMPLE_BYTES
+
+    if out is not None:
+        return check_out(out, shape, *inputs)
+    nbytes = math.prod(shape) * 8
+    if nbytes > MAX_SAMPLE_BYTES:
+        count, N, batch = (*shape, 1)[:3]
+        raise InvalidRunError(f"{count} samples of {N} x {batch} states need {nbytes / 2**30:.1f} GiB "
+                              f"(limit {MAX_SAMPLE_BYTES / 2**30:.0f} GiB); sample less often (larger every)")
+    return np.empty(shape, dtype=np.float64)
+
+
 def check_out(out, shape, *inputs) -> np.ndarray:
     """``out`` if it can receive a run's samples in place, else one :class:`InvalidRunError` line.
 

@@ -32,8 +32,8 @@ from ..errors import InvalidRunError, NumericalRangeError
 from ..progress import Progress, progress_wanted
 from ..systems import System
 from ..checks import check_flag
-from .guards import (check_backend, check_count, check_inputs, check_out, check_range, check_result, check_stability,
-                     check_work, initial_state, run_label, scan_states)
+from .guards import (check_backend, check_count, check_inputs, check_range, check_result, check_stability,
+                     check_work, initial_state, run_label, sample_array, scan_states)
 from .kernels import kernel, resolve_backend
 from .precision import check_dps, run_mpmath
 from .runge_kutta import iterate_runge_kutta
@@ -195,14 +195,7 @@ def iterate(system, word, h, steps, x0=None, params=None, every=1, *, kahan=Fals
     batch = 1 if single else X.shape[1]
     count = n_samples(steps, every)
     shape = (count, system.N) if single else (count, system.N, batch)
-    if out is not None:  # the caller's memory: only its layout is checked
-        out = check_out(out, shape, x0, X)
-    else:
-        nbytes = count * system.N * batch * 8
-        if nbytes > MAX_SAMPLE_BYTES:
-            raise InvalidRunError(f"{count} samples of {system.N} x {batch} states need {nbytes / 2**30:.1f} GiB "
-                                  f"(limit {MAX_SAMPLE_BYTES / 2**30:.0f} GiB); sample less often (larger every)")
-        out = np.empty(shape, dtype=np.float64)  # not zeroed: the kernels write every sample
+    out = sample_array(out, shape, x0, X)
     what = run_label(system, kern.word, h, X, origin)
     reporter = Progress(steps * batch, f"iterate {system.name} {kern.word}",
                         enabled=_enabled(progress, steps * batch * (30 if be == "numpy" and single else 1)))
@@ -393,10 +386,7 @@ def iterate_chunks(system, word, h, steps, x0=None, params=None, every=1, *, kah
     check_work(check_count(steps, "steps", 0), x0)  # from the request, before any work
     kahan, check_stable = check_flag(kahan, "kahan"), check_flag(check_stable, "check_stable")
     backend = check_backend(backend)
-    chunk_samples = _count(chunk_samples, "chunk_samples", 2)
-    if chunk_samples * system.N * 8 > MAX_SAMPLE_BYTES:  # one block is held at a time: the same memory bound
-        raise InvalidRunError(f"chunk_samples = {chunk_samples} blocks of {system.N} coordinates need more than "
-                              f"{MAX_SAMPLE_BYTES / 2**30:.0f} GiB; take fewer samples per block")
+    chunk_samples = _block_samples(chunk_samples, system.N)
     kern = kernel(system, word)
     run = _prepare(system, kern, h, steps, every, x0, params, backend, None, check_stable, kahan)
     if run.X.ndim != 1:
@@ -432,15 +422,21 @@ def _runge_kutta_options(tableau, dps, fma) -> None:
         raise InvalidRunError(f"fma=True applies to the compiled splitting kernels, not to the Runge-Kutta method {tableau.name}")
 
 
+def _block_samples(chunk_samples, N: int) -> int:
+    """``chunk_samples`` checked: at least 2, and one block (held at a time) within the samples' memory bound."""
+    chunk_samples = _count(chunk_samples, "chunk_samples", 2)
+    if chunk_samples * N * 8 > MAX_SAMPLE_BYTES:
+        raise InvalidRunError(f"chunk_samples = {chunk_samples} blocks of {N} coordinates need more than "
+                              f"{MAX_SAMPLE_BYTES / 2**30:.0f} GiB; take fewer samples per block")
+    return chunk_samples
+
+
 def _runge_kutta_chunks(system, tableau, h, steps, x0, params, every, kahan, backend, chunk_samples):
     """:func:`iterate_chunks` for a Runge--Kutta method: blocks of :func:`iterate_runge_kutta` runs, the state and
     the compensation carried from block to block (the same samples as one run)."""
     x0, _ = initial_state(system, x0)
     steps = check_count(steps, "steps", 0)
-    chunk_samples = _count(chunk_samples, "chunk_samples", 2)
-    if chunk_samples * system.N * 8 > MAX_SAMPLE_BYTES:
-        raise InvalidRunError(f"chunk_samples = {chunk_samples} blocks of {system.N} coordinates need more than "
-                              f"{MAX_SAMPLE_BYTES / 2**30:.0f} GiB; take fewer samples per block")
+    chunk_samples = _block_samples(chunk_samples, system.N)
     first = iterate_runge_kutta(system, tableau, h, 0, x0, params, 1, backend=backend)  # validates the run
     if first.ndim != 2:
         raise InvalidRunError(f"iterate_chunks takes one initial state of shape ({system.N},), got shape {first.shape[1:]}")

@@ -198,9 +198,9 @@ def iterate_runge_kutta(system, method, h, steps, x0=None, params=None, every=1,
     """
     from ..checks import check_flag
     from ..systems.system import as_system
-    from .guards import check_backend, check_count, check_out, initial_state, run_label
+    from .guards import check_backend, check_count, initial_state, run_label, sample_array
     from .kernels import resolve_backend
-    from .samples import MAX_SAMPLE_BYTES, n_samples
+    from .samples import n_samples
 
     if stats is not None and not isinstance(stats, dict):
         raise InvalidRunError(f"stats must be a dict to receive the run's work, got {type(stats).__name__}")
@@ -233,14 +233,7 @@ def iterate_runge_kutta(system, method, h, steps, x0=None, params=None, every=1,
     batch = 1 if single else X.shape[1]
     count = n_samples(steps, every)
     shape = (count, system.N) if single else (count, system.N, batch)
-    if out is not None:
-        out = check_out(out, shape, x0, X)
-    else:
-        nbytes = count * system.N * batch * 8
-        if nbytes > MAX_SAMPLE_BYTES:
-            raise InvalidRunError(f"{count} samples of {system.N} x {batch} states need {nbytes / 2**30:.1f} GiB "
-                                  f"(limit {MAX_SAMPLE_BYTES / 2**30:.0f} GiB); sample less often (larger every)")
-        out = np.empty(shape, dtype=np.float64)
+    out = sample_array(out, shape, x0, X)
     columns = [X] if single else [np.ascontiguousarray(X[:, k]) for k in range(batch)]
     what = run_label(system, tableau.name, h, X, origin)
     total = 0
