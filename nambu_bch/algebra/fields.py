@@ -49,6 +49,11 @@ class CoefficientField:
     __slots__ = ("domain", "ground", "parameters", "extension")
 
     def __init__(self, domain):
+        from sympy.polys.domains.domain import Domain
+
+        if not isinstance(domain, Domain):
+            raise InvalidRunError(f"a coefficient field wraps a sympy domain (QQ, QQ.frac_field(a), "
+                                  f"QQ.algebraic_field(theta)), got {type(domain).__name__}")
         fraction = bool(getattr(domain, "is_FractionField", False))
         ground = domain.domain if fraction else domain
         if not (ground.is_QQ or ground.is_ZZ or ground.is_AlgebraicField):
