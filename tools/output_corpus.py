@@ -120,16 +120,22 @@ def main(argv: list[str] | None = None) -> int:
         write_atomic(args.directory / "manifest.json", json.dumps(manifest, indent=1) + "\n")
         print(f"recorded {len(todo)} requests in {args.directory}")
         return 0
-    differ = 0
+    differ, new = 0, []
     for (i, n, _), out in zip(todo, outputs):
-        old = (args.directory / file_name(i, n)).read_bytes()
+        try:
+            old = (args.directory / file_name(i, n)).read_bytes()
+        except FileNotFoundError:  # a request added to the corpus after this recording: nothing to compare with
+            new.append(n)
+            continue
         if old != out:
             differ += 1
             print(f"DIFFERS {n}")
             diff = difflib.unified_diff(old.decode(errors="replace").splitlines(), out.decode(errors="replace").splitlines(),
                                         "recorded", "now", lineterm="", n=1)
             print("\n".join(list(diff)[:40]))
-    print(f"{len(todo) - differ} of {len(todo)} requests identical")
+    compared = len(todo) - len(new)
+    print(f"{compared - differ} of {compared} recorded requests identical"
+          + (f"; {len(new)} not in the recording (added later): {', '.join(new)}" if new else ""))
     return 1 if differ else 0
 
 
