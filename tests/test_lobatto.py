@@ -94,9 +94,25 @@ def test_refusals():
 
 
 def test_cli_refuses_the_pair_as_a_composition(capsys):
-    """The CLI takes compositions only: a partitioned pair's name is refused in one line that says where it lives."""
+    """The CLI takes compositions and plain tableaux: a partitioned pair's name is refused in one line that says where
+    it lives."""
     from nambu_bch.cli import main
 
     assert main(["shadow", "--model", "ho", "--integrator", "lobatto-iiia-iiib-3"]) == 2
     err = capsys.readouterr().err.strip()
-    assert "\n" not in err and "'lobatto-iiia-iiib-3' is a Runge-Kutta method" in err
+    assert "\n" not in err and "'lobatto-iiia-iiib-3' is a partitioned Runge-Kutta pair" in err
+    assert "runge_kutta_shadow" in err
+
+
+def test_a_pair_where_only_plain_tableaux_are_taken_says_where_pairs_are_available():
+    """The partitioned pairs are not stepped in float64 nor taken by shadow_hamiltonians: the refusal says so
+    (instead of the plain tableaux' message, which lists those entry points as accepting it)."""
+    import pytest
+
+    import nambu_bch as nb
+    from nambu_bch.errors import InvalidCompositionError
+
+    for call in (lambda: nb.shadow_hamiltonians("ho", "lobatto-iiia-iiib-2", order=2),
+                 lambda: nb.iterate("ho", "lobatto-iiia-iiib-2", 0.1, 3)):
+        with pytest.raises(InvalidCompositionError, match="partitioned Runge-Kutta pair.*runge_kutta_shadow"):
+            call()

@@ -559,7 +559,13 @@ def _generic(text) -> Composition:
         return composition(pairs)
     from .runge_kutta import PARTITIONED, TABLEAUX
 
-    if text.lower() in TABLEAUX or text.lower() in PARTITIONED:  # a Runge-Kutta method is no word over the pieces: say where it is available
+    # a Runge-Kutta method is no word over the pieces: say where it is available
+    if text.lower() in PARTITIONED:
+        raise InvalidCompositionError(
+            f"{text!r} is a partitioned Runge-Kutta pair, not a composition of the pieces; its modified equation and "
+            "shadow question are available from Python on canonical systems (modified_equation, runge_kutta_shadow); "
+            "shadow_hamiltonians, check, iterate, compare and the command line do not take pairs")
+    if text.lower() in TABLEAUX:
         raise InvalidCompositionError(
             f"{text!r} is a Runge-Kutta method, not a composition of the pieces; shadow_hamiltonians, check, iterate "
             "and compare accept it; the composition routes (BCH, FI, exact) do not")
