@@ -82,7 +82,7 @@ def gradient_composition(factors, name: str = "", order: int = 0, citation: str 
 
     Each piece's ``b`` must sum to one; ``c`` (the coefficient of ``h^3 [X_2, [X_1, X_2]]``) is allowed on piece 2.
     """
-    from ..integrators.composition import _exact
+    from ..integrators.composition import _exact, sums_not_one
 
     if not isinstance(factors, (list, tuple)) or not 1 <= len(factors) <= MAX_GENERALIZED_FACTORS:
         raise InvalidCompositionError(
@@ -97,10 +97,11 @@ def gradient_composition(factors, name: str = "", order: int = 0, citation: str 
         if c != 0 and item[0] != 2:
             raise InvalidCompositionError(f"the force-gradient term [X_2,[X_1,X_2]] goes with piece 2, got {show(item)}")
         out.append((item[0], b, c))
-    for k in (1, 2):
-        total = sympy.nsimplify(sum(b for p, b, _ in out if p == k))
-        if total != 1:
-            raise InvalidCompositionError(f"the coefficients b of piece {k} in {show(factors)} sum to {total}, not 1")
+    pieces = {p for p, _, _ in out}
+    bad = sums_not_one([(p, b) for p, b, _ in out] + [(k, sympy.Integer(0)) for k in (1, 2) if k not in pieces])
+    if bad:
+        k, total = min(bad.items(), key=lambda item: item[0])
+        raise InvalidCompositionError(f"the coefficients b of piece {k} in {show(factors)} sum to {total}, not 1")
     return GradientComposition(tuple(out), name, order, citation)
 
 

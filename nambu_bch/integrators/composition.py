@@ -111,8 +111,7 @@ class Composition:
                 )
         coeffs = tuple(_exact(c, self.name) for c in self.coefficients)
         object.__setattr__(self, "coefficients", coeffs)
-        sums = {k: sympy.nsimplify(sum(c for p, c in zip(self.pieces, coeffs) if p == k)) for k in set(self.pieces)}
-        bad = {k: s for k, s in sums.items() if not is_zero(s - 1)}
+        bad = sums_not_one(zip(self.pieces, coeffs))
         if bad:
             detail = ", ".join(f"piece {k}: {s}" for k, s in sorted(bad.items()))
             raise InconsistentCoefficientsError(
@@ -312,6 +311,16 @@ def composition_for(spec, target) -> Composition:
             f"a composition is used with a System or a Splitting (e.g. model('ho3')), got {type(target).__name__}"
         )
     return composition(spec, len(splitting)).check(splitting)
+
+
+def sums_not_one(pairs) -> dict:
+    """``{piece: sum}`` of the pieces whose exact coefficients in ``pairs`` (piece, coefficient) do not sum to 1
+    (zero decided by :func:`~nambu_bch.algebra.zero.is_zero`); empty when every piece's do."""
+    totals: dict = {}
+    for k, c in pairs:
+        totals[k] = totals.get(k, 0) + c
+    sums = {k: sympy.nsimplify(t) for k, t in totals.items()}
+    return {k: t for k, t in sums.items() if not is_zero(t - 1)}
 
 
 def _exact(c, name):
