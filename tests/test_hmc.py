@@ -98,3 +98,11 @@ def test_results_are_reproducible_values_that_pickle():
     assert d["kind"] == "hybrid_monte_carlo" and "samples" not in d and len(a.to_dict(samples=True)["samples"]) == 4
     assert "acceptance" in str(a)
     assert issubclass(InvalidRunError, NambuBCHError)
+
+
+def test_an_expectation_beyond_float64_is_refused():
+    from nambu_bch.errors import NumericalRangeError
+
+    run = hybrid_monte_carlo("ho", "212", 0.5, 2, chains=20, iterations=2, seed=0)
+    with pytest.raises(NumericalRangeError, match="not finite"):
+        run.expectation(lambda x: 1e308 + 0 * x[0])  # finite values whose sum overflows

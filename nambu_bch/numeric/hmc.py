@@ -140,21 +140,27 @@ class MonteCarloRun(ValueEquality):
         w = self.weights()
         return float(w.sum() ** 2 / (w * w).sum() / w.size)
 
-    def expectation(self, f, groups: int = 20) -> Estimate:
-        """The weighted mean of ``f`` over the samples, and its standard error from ``groups`` groups of chains.
+    def expectation(self, f, groups=None) -> Estimate:
+        """The weighted mean of ``f`` over the samples, and its standard error from ``groups`` groups of chains
+        (None: 20, or one per chain when there are fewer).
 
         ``f`` maps an array of states of shape ``(N, ...)`` (one row per coordinate) to values of shape ``(...)``,
         e.g. ``lambda x: x[0]**2``.
         """
-        groups = check_int(groups, "groups", 2, self.chains)
+        groups = min(20, self.chains) if groups is None else check_int(groups, "groups", 2, self.chains)
         values = np.asarray(f(np.moveaxis(self.samples, 1, 0)), dtype=np.float64)
         if values.shape != self.log_weights.shape:
             raise InvalidRunError(f"f must map states of shape (N, iterations, chains) to shape "
                                   f"{self.log_weights.shape}, got {values.shape}")
         w = self.weights()
-        parts = [float((wg * vg).sum() / wg.sum())
-                 for wg, vg in zip(np.array_split(w, groups, axis=1), np.array_split(values, groups, axis=1))]
-        return Estimate(float((w * values).sum() / w.sum()), float(np.std(parts) / math.sqrt(groups)))
+        with np.errstate(all="ignore"):
+            parts = [float((wg * vg).sum() / wg.sum())
+                     for wg, vg in zip(np.array_split(w, groups, axis=1), np.array_split(values, groups, axis=1))]
+            out = Estimate(float((w * values).sum() / w.sum()), float(np.std(parts) / math.sqrt(groups)))
+        if not (math.isfinite(out.value) and math.isfinite(out.error)):
+            raise NumericalRangeError("the expectation or its error is not finite in float64 (f is too large at the "
+                                      "samples); rescale f")
+        return out
 
     def to_dict(self, samples: bool = False) -> dict:
         """JSON-ready summary (the samples and weights only with ``samples=True``)."""
@@ -347,7 +353,7 @@ def _check_pieces(system, comp, signs) -> None:
                 flips = ", ".join(str(c) for c, t in zip(coords, signs) if t < 0)
                 raise InvalidCompositionError(
                     f"negating {flips} does not reverse piece {piece.number} of {system.name} (its {c}-component "
-                    f"{x} fails X(R x) = -R X(x)), so the scheme is not reversible under that flip; choose flip=...")
+                    f"{x} fails X(R x) = -R X(x)), so the scheme is not reversible under that flip; flip other coordinates")
 
 
 def _check_invariant(expr, coords, signs, name) -> None:
@@ -355,7 +361,7 @@ def _check_invariant(expr, coords, signs, name) -> None:
     if not is_zero(expr.xreplace(flipped) - expr):
         flips = ", ".join(str(c) for c, s in zip(coords, signs) if s < 0)
         raise InvalidRunError(f"{name} is not invariant under negating {flips}, so the flip does not preserve "
-                              f"exp(-{name}); choose flip=...")
+                              f"exp(-{name}); flip other coordinates")
 
 
 def _gaussian_scales(H, coordinates, refresh, coords, exact_params) -> np.ndarray:
