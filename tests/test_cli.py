@@ -67,6 +67,7 @@ SMOKE = (
     ("check", "--model", "ho", "--steps", "10", "--format", "json"),
     ("plot", "--help"),
     ("compare", "--model", "ho", "--integrator", "TVT", "--integrator", "VTV", "--step-counts", "10,20", "--t-end", "1"),
+    ("sample", "--model", "ho", "--integrator", "TVT", "--chains", "20", "--iterations", "3", "--seed", "1"),
 )
 
 

@@ -63,7 +63,7 @@ RECORDS = (
     "OrderFit", "PrecisionStudy", "StepProgram", "TruncationStudy", "DirectResult", "Existence", "FICommutator",
     "FINested", "FIOrder", "FIRepresentation", "FIResult", "OrderSolution", "Piece", "FieldBackend",
     "ExpressionBackend", "PolynomialBackend", "ShadowTrajectory", "ButcherTableau", "SeparableShadow", "ContractionSum",
-    "Contraction", "NumericalShadow", "ModifiedEquation",
+    "Contraction", "NumericalShadow", "ModifiedEquation", "MonteCarloRun", "Estimate",
 )
 
 
@@ -227,6 +227,8 @@ def _base_table():
                                                  which=("H", "H_S")),
         "nambu_bch.numeric.numerical_shadow": lambda v: dict(q=v["ho_qp"][0], p=v["ho_qp"][1], forces_or_system=v["ho"],
                                                              h=0.1),
+        "nambu_bch.numeric.hybrid_monte_carlo": lambda v: dict(system=v["ho"], word="212", h=0.5, steps=2, chains=20,
+                                                               iterations=2, burn=0, seed=0),
         "nambu_bch.paper_figures": lambda v: dict(outdir="figures", t_short=1.0, t_long=2.0, every_long=1, dpi=10),
         "nambu_bch.numeric.Progress": lambda v: dict(total=10, enabled=False),
         "nambu_bch.numeric.RunningStats": lambda v: {},

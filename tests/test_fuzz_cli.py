@@ -76,6 +76,8 @@ EDGE = {
     "--step-counts": ("0,4", BIG + ",4", "4"), "--param": ("m=" + TOWERS[0], "m=nan", "m=" + BIG),
     "--H": (TOWERS[1], PAYLOADS[0], "x1^2"), "--G": (PAYLOADS[0], "x1^2"), "--coords": ("x1 x1", "h x2"),
     "--model": ("nonexistent", "henon-heiles"), "--integrator": ("1234", "yoshida:yoshida:121"),
+    "--chains": ("0", "1", BIG), "--iterations": ("0", BIG), "--burn": ("-1", BIG), "--seed": ("-1", "junk", BIG),
+    "--refresh": ("", "x1,x1", "x9"), "--flip": ("x1,x2", "x9"), "--observable": (PAYLOADS[0], TOWERS[1], "x1^2"),
     "--name": ("\\input{x}", "a\nb"), "--output": ("out\n.txt", "out\u202e.txt", "nodir/out.txt"),
 }
 #: Options whose value is a path: relative, at most DEPTH - 1 levels up.

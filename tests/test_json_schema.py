@@ -187,3 +187,12 @@ def test_fi_and_models_validate(capsys):
     models = run(capsys, "models")
     validator("models").validate(models)
     assert {m["model"] for m in models["models"]} >= {"ho", "ho3", "rigid-body", "lotka-volterra"}
+
+
+def test_sample_json_matches_its_schema(capsys):
+    """``nambu-bch sample`` (hybrid Monte Carlo): the document's shape, and <x1^2> = 1 for the oscillator at m = omega = 1."""
+    data = run(capsys, "sample", "--model", "ho", "--integrator", "212", "--h", "0.5", "--steps", "2", "--chains", "200",
+               "--iterations", "20", "--seed", "2", "--target", "H_S", "--alpha", "0")
+    validator("sample").validate(data)
+    e = data["expectations"]["x1^2"]
+    assert data["target"] == "H_S" and abs(e["value"] - 1) < 5 * e["error"]

@@ -76,6 +76,9 @@ BUILDERS = {
     "ShadowTrajectory": lambda: nb.shadow_along(_ho3(), "12321", nb.iterate(_ho3(), "12321", 0.1, 20, (1, 1, 1)), 0.1),
     "NumericalShadow": lambda: importlib.import_module("nambu_bch.numeric").numerical_shadow(
         *np.hsplit(nb.iterate("ho", "212", 0.1, 20, (1.0, 0.0)), 2), "ho", 0.1),
+    "MonteCarloRun": lambda: importlib.import_module("nambu_bch.numeric").hybrid_monte_carlo(
+        "ho", "212", 0.5, 2, chains=20, iterations=3, seed=0),
+    "Estimate": lambda: importlib.import_module("nambu_bch.numeric").Estimate(1.0, 0.1),
     "RunningStats": lambda: importlib.import_module("nambu_bch.numeric").RunningStats(),
     "CoefficientField": lambda: importlib.import_module("nambu_bch.algebra").PolynomialAlgebra(
         sympy.symbols("x1 x2"), [sympy.Symbol("m")], extension=[sympy.cbrt(2)]).coefficient_field,

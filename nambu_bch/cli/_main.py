@@ -12,6 +12,9 @@ Synopsis::
     nambu-bch plot     [SYSTEM] [--integrator WORD] [--outdir DIR] [--h H] [--steps N] [--short-steps N]
                        [--x0 X] [--every K] [--dpi DPI] [--fig-format png|pdf|svg]
     nambu-bch compare  [SYSTEM] [--integrator WORD ...] [--t-end T] [--step-counts N,N,...] [--figure FILE]
+    nambu-bch sample   [SYSTEM] [--integrator WORD] [--h H] [--steps L] [--refresh NAMES] [--flip NAMES]
+                       [--target H|H_S] [--order K] [--alpha A] [--chains C] [--iterations I] [--burn B]
+                       [--seed S] [--x0 X] [--observable EXPR ...]
 
     SYSTEM is one of   --model NAME                         (built-in; default ho3)
                        --system FILE.toml                   (see nambu_bch.model_file)
@@ -52,7 +55,7 @@ The package: :mod:`._main` (this entry point, error handling and exit codes),
 :mod:`._options` (option groups, flag conversion, the system and integrator from
 the flags), :mod:`._output` (formats and writing), one module per subcommand
 (``models``, ``bch``, ``fi``, ``shadow``, ``conserved``, ``exact``, ``check``,
-``plot``, ``compare``, each with ``register(sub)`` and ``run(args)``) and
+``plot``, ``compare``, ``sample``, each with ``register(sub)`` and ``run(args)``) and
 :mod:`.cache` (the ``models`` output cache).  Nothing is imported from sympy
 before a subcommand runs: ``--help`` and argument errors answer at once.
 """
@@ -69,7 +72,7 @@ from ._options import PROG, UsageError, _Formatter, _Parser, normalise, one_line
 from ._output import say, stdout_closed
 
 #: The subcommands in the order of ``--help``: each module ``nambu_bch.cli.<name>`` has ``register(sub)``, ``run(args)``.
-SUBCOMMANDS = ("models", "bch", "fi", "shadow", "conserved", "exact", "check", "plot", "compare")
+SUBCOMMANDS = ("models", "bch", "fi", "shadow", "conserved", "exact", "check", "plot", "compare", "sample")
 
 
 def build_parser() -> argparse.ArgumentParser:

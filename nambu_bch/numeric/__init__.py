@@ -4,7 +4,8 @@
 mpmath fallbacks, optional Kahan summation); ``check`` measures every error the package
 predicts; ``paper_figures`` redraws Figs. 1-4; ``shadow_along``
 evaluates the shadow pair along any trajectory, ``numerical_shadow`` the Skeel-Hardy shadow Hamiltonian
-from a canonical trajectory alone; the studies answer speed-versus-accuracy questions.
+from a canonical trajectory alone; ``hybrid_monte_carlo`` samples exp(-H) or the shadow exp(-H_S) with
+the schemes, canonical or Nambu; the studies answer speed-versus-accuracy questions.
 """
 
 from ..progress import Progress
@@ -12,6 +13,7 @@ from .codegen import StepProgram, step_program
 from .diagnostics import (CheckResult, DriftFit, OrderFit, RunningStats, check, drift_rate, fit_order, observed_order,
                           quantities)
 from .figures import FigureSet, paper_figures
+from .hmc import Estimate, MonteCarloRun, hybrid_monte_carlo
 from .iterate import iterate, iterate_chunks
 from .kernels import Kernel, cache_dir, kernel, numba_available
 from .runge_kutta import rk_iterate, rk_step_function
@@ -23,9 +25,11 @@ from .studies import HScan, PrecisionStudy, TruncationStudy, h_scan, precision_s
 __all__ = [
     "CheckResult",
     "DriftFit",
+    "Estimate",
     "FigureSet",
     "HScan",
     "Kernel",
+    "MonteCarloRun",
     "NumericalShadow",
     "OrderFit",
     "PrecisionStudy",
@@ -39,6 +43,7 @@ __all__ = [
     "drift_rate",
     "fit_order",
     "h_scan",
+    "hybrid_monte_carlo",
     "iterate",
     "iterate_chunks",
     "kernel",
