@@ -75,7 +75,7 @@ from ..integrators.composition import composition_for
 from ..integrators.step import parameter_values
 from .codegen import PAIR_FUNCTION, TEMPLATE_VERSION, python_source, source_hash, step_program
 
-BACKENDS = ("auto", "numba", "numpy")
+from .guards import BACKENDS, linear_part  # the accepted names live with the other checks of a run's inputs
 #: numba's fast-math flags of a run with ``fma=True``: contraction of ``a*b + c`` into one fused
 #: multiply-add only -- no reassociation, no finite-math or signed-zero assumptions.
 CONTRACT = frozenset({"contract"})
@@ -255,8 +255,6 @@ class Kernel:
 
     def _generate(self):
         """Generate the source from the exact sub-flows (sympy), write it and its index, load it."""
-        from .guards import linear_part
-
         program = self.program
         self.source = python_source(program)
         name = f"nambu_bch_kernel_{source_hash(self.source)}"
