@@ -11,10 +11,10 @@ import pytest
 from nambu_bch import model
 from nambu_bch.cli import main
 from nambu_bch.errors import InvalidSystemError
-from nambu_bch.model_file import load_system
+from nambu_bch.systems.spec import load_system
 from nambu_bch.systems import System
 from nambu_bch.systems.spec import SystemSpec
-from nambu_bch.systems.system import as_system
+from nambu_bch.systems.spec import as_system
 
 BAD = [
     # (coordinates, Hamiltonians, parameters, the message System gives)

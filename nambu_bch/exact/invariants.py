@@ -48,7 +48,7 @@ from math import comb, prod
 import sympy
 
 from ..algebra import PolynomialAlgebra
-from ..systems.system import as_system
+from ..systems.spec import as_system
 from ..algebra.ansatz import Ansatz, Rows
 from ..algebra.zero import is_zero
 from ..algebra.elimination import nullspace, rank, solve_affine
@@ -438,7 +438,7 @@ def conserved_quantities(system, word, degree=None) -> ConservedQuantities:
     G_c = G + h**2*x2**2/(4*m**2)
     H = m*omega**2*x3/2 + x2**2/(2*m), G = -x1**2 + x3
     """
-    from ..systems.system import as_system
+    from ..systems.spec import as_system
 
     system = as_system(system)
     comp = composition_for(word, system)

@@ -141,7 +141,7 @@ def step_program(system, word) -> StepProgram:
     >>> prog.constants[:3]
     ((k0, h/(2*m)), (k1, -h*m*omega**2/2), (k2, 2*h/m))
     """
-    from ..systems.system import as_system
+    from ..systems.spec import as_system
 
     system = as_system(system)
     comp = composition_for(word, system.splitting)

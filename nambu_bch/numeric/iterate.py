@@ -84,7 +84,7 @@ def batch_workers(workers, batch: int, steps: int) -> int:
 def as_system(system) -> System:
     """A :class:`~nambu_bch.systems.System` from a System, a built-in model name or a system specification
     (:func:`nambu_bch.systems.system.as_system`, the one reading of a ``system`` argument)."""
-    from ..systems.system import as_system
+    from ..systems.spec import as_system
 
     return as_system(system)
 

@@ -66,7 +66,7 @@ from ..errors import InvalidOrderError, NambuBCHError
 from ..integrators.composition import composition_for
 from ..parsing import as_expression
 from ..symbols import ALPHA, STEP
-from ..systems.system import as_system
+from ..systems.spec import as_system
 from .direct_route import needed_degree, operator_columns
 from .fi_nested import RawOps, nested_hull
 from .fundamental_identity import representations, single_representations
