@@ -56,7 +56,7 @@ from itertools import product
 import sympy
 
 from ..algebra.ansatz import Ansatz, Rows
-from ..algebra.elimination import Echelon, kernel_rref, normal_form, rank, solve_affine
+from ..algebra.elimination import Echelon, SparseMatrix, kernel_rref, normal_form, rank, solve_affine
 from ..algebra.zero import is_zero
 from ..bch import expand_terms, formal_bch
 from ..bch.expansion import piece_evaluator, term_evaluator
@@ -503,7 +503,7 @@ def fi_route(system, word, order: int = 2, degree=None, terms=None) -> FIResult:
     hams = system.hamiltonians
     ansatz = Ansatz(alg.n, degree, len(hams))
     wcols, rows, columns, rhs = _weight_system(ctx, commutators, ansatz)
-    sol = solve_affine(columns, [rhs], len(rows), alg.domain)
+    sol = solve_affine(SparseMatrix.from_columns(columns, len(rows), alg.domain), [rhs])
     result = FIResult(system, comp, power, commutators, sol.consistent, degree, _ctx=ctx)
     if not sol.consistent:
         inverse = rows.keys()
@@ -516,7 +516,8 @@ def fi_route(system, word, order: int = 2, degree=None, terms=None) -> FIResult:
     members = _canonical_members(alg, commutators, wcols, ansatz, sol, prios)
     result.members = tuple(members)
     result.kernel = kernel_rref(sol.kernel, prios[0], alg.domain)
-    fi_dim = rank([{c: v for c, v in vec.items() if c >= nw} for vec in result.kernel], nw + len(ansatz), alg.domain)
+    fi_dim = rank(SparseMatrix.from_rows([{c: v for c, v in vec.items() if c >= nw} for vec in result.kernel],
+                                         nw + len(ansatz), alg.domain))
     family, result.span = _whole_family(alg, hams, ansatz, nw, sol.particular, [0], degree if user_degree else None,
                                         [m.corrections for m in members], fi_dim, power)
     result.corrections = _family(family)
@@ -656,7 +657,7 @@ def _direct_kernel_dim(alg, hams, ansatz) -> int:
     """``dim ker (dH, dG) -> X_{dH,G} + X_{H,dG}`` on the polynomials of ``ansatz`` (the direct route's gauge)."""
     rows = Rows()
     vecs = operator_columns(alg, [alg.convert(Hk) for Hk in hams], ansatz, rows)
-    return len(vecs) - rank(vecs, len(rows), alg.domain)
+    return len(vecs) - rank(SparseMatrix.from_rows(vecs, len(rows), alg.domain))
 
 
 @dataclass(frozen=True)
@@ -756,7 +757,7 @@ def _operator(alg, hams, rings, degree, kernel=True) -> tuple:
         rows = Rows()
         entry = _OPERATOR[key] = [rows, operator_columns(alg, rings, Ansatz(alg.n, degree, len(rings)), rows), None]
     if kernel and entry[2] is None:
-        entry[2] = solve_affine(entry[1], [], len(entry[0]), alg.domain).kernel
+        entry[2] = solve_affine(SparseMatrix.from_columns(entry[1], len(entry[0]), alg.domain), []).kernel
     return tuple(entry)
 
 
@@ -1019,7 +1020,7 @@ def _solve_order(system, ctx, ops, memo, series, j, corrections, degree) -> FIOr
     powers = sorted(rhs_sums)
     rhs = [rows.vector(rhs_sums[k].terms) for k in powers]
     nw = len(dvecs)
-    sol = solve_affine(columns, rhs, len(rows), domain)
+    sol = solve_affine(SparseMatrix.from_columns(columns, len(rows), domain), rhs)
     out = FIOrder(j, "solved", degree, commutators, directions)
     if not sol.consistent:
         inverse = rows.keys()
