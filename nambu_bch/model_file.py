@@ -18,18 +18,18 @@ Format (every expression is parsed by the safe parser, never evaluated)::
     citation = "..."                                  # optional
 
 Unknown keys are an error naming the accepted ones, so typos do not pass
-silently.
+silently.  This module holds the format (its keys, the bounded read of a private regular file, parameter values);
+:func:`nambu_bch.systems.spec.load_spec` reads a file into a :class:`~nambu_bch.systems.spec.SystemSpec` and
+:func:`nambu_bch.systems.spec.load_system` builds its system.
 """
 
 from __future__ import annotations
 
 import os
 import stat
-import tomllib
 
 from .errors import InvalidSystemError
 from .parsing import parse_expression
-from .systems.system import USER_NAME
 
 #: Largest accepted model file, in bytes.
 MAX_FILE_SIZE = 64 * 1024
@@ -48,94 +48,6 @@ def parse_value(text, what: str):
     if not value.is_number or value.is_real is False or value.free_symbols:
         raise InvalidSystemError(f"{what} = {text!r} is not a real number; give e.g. 1, 0.5 or 1/2")
     return value
-
-
-def load_system(path, values: dict | None = None):
-    """The :class:`~nambu_bch.systems.System` the TOML file at ``path`` defines.
-
-    Parameters
-    ----------
-    path : str or path-like
-    values : dict, optional
-        Filled with the numeric parameter values the file gives (exact sympy numbers).
-
-    Raises
-    ------
-    InvalidSystemError
-        On a missing / unreadable / oversized file, TOML syntax errors, unknown
-        keys or a malformed entry; :class:`ExpressionParseError` on a bad expression.
-    """
-    spec = load_spec(path)
-    system = spec.build()
-    if values is not None:
-        values.update(dict(spec.values))
-    return system
-
-
-def load_spec(path):
-    """The :class:`~nambu_bch.systems.spec.SystemSpec` of the TOML file at ``path`` (read and its shape checked;
-    the system itself is checked and built by :meth:`~nambu_bch.systems.spec.SystemSpec.build`)."""
-    from .systems.spec import SystemSpec
-
-    shown = os.fspath(path)
-    raw = _read_regular_file(shown)
-    try:
-        data = tomllib.loads(raw.decode("utf-8"))
-    except tomllib.TOMLDecodeError as exc:
-        raise InvalidSystemError(f"--system {shown}: not valid TOML ({' '.join(str(exc).split())})") from None
-    except UnicodeDecodeError:
-        raise InvalidSystemError(f"--system {shown}: not valid TOML (not UTF-8 text)") from None
-    except RecursionError:
-        raise InvalidSystemError(f"--system {shown}: not accepted (arrays or tables nested too deeply)") from None
-    unknown = sorted(set(data) - set(KEYS))
-    if unknown:
-        raise InvalidSystemError(f"--system {shown}: unknown key(s) {', '.join(unknown)}; accepted keys are {', '.join(KEYS)}")
-
-    def text_list(key, value):
-        if isinstance(value, str):
-            value = value.replace(",", " ").split()
-        if not isinstance(value, list) or not all(isinstance(v, str) for v in value):
-            raise InvalidSystemError(f"--system {shown}: {key} must be a list of strings or one string, got {value!r}")
-        return value
-
-    if "coordinates" not in data:
-        raise InvalidSystemError(f"--system {shown}: the key 'coordinates' is missing (e.g. coordinates = [\"x1\", \"x2\"])")
-    coordinates = text_list("coordinates", data["coordinates"])
-    if "hamiltonians" in data:
-        if "H" in data or "G" in data:
-            raise InvalidSystemError(f"--system {shown}: give either 'hamiltonians' or 'H'/'G', not both")
-        hams = data["hamiltonians"]
-        if not isinstance(hams, list) or not all(isinstance(v, str) for v in hams):
-            raise InvalidSystemError(f"--system {shown}: hamiltonians must be a list of strings")
-    else:
-        if "H" not in data:
-            raise InvalidSystemError(f"--system {shown}: the key 'H' (or 'hamiltonians') is missing")
-        hams = [data["H"]] + ([data["G"]] if "G" in data else [])
-        if not all(isinstance(v, str) for v in hams):
-            raise InvalidSystemError(f"--system {shown}: H and G must be strings such as \"x2^2/2 + x1^2/2\"")
-    params = data.get("parameters", [])
-    values = {}
-    if isinstance(params, dict):
-        names = list(params)
-        values = {key: parse_value(value, f"--system {shown}: parameter {key}") for key, value in params.items()}
-    else:
-        names = text_list("parameters", params)
-    for key in ("name", "split", "description", "citation", "bracket"):
-        if key in data and not isinstance(data[key], str):
-            raise InvalidSystemError(f"--system {shown}: {key} must be a string, got {data[key]!r}")
-    if "name" in data:
-        name = data["name"]
-    else:  # the file's base name when it is a valid name, else 'custom'
-        stem = os.path.splitext(os.path.basename(shown))[0]
-        name = stem if USER_NAME.match(stem) else "custom"
-    where = f"--system {shown}"
-    labels = {"coordinates": where, "parameters": where, "count": where, "system": where, "name": f"{where}: name"}
-    return SystemSpec(
-        hamiltonians=tuple((text, f"{where}: {label}") for text, label in zip(hams, _labels(len(hams)))),
-        coordinates=tuple(coordinates), parameters=tuple(names), values=tuple(values.items()),
-        split=data.get("split"), bracket=data.get("bracket"), name=name,
-        description=data.get("description", ""), citation=data.get("citation", ""), labels=tuple(labels.items()),
-    )
 
 
 def _read_regular_file(shown, flag="--system", error=InvalidSystemError) -> bytes:

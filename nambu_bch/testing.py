@@ -37,7 +37,7 @@ from .errors import NambuBCHError
 from .parsing import as_expression, as_symbols
 from .symbols import STEP
 from .systems import model
-from .systems.system import as_system
+from .systems.spec import as_system
 
 __all__ = [
     "assert_fields_equal",

@@ -37,7 +37,7 @@ from nambu_bch.errors import (
     UnknownPieceError,
 )
 from nambu_bch.integrators import composition, composition_for, strang_word
-from nambu_bch.model_file import load_system
+from nambu_bch.systems.spec import load_system
 from nambu_bch.parsing import parse_expression
 from nambu_bch.systems.system import USER_NAME
 

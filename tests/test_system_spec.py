@@ -11,10 +11,10 @@ import pytest
 from nambu_bch import model
 from nambu_bch.cli import main
 from nambu_bch.errors import InvalidSystemError
-from nambu_bch.model_file import load_system
+from nambu_bch.systems.spec import load_system
 from nambu_bch.systems import System
 from nambu_bch.systems.spec import SystemSpec
-from nambu_bch.systems.system import as_system
+from nambu_bch.systems.spec import as_system
 
 BAD = [
     # (coordinates, Hamiltonians, parameters, the message System gives)
@@ -81,6 +81,7 @@ def test_every_system_argument_is_read_by_one_function():
             call()
         messages.add(str(exc.value))
     assert messages == {"system must be a System or a built-in model name such as 'ho3', got float"}
+    assert numeric_as_system is as_system   # one function, not a wrapper with a message of its own
     assert as_system(SystemSpec(model="ho3")).hamiltonians == model("ho3").hamiltonians
     assert numeric_as_system(SystemSpec(model="ho3", split="single")).split == "single"
 

@@ -264,7 +264,7 @@ def euler_top_coefficients(system) -> tuple:
 
     For the package's ``rigid-body``: ``a1 = (I3 - I2)/(I2 I3)`` and cyclic.
     """
-    from ..systems.system import as_system
+    from ..systems.spec import as_system
 
     system = as_system(system)
     if system.N != 3:
@@ -286,7 +286,7 @@ def euler_top_density(system):
     The map keeps ``dx / phi`` (:func:`euler_top_closed_forms`); this is the ``rho`` of the density bracket
     (:func:`nambu_bch.shadow.density_bracket.density_shadow`).
     """
-    from ..systems.system import as_system
+    from ..systems.spec import as_system
 
     system = as_system(system)
     a = euler_top_coefficients(system)

@@ -144,7 +144,7 @@ def modified_equation(system, method, order: int = 2) -> ModifiedEquation:
     >>> M[2].to_sympy()      # 1/12 f'f'f (f'' = 0): HLW IX.1
     (-omega**2*x2/(12*m), m*omega**4*x1/12)
     """
-    from ..systems.system import as_system
+    from ..systems.spec import as_system
 
     system = as_system(system)
     pair = _partitioned(method)
@@ -184,7 +184,7 @@ def modified_equation_by_taylor(system, method, order: int = 2) -> tuple:
     A partitioned pair (:data:`~nambu_bch.integrators.runge_kutta.PARTITIONED`) integrates the ``q`` components
     with its first tableau and the ``p`` components with its second (HLW Sect. II.2), on a canonical system.
     """
-    from ..systems.system import as_system
+    from ..systems.spec import as_system
 
     system = as_system(system)
     order = check_order(order, MAX_RK_ORDER)
@@ -268,7 +268,7 @@ def runge_kutta_shadow(system, method, order: int = 2, degree=None, max_unknowns
     of obstruction (``.orders[j - 1].certificate``).
     """
     from ..shadow.direct_route import direct_route
-    from ..systems.system import as_system
+    from ..systems.spec import as_system
 
     system = as_system(system)
     M = modified_equation(system, method, order)

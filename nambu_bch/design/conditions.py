@@ -28,7 +28,6 @@ from dataclasses import dataclass, replace
 from math import factorial
 
 import sympy
-from sympy.polys.constructor import construct_domain
 from sympy.polys.domains import QQ
 from sympy.polys.rings import ring
 
@@ -37,9 +36,10 @@ from ..errors import InvalidCompositionError, InvalidOrderError
 from ..integrators.composition import MAX_FACTORS, Composition
 from ..integrators.composition import composition as make_composition
 from ..integrators.composition import three_parts
-from ..integrators.methods import with_error_bound
+from ..integrators.composition import with_error_bound
+from .defects import ErrorConstant, _check_work, _Exact
 from .structure import check_structure, rkn_annihilator, structured_analysis
-from .words import MAX_WORK, log_coefficients, lyndon_defects, work
+from .words import log_coefficients
 
 #: Highest degree ``p + 1`` searched when the order of a composition is determined.
 MAX_DEGREE = 12
@@ -60,78 +60,6 @@ def _parts(comp: Composition, parts) -> int:
             f"needs every piece 1..{parts} (the scheme must be consistent with exp(X_1 + ... + X_{parts}))"
         )
     return parts
-
-
-def _check_work(parts, degree, n_factors, what):
-    if work(parts, degree, n_factors) > MAX_WORK:
-        raise InvalidOrderError(
-            f"{what}: the Lyndon defects of degree {degree} in {parts} pieces with {n_factors} factors need "
-            f"about {work(parts, degree, n_factors)} operations, more than the limit {MAX_WORK}; ask for a lower order"
-        )
-
-
-class _Exact:
-    """The exact coefficient field of a composition (QQ or an algebraic field) and its factors in it."""
-
-    def __init__(self, comp: Composition):
-        K, elems = construct_domain(list(comp.coefficients), extension=True)
-        if K.is_ZZ:
-            K, elems = QQ, [QQ.convert(e) for e in elems]
-        self.K = K
-        self.factors = list(zip(comp.pieces, elems))
-        self._inverse_factorials = {}
-
-    def inv(self, m):
-        """``1/m!`` in ``K`` (memoised: converting a sympy number into an algebraic field is slow, and the
-        defects ask for the same few ``m`` hundreds of thousands of times)."""
-        value = self._inverse_factorials.get(m)
-        if value is None:
-            value = self._inverse_factorials[m] = self.K.convert(sympy.Rational(1, factorial(m)))
-        return value
-
-    def defects(self, parts, degree):
-        return lyndon_defects(self.factors, parts, degree, self.K.one, self.K.zero, self.inv)
-
-
-@dataclass(frozen=True)
-class ErrorConstant:
-    """The order ``p`` and local error measure of a composition (see module docstring).
-
-    Attributes
-    ----------
-    composition : Composition
-    parts : int
-    order : int               -- ``p``: all Lyndon defects of length ``<= p`` vanish exactly
-    squared : sympy number    -- ``LEM^2``, exact
-    defects : dict            -- ``{Lyndon word: exact defect}`` at length ``p + 1``
-    tolerance : float         -- 0 (exact coefficients), or the stated ``error_bound`` of a
-                                 composition with decimal coefficients below which defects count as zero
-    structure : str           -- ``""``, or ``"rkn"``: order and constant on the RKN quotient
-                                 (:mod:`nambu_bch.design.structure`)
-    """
-
-    composition: Composition
-    parts: int
-    order: int
-    squared: object
-    defects: dict
-    tolerance: float = 0.0
-    structure: str = ""
-
-    @property
-    def value(self) -> float:
-        """``LEM`` as a float (from the exact square, 30 digits)."""
-        return float(sympy.sqrt(self.squared).evalf(30))
-
-    def __float__(self):
-        return self.value
-
-    def to_dict(self) -> dict:
-        out = {"composition": str(self.composition), "parts": self.parts, "order": self.order,
-               "error_constant": self.value, "error_constant_squared": str(self.squared), "tolerance": self.tolerance}
-        if self.structure:
-            out["structure"] = self.structure
-        return out
 
 
 def _on_three_parts(comp: Composition) -> Composition:

@@ -54,7 +54,7 @@ import sympy
 from sympy.polys.domains import QQ
 from sympy.polys.orderings import grevlex
 
-from ..algebra.elimination import solve_affine
+from ..algebra.elimination import SparseMatrix, solve_affine
 from ..checks import check_flag, check_int, is_int, show
 from ..errors import InvalidOrderError, NambuBCHError
 from ..integrators.composition import Composition
@@ -604,7 +604,7 @@ def _rational_form(T, conds, x, best, order, dps, label, citation, optimum, lem_
         # x = particular + sum over the free unknowns f of x_f * (kernel vector of f)
         columns = [{r: QQ.from_sympy(P.coeff_monomial(v)) for r, P in enumerate(linear)} for v in x]
         rhs = {r: QQ.from_sympy(-P.coeff_monomial(1)) for r, P in enumerate(linear)}
-        S = solve_affine(columns, [rhs], len(linear), QQ, certificate=False)
+        S = solve_affine(SparseMatrix.from_columns(columns, len(linear), QQ), [rhs], certificate=False)
         if S.consistent:
             free = [j for j in range(len(x)) if j not in S.pivots]
             sol = dict(S.particular[0])

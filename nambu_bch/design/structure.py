@@ -41,14 +41,15 @@ Laskar & Robutel, *High order symplectic integrators for perturbed Hamiltonian s
 from __future__ import annotations
 
 from dataclasses import dataclass
-from functools import lru_cache
-from itertools import product
-from math import factorial
 
 import sympy
 
 from ..errors import InvalidCompositionError, InvalidOrderError
-from .words import log_coefficients, lyndon_defect_words
+from ..integrators.composition import composition as make_composition
+from .defects import (  # noqa: F401  (rkn_ideal, rkn_annihilator, structured_bound: read from here too)
+    ErrorConstant, _check_work, _Exact, _log_vectors, _residual, _squared_norm, rkn_annihilator, rkn_ideal,
+    structured_bound)
+from .words import lyndon_defect_words
 
 #: The structures :func:`structured_analysis` and ``order_conditions(..., structure=)`` accept.
 STRUCTURES = ("rkn",)
@@ -64,63 +65,6 @@ def check_structure(structure) -> str:
         raise InvalidCompositionError(
             f"structure must be one of {', '.join(repr(s) for s in STRUCTURES)} or None, got {structure!r}")
     return structure.strip().lower()
-
-
-def _bracket(x: dict, y: dict) -> dict:
-    """``xy - yx`` in the free associative algebra (polynomials as ``{word tuple: int}``)."""
-    out: dict = {}
-    for u, a in x.items():
-        for v, b in y.items():
-            out[u + v] = out.get(u + v, 0) + a * b
-            out[v + u] = out.get(v + u, 0) - a * b
-    return {w: c for w, c in out.items() if c}
-
-
-@lru_cache(maxsize=32)
-def rkn_ideal(degree: int) -> tuple:
-    """The Lyndon coordinates of a spanning set of ``I_q``, the ideal of ``[2,[2,[2,1]]]`` at degree ``q = degree``.
-
-    Rows are integer tuples over :func:`~nambu_bch.design.words.lyndon_defect_words` ``(2, degree)``, reduced to a
-    basis (row echelon form).  Empty below degree 4.
-    """
-    if degree < 4:
-        return ()
-    one, two = {(1,): 1}, {(2,): 1}
-    relation = _bracket(two, _bracket(two, _bracket(two, one)))
-    words = lyndon_defect_words(2, degree)
-    rows = []
-    for letters in product((one, two), repeat=degree - 4):
-        element = relation
-        for x in reversed(letters):
-            element = _bracket(x, element)
-        rows.append([element.get(w, 0) for w in words])
-    if not rows:
-        return ()
-    M = sympy.Matrix(rows).rref()[0]
-    basis = [tuple(int(x) for x in M.row(i)) for i in range(M.rows) if any(M.row(i))]
-    return tuple(basis)
-
-
-@lru_cache(maxsize=32)
-def rkn_annihilator(degree: int) -> tuple:
-    """Integer rows ``a`` with ``a . v(i) = 0`` for every ``i`` in ``I_q``: one per independent RKN order condition.
-
-    Each row is labelled by the Lyndon word of its free column: ``((word, row), ...)``.
-    """
-    words = lyndon_defect_words(2, degree)
-    ideal = rkn_ideal(degree)
-    if not ideal:
-        return tuple((w, tuple(int(i == j) for j in range(len(words)))) for i, w in enumerate(words))
-    pivots = set(sympy.Matrix(ideal).rref()[1])
-    free_columns = [j for j in range(len(words)) if j not in pivots]
-    out = []
-    for vec in sympy.Matrix(ideal).nullspace():  # one vector per free column, 1 there and 0 at the other free ones
-        denominators = sympy.ilcm(*[sympy.Rational(x).q for x in vec])
-        row = tuple(int(x * denominators) for x in vec)
-        free = next(j for j in free_columns if row[j] != 0)
-        out.append((words[free], row))
-    out.sort(key=lambda item: item[0])
-    return tuple(out)
 
 
 def condition_counts(max_degree: int, structure=None) -> tuple:
@@ -147,32 +91,6 @@ def _check_two_pieces(comp, what):
             f"{sorted(set(comp.pieces))}")
 
 
-def _log_vectors(field, degree):
-    """``[(word, q! [word] log Phi)]`` over the Lyndon words of length ``degree`` (in ``field.K``)."""
-    K = field.K
-    coefficients = log_coefficients(field.factors, 2, degree, K.one, K.zero,
-                                    lambda a, b: K.convert(sympy.Rational(a, b)))
-    scale = K.convert(factorial(degree))
-    return [(w, coefficients[w] * scale) for w in lyndon_defect_words(2, degree)]
-
-
-def _residual(values: list, degree: int, structure: str) -> list:
-    """``values`` (exact sympy numbers, Lyndon coordinates) minus their orthogonal projection on ``v(I_q)``."""
-    if structure != "rkn" or not rkn_ideal(degree):
-        return list(values)
-    N = sympy.Matrix([row for _, row in rkn_annihilator(degree)])
-    d = sympy.Matrix(values)
-    y = N * d
-    r = N.T * (N * N.T).inv() * y
-    return [sympy.expand(x) for x in r]
-
-
-def _squared_norm(values, is_complex) -> object:
-    if is_complex:
-        return sympy.expand(sum(v * sympy.conjugate(v) for v in values))
-    return sympy.expand(sum(v * v for v in values))
-
-
 def structured_analysis(spec, structure="rkn"):
     """Order and error constant of a two-part composition on the quotient of the free Lie algebra by ``structure``.
 
@@ -189,9 +107,6 @@ def structured_analysis(spec, structure="rkn"):
     ----------
     Blanes, Casas & Murua, Acta Numerica 33 (2024), Sect. 3; Blanes & Moan, J. Comput. Appl. Math. 142 (2002) 313.
     """
-    from ..integrators.composition import composition as make_composition
-    from .conditions import ErrorConstant, _check_work, _Exact
-
     structure = check_structure(structure)
     comp = make_composition(spec, 2)
     _check_two_pieces(comp, f"structure {structure!r}")
@@ -215,19 +130,6 @@ def structured_analysis(spec, structure="rkn"):
     raise InvalidOrderError(
         f"composition {comp.name!r} has {structure} order >= {MAX_STRUCTURED_DEGREE}; structured error constants "
         f"are computed up to order {MAX_STRUCTURED_DEGREE - 1}")
-
-
-def structured_bound(comp, order: int, structure: str) -> float:
-    """The largest absolute residual Lyndon coordinate of ``log Phi`` at degrees ``1..order`` modulo ``structure``
-    (the stated accuracy of a decimal table whose published order holds on that structure)."""
-    from .conditions import _Exact
-
-    field = _Exact(comp)
-    worst = 0.0
-    for degree in range(1, order + 1):
-        exact = [field.K.to_sympy(v) for _, v in _log_vectors(field, degree)]
-        worst = max([worst, *(abs(complex(x)) for x in _residual(exact, degree, structure))])
-    return worst
 
 
 # ---------------------------------------------------------------------------------------------
@@ -300,8 +202,6 @@ def generalized_order(spec, powers: int = 2, max_degree: int = 9) -> Generalized
     Appl. Numer. Math. 68 (2013) 58.
     """
     from ..checks import is_int
-    from ..integrators.composition import composition as make_composition
-    from .conditions import _check_work, _Exact
 
     if not is_int(powers, 1, 8):
         raise InvalidOrderError(f"powers must be an integer in 1..8 (powers of eps), got {powers!r}")

@@ -223,7 +223,7 @@ def exact_shadow_hamiltonians(system, word) -> ExactShadow:
     >>> exact_shadow_hamiltonians(model("ho3"), "12321").series(2)[0]     # Eq. (ESH12321)
     h**2*(alpha*m*omega**4*x3/12 + alpha*omega**2*x2**2/(12*m)) + m*omega**2*x3/2 + x2**2/(2*m)
     """
-    from ..systems.system import as_system
+    from ..systems.spec import as_system
 
     system = as_system(system)
     frequency(system)  # cheap structural check first: no omega and no harmonic core -> no factor form

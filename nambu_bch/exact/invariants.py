@@ -48,10 +48,10 @@ from math import comb, prod
 import sympy
 
 from ..algebra import PolynomialAlgebra
-from ..systems.system import as_system
+from ..systems.spec import as_system
 from ..algebra.ansatz import Ansatz, Rows
 from ..algebra.zero import is_zero
-from ..algebra.elimination import nullspace, rank, solve_affine
+from ..algebra.elimination import SparseMatrix, nullspace, rank, solve_affine
 from ..errors import InvalidOrderError, InvalidSystemError, NoExactResultError, ResourceLimitError
 from ..integrators import composed_map, composition_for
 from ..integrators.flows import exact_flow
@@ -193,12 +193,7 @@ def _invariant_basis(setup: _Setup, degree: int):
     vectors = [rows.vector(diff) for diff in columns]
     if not len(rows):  # the map is the identity: every monomial is invariant
         return [R({mu: setup.K.one}) for mu in monos]
-    mat: dict = {}
-    for col, vec in enumerate(vectors):
-        for r, c in vec.items():
-            if c:
-                mat.setdefault(r, {})[col] = c
-    kernel = nullspace(mat, len(rows), len(monos), setup.K)
+    kernel = nullspace(SparseMatrix.from_columns(vectors, len(rows), setup.K))
     return [R({monos[c]: v for c, v in sorted(vec.items()) if v}) for vec in kernel]
 
 
@@ -233,7 +228,8 @@ def _normalise(setup: _Setup, basis, target):
         if count > _MAX_CANDIDATES:
             break
         columns = [{i: b.get(mu, K.zero) for i, mu in enumerate(S)} for b in basis]
-        sol = solve_affine(columns, [{i: T.get(mu, K.zero) for i, mu in enumerate(S)}], r, K, certificate=False)
+        sol = solve_affine(SparseMatrix.from_columns(columns, r, K), [{i: T.get(mu, K.zero) for i, mu in enumerate(S)}],
+                           certificate=False)
         if sol.kernel:  # the r x r minor on S is singular
             continue
         coeffs = [sol.particular[0].get(j, K.zero) for j in range(r)]
@@ -438,7 +434,7 @@ def conserved_quantities(system, word, degree=None) -> ConservedQuantities:
     G_c = G + h**2*x2**2/(4*m**2)
     H = m*omega**2*x3/2 + x2**2/(2*m), G = -x1**2 + x3
     """
-    from ..systems.system import as_system
+    from ..systems.spec import as_system
 
     system = as_system(system)
     comp = composition_for(word, system)
@@ -501,7 +497,7 @@ def _rank(setup, polys) -> int:
     if not monos:
         return 0
     index = {m: j for j, m in enumerate(monos)}
-    return rank([{index[m]: c for m, c in p.items()} for p in polys], len(monos), setup.K)
+    return rank(SparseMatrix.from_rows([{index[m]: c for m, c in p.items()} for p in polys], len(monos), setup.K))
 
 
 def _primitive(p):

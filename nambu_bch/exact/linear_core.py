@@ -81,14 +81,7 @@ def linear_core(coordinates, rhs, name="system") -> LinearCore:
     >>> linear_core((x1, x2, x3), (x2/m, -m*omega**2*x1, 2*x1*x2/m)).Omega   # Eq. (NambuOHeqs)
     omega
     """
-    if isinstance(coordinates, (str, bytes)) or not hasattr(coordinates, "__iter__"):
-        raise NoExactResultError(f"the coordinates of {name} are a sequence of sympy symbols, got {show(coordinates)}")
-    coords = tuple(coordinates)
-    if not coords or not all(isinstance(c, sympy.Symbol) for c in coords) or len(set(coords)) != len(coords):
-        raise NoExactResultError(f"the coordinates of {name} must be distinct sympy symbols, got {show(coordinates)}")
-    if isinstance(rhs, (str, bytes)) or not hasattr(rhs, "__iter__") or len(rhs := tuple(rhs)) != len(coords):
-        raise NoExactResultError(f"{name} needs one right-hand side per coordinate ({len(coords)}), got {show(rhs)}")
-    rhs = [sympy.expand(as_expression(r, coords, f"right-hand side {i + 1} of {name}")) for i, r in enumerate(rhs)]
+    coords, rhs = _checked_equations(coordinates, rhs, name)
     fail = NoExactResultError(
         f"{name} has no harmonic core: the equations {tuple(rhs)} are not of the form (y1, y2)' = A y with "
         "tr A = 0, det A > 0 and the other coordinates driven by a quadratic in y (linear oscillators such as ho, ho3)"
@@ -97,15 +90,7 @@ def linear_core(coordinates, rhs, name="system") -> LinearCore:
         polys = [sympy.Poly(r, *coords) for r in rhs]
     except sympy.PolynomialError:
         raise fail from None
-    n = len(coords)
-    core = [i for i, p in enumerate(polys)
-            if not p.is_zero and p.total_degree() == 1 and all(sum(m) == 1 for m in p.monoms())]
-    while True:  # the linear equations that only involve each other
-        keep = [i for i in core if all(polys[i].degree(coords[j]) <= 0 for j in range(n) if j not in core)]
-        if keep == core:
-            break
-        core = keep
-    driven = [i for i in range(n) if i not in core]
+    core, driven = _core_and_driven(polys, coords)
     if len(core) != 2 or any(any(polys[k].degree(coords[j]) > 0 for j in driven) or polys[k].total_degree() > 2
                              for k in driven):
         raise fail
@@ -117,3 +102,30 @@ def linear_core(coordinates, rhs, name="system") -> LinearCore:
     if det.is_zero or det.is_negative or (det.is_number and not det > 0):
         raise fail
     return LinearCore(tuple(core), tuple(driven), A, det, positive_sqrt(det))
+
+
+def _checked_equations(coordinates, rhs, name) -> tuple:
+    """``(coordinates, expanded right-hand sides)``: distinct sympy symbols and one expression per coordinate (read
+    by the whitelist parser when given as text), else :class:`NoExactResultError` naming the input."""
+    if isinstance(coordinates, (str, bytes)) or not hasattr(coordinates, "__iter__"):
+        raise NoExactResultError(f"the coordinates of {name} are a sequence of sympy symbols, got {show(coordinates)}")
+    coords = tuple(coordinates)
+    if not coords or not all(isinstance(c, sympy.Symbol) for c in coords) or len(set(coords)) != len(coords):
+        raise NoExactResultError(f"the coordinates of {name} must be distinct sympy symbols, got {show(coordinates)}")
+    if isinstance(rhs, (str, bytes)) or not hasattr(rhs, "__iter__") or len(rhs := tuple(rhs)) != len(coords):
+        raise NoExactResultError(f"{name} needs one right-hand side per coordinate ({len(coords)}), got {show(rhs)}")
+    return coords, [sympy.expand(as_expression(r, coords, f"right-hand side {i + 1} of {name}")) for i, r in enumerate(rhs)]
+
+
+def _core_and_driven(polys, coords) -> tuple:
+    """``(core, driven)`` index lists: the largest set of homogeneous linear equations that involve only each other,
+    and the remaining coordinates."""
+    n = len(coords)
+    core = [i for i, p in enumerate(polys)
+            if not p.is_zero and p.total_degree() == 1 and all(sum(m) == 1 for m in p.monoms())]
+    while True:  # the linear equations that only involve each other
+        keep = [i for i in core if all(polys[i].degree(coords[j]) <= 0 for j in range(n) if j not in core)]
+        if keep == core:
+            break
+        core = keep
+    return core, [i for i in range(n) if i not in core]

@@ -58,7 +58,7 @@ def _check_kind(kind):
 
 
 def _word(system, word) -> str:
-    from ..systems.system import as_system
+    from ..systems.spec import as_system
 
     system = as_system(system)
     comp = composition_for(word, system)
@@ -94,7 +94,7 @@ def modified_equations(system, word, kind) -> tuple:
     >>> modified_equations(model("ho3"), "32123", "c")          # Eq. (NambuCQeqs)
     (x2/m, h**2*m*omega**4*x1/4 - m*omega**2*x1, -h**2*omega**2*x1*x2/m + 2*x1*x2/m)
     """
-    from ..systems.system import as_system
+    from ..systems.spec import as_system
 
     _check_kind(kind)
     system = as_system(system)
@@ -250,7 +250,7 @@ def modified_solution(system, word, kind) -> ModifiedSolution:
     >>> modified_solution(model("ho"), "121", "o").expressions[0]
     x1_0*cos(omega*t) + x2_0*sin(omega*t)/(m*omega)
     """
-    from ..systems.system import as_system
+    from ..systems.spec import as_system
 
     _check_kind(kind)
     system = as_system(system)

@@ -19,7 +19,7 @@ from .flows import TIME, exact_flow
 def parameter_values(system, params=None) -> dict:
     """``{Symbol: float}`` for every parameter; missing ones default to 1 (``m = omega = 1``)."""
     from ..checks import finite_float, show
-    from ..systems.system import as_system
+    from ..systems.spec import as_system
 
     system = as_system(system)
     if params is not None and not isinstance(params, dict):

@@ -141,7 +141,7 @@ def step_program(system, word) -> StepProgram:
     >>> prog.constants[:3]
     ((k0, h/(2*m)), (k1, -h*m*omega**2/2), (k2, 2*h/m))
     """
-    from ..systems.system import as_system
+    from ..systems.spec import as_system
 
     system = as_system(system)
     comp = composition_for(word, system.splitting)
@@ -590,26 +590,32 @@ def python_source(program: StepProgram) -> str:
       batches (same arguments, same operations in the same order; it returns a positive number
       when a sample is not finite, 0 otherwise).
     """
-    N = program.N
-    s = [f"s{i}" for i in range(N)]
     consts = [f"k{j} = K[{j}]" for j in range(len(program.constants))] or ["pass"]
     scalar = lambda e: print_python(e, "_")  # noqa: E731
-    vector = lambda e: print_python(e, "_np_")  # noqa: E731
+    src = [_HEADER.format(version=TEMPLATE_VERSION), constants_source(program)]
+    if any(u.pairs for u in program.updates):
+        src.append(pair_function_source())
+    for kahan in (False, True):
+        body = body_lines(program, scalar, kahan)
+        src.append(_run_source(program, body, consts, kahan))
+        src.append(_run_batch_source(program, body, scalar, consts, kahan))
+        src.append(_run_numpy_source(program, consts, kahan))
+    return "\n".join(src)
+
+
+def _run_source(program: StepProgram, body, consts, kahan) -> str:
+    """``run`` / ``run_kahan``: one trajectory, the state in locals ``s_i``, a sample row per kept step."""
+    N = program.N
+    s = [f"s{i}" for i in range(N)]
     load = "; ".join(f"{v} = x[{i}]" for i, v in enumerate(s))
     store = "; ".join(f"x[{i}] = {v}" for i, v in enumerate(s))
     finite = " and ".join(f"_isfinite({v})" for v in s)
     sample = "; ".join(f"out[j, {i}] = {v}" for i, v in enumerate(s))
-    src = [_HEADER.format(version=TEMPLATE_VERSION), constants_source(program)]
-    if any(u.pairs for u in program.updates):
-        src.append(pair_function_source())
-
-    for kahan in (False, True):
-        body = body_lines(program, scalar, kahan)
-        name = "run_kahan" if kahan else "run"
-        args = "x, c, K, steps, every, out" if kahan else "x, K, steps, every, out"
-        comp_load = "; ".join(f"c{i} = c[{i}]" for i in range(N))
-        comp_store = "; ".join(f"c[{i}] = c{i}" for i in range(N))
-        src.append(f"""
+    name = "run_kahan" if kahan else "run"
+    args = "x, c, K, steps, every, out" if kahan else "x, K, steps, every, out"
+    comp_load = "; ".join(f"c{i} = c[{i}]" for i in range(N))
+    comp_store = "; ".join(f"c[{i}] = c{i}" for i in range(N))
+    return f"""
 def {name}({args}):
 {_indent(consts, 4)}
     {load}
@@ -618,49 +624,38 @@ def {name}({args}):
     {store}
     {comp_store if kahan else ''}
     return n
-""")
-        # batch: chunks of states kept in small contiguous arrays, inner loop over the chunk; the
-        # start states are read from X (copied into out[0] when ``start``), the final ones written back
-        # into X only when ``back``; the sample pass counts non-finite values (the result check)
-        name = "run_batch_kahan" if kahan else "run_batch"
-        args = ("X, C, K, steps, every, out, chunk, start, back, lo, hi" if kahan else
-                "X, K, steps, every, out, chunk, start, back, lo, hi")
-        # the chunk's rows in one buffer, each row 64-byte aligned: an allocation only 16- or 32-byte aligned
-        # splits every 8-wide (AVX-512) load across two cache lines, measured 1.8x slower
-        rows = [f"S{i}" for i in range(N)] + ([f"Q{i}" for i in range(N)] if kahan else [])
-        spare = [f"R{q}" for q in range(len(rows))] if any(u.pairs for u in program.updates) else []
-        alloc = ["W = (chunk + 7) // 8 * 8", f"buf = np.empty({len(rows) + len(spare)} * W + 8)",
-                 "off = (8 - (buf.ctypes.data // 8) % 8) % 8"]
-        alloc += [f"{r} = buf[off + {q} * W:off + {q} * W + chunk]" for q, r in enumerate(rows + spare)]
-        # the memory passes as one element loop per row (numba vectorises each; a slice assignment
-        # ``S0[:nb] = X[0, b0:b0 + nb]`` runs as fast but makes numba compile its broadcasting error
-        # path, which doubled the kernel's compile time; one loop over all rows at once measured 3-4x slower)
-        gather = [line for i in range(N) for line in _row_copy(f"S{i}", f"X[{i}, b0:b0 + nb]")]
-        gather += [line for i in range(N) for line in _row_copy(f"Q{i}", f"C[{i}, b0:b0 + nb]")] if kahan else []
-        first = [line for i in range(N) for line in _row_copy(f"out[0, {i}, b0:b0 + nb]", f"S{i}")]
-        scatter = [line for i in range(N) for line in _row_copy(f"X[{i}, b0:b0 + nb]", f"S{i}")]
-        comp_back = [line for i in range(N) for line in _row_copy(f"C[{i}, b0:b0 + nb]", f"Q{i}")] if kahan else []
-        inner_load = [f"s{i} = S{i}[b]" for i in range(N)] + ([f"c{i} = Q{i}[b]" for i in range(N)] if kahan else [])
-        inner_store = [f"S{i}[b] = s{i}" for i in range(N)] + ([f"Q{i}[b] = c{i}" for i in range(N)] if kahan else [])
-        chunk_step = ["for b in range(nb):", *("    " + line for line in inner_load + body + inner_store)]
-        if any(u.pairs for u in program.updates):
-            # shared exponentials: one branch-free pass over the chunk (vectorised); if some |u| left the
-            # series range, the chunk's step is undone and redone with the library branch -- the same bits
-            # as the branchy loop either way.  The redo (scalar, rare) calls the pair function instead of
-            # repeating its statements per sub-flow: half the source numba compiles
-            fast = body_lines(program, scalar, kahan, select=True)
-            redo = body_lines(program, scalar, kahan, pair_call=PAIR_FUNCTION)
-            saved = [line for q, r in enumerate(rows) for line in _row_copy(f"R{q}", r)]
-            restore = [line for q, r in enumerate(rows) for line in _row_copy(r, f"R{q}")]
-            chunk_step = [*saved, "over = 0", "for b in range(nb):",
-                          *("    " + line for line in inner_load + fast + inner_store),
-                          "if over:", *("    " + line for line in restore),
-                          "    for b in range(nb):", *("        " + line for line in inner_load + redo + inner_store)]
-        chunk_sample = []
-        for i in range(N):  # the sample, row by row, counting non-finite values as it is written
-            chunk_sample += [f"row = out[j, {i}, b0:b0 + nb]", "for b in range(nb):",
-                             f"    v = S{i}[b]; row[b] = v; bad += 0 if abs(v) <= _MAX else 1"]
-        src.append(f"""
+"""
+
+
+def _run_batch_source(program: StepProgram, body, scalar, consts, kahan) -> str:
+    """``run_batch`` / ``run_batch_kahan``: chunks of states kept in small contiguous arrays, inner loop over the
+    chunk; the start states are read from X (copied into out[0] when ``start``), the final ones written back into
+    X only when ``back``; the sample pass counts non-finite values (the result check)."""
+    N = program.N
+    name = "run_batch_kahan" if kahan else "run_batch"
+    args = ("X, C, K, steps, every, out, chunk, start, back, lo, hi" if kahan else
+            "X, K, steps, every, out, chunk, start, back, lo, hi")
+    # the chunk's rows in one buffer, each row 64-byte aligned: an allocation only 16- or 32-byte aligned
+    # splits every 8-wide (AVX-512) load across two cache lines, measured 1.8x slower
+    rows = [f"S{i}" for i in range(N)] + ([f"Q{i}" for i in range(N)] if kahan else [])
+    spare = [f"R{q}" for q in range(len(rows))] if any(u.pairs for u in program.updates) else []
+    alloc = ["W = (chunk + 7) // 8 * 8", f"buf = np.empty({len(rows) + len(spare)} * W + 8)",
+             "off = (8 - (buf.ctypes.data // 8) % 8) % 8"]
+    alloc += [f"{r} = buf[off + {q} * W:off + {q} * W + chunk]" for q, r in enumerate(rows + spare)]
+    # the memory passes as one element loop per row (numba vectorises each; a slice assignment
+    # ``S0[:nb] = X[0, b0:b0 + nb]`` runs as fast but makes numba compile its broadcasting error
+    # path, which doubled the kernel's compile time; one loop over all rows at once measured 3-4x slower)
+    gather = [line for i in range(N) for line in _row_copy(f"S{i}", f"X[{i}, b0:b0 + nb]")]
+    gather += [line for i in range(N) for line in _row_copy(f"Q{i}", f"C[{i}, b0:b0 + nb]")] if kahan else []
+    first = [line for i in range(N) for line in _row_copy(f"out[0, {i}, b0:b0 + nb]", f"S{i}")]
+    scatter = [line for i in range(N) for line in _row_copy(f"X[{i}, b0:b0 + nb]", f"S{i}")]
+    comp_back = [line for i in range(N) for line in _row_copy(f"C[{i}, b0:b0 + nb]", f"Q{i}")] if kahan else []
+    chunk_step = _chunk_step(program, body, scalar, kahan, rows)
+    chunk_sample = []
+    for i in range(N):  # the sample, row by row, counting non-finite values as it is written
+        chunk_sample += [f"row = out[j, {i}, b0:b0 + nb]", "for b in range(nb):",
+                         f"    v = S{i}[b]; row[b] = v; bad += 0 if abs(v) <= _MAX else 1"]
+    return f"""
 def {name}({args}):
 {_indent(consts, 4)}
     bad = 0
@@ -675,17 +670,45 @@ def {name}({args}):
 {_indent(scatter, 12)}
 {_indent(comp_back, 8)}
     return bad
-""")
-        # numpy fallback: the same statements on chunk arrays
-        name = "run_numpy_kahan" if kahan else "run_numpy"
-        vbody = body_lines(program, vector, kahan, vector=True, prefix="_np_")
-        vload = [f"s{i} = X[{i}, b0:b1].copy()" for i in range(N)] + ([f"c{i} = C[{i}, b0:b1].copy()" for i in range(N)] if kahan else [])
-        vfirst = [f"out[0, {i}, b0:b1] = s{i}" for i in range(N)]
-        vstore = [f"X[{i}, b0:b1] = s{i}" for i in range(N)]
-        vcomp = [f"C[{i}, b0:b1] = c{i}" for i in range(N)] if kahan else []
-        vsample = [f"out[j, {i}, b0:b1] = s{i}" for i in range(N)]
-        vsample.append("bad += 0 if (" + " and ".join(f"_np_isfinite(s{i}).all()" for i in range(N)) + ") else 1")
-        src.append(f"""
+"""
+
+
+def _chunk_step(program: StepProgram, body, scalar, kahan, rows) -> list:
+    """One step of every state of a chunk (the batch kernel's inner loop)."""
+    N = program.N
+    inner_load = [f"s{i} = S{i}[b]" for i in range(N)] + ([f"c{i} = Q{i}[b]" for i in range(N)] if kahan else [])
+    inner_store = [f"S{i}[b] = s{i}" for i in range(N)] + ([f"Q{i}[b] = c{i}" for i in range(N)] if kahan else [])
+    if not any(u.pairs for u in program.updates):
+        return ["for b in range(nb):", *("    " + line for line in inner_load + body + inner_store)]
+    # shared exponentials: one branch-free pass over the chunk (vectorised); if some |u| left the
+    # series range, the chunk's step is undone and redone with the library branch -- the same bits
+    # as the branchy loop either way.  The redo (scalar, rare) calls the pair function instead of
+    # repeating its statements per sub-flow: half the source numba compiles
+    fast = body_lines(program, scalar, kahan, select=True)
+    redo = body_lines(program, scalar, kahan, pair_call=PAIR_FUNCTION)
+    saved = [line for q, r in enumerate(rows) for line in _row_copy(f"R{q}", r)]
+    restore = [line for q, r in enumerate(rows) for line in _row_copy(r, f"R{q}")]
+    return [*saved, "over = 0", "for b in range(nb):",
+            *("    " + line for line in inner_load + fast + inner_store),
+            "if over:", *("    " + line for line in restore),
+            "    for b in range(nb):", *("        " + line for line in inner_load + redo + inner_store)]
+
+
+def _run_numpy_source(program: StepProgram, consts, kahan) -> str:
+    """``run_numpy`` / ``run_numpy_kahan``: the vectorised numpy fallback, the same statements on chunk arrays."""
+    N = program.N
+    name = "run_numpy_kahan" if kahan else "run_numpy"
+    args = ("X, C, K, steps, every, out, chunk, start, back, lo, hi" if kahan else
+            "X, K, steps, every, out, chunk, start, back, lo, hi")
+    vector = lambda e: print_python(e, "_np_")  # noqa: E731
+    vbody = body_lines(program, vector, kahan, vector=True, prefix="_np_")
+    vload = [f"s{i} = X[{i}, b0:b1].copy()" for i in range(N)] + ([f"c{i} = C[{i}, b0:b1].copy()" for i in range(N)] if kahan else [])
+    vfirst = [f"out[0, {i}, b0:b1] = s{i}" for i in range(N)]
+    vstore = [f"X[{i}, b0:b1] = s{i}" for i in range(N)]
+    vcomp = [f"C[{i}, b0:b1] = c{i}" for i in range(N)] if kahan else []
+    vsample = [f"out[j, {i}, b0:b1] = s{i}" for i in range(N)]
+    vsample.append("bad += 0 if (" + " and ".join(f"_np_isfinite(s{i}).all()" for i in range(N)) + ") else 1")
+    return f"""
 def {name}({args}):
 {_indent(consts, 4)}
     bad = 0
@@ -699,8 +722,7 @@ def {name}({args}):
 {_indent(vstore, 12)}
 {_indent(vcomp, 8)}
     return bad
-""")
-    return "\n".join(src)
+"""
 
 
 

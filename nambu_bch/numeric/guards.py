@@ -43,6 +43,10 @@ from ..integrators.step import parameter_values
 TINY = np.finfo(np.float64).tiny
 #: Relative disagreement with the extended-precision step that counts as over/underflow.
 RANGE_RTOL = 1e-6
+#: The kernel backends a run accepts (:func:`~nambu_bch.numeric.kernels.resolve_backend` resolves ``"auto"``).
+BACKENDS = ("auto", "numba", "numpy")
+#: Largest sample array accepted (bytes); beyond it, sample less often (larger ``every``).
+MAX_SAMPLE_BYTES = 16 * 2**30
 
 
 def finite_array(values, what) -> np.ndarray:
@@ -85,8 +89,6 @@ def check_count(value, what, minimum):
 def check_backend(backend) -> str:
     """``backend`` if it is a string (:func:`~nambu_bch.numeric.kernels.resolve_backend` checks the name)."""
     if not isinstance(backend, str):
-        from .kernels import BACKENDS
-
         raise InvalidRunError(f"backend must be one of {', '.join(BACKENDS)}, got {show(backend)}")
     return backend
 
@@ -189,9 +191,7 @@ def check_inputs(system, h, steps, every, x0, params=None, exact=False, scan=Non
 def sample_array(out, shape, *inputs) -> np.ndarray:
     """Where a run writes its samples of ``shape``: the caller's ``out`` (its layout checked by :func:`check_out`),
     else a new float64 array, not zeroed (the loops write every sample), refused in one line above
-    :data:`~nambu_bch.numeric.samples.MAX_SAMPLE_BYTES`."""
-    from .samples import MAX_SAMPLE_BYTES
-
+    :data:`MAX_SAMPLE_BYTES`."""
     if out is not None:
         return check_out(out, shape, *inputs)
     nbytes = math.prod(shape) * 8

@@ -30,7 +30,7 @@ import numpy as np
 
 from ..errors import InvalidRunError, NumericalRangeError
 from ..progress import Progress, progress_wanted
-from ..systems import System
+from ..systems.spec import as_system  # the one reading of a system argument (numeric modules import it from here)
 from ..checks import check_flag
 from .guards import (check_backend, check_count, check_inputs, check_range, check_result, check_stability,
                      check_work, initial_state, run_label, sample_array, scan_states)
@@ -79,14 +79,6 @@ def batch_workers(workers, batch: int, steps: int) -> int:
     if workers is not None:
         return workers
     return max(1, min(available_threads(), batch * steps // PARALLEL_WORK))
-
-
-def as_system(system) -> System:
-    """A :class:`~nambu_bch.systems.System` from a System, a built-in model name or a system specification
-    (:func:`nambu_bch.systems.system.as_system`, the one reading of a ``system`` argument)."""
-    from ..systems.system import as_system
-
-    return as_system(system)
 
 
 def iterate(system, word, h, steps, x0=None, params=None, every=1, *, kahan=False, dps=None,

@@ -35,7 +35,7 @@ MAX_NEWTON = 50
 def rk_step_function(system, method, params=None):
     """``step(y, h) -> y1`` (float64 arrays of shape ``(N,)``) for the Runge--Kutta ``method`` on ``system``."""
     from ..integrators.step import parameter_values
-    from ..systems.system import as_system
+    from ..systems.spec import as_system
 
     system = as_system(system)
     tableau = butcher_tableau(method)
@@ -86,7 +86,7 @@ def rk_step_function(system, method, params=None):
 def rk_iterate(system, method, h, steps, x0, params=None, every=1) -> np.ndarray:
     """``steps`` steps of the Runge--Kutta ``method``; the states at steps ``0, every, 2 every, ..`` (shape ``(samples, N)``)."""
     from ..integrators.step import parameter_values
-    from ..systems.system import as_system
+    from ..systems.spec import as_system
 
     system = as_system(system)
     parameter_values(system, params)  # first: its message shows a wrong params value on one line
@@ -128,7 +128,7 @@ _RK_FUNCTIONS = ("rk_field", "rk_jacobian", "rk_solve", "rk_newton", "rk_explici
 
 def _module(system, backend):
     """The generated Runge--Kutta module of ``system``: interpreted, or with its functions compiled by numba."""
-    from ..systems.system import as_system
+    from ..systems.spec import as_system
     from .codegen import runge_kutta_source, source_hash
     from .kernels import _load_module, _write_file, cache_dir
 
@@ -197,7 +197,7 @@ def iterate_runge_kutta(system, method, h, steps, x0=None, params=None, every=1,
     (Newton's method for the stage equations).
     """
     from ..checks import check_flag
-    from ..systems.system import as_system
+    from ..systems.spec import as_system
     from .guards import check_backend, check_count, initial_state, run_label, sample_array
     from .kernels import resolve_backend
     from .samples import n_samples

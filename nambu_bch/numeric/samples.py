@@ -14,14 +14,10 @@ import numpy as np
 
 from ..checks import show
 from ..errors import NumericalRangeError, ResourceLimitError
-
-#: Largest sample array accepted (bytes); beyond it, sample less often (larger ``every``).
-MAX_SAMPLE_BYTES = 16 * 2**30
+from .guards import MAX_SAMPLE_BYTES, check_count, finite_float  # noqa: F401  (MAX_SAMPLE_BYTES: read here by iterate)
 
 
 def _grid(steps, every):
-    from .guards import check_count
-
     return check_count(steps, "steps", 0), check_count(every, "every", 1)
 
 
@@ -58,8 +54,6 @@ def sample_times(h, steps: int, every: int = 1) -> np.ndarray:
     >>> sample_times(0.5, 4, 3).tolist()
     [0.0, 1.5, 2.0]
     """
-    from .guards import finite_float
-
     h = finite_float(h, "h")
     grid = sample_steps(steps, every)
     if not np.isfinite(h * float(grid[-1])):

@@ -30,7 +30,7 @@ SOLVE_UNKNOWNS = 4000
 
 
 def _system(system):
-    from ..systems.system import as_system
+    from ..systems.spec import as_system
 
     return as_system(system)
 

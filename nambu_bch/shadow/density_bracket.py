@@ -114,7 +114,7 @@ def density_shadow(system, method, density, order: int = 2, degree=None, max_unk
     True
     """
     from ..bseries.modified import modified_equation
-    from ..systems.system import as_system
+    from ..systems.spec import as_system
     from .direct_route import direct_route
 
     system = as_system(system)

@@ -713,7 +713,7 @@ def direct_route(system, word, order: int = 2, degree=None, max_unknowns=None, p
     >>> sympy.expand(R.shadow()[0] - model("ho").H)
     h**2*m*omega**4*x1**2/12 - h**2*omega**2*x2**2/(24*m)
     """
-    from ..systems.system import as_system
+    from ..systems.spec import as_system
 
     system = as_system(system)
     order = check_order(order)

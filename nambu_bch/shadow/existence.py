@@ -72,7 +72,7 @@ import numpy as np
 import sympy
 
 from ..algebra.ansatz import Ansatz, Rows
-from ..algebra.elimination import solve_affine
+from ..algebra.elimination import SparseMatrix, solve_affine
 from ..checks import check_flag, check_type, finite_float, is_int, show
 from ..errors import NambuBCHError
 from ..parsing import as_expression
@@ -240,7 +240,7 @@ def exact_average(system, g, max_unknowns: int = MAX_EXACT_UNKNOWNS):
     cols = [vec(X.apply(alg.convert(sympy.Mul(*(x**k for x, k in zip(coords, e)))))) for e in pmonos]
     ccols = [vec(sympy.Mul(*(H**k for H, k in zip(hams, e)))) for e in cmonos]
     b = vec(g)
-    solution = solve_affine(cols + ccols, [b], len(rows), alg.domain, certificate=False)
+    solution = solve_affine(SparseMatrix.from_columns(cols + ccols, len(rows), alg.domain), [b], certificate=False)
     if not solution.consistent:
         return None
     particular = solution.particular[0]

@@ -56,7 +56,7 @@ from itertools import product
 import sympy
 
 from ..algebra.ansatz import Ansatz, Rows
-from ..algebra.elimination import Echelon, kernel_rref, normal_form, rank, solve_affine
+from ..algebra.elimination import Echelon, SparseMatrix, kernel_rref, normal_form, rank, solve_affine
 from ..algebra.zero import is_zero
 from ..bch import expand_terms, formal_bch
 from ..bch.expansion import piece_evaluator, term_evaluator
@@ -66,7 +66,7 @@ from ..errors import InvalidOrderError, NambuBCHError
 from ..integrators.composition import composition_for
 from ..parsing import as_expression
 from ..symbols import ALPHA, STEP
-from ..systems.system import as_system
+from ..systems.spec import as_system
 from .direct_route import needed_degree, operator_columns
 from .fi_nested import RawOps, nested_hull
 from .fundamental_identity import representations, single_representations
@@ -493,8 +493,42 @@ def fi_route(system, word, order: int = 2, degree=None, terms=None) -> FIResult:
     Horikoshi, Eqs. (BCH2)-(BCH5), (CL2a), (CL2b), (1AX)-(2BY), (CL5)-(CL8), (SH12321c), (Xeff3).
     """
     system = as_system(system)
-    splitting = system.splitting
-    comp = composition_for(word, splitting)
+    comp, power = _checked_request(system, word, order, terms)
+    alg = system.algebra
+    atoms, per_slot = _atoms(system)
+    ctx = {"algebra": alg, "atoms": atoms, "per_slot": per_slot}
+    commutators = _commutators(system, comp, power, terms, atoms)
+    user_degree = degree is not None
+    degree = _ansatz_degree(commutators, degree)
+    hams = system.hamiltonians
+    ansatz = Ansatz(alg.n, degree, len(hams))
+    wcols, rows, columns, rhs = _weight_system(ctx, commutators, ansatz)
+    sol = solve_affine(SparseMatrix.from_columns(columns, len(rows), alg.domain), [rhs])
+    result = FIResult(system, comp, power, commutators, sol.consistent, degree, _ctx=ctx)
+    if not sol.consistent:
+        inverse = rows.keys()
+        result.certificate = {str(inverse[r]): alg.domain.to_sympy(v) for r, v in sol.certificate.items()}
+        return result
+    nw = len(wcols)
+    ctx.update(nw=nw, ansatz=ansatz)
+    # the canonical members (one rule: algebra/ansatz.py), the weights cleared last
+    prios = ansatz.priorities([alg.convert(Hk).keys() for Hk in hams], offset=nw, rest=range(nw))
+    members = _canonical_members(alg, commutators, wcols, ansatz, sol, prios)
+    result.members = tuple(members)
+    result.kernel = kernel_rref(sol.kernel, prios[0], alg.domain)
+    fi_dim = rank(SparseMatrix.from_rows([{c: v for c, v in vec.items() if c >= nw} for vec in result.kernel],
+                                         nw + len(ansatz), alg.domain))
+    family, result.span = _whole_family(alg, hams, ansatz, nw, sol.particular, [0], degree if user_degree else None,
+                                        [m.corrections for m in members], fi_dim, power)
+    result.corrections = _family(family)
+    if order > power:
+        _higher_orders(result, order, degree if user_degree else None)
+    return result
+
+
+def _checked_request(system, word, order, terms) -> tuple:
+    """``(composition, lowest power)`` of a request, the order and ``terms`` checked against that power."""
+    comp = composition_for(word, system.splitting)
     power = 2 if comp.symmetric else 1
     if not is_int(order, power, MAX_FI_ORDER):
         raise InvalidOrderError(
@@ -503,9 +537,13 @@ def fi_route(system, word, order: int = 2, degree=None, terms=None) -> FIResult:
         )
     if terms is not None and order != power:
         raise InvalidOrderError(f"terms= gives the h^{power} brackets only; got order={order!r}")
-    alg = system.algebra
-    atoms, per_slot = _atoms(system)
-    ctx = {"algebra": alg, "atoms": atoms, "per_slot": per_slot}
+    return comp, power
+
+
+def _commutators(system, comp, power, terms, atoms) -> list:
+    """The lowest-order commutators (the formal BCH series expanded and pruned, or the given ``terms``), merged,
+    each with its distinct FI representations (Eqs. (1AX)-(2BY), (CL5)-(CL8))."""
+    splitting = system.splitting
     if terms is None:
         terms = expand_terms(formal_bch(comp, power + 1).terms(power + 1), splitting, prune=True,
                              evaluators=_evaluators(splitting))
@@ -519,21 +557,29 @@ def fi_route(system, word, order: int = 2, degree=None, terms=None) -> FIResult:
             entries.append((coef, tuple(tree)))
     entries = _merge(entries)
     commutators = []
-    ops = _raw_ops(alg, atoms)
+    ops = _raw_ops(system.algebra, atoms)
     for coef, leaves in entries:
         distinct = [FIRepresentation(labels, shown, formal) for labels, shown, formal in _distinct_forms(ops, leaves)]
         commutators.append(FICommutator(coef, leaves, distinct))
-    hams = system.hamiltonians
-    slots = len(hams)
-    user_degree = degree is not None
+    return commutators
+
+
+def _ansatz_degree(commutators, degree) -> int:
+    """``degree`` checked, or by default the largest monomial degree met in the representations (at least 1)."""
     if degree is None:
         degree = max((sum(v) for c in commutators for r in c.representations for key in r.formal.terms
                       for kind, v in key if kind == 0), default=1)
-        degree = max(degree, 1)
-    elif not is_int(degree, 1):
+        return max(degree, 1)
+    if not is_int(degree, 1):
         raise InvalidOrderError(f"degree must be a positive integer (the ansatz degree) or None, got {degree!r}")
-    ansatz = Ansatz(alg.n, degree, slots)
-    # columns: weights (t, r), then the ansatz's corrections (a, monomial)
+    return degree
+
+
+def _weight_system(ctx, commutators, ansatz) -> tuple:
+    """The affine system of Eq. (BCH5): columns the weights ``(t, r)`` of each representation, then the ansatz's
+    corrections ``(a, monomial)``; rows the formal Liouville keys and one "weights sum to 1" row per commutator.
+    Returns ``(weight columns, rows, columns, right-hand side)``."""
+    alg = ctx["algebra"]
     wcols = [(t, r) for t, c in enumerate(commutators) for r in range(len(c.representations))]
     rows = Rows()
     columns = []
@@ -547,16 +593,12 @@ def fi_route(system, word, order: int = 2, degree=None, terms=None) -> FIResult:
         formal = _monomial_column(ctx, a, e)
         columns.append({rows(("k", k)): -v for k, v in formal.terms.items()})
     rhs = {rows(("w", t)): alg.domain.one for t in range(len(commutators))}
-    sol = solve_affine(columns, [rhs], len(rows), alg.domain)
-    result = FIResult(system, comp, power, commutators, sol.consistent, degree, _ctx=ctx)
-    if not sol.consistent:
-        inverse = rows.keys()
-        result.certificate = {str(inverse[r]): alg.domain.to_sympy(v) for r, v in sol.certificate.items()}
-        return result
+    return wcols, rows, columns, rhs
+
+
+def _canonical_members(alg, commutators, wcols, ansatz, sol, prios) -> list:
+    """One :class:`FIMember` per priority order: the canonical solution's weights and corrections."""
     nw = len(wcols)
-    ctx.update(nw=nw, ansatz=ansatz)
-    # the canonical members (one rule: algebra/ansatz.py), the weights cleared last
-    prios = ansatz.priorities([alg.convert(Hk).keys() for Hk in hams], offset=nw, rest=range(nw))
     members = []
     for prio in prios:
         vec, = Ansatz.canonical(sol.particular, sol.kernel, prio, alg.domain)
@@ -566,15 +608,7 @@ def fi_route(system, word, order: int = 2, degree=None, terms=None) -> FIResult:
                 t, r = wcols[col]
                 weights[t][r] = alg.domain.to_sympy(v)
         members.append(FIMember(weights, ansatz.expressions(vec, alg.coordinates, alg.domain, offset=nw)))
-    result.members = tuple(members)
-    result.kernel = kernel_rref(sol.kernel, prios[0], alg.domain)
-    fi_dim = rank([{c: v for c, v in vec.items() if c >= nw} for vec in result.kernel], nw + len(ansatz), alg.domain)
-    family, result.span = _whole_family(alg, hams, ansatz, nw, sol.particular, [0], degree if user_degree else None,
-                                        [m.corrections for m in members], fi_dim, power)
-    result.corrections = _family(family)
-    if order > power:
-        _higher_orders(result, order, degree if user_degree else None)
-    return result
+    return members
 
 
 # -- higher orders -----------------------------------------------------------------------------------
@@ -623,7 +657,7 @@ def _direct_kernel_dim(alg, hams, ansatz) -> int:
     """``dim ker (dH, dG) -> X_{dH,G} + X_{H,dG}`` on the polynomials of ``ansatz`` (the direct route's gauge)."""
     rows = Rows()
     vecs = operator_columns(alg, [alg.convert(Hk) for Hk in hams], ansatz, rows)
-    return len(vecs) - rank(vecs, len(rows), alg.domain)
+    return len(vecs) - rank(SparseMatrix.from_rows(vecs, len(rows), alg.domain))
 
 
 @dataclass(frozen=True)
@@ -723,7 +757,7 @@ def _operator(alg, hams, rings, degree, kernel=True) -> tuple:
         rows = Rows()
         entry = _OPERATOR[key] = [rows, operator_columns(alg, rings, Ansatz(alg.n, degree, len(rings)), rows), None]
     if kernel and entry[2] is None:
-        entry[2] = solve_affine(entry[1], [], len(entry[0]), alg.domain).kernel
+        entry[2] = solve_affine(SparseMatrix.from_columns(entry[1], len(entry[0]), alg.domain), []).kernel
     return tuple(entry)
 
 
@@ -986,7 +1020,7 @@ def _solve_order(system, ctx, ops, memo, series, j, corrections, degree) -> FIOr
     powers = sorted(rhs_sums)
     rhs = [rows.vector(rhs_sums[k].terms) for k in powers]
     nw = len(dvecs)
-    sol = solve_affine(columns, rhs, len(rows), domain)
+    sol = solve_affine(SparseMatrix.from_columns(columns, len(rows), domain), rhs)
     out = FIOrder(j, "solved", degree, commutators, directions)
     if not sol.consistent:
         inverse = rows.keys()

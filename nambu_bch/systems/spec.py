@@ -1,8 +1,8 @@
 """Which system a request means: one specification, one validator, one builder.
 
-A system is chosen by a built-in model name, a TOML file (:func:`nambu_bch.model_file.load_spec`), or
+A system is chosen by a built-in model name, a TOML file (:func:`load_spec`), or
 Hamiltonians with coordinates and parameters.  The command line (``--model``, ``--system``, ``--H``/``--G``),
-the TOML loader and the API (:func:`~nambu_bch.systems.system.as_system`) each describe their input as a
+the TOML loader and the API (:func:`as_system`) each describe their input as a
 :class:`SystemSpec`; :meth:`SystemSpec.validate` checks it before any expression is parsed and
 :meth:`SystemSpec.build` makes the :class:`~nambu_bch.systems.System`.
 
@@ -14,11 +14,16 @@ one message and one exception type, :class:`~nambu_bch.errors.InvalidSystemError
 
 from __future__ import annotations
 
+import os
 import re
+import tomllib
 from dataclasses import dataclass
 
 from ..errors import InvalidSystemError, shown
-from .system import check_hamiltonian_count, check_name, check_parameter_names, check_symbols, infer_bracket
+from ..model_file import KEYS, _labels, _read_regular_file, parse_value
+from .catalog import model
+from .system import (USER_NAME, System, check_hamiltonian_count, check_name, check_parameter_names, check_symbols,
+                     infer_bracket)
 
 #: The keys of ``SystemSpec.labels`` and what each names (the default label is empty: the API's wording).
 LABEL_KEYS = {
@@ -156,16 +161,12 @@ class SystemSpec:
         if self.hamiltonians:
             return self._from_expressions(coords)
         if self.file:
-            from ..model_file import load_spec
-
             inner = load_spec(self.file)
             system = inner.build()
             if defaults is not None:
                 defaults.update(dict(inner.values))
             source = f"the system of {shown(self.file)}"
         else:
-            from .catalog import model
-
             system = model(self.model)
             source = f"model {system.name}"
         self._check_parameters_of(system, source)
@@ -177,7 +178,6 @@ class SystemSpec:
         import sympy
 
         from ..parsing import parse_expression
-        from .system import System
 
         symbols = [sympy.Symbol(s) for s in (*coords, *self.parameters)]
         parsed = [parse_expression(text, symbols, what=label) if isinstance(text, str) else text
@@ -233,3 +233,102 @@ def _check_inferred_coordinates(hams, coords, names, bracket) -> None:
     wanted = " ".join(f"x{k}" for k in range(1, top + 1))
     raise InvalidSystemError(f"{meant}; pass --coords {wanted!r} for the coordinates the expressions use "
                              "(--param NAME declares a parameter)")
+
+
+def as_system(system, what: str = "system") -> "System":
+    """``system`` itself, the built-in model of that name, or the system a :class:`~nambu_bch.systems.spec.SystemSpec`
+    builds; else :class:`InvalidSystemError` in one line.  The one reading of a ``system`` argument of the API."""
+    if isinstance(system, System):
+        return system
+    if isinstance(system, str):
+        return model(system)
+    if isinstance(system, SystemSpec):
+        return system.build()
+    raise InvalidSystemError(f"{what} must be a System or a built-in model name such as 'ho3', got {type(system).__name__}")
+
+
+# -- the TOML producer (the format: :mod:`nambu_bch.model_file`) ----------------------------------------------
+def load_system(path, values: dict | None = None):
+    """The :class:`~nambu_bch.systems.System` the TOML file at ``path`` defines.
+
+    Parameters
+    ----------
+    path : str or path-like
+    values : dict, optional
+        Filled with the numeric parameter values the file gives (exact sympy numbers).
+
+    Raises
+    ------
+    InvalidSystemError
+        On a missing / unreadable / oversized file, TOML syntax errors, unknown
+        keys or a malformed entry; :class:`ExpressionParseError` on a bad expression.
+    """
+    spec = load_spec(path)
+    system = spec.build()
+    if values is not None:
+        values.update(dict(spec.values))
+    return system
+
+
+def load_spec(path):
+    """The :class:`~nambu_bch.systems.spec.SystemSpec` of the TOML file at ``path`` (read and its shape checked;
+    the system itself is checked and built by :meth:`~nambu_bch.systems.spec.SystemSpec.build`)."""
+    shown = os.fspath(path)
+    raw = _read_regular_file(shown)
+    try:
+        data = tomllib.loads(raw.decode("utf-8"))
+    except tomllib.TOMLDecodeError as exc:
+        raise InvalidSystemError(f"--system {shown}: not valid TOML ({' '.join(str(exc).split())})") from None
+    except UnicodeDecodeError:
+        raise InvalidSystemError(f"--system {shown}: not valid TOML (not UTF-8 text)") from None
+    except RecursionError:
+        raise InvalidSystemError(f"--system {shown}: not accepted (arrays or tables nested too deeply)") from None
+    unknown = sorted(set(data) - set(KEYS))
+    if unknown:
+        raise InvalidSystemError(f"--system {shown}: unknown key(s) {', '.join(unknown)}; accepted keys are {', '.join(KEYS)}")
+
+    def text_list(key, value):
+        if isinstance(value, str):
+            value = value.replace(",", " ").split()
+        if not isinstance(value, list) or not all(isinstance(v, str) for v in value):
+            raise InvalidSystemError(f"--system {shown}: {key} must be a list of strings or one string, got {value!r}")
+        return value
+
+    if "coordinates" not in data:
+        raise InvalidSystemError(f"--system {shown}: the key 'coordinates' is missing (e.g. coordinates = [\"x1\", \"x2\"])")
+    coordinates = text_list("coordinates", data["coordinates"])
+    if "hamiltonians" in data:
+        if "H" in data or "G" in data:
+            raise InvalidSystemError(f"--system {shown}: give either 'hamiltonians' or 'H'/'G', not both")
+        hams = data["hamiltonians"]
+        if not isinstance(hams, list) or not all(isinstance(v, str) for v in hams):
+            raise InvalidSystemError(f"--system {shown}: hamiltonians must be a list of strings")
+    else:
+        if "H" not in data:
+            raise InvalidSystemError(f"--system {shown}: the key 'H' (or 'hamiltonians') is missing")
+        hams = [data["H"]] + ([data["G"]] if "G" in data else [])
+        if not all(isinstance(v, str) for v in hams):
+            raise InvalidSystemError(f"--system {shown}: H and G must be strings such as \"x2^2/2 + x1^2/2\"")
+    params = data.get("parameters", [])
+    values = {}
+    if isinstance(params, dict):
+        names = list(params)
+        values = {key: parse_value(value, f"--system {shown}: parameter {key}") for key, value in params.items()}
+    else:
+        names = text_list("parameters", params)
+    for key in ("name", "split", "description", "citation", "bracket"):
+        if key in data and not isinstance(data[key], str):
+            raise InvalidSystemError(f"--system {shown}: {key} must be a string, got {data[key]!r}")
+    if "name" in data:
+        name = data["name"]
+    else:  # the file's base name when it is a valid name, else 'custom'
+        stem = os.path.splitext(os.path.basename(shown))[0]
+        name = stem if USER_NAME.match(stem) else "custom"
+    where = f"--system {shown}"
+    labels = {"coordinates": where, "parameters": where, "count": where, "system": where, "name": f"{where}: name"}
+    return SystemSpec(
+        hamiltonians=tuple((text, f"{where}: {label}") for text, label in zip(hams, _labels(len(hams)))),
+        coordinates=tuple(coordinates), parameters=tuple(names), values=tuple(values.items()),
+        split=data.get("split"), bracket=data.get("bracket"), name=name,
+        description=data.get("description", ""), citation=data.get("citation", ""), labels=tuple(labels.items()),
+    )

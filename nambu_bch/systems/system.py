@@ -13,6 +13,7 @@ from ..algebra import PolynomialAlgebra, VectorField, liouville_field
 from ..checks import check_int, show
 from ..errors import InvalidSystemError, NambuBCHError
 from ..parsing import SYMBOL_NAME, as_expression
+from .pieces import build_canonical_split, build_full_split, build_single_split, build_triplet_split
 
 #: Symbols reserved by the package: the step and the family parameter.
 RESERVED_SYMBOLS = ("h", "alpha")
@@ -51,21 +52,6 @@ def check_name(name, what: str = "name", strict: bool = True) -> str:
         raise InvalidSystemError(f"{what} {shown} is not accepted; a name is {rule}")
     return name
 
-
-def as_system(system, what: str = "system") -> "System":
-    """``system`` itself, the built-in model of that name, or the system a :class:`~nambu_bch.systems.spec.SystemSpec`
-    builds; else :class:`InvalidSystemError` in one line.  The one reading of a ``system`` argument of the API."""
-    if isinstance(system, System):
-        return system
-    if isinstance(system, str):
-        from .catalog import model
-
-        return model(system)
-    from .spec import SystemSpec
-
-    if isinstance(system, SystemSpec):
-        return system.build()
-    raise InvalidSystemError(f"{what} must be a System or a built-in model name such as 'ho3', got {type(system).__name__}")
 
 #: The kinds of bracket a system may carry (see :func:`infer_bracket`).
 BRACKETS = ("canonical", "nambu", "triplets", "lie-poisson")
@@ -350,13 +336,11 @@ class System:
     @cached_property
     def splitting(self):
         """The default splitting of this system (see :mod:`nambu_bch.systems.splitting`)."""
-        from .splitting import canonical_split, full_split, single_split, triplet_split
-
         if self.bracket == "canonical":
-            return canonical_split(self, fine=self.split == "fine")
+            return build_canonical_split(self, fine=self.split == "fine")
         if self.bracket == "triplets":
-            return triplet_split(self, single=self.split == "single")
-        return full_split(self) if self.split == "full" else single_split(self)
+            return build_triplet_split(self, single=self.split == "single")
+        return build_full_split(self) if self.split == "full" else build_single_split(self)
 
     @property
     def dof(self):
