@@ -48,10 +48,10 @@ SURFACE = {
         "SUBCOMMANDS", "UsageError", "build_parser", "main",
     ),
     "nambu_bch.design": (
-        "CatalogComposition", "Comparison", "DesignedComposition", "ErrorConstant", "LeadingError",
-        "NoSolutionError", "OrderConditions", "Template", "compare", "composition_order", "cost", "error_analysis",
-        "error_constant", "field_size", "leading_error", "methods", "optimize_composition", "order_conditions",
-        "template",
+        "CatalogComposition", "Comparison", "DesignedComposition", "ErrorConstant", "GradientField", "GradientShadow",
+        "LeadingError", "NoSolutionError", "OrderConditions", "Template", "compare", "composition_order", "cost",
+        "error_analysis", "error_constant", "field_size", "gradient_effective_field", "gradient_shadow",
+        "leading_error", "methods", "optimize_composition", "order_conditions", "template",
     ),
     "nambu_bch.exact": (
         "ConservedQuantities", "ExactShadow", "F", "F_series", "LinearCore", "ModifiedSolution",
@@ -64,9 +64,10 @@ SURFACE = {
         "parameter_values", "step_function", "strang_word", "subflow_functions",
     ),
     "nambu_bch.numeric": (
-        "CheckResult", "DriftFit", "FigureSet", "HScan", "Kernel", "NumericalShadow", "OrderFit", "PrecisionStudy",
-        "Progress", "RunningStats", "ShadowTrajectory", "StepProgram", "TruncationStudy", "cache_dir", "check",
-        "drift_rate", "fit_order", "h_scan", "iterate", "iterate_chunks", "kernel", "n_samples", "numba_available",
+        "CheckResult", "DriftFit", "FigureSet", "GradientCheck", "HScan", "Kernel", "NumericalShadow", "OrderFit",
+        "PrecisionStudy", "Progress", "RunningStats", "ShadowTrajectory", "StepProgram", "TruncationStudy", "cache_dir",
+        "check", "drift_rate", "fit_order", "gradient_check", "h_scan", "iterate", "iterate_chunks",
+        "iterate_gradient", "iterate_processed", "kernel", "n_samples", "numba_available",
         "numerical_shadow", "observed_order",
         "paper_figures", "precision_study", "quantities", "rk_iterate", "rk_step_function", "sample_steps",
         "sample_times", "shadow_along", "step_program", "truncation_study",

@@ -42,6 +42,7 @@ from dataclasses import dataclass
 import sympy
 
 from ..errors import InvalidCompositionError, InvalidSystemError
+from ..values import ValueEquality
 from .generalized import MAX_SERIES_DEGREE, _bracket_basis, _gradient_spec, _log_of
 from .words import lyndon_defect_words
 
@@ -147,11 +148,12 @@ def _value(E, u, n):
 
 
 @dataclass(frozen=True, eq=False)
-class GradientField:
+class GradientField(ValueEquality):
     """``X_eff = sum_j h^j Z_j`` of a force-gradient composition on a system, by one route.
 
     ``coefficients``: the ``Z_j`` as tuples of exact sympy expressions (components in the coordinates' order);
-    ``lie``: per ``j`` the Lyndon coordinates ``[(u, alpha_u)]`` of ``Z_j`` (formal route only).
+    ``lie``: per ``j`` the Lyndon coordinates ``[(u, alpha_u)]`` of ``Z_j`` (formal route only).  ``==`` compares
+    the field (system, composition, order, ``Z_j``), so the two routes' results are equal exactly when they agree.
     """
 
     system: object
@@ -164,14 +166,9 @@ class GradientField:
     def __getitem__(self, j):
         return self.coefficients[j]
 
-    def __eq__(self, other):
-        if not isinstance(other, GradientField):
-            return NotImplemented
-        return (self.order == other.order and len(self.coefficients) == len(other.coefficients)
-                and all(sympy.expand(a - b) == 0 for Z, Y in zip(self.coefficients, other.coefficients)
-                        for a, b in zip(Z, Y)))
-
-    __hash__ = None
+    def _value(self) -> tuple:
+        """The exact data (``==``, ``hash``): the field itself, whichever route computed it."""
+        return self.system, self.composition, self.order, self.coefficients
 
     def to_dict(self) -> dict:
         return {"system": self.system.name, "composition": str(self.composition), "route": self.route,
@@ -272,13 +269,16 @@ def _backward(S, comp, order):
 
 
 @dataclass(frozen=True, eq=False)
-class GradientShadow:
+class GradientShadow(ValueEquality):
     """``H_S = sum_j h^j H_j`` of a force-gradient composition on a canonical system (exact sympy ``terms``)."""
 
     system: object
     composition: object
     order: int
     terms: tuple
+
+    def _value(self) -> tuple:
+        return self.system, self.composition, self.order, self.terms
 
     @property
     def hamiltonian(self):

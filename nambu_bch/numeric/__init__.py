@@ -12,6 +12,7 @@ from .codegen import StepProgram, step_program
 from .diagnostics import (CheckResult, DriftFit, OrderFit, RunningStats, check, drift_rate, fit_order, observed_order,
                           quantities)
 from .figures import FigureSet, paper_figures
+from .force_gradient import GradientCheck, gradient_check, iterate_gradient, iterate_processed
 from .iterate import iterate, iterate_chunks
 from .kernels import Kernel, cache_dir, kernel, numba_available
 from .runge_kutta import rk_iterate, rk_step_function
@@ -24,6 +25,7 @@ __all__ = [
     "CheckResult",
     "DriftFit",
     "FigureSet",
+    "GradientCheck",
     "HScan",
     "Kernel",
     "NumericalShadow",
@@ -38,9 +40,12 @@ __all__ = [
     "check",
     "drift_rate",
     "fit_order",
+    "gradient_check",
     "h_scan",
     "iterate",
     "iterate_chunks",
+    "iterate_gradient",
+    "iterate_processed",
     "kernel",
     "n_samples",
     "numba_available",

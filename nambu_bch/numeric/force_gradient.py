@@ -26,10 +26,13 @@ Blanes, Casas & Ros, SIAM J. Sci. Comput. 21 (1999) 711.
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
 import sympy
 
 from ..errors import ResourceLimitError
+from ..values import ValueEquality
 
 #: Most trajectory-steps of one numpy-loop run (a few seconds).
 MAX_GRADIENT_STEPS = 2_000_000
@@ -229,13 +232,21 @@ def is_processed_kernel(word) -> bool:
     return isinstance(word, str) and word.strip().lower() in PROCESSED_KERNELS
 
 
-class GradientCheck:
+@dataclass(frozen=True, eq=False)
+class GradientCheck(ValueEquality):
     """The result of :func:`gradient_check`: per step size the largest drift of ``H`` and of the truncated shadow
     Hamiltonian ``H_S^[k]`` along the run, and the fitted slopes against ``h``."""
 
-    def __init__(self, system, method, processed, hs, energy, shadow, shadow_order):
-        self.system, self.method, self.processed = system, method, processed
-        self.hs, self.energy, self.shadow, self.shadow_order = list(hs), list(energy), list(shadow), shadow_order
+    system: object
+    method: str
+    processed: bool
+    hs: tuple
+    energy: tuple
+    shadow: tuple
+    shadow_order: object
+
+    def _value(self) -> tuple:
+        return self.system, self.method, self.processed, self.hs, self.energy, self.shadow, self.shadow_order
 
     @staticmethod
     def _slope(hs, ys):
@@ -254,8 +265,8 @@ class GradientCheck:
 
     def to_dict(self) -> dict:
         return {"system": self.system.name, "integrator": self.method, "processed": self.processed,
-                "h": self.hs, "max_H_drift": self.energy, "energy_slope": self.energy_slope,
-                "shadow_order": self.shadow_order, "max_H_S_drift": self.shadow, "shadow_slope": self.shadow_slope}
+                "h": list(self.hs), "max_H_drift": list(self.energy), "energy_slope": self.energy_slope,
+                "shadow_order": self.shadow_order, "max_H_S_drift": list(self.shadow), "shadow_slope": self.shadow_slope}
 
     def __str__(self):
         lines = [f"{self.method} on {self.system.name}" + (" (processed: P K^n P^-1)" if self.processed else "")]
@@ -286,8 +297,18 @@ def gradient_check(system, method, h, steps, x0=None, params=None, halvings: int
     from ..errors import InvalidRunError
     from .diagnostics import numpy_function
 
+    from ..checks import finite_float
+    from .guards import check_count
+
     if not is_int(halvings, 1, 4):
         raise InvalidRunError(f"halvings must be an integer in 1..4, got {halvings!r}")
+    h = finite_float(h, "h")
+    steps = check_count(steps, "steps", 1)
+    if h == 0:
+        raise InvalidRunError("h must be non-zero")
+    if steps * 2**halvings > MAX_GRADIENT_STEPS:  # the finest run, refused before any work
+        raise ResourceLimitError(f"steps = {steps} with {halvings} halvings needs {steps * 2**halvings} steps, more "
+                                 f"than the {MAX_GRADIENT_STEPS:.0e} a force-gradient run accepts")
     step = GradientStep(system, method, params)
     S = step.system
     processed = is_processed_kernel(method)
@@ -311,4 +332,5 @@ def gradient_check(system, method, h, steps, x0=None, params=None, halvings: int
         if shadow_f is not None:
             s = np.broadcast_to(np.asarray(shadow_f(*x.T, hi), dtype=float), e.shape)
             drift.append(float(np.max(np.abs(s - s[0]))))
-    return GradientCheck(S, name, processed, hs, energy, drift if shadow_f is not None else [None] * len(hs), k)
+    return GradientCheck(S, name, processed, tuple(hs), tuple(energy),
+                         tuple(drift) if shadow_f is not None else (None,) * len(hs), k)
