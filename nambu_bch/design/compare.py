@@ -178,7 +178,9 @@ def _words(words) -> list:
 
     from ..integrators.runge_kutta import ButcherTableau
 
-    if isinstance(words, (str, Composition, ButcherTableau)):
+    from .generalized import GradientComposition
+
+    if isinstance(words, (str, Composition, ButcherTableau, GradientComposition)):
         return [words]
     try:
         out = list(words)
@@ -190,7 +192,7 @@ def _words(words) -> list:
     if len(out) > MAX_WORDS:
         raise InvalidRunError(f"compare takes at most {MAX_WORDS} integrators, got {len(out)}")
     for w in out:
-        if not isinstance(w, (str, Composition, ButcherTableau)):
+        if not isinstance(w, (str, Composition, ButcherTableau, GradientComposition)):
             raise InvalidCompositionError(f"each integrator must be a word, alias, Composition, Runge-Kutta method name "
                                           f"or ButcherTableau, got {show(w)}")
     return out
@@ -265,6 +267,10 @@ def compare(system, words, t_end: float = 10.0, steps=(20, 40, 80, 160, 320, 640
             rows.append(_runge_kutta_row(system, tableau, label, t_end, steps, x0, params, x_ref, ref_err, box, samples))
             curves[label] = rows[-1].pop("points")
             continue
+        if _is_gradient(word):
+            rows.append(_gradient_row(system, word, t_end, steps, x0, params, x_ref, ref_err, box, samples))
+            curves[rows[-1]["integrator"]] = rows[-1].pop("points")
+            continue
         comp = composition_for(word, system.splitting)
         label = word if isinstance(word, str) else comp.name
         try:
@@ -295,6 +301,69 @@ def compare(system, words, t_end: float = 10.0, steps=(20, 40, 80, 160, 320, 640
         })
         curves[label] = pts
     return Comparison(system.name, t_end, x0, params, rows, curves, ref_name, ref_err)
+
+
+def _is_gradient(word) -> bool:
+    from ..numeric.force_gradient import is_gradient_method
+
+    return is_gradient_method(word)
+
+
+def _gradient_row(system, word, t_end, steps, x0, params, x_ref, ref_err, box, samples) -> dict:
+    """The row of a force-gradient composition or a processed kernel (:mod:`nambu_bch.numeric.force_gradient`).
+
+    ``order`` and ``error_constant`` are the formal ones (:func:`~nambu_bch.design.generalized.gradient_analysis`), the
+    effective order for a processed kernel (:func:`~nambu_bch.design.generalized.effective_order`); ``cost`` counts a
+    force-gradient kick as :data:`~nambu_bch.numeric.force_gradient.GRADIENT_KICK_COST` evaluations and a processed run
+    pays two processor applications of :data:`~nambu_bch.numeric.force_gradient.PROCESSOR_COST` each, once per run.
+    ``leading_power`` is the first non-zero ``h^j Z_j`` of X_eff on the system (formal route), ``leading_size`` its
+    largest norm on the default box.
+    """
+    from ..numeric.force_gradient import (PROCESSOR_COST, GradientStep, is_processed_kernel, iterate_gradient,
+                                          iterate_processed)
+    from .generalized import effective_order, gradient_analysis
+    from .gradient_system import gradient_effective_field
+    from .system_error import field_size
+
+    step = GradientStep(system, word, params)  # refuses a system without the T(p) + V(q) structure, in one line
+    label = word if isinstance(word, str) else str(step.composition)
+    processed = is_processed_kernel(word)
+    if processed:
+        analysis = effective_order(word)
+        order, lem = analysis.order, analysis.value
+    else:
+        analysis = gradient_analysis(word)
+        order, lem = analysis.order, analysis.value
+    per_step, extra = step.cost()
+    if processed:
+        extra += 2 * PROCESSOR_COST
+    try:
+        X = gradient_effective_field(system, word, order=min(order + 1, 6))
+        power = next((j for j in range(1, X.order + 1) if any(X[j])), None)
+        size = float("nan") if power is None else field_size(X[power], system, box, samples, params, 0)
+    except NambuBCHError:
+        power, size = None, float("nan")
+    run = iterate_processed if processed else iterate_gradient
+    pts = []
+    for N in steps:
+        h = t_end / N
+        try:
+            final = np.asarray(run(system, word, h, N, x0, params, every=N)[-1], float)
+            err = float(np.linalg.norm(final - x_ref))
+        except NambuBCHError as exc:
+            pts.append({"steps": N, "h": h, "evaluations": N * per_step + extra, "error": float("nan"), "note": str(exc)})
+            continue
+        pts.append({"steps": N, "h": h, "evaluations": N * per_step + extra, "error": err})
+    good = [p for p in pts if np.isfinite(p["error"]) and p["error"] > max(FLOOR, 100 * ref_err)]
+    return {
+        "integrator": label, "name": str(step.composition), "order": order, "error_constant": lem,
+        "cost": per_step, "fsal_extra": extra, "leading_power": power, "leading_size": size,
+        "slope": slope([p["evaluations"] for p in good], [p["error"] for p in good]),
+        "slope_points": len(good),
+        "best_error": min((p["error"] for p in pts if np.isfinite(p["error"])), default=float("nan")),
+        "citation": step.composition.citation, "family": "processed" if processed else "force-gradient",
+        "points": pts,
+    }
 
 
 def _runge_kutta_row(system, tableau, label, t_end, steps, x0, params, x_ref, ref_err, box, samples) -> dict:
