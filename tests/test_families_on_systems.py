@@ -180,6 +180,18 @@ def test_compare_rows_for_the_new_families(comparison):
     assert rows["pefrl"]["slope"] == pytest.approx(-4, abs=0.2)
 
 
+def test_rkn_constants_in_the_rows_of_a_canonical_system(comparison):
+    """On T(p) + V(q) the rows carry the constants modulo the RKN relations, by which PEFRL was optimised (the RKN
+    value 0.1597 of docs/integrators.md, "Structured pieces"); a Nambu system has no such rows."""
+    from nambu_bch.design.compare import _has_rkn_structure
+
+    rows = {r["integrator"]: r for r in comparison.rows}
+    assert round(rows["pefrl"]["error_constant_rkn"], 4) == 0.1597 and rows["pefrl"]["order_rkn"] == 4
+    assert rows["121"]["error_constant_rkn"] == rows["121"]["error_constant"]      # below degree 4 nothing changes
+    assert rows["chin-4a"]["error_constant_rkn"] < rows["chin-4a"]["error_constant"]
+    assert not _has_rkn_structure(nb.model("ho3")) and _has_rkn_structure(nb.model("pendulum"))
+
+
 def test_error_constants_as_computed(comparison):
     """Computed (no published table in this norm): Chin 4A, the processed Takahashi-Imada kernel, PEFRL."""
     rows = {r["integrator"]: r for r in comparison.rows}

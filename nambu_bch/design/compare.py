@@ -14,6 +14,11 @@ Per word:
   against the evaluations ``N cost (+1)``, and the least-squares slope of
   ``log(error)`` against ``log(evaluations)`` over the points above round-off: ``-order``.
 
+On a canonical ``T(p) + V(q)`` system with ``T`` a constant quadratic form, two-part rows also carry
+``order_rkn`` and ``error_constant_rkn``: order and constant modulo the RKN relations (:mod:`.structure`), by which
+RKN-optimised methods are designed and ranked.  Force-gradient compositions and processed kernels
+(:mod:`nambu_bch.numeric.force_gradient`) have rows of their own (``family``, their cost counted as there).
+
 Runge--Kutta and Kahan methods (a name of :data:`~nambu_bch.integrators.runge_kutta.TABLEAUX` or a
 ``ButcherTableau``) are compared on the same runs: ``order`` is the tableau's, ``error_constant`` None,
 ``leading_power`` / ``leading_size`` those of the first non-zero ``h^j Z_j`` of the modified field
@@ -260,6 +265,7 @@ def compare(system, words, t_end: float = 10.0, steps=(20, 40, 80, 160, 320, 640
                         f"bounded up to t_end = {t_end:g}") from None
     ref_err = float(np.linalg.norm(x_ref - x_half)) / 63.0  # order 6: error(h) ~ (error(2h) - error(h)) / (2^6 - 1)
     rows, curves = [], {}
+    rkn_system = _has_rkn_structure(system)
     for word in words:
         tableau = runge_kutta_method(word)
         if tableau is not None:
@@ -280,6 +286,7 @@ def compare(system, words, t_end: float = 10.0, steps=(20, 40, 80, 160, 320, 640
             order, lem = None, None
         lead = leading_error(system, comp, box=box, samples=samples, params=params, hamiltonian=False)
         per_step, extra = cost(comp)
+        rkn = _rkn_constant(system, comp) if rkn_system else {}
         pts = []
         for N in steps:
             h = t_end / N
@@ -297,10 +304,33 @@ def compare(system, words, t_end: float = 10.0, steps=(20, 40, 80, 160, 320, 640
             "slope": slope([p["evaluations"] for p in good], [p["error"] for p in good]),
             "slope_points": len(good),
             "best_error": min((p["error"] for p in pts if np.isfinite(p["error"])), default=float("nan")),
-            "citation": comp.citation,
+            "citation": comp.citation, **rkn,
         })
         curves[label] = pts
     return Comparison(system.name, t_end, x0, params, rows, curves, ref_name, ref_err)
+
+
+def _has_rkn_structure(system) -> bool:
+    """Whether ``system`` is canonical ``T(p) + V(q)`` with ``T`` a constant quadratic form: there the RKN relations
+    hold (:mod:`.structure`) and the rows carry ``error_constant_rkn`` too."""
+    from ..errors import InvalidSystemError
+    from .gradient_system import gradient_structure
+
+    try:
+        gradient_structure(system)
+    except InvalidSystemError:
+        return False
+    return True
+
+
+def _rkn_constant(system, comp) -> dict:
+    """``{"order_rkn", "error_constant_rkn"}`` of a two-part composition on the RKN quotient (empty if it does not
+    apply): the constants RKN-optimised methods (PEFRL, Blanes-Moan SRKN) are designed for."""
+    try:
+        analysis = error_analysis(comp, 2, structure="rkn")
+    except NambuBCHError:
+        return {}
+    return {"order_rkn": analysis.order, "error_constant_rkn": analysis.value}
 
 
 def _is_gradient(word) -> bool:
@@ -334,6 +364,7 @@ def _gradient_row(system, word, t_end, steps, x0, params, x_ref, ref_err, box, s
     else:
         analysis = gradient_analysis(word)
         order, lem = analysis.order, analysis.value
+        rkn = gradient_analysis(word, structure="rkn")
     per_step, extra = step.cost()
     if processed:
         extra += 2 * PROCESSOR_COST
@@ -362,6 +393,7 @@ def _gradient_row(system, word, t_end, steps, x0, params, x_ref, ref_err, box, s
         "slope_points": len(good),
         "best_error": min((p["error"] for p in pts if np.isfinite(p["error"])), default=float("nan")),
         "citation": step.composition.citation, "family": "processed" if processed else "force-gradient",
+        **({} if processed else {"order_rkn": rkn.order, "error_constant_rkn": rkn.value}),
         "points": pts,
     }
 
