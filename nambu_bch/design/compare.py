@@ -143,8 +143,10 @@ class Comparison:
         fig, ax = plt.subplots(figsize=(6.4, 4.4))
         for r in self.rows:
             pts = self.curves[r["integrator"]]
-            ax.loglog([p["evaluations"] for p in pts], [max(p["error"], 1e-17) for p in pts], "o-",
-                      label=f"{r['integrator']} (p={r['order']}, slope {r['slope']:.2f})")
+            family = r.get("family")  # force-gradient and processed rows dashed, named by their family
+            ax.loglog([p["evaluations"] for p in pts], [max(p["error"], 1e-17) for p in pts], "s--" if family else "o-",
+                      label=f"{r['integrator']} (p={r['order']}, slope {r['slope']:.2f}"
+                            + (f", {family})" if family else ")"))
         ax.set_xlabel("sub-flow evaluations")
         ax.set_ylabel(f"global error at T = {self.t_end:g}")
         ax.set_title(f"work-precision, {self.system}")
