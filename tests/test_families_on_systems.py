@@ -157,6 +157,7 @@ def test_gradient_check_drift_slopes():
     assert R.energy_slope == pytest.approx(4, abs=0.15) and R.shadow_slope == pytest.approx(6, abs=0.2)
     P = gradient_check("ho", "takahashi-imada", 0.2, 20, (1.0, 0.0), halvings=1)
     assert P.processed and P.energy_slope == pytest.approx(4, abs=0.2) and np.isnan(P.shadow_slope)
+    assert P.kernel_energy_slope == pytest.approx(2, abs=0.2) and "kernel alone" in str(P)
     assert json.loads(json.dumps(R.to_dict()))["shadow_order"] == 4
 
 

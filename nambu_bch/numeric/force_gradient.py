@@ -244,9 +244,16 @@ class GradientCheck(ValueEquality):
     energy: tuple
     shadow: tuple
     shadow_order: object
+    kernel_energy: tuple = ()
 
     def _value(self) -> tuple:
-        return self.system, self.method, self.processed, self.hs, self.energy, self.shadow, self.shadow_order
+        return (self.system, self.method, self.processed, self.hs, self.energy, self.shadow, self.shadow_order,
+                self.kernel_energy)
+
+    @property
+    def kernel_energy_slope(self) -> float:
+        """For a processed kernel: the slope of the bare kernel's ``H`` drift (its own order, below the effective)."""
+        return self._slope(self.hs, self.kernel_energy) if self.kernel_energy else float("nan")
 
     @staticmethod
     def _slope(hs, ys):
@@ -266,20 +273,27 @@ class GradientCheck(ValueEquality):
     def to_dict(self) -> dict:
         return {"system": self.system.name, "integrator": self.method, "processed": self.processed,
                 "h": list(self.hs), "max_H_drift": list(self.energy), "energy_slope": self.energy_slope,
-                "shadow_order": self.shadow_order, "max_H_S_drift": list(self.shadow), "shadow_slope": self.shadow_slope}
+                "shadow_order": self.shadow_order, "max_H_S_drift": list(self.shadow), "shadow_slope": self.shadow_slope,
+                "kernel_max_H_drift": list(self.kernel_energy), "kernel_energy_slope": self.kernel_energy_slope}
 
     def __str__(self):
         lines = [f"{self.method} on {self.system.name}" + (" (processed: P K^n P^-1)" if self.processed else "")]
         head = f"{'h':>10} {'max|H - H(0)|':>15}"
         if self.shadow_order is not None:
             head += f" {'max|H_S^[' + str(self.shadow_order) + '] - H_S(0)|':>24}"
+        if self.kernel_energy:
+            head += f" {'kernel alone':>15}"
         lines.append(head)
         for i, h in enumerate(self.hs):
             row = f"{h:>10.4g} {self.energy[i]:>15.3e}"
             if self.shadow_order is not None:
                 row += f" {self.shadow[i]:>24.3e}"
+            if self.kernel_energy:
+                row += f" {self.kernel_energy[i]:>15.3e}"
             lines.append(row)
         lines.append(f"slope of the H drift vs h: {self.energy_slope:.2f}")
+        if self.kernel_energy:
+            lines.append(f"slope of the kernel's own H drift vs h: {self.kernel_energy_slope:.2f}")
         if self.shadow_order is not None:
             lines.append(f"slope of the H_S^[{self.shadow_order}] drift vs h: {self.shadow_slope:.2f} "
                          f"(expected {self.shadow_order + 2} for a symmetric method)")
@@ -289,7 +303,9 @@ class GradientCheck(ValueEquality):
 def gradient_check(system, method, h, steps, x0=None, params=None, halvings: int = 2) -> GradientCheck:
     """Run a force-gradient method (or a processed kernel) at ``h, h/2, ...`` over the same time ``steps h`` and
     measure the drift of ``H`` and, for a force-gradient composition of order ``p``, of ``H_S`` through ``h^p``
-    (:func:`nambu_bch.design.gradient_system.gradient_shadow`): the slopes are ``p`` and ``p + 2``.
+    (:func:`nambu_bch.design.gradient_system.gradient_shadow`): the slopes are ``p`` and ``p + 2``.  For a processed
+    kernel the drift of ``H`` along the processed output has the effective order's slope, and the bare kernel's
+    (``kernel_energy``) its own order's.
     """
     from ..checks import is_int
     from ..design.generalized import _gradient_spec, gradient_analysis
@@ -321,7 +337,7 @@ def gradient_check(system, method, h, steps, x0=None, params=None, halvings: int
         k = gradient_analysis(method).order
         shadow = gradient_shadow(S, method, k)
         shadow_f = sympy.lambdify((*coords, STEP), shadow.truncated(k).subs(values), modules="numpy")
-    hs, energy, drift = [], [], []
+    hs, energy, drift, bare = [], [], [], []
     for i in range(halvings + 1):
         hi, ni = float(h) / 2**i, int(steps) * 2**i
         run = iterate_processed if processed else iterate_gradient
@@ -329,8 +345,11 @@ def gradient_check(system, method, h, steps, x0=None, params=None, halvings: int
         e = energy_f(x)
         hs.append(hi)
         energy.append(float(np.max(np.abs(e - e[0]))))
+        if processed:
+            k_run = energy_f(iterate_gradient(S, method, hi, ni, x0, params))
+            bare.append(float(np.max(np.abs(k_run - k_run[0]))))
         if shadow_f is not None:
             s = np.broadcast_to(np.asarray(shadow_f(*x.T, hi), dtype=float), e.shape)
             drift.append(float(np.max(np.abs(s - s[0]))))
     return GradientCheck(S, name, processed, tuple(hs), tuple(energy),
-                         tuple(drift) if shadow_f is not None else (None,) * len(hs), k)
+                         tuple(drift) if shadow_f is not None else (None,) * len(hs), k, tuple(bare))
