@@ -112,6 +112,11 @@ def test_bad_route_and_decimal_coefficients_refused():
         gradient_effective_field("ho", "chin-4a", route="magic")
     with pytest.raises(InvalidCompositionError, match="exact coefficients"):
         gradient_effective_field("ho", "pefrl", order=2)
+    complex_jump = "1:1/4+I/4,2:1/2+I/2,1:1/2,2:1/2-I/2,1:1/4-I/4"
+    with pytest.raises(InvalidCompositionError, match="real coefficients"):
+        gradient_effective_field("ho", complex_jump, order=2)
+    with pytest.raises(InvalidCompositionError, match="real coefficients"):
+        iterate_gradient("ho", complex_jump, 0.1, 2, (1.0, 0.0))
 
 
 # ------------------------------------------------------------------------------------------------

@@ -112,6 +112,15 @@ def gradient_structure(system) -> GradientStructure:
     return GradientStructure(system, T, V, G, positions, momenta, {1: splitting[1].field, 2: splitting[2].field, 3: W})
 
 
+def check_real_exact(comp, what: str) -> None:
+    """Refuse, in one line, a composition these routes cannot take: published decimals (``X_eff`` would carry their
+    rounding) or complex coefficients (the kicks are real flows)."""
+    if comp.error_bound:
+        raise InvalidCompositionError(f"{what} needs exact coefficients; {str(comp)!r} has published decimals")
+    if comp.is_complex:
+        raise InvalidCompositionError(f"{what} needs real coefficients; {str(comp)!r} has complex ones")
+
+
 def _check_order(order):
     from ..checks import is_int
     from ..errors import InvalidOrderError
@@ -132,7 +141,7 @@ def lie_coordinates(K, S, series: dict, q: int) -> list:
     M = sympy.Matrix([[K.to_sympy(P.get(w, K.zero)) for P in basis] for w in words])
     v = sympy.Matrix([K.to_sympy(series.get(w, K.zero)) for w in words])
     alpha = M.LUsolve(v)
-    return [(u, sympy.nsimplify(a) if a.is_Float else sympy.expand(a)) for u, a in zip(words, alpha)]
+    return [(u, sympy.expand(a)) for u, a in zip(words, alpha)]
 
 
 def _tree(u):
@@ -200,8 +209,7 @@ def gradient_effective_field(system, spec, order: int = 4, route: str = "formal"
     """
     S = gradient_structure(system)
     comp = _gradient_spec(spec)
-    if comp.error_bound:
-        raise InvalidCompositionError(f"X_eff on a system needs exact coefficients; {str(comp)!r} has published decimals")
+    check_real_exact(comp, "X_eff on a system")
     order = _check_order(order)
     if route == "formal":
         return _formal(S, comp, order)

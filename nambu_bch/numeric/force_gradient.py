@@ -68,6 +68,11 @@ class GradientStep:
         S = gradient_structure(system)
         self.structure, self.system = S, S.system
         self.composition = _gradient_spec(spec)
+        if self.composition.is_complex:
+            from ..errors import InvalidCompositionError
+
+            raise InvalidCompositionError(f"a force-gradient run needs real coefficients; {self.composition} has "
+                                          f"complex ones")
         values = _values(S.system, params)
         q, p = S.positions, S.momenta
         d = len(q)
