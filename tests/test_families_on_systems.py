@@ -234,3 +234,13 @@ def test_errors_are_one_line_nambu_errors():
         with pytest.raises(NambuBCHError) as info:
             call()
         assert "\n" not in str(info.value)
+
+
+def test_work_precision_figure_with_the_new_families(comparison):
+    import matplotlib.pyplot as plt
+
+    fig = comparison.figure()
+    labels = [t.get_text() for t in fig.axes[0].get_legend().get_texts()]
+    plt.close(fig)
+    assert any("chin-4a" in t and "force-gradient" in t for t in labels)
+    assert any("takahashi-imada" in t and "processed" in t for t in labels)
