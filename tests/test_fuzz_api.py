@@ -64,6 +64,7 @@ RECORDS = (
     "FINested", "FIOrder", "FIRepresentation", "FIResult", "OrderSolution", "Piece", "FieldBackend",
     "ExpressionBackend", "PolynomialBackend", "ShadowTrajectory", "ButcherTableau", "SeparableShadow", "ContractionSum",
     "Contraction", "NumericalShadow", "ModifiedEquation", "MonteCarloRun", "Estimate",
+    "Contraction", "NumericalShadow", "ModifiedEquation", "GradientField", "GradientShadow", "GradientCheck",
 )
 
 
@@ -217,11 +218,18 @@ def _base_table():
         "nambu_bch.design.error_analysis": lambda v: dict(spec="121", parts=2),
         "nambu_bch.design.field_size": lambda v: dict(components=(v["x"][1], -v["x"][0], 0), system=v["ho3"], samples=5),
         "nambu_bch.design.methods": lambda v: {},
+        "nambu_bch.design.gradient_effective_field": lambda v: dict(system=v["ho"], spec="chin-4a", order=2),
+        "nambu_bch.design.gradient_shadow": lambda v: dict(system=v["ho"], spec="chin-4a", order=2),
         "nambu_bch.design.template": lambda v: dict(spec="strang", parts=2, stages=1),
         # numeric
         "nambu_bch.check": num,
         "nambu_bch.iterate": num,
         "nambu_bch.numeric.iterate_chunks": num,
+        "nambu_bch.numeric.iterate_gradient": lambda v: dict(system=v["ho"], spec="chin-4a", h=0.1, steps=10, x0=(1.0, 0.0)),
+        "nambu_bch.numeric.iterate_processed": lambda v: dict(system=v["ho"], kernel="takahashi-imada", h=0.1, steps=10,
+                                                              x0=(1.0, 0.0)),
+        "nambu_bch.numeric.gradient_check": lambda v: dict(system=v["ho"], method="chin-4a", h=0.2, steps=5, x0=(1.0, 0.0),
+                                                           halvings=1),
         "nambu_bch.numeric.sample_times": lambda v: dict(h=0.1, steps=10),
         "nambu_bch.shadow_along": lambda v: dict(system=v["ho3"], word="12321", trajectory=[[1.0, 1.0, 1.0]] * 4, h=0.1,
                                                  which=("H", "H_S")),

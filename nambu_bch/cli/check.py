@@ -10,7 +10,9 @@ HELP = "iterate the integrator and report the conservation diagnostics"
 EXAMPLES = ("examples:\n  nambu-bch check --integrator 32123 --h 0.1 --steps 100000 --x0 1,1,1\n"
             "  nambu-bch check --model rigid-body --param I1=1 --param I2=2 --param I3=3 --format json\n"
             "  nambu-bch check --model henon-heiles --integrator 212 --x0 0.1,-0.2,0.3,0.25 --numerical-shadow 6\n"
-            "  nambu-bch check --model rigid-body --integrator midpoint --h 0.1 --steps 2000   # Newton, compiled")
+            "  nambu-bch check --model rigid-body --integrator midpoint --h 0.1 --steps 2000   # Newton, compiled\n"
+            "  nambu-bch check --model henon-heiles --integrator chin-4a --x0 0.1,-0.2,0.3,0.25 --h 0.2 --steps 50\n"
+            "      # force-gradient (or takahashi-imada, processed): drift of H and H_S at h, h/2, h/4 and the slopes")
 
 
 def register(sub) -> None:
@@ -32,6 +34,9 @@ def run(args):
     from ..numeric.diagnostics import check
 
     system, values = system_from_args(args)
+    if _gradient_method(args):
+        _gradient_check(args, system, values)
+        return
     word, comp = integrator_from_args(args, system, runge_kutta=True)
     params, x0 = numeric_inputs(args, system, values)
     order = args.order if args.order is not None else 2
@@ -76,3 +81,28 @@ def _numerical_shadow(system, word, h, steps, x0, params, order):
     x = iterate(system, word, h, steps, x0, params=params)
     d = system.N // 2
     return numerical_shadow(x[:, :d], x[:, d:], system, h, order=order, word=word, params=params)
+
+
+def _gradient_method(args) -> bool:
+    from ..numeric.force_gradient import is_gradient_method
+
+    return args.integrator is not None and is_gradient_method(args.integrator)
+
+
+def _gradient_check(args, system, values):
+    """A force-gradient composition or a processed kernel (``chin-4a``, ``takahashi-imada``): the drift of ``H`` and of
+    the truncated shadow Hamiltonian at ``h``, ``h/2``, ``h/4`` over the same time, with their slopes
+    (:func:`nambu_bch.numeric.gradient_check`)."""
+    from ..errors import NambuBCHError
+    from ..numeric.gradient_check import gradient_check
+
+    for flag, name in ((args.numerical_shadow, "--numerical-shadow"), (args.alpha, "--alpha"),
+                       (getattr(args, "tableau", None), "--tableau"), (args.order, "--order")):
+        if flag is not None:
+            raise NambuBCHError(f"{name} does not apply to --integrator {args.integrator}: its check measures the drift "
+                                f"of H and of its own shadow Hamiltonian at h, h/2, h/4")
+    if args.every != 1:
+        raise NambuBCHError(f"--every does not apply to --integrator {args.integrator}: every step is measured")
+    params, x0 = numeric_inputs(args, system, values)
+    report = gradient_check(system, args.integrator, args.h, args.steps, x0, params)
+    emit(args, text=lambda: str(report), data=report.to_dict, system=system)

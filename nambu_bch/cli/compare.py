@@ -17,13 +17,17 @@ EXAMPLES = (
     "  nambu-bch compare --model rigid-body --param I1=1 --param I2=2 --param I3=3 --integrator 12321 \\\n"
     "      --integrator 21312 --t-end 5 --step-counts 20,40,80,160 --figure wp.png --format json\n"
     "  nambu-bch compare --integrator strang --integrator kahan-li      # defaults: --model ho3, T = 10\n"
+    "  nambu-bch compare --model henon-heiles --x0 0.1,-0.2,0.3,0.25 --integrator 121 --integrator pefrl \\\n"
+    "      --integrator bm-srkn6 --integrator saba2 --integrator chin-4a --integrator takahashi-imada\n"
     "\n"
     "integrators: digit words, aliases (strang, lie-trotter, forest-ruth, yoshida:WORD, suzuki[:WORD],\n"
     "kahan-li[:WORD], yoshida6[:WORD], blanes-moan) or 'piece:coeff,...'; cost = sub-flow evaluations per\n"
     "step after merging equal neighbours (also across steps); Runge-Kutta methods (midpoint, gauss4, rk4,\n"
     "kahan, ... or --tableau FILE): field evaluations per step, measured (s per Newton iteration); the\n"
     "slope of log(error) vs log(evaluations)\n"
-    "is -order. The reference solution is the 6th-order Kahan-Li composition at h_min/8."
+    "is -order. The reference solution is the 6th-order Kahan-Li composition at h_min/8. Force-gradient methods\n"
+    "(chin-4a; takahashi-imada, run processed) on canonical T(p) + V(q) systems count a gradient kick as 2\n"
+    "evaluations and each of the two processor applications of a run as 2."
 )
 MAX_INTEGRATORS = 12
 

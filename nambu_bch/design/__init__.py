@@ -10,7 +10,9 @@
   SABA/SBAB) by name;
 * :mod:`.structure` -- order and error constants on the RKN quotient (``structure="rkn"``) and the generalised
   order of near-integrable splittings ``A + eps B``;
-* :mod:`.generalized` -- force-gradient factors and processed kernels (effective order).
+* :mod:`.generalized` -- force-gradient factors and processed kernels (effective order);
+* :mod:`.gradient_system` -- force-gradient compositions on a canonical system: X_eff (two routes), shadow
+  Hamiltonians.
 """
 
 from .catalog import CatalogComposition, methods
@@ -25,6 +27,7 @@ from .conditions import (
     order_conditions,
     template,
 )
+from .gradient_system import GradientField, GradientShadow, gradient_effective_field, gradient_shadow
 from .optimize import DesignedComposition, NoSolutionError, optimize_composition
 from .system_error import LeadingError, field_size, leading_error
 
@@ -33,6 +36,8 @@ __all__ = [
     "Comparison",
     "DesignedComposition",
     "ErrorConstant",
+    "GradientField",
+    "GradientShadow",
     "LeadingError",
     "NoSolutionError",
     "OrderConditions",
@@ -43,6 +48,8 @@ __all__ = [
     "error_analysis",
     "error_constant",
     "field_size",
+    "gradient_effective_field",
+    "gradient_shadow",
     "leading_error",
     "methods",
     "optimize_composition",

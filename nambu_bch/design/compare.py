@@ -14,6 +14,11 @@ Per word:
   against the evaluations ``N cost (+1)``, and the least-squares slope of
   ``log(error)`` against ``log(evaluations)`` over the points above round-off: ``-order``.
 
+On a canonical ``T(p) + V(q)`` system with ``T`` a constant quadratic form, two-part rows also carry
+``order_rkn`` and ``error_constant_rkn``: order and constant modulo the RKN relations (:mod:`.structure`), by which
+RKN-optimised methods are designed and ranked.  Force-gradient compositions and processed kernels
+(:mod:`nambu_bch.numeric.force_gradient`) have rows of their own (``family``, their cost counted as there).
+
 Runge--Kutta and Kahan methods (a name of :data:`~nambu_bch.integrators.runge_kutta.TABLEAUX` or a
 ``ButcherTableau``) are compared on the same runs: ``order`` is the tableau's, ``error_constant`` None,
 ``leading_power`` / ``leading_size`` those of the first non-zero ``h^j Z_j`` of the modified field
@@ -138,8 +143,10 @@ class Comparison:
         fig, ax = plt.subplots(figsize=(6.4, 4.4))
         for r in self.rows:
             pts = self.curves[r["integrator"]]
-            ax.loglog([p["evaluations"] for p in pts], [max(p["error"], 1e-17) for p in pts], "o-",
-                      label=f"{r['integrator']} (p={r['order']}, slope {r['slope']:.2f})")
+            family = r.get("family")  # force-gradient and processed rows dashed, named by their family
+            ax.loglog([p["evaluations"] for p in pts], [max(p["error"], 1e-17) for p in pts], "s--" if family else "o-",
+                      label=f"{r['integrator']} (p={r['order']}, slope {r['slope']:.2f}"
+                            + (f", {family})" if family else ")"))
         ax.set_xlabel("sub-flow evaluations")
         ax.set_ylabel(f"global error at T = {self.t_end:g}")
         ax.set_title(f"work-precision, {self.system}")
@@ -178,7 +185,9 @@ def _words(words) -> list:
 
     from ..integrators.runge_kutta import ButcherTableau
 
-    if isinstance(words, (str, Composition, ButcherTableau)):
+    from .generalized import GradientComposition
+
+    if isinstance(words, (str, Composition, ButcherTableau, GradientComposition)):
         return [words]
     try:
         out = list(words)
@@ -190,7 +199,7 @@ def _words(words) -> list:
     if len(out) > MAX_WORDS:
         raise InvalidRunError(f"compare takes at most {MAX_WORDS} integrators, got {len(out)}")
     for w in out:
-        if not isinstance(w, (str, Composition, ButcherTableau)):
+        if not isinstance(w, (str, Composition, ButcherTableau, GradientComposition)):
             raise InvalidCompositionError(f"each integrator must be a word, alias, Composition, Runge-Kutta method name "
                                           f"or ButcherTableau, got {show(w)}")
     return out
@@ -258,12 +267,17 @@ def compare(system, words, t_end: float = 10.0, steps=(20, 40, 80, 160, 320, 640
                         f"bounded up to t_end = {t_end:g}") from None
     ref_err = float(np.linalg.norm(x_ref - x_half)) / 63.0  # order 6: error(h) ~ (error(2h) - error(h)) / (2^6 - 1)
     rows, curves = [], {}
+    rkn_system = _has_rkn_structure(system)
     for word in words:
         tableau = runge_kutta_method(word)
         if tableau is not None:
             label = word if isinstance(word, str) else tableau.name
             rows.append(_runge_kutta_row(system, tableau, label, t_end, steps, x0, params, x_ref, ref_err, box, samples))
             curves[label] = rows[-1].pop("points")
+            continue
+        if _is_gradient(word):
+            rows.append(_gradient_row(system, word, t_end, steps, x0, params, x_ref, ref_err, box, samples))
+            curves[rows[-1]["integrator"]] = rows[-1].pop("points")
             continue
         comp = composition_for(word, system.splitting)
         label = word if isinstance(word, str) else comp.name
@@ -274,6 +288,7 @@ def compare(system, words, t_end: float = 10.0, steps=(20, 40, 80, 160, 320, 640
             order, lem = None, None
         lead = leading_error(system, comp, box=box, samples=samples, params=params, hamiltonian=False)
         per_step, extra = cost(comp)
+        rkn = _rkn_constant(system, comp) if rkn_system else {}
         pts = []
         for N in steps:
             h = t_end / N
@@ -291,10 +306,98 @@ def compare(system, words, t_end: float = 10.0, steps=(20, 40, 80, 160, 320, 640
             "slope": slope([p["evaluations"] for p in good], [p["error"] for p in good]),
             "slope_points": len(good),
             "best_error": min((p["error"] for p in pts if np.isfinite(p["error"])), default=float("nan")),
-            "citation": comp.citation,
+            "citation": comp.citation, **rkn,
         })
         curves[label] = pts
     return Comparison(system.name, t_end, x0, params, rows, curves, ref_name, ref_err)
+
+
+def _has_rkn_structure(system) -> bool:
+    """Whether ``system`` is canonical ``T(p) + V(q)`` with ``T`` a constant quadratic form: there the RKN relations
+    hold (:mod:`.structure`) and the rows carry ``error_constant_rkn`` too."""
+    from ..errors import InvalidSystemError
+    from .gradient_system import gradient_structure
+
+    try:
+        gradient_structure(system)
+    except InvalidSystemError:
+        return False
+    return True
+
+
+def _rkn_constant(system, comp) -> dict:
+    """``{"order_rkn", "error_constant_rkn"}`` of a two-part composition on the RKN quotient (empty if it does not
+    apply): the constants RKN-optimised methods (PEFRL, Blanes-Moan SRKN) are designed for."""
+    try:
+        analysis = error_analysis(comp, 2, structure="rkn")
+    except NambuBCHError:
+        return {}
+    return {"order_rkn": analysis.order, "error_constant_rkn": analysis.value}
+
+
+def _is_gradient(word) -> bool:
+    from ..numeric.force_gradient import is_gradient_method
+
+    return is_gradient_method(word)
+
+
+def _gradient_row(system, word, t_end, steps, x0, params, x_ref, ref_err, box, samples) -> dict:
+    """The row of a force-gradient composition or a processed kernel (:mod:`nambu_bch.numeric.force_gradient`).
+
+    ``order`` and ``error_constant`` are the formal ones (:func:`~nambu_bch.design.generalized.gradient_analysis`), the
+    effective order for a processed kernel (:func:`~nambu_bch.design.generalized.effective_order`); ``cost`` counts a
+    force-gradient kick as :data:`~nambu_bch.numeric.force_gradient.GRADIENT_KICK_COST` evaluations and a processed run
+    pays two processor applications of :data:`~nambu_bch.numeric.force_gradient.PROCESSOR_COST` each, once per run.
+    ``leading_power`` is the first non-zero ``h^j Z_j`` of X_eff on the system (formal route), ``leading_size`` its
+    largest norm on the default box.
+    """
+    from ..numeric.force_gradient import (PROCESSOR_COST, GradientStep, is_processed_kernel, iterate_gradient,
+                                          iterate_processed)
+    from .generalized import effective_order, gradient_analysis
+    from .gradient_system import gradient_effective_field
+    from .system_error import field_size
+
+    step = GradientStep(system, word, params)  # refuses a system without the T(p) + V(q) structure, in one line
+    label = word if isinstance(word, str) else str(step.composition)
+    processed = is_processed_kernel(word)
+    if processed:
+        analysis = effective_order(word)
+        order, lem = analysis.order, analysis.value
+    else:
+        analysis = gradient_analysis(word)
+        order, lem = analysis.order, analysis.value
+        rkn = gradient_analysis(word, structure="rkn")
+    per_step, extra = step.cost()
+    if processed:
+        extra += 2 * PROCESSOR_COST
+    try:
+        X = gradient_effective_field(system, word, order=min(order + 1, 6))
+        power = next((j for j in range(1, X.order + 1) if any(X[j])), None)
+        size = float("nan") if power is None else field_size(X[power], system, box, samples, params, 0)
+    except NambuBCHError:
+        power, size = None, float("nan")
+    run = iterate_processed if processed else iterate_gradient
+    pts = []
+    for N in steps:
+        h = t_end / N
+        try:
+            final = np.asarray(run(system, word, h, N, x0, params, every=N)[-1], float)
+            err = float(np.linalg.norm(final - x_ref))
+        except NambuBCHError as exc:
+            pts.append({"steps": N, "h": h, "evaluations": N * per_step + extra, "error": float("nan"), "note": str(exc)})
+            continue
+        pts.append({"steps": N, "h": h, "evaluations": N * per_step + extra, "error": err})
+    good = [p for p in pts if np.isfinite(p["error"]) and p["error"] > max(FLOOR, 100 * ref_err)]
+    return {
+        "integrator": label, "name": str(step.composition), "order": order, "error_constant": lem,
+        "cost": per_step, "fsal_extra": extra, "leading_power": power, "leading_size": size,
+        "slope": slope([p["evaluations"] for p in good], [p["error"] for p in good]),
+        "slope_points": len(good),
+        "best_error": min((p["error"] for p in pts if np.isfinite(p["error"])), default=float("nan")),
+        "citation": step.composition.citation, "family": "processed" if processed else "force-gradient",
+        **({} if processed else {"order_rkn": rkn.order, "error_constant_rkn": rkn.value}),
+        "points": pts,
+    }
 
 
 def _runge_kutta_row(system, tableau, label, t_end, steps, x0, params, x_ref, ref_err, box, samples) -> dict:

@@ -193,3 +193,17 @@ def structured_bound(comp, order: int, structure: str) -> float:
         exact = [field.K.to_sympy(v) for _, v in _log_vectors(field, degree)]
         worst = max([worst, *(abs(complex(x)) for x in _residual(exact, degree, structure))])
     return worst
+
+
+def generalized_bound(comp, orders) -> float:
+    """The largest absolute ``q! [w] log Phi`` over the Lyndon words ``w`` with ``m`` letters 2 and length
+    ``2 <= q <= r_m``, ``(r_1, r_2, ...) = orders``: the stated accuracy of a decimal table whose published
+    generalised order holds (the ``eps^m`` part of its error vanishes through degree ``r_m``)."""
+    field = _Exact(comp)
+    worst = 0.0
+    for degree in range(2, max(orders) + 1):
+        for w, v in _log_vectors(field, degree):
+            m = w.count(2)
+            if 1 <= m <= len(orders) and degree <= orders[m - 1]:
+                worst = max(worst, abs(complex(field.K.to_sympy(v))))
+    return worst

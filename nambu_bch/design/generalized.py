@@ -392,6 +392,8 @@ def _catalogue():
 
 
 GRADIENT_METHODS = tuple(_catalogue())
+#: The catalogue kernels that are run processed (``P K P^(-1)``, :mod:`nambu_bch.numeric.force_gradient`).
+PROCESSED_KERNELS = ("takahashi-imada",)
 
 
 def _gradient_spec(spec) -> GradientComposition:

@@ -749,7 +749,16 @@ def _ab(table) -> Composition:
 def _catalog_build(kind: str, word, n_pieces):
     table = TABLES[kind]
     if table.kind == "ab":
-        return _ab(table) if table.exact else with_error_bound(_ab(table), 2, table.structure)
+        if table.exact:
+            return _ab(table)
+        comp = with_error_bound(_ab(table), 2, table.structure)
+        if table.generalized:  # the published accuracy is that of the generalised order, not only the classical one
+            from ..design.defects import generalized_bound
+
+            bound = max(comp.error_bound, generalized_bound(comp, table.generalized))
+            comp = CatalogComposition(comp.pieces, comp.coefficients, comp.name, comp.order,
+                                      comp.citation.replace(f"{comp.error_bound:.1e}", f"{bound:.1e}"), bound, comp.structure)
+        return comp
     base = _base(word, n_pieces, kind)
     comp = _stages(base, _palindrome(table.values), f"{kind}:{base.name}", table.order, table.reference)
     return with_error_bound(comp, base.n_pieces)

@@ -159,9 +159,26 @@ SBAB2 = MethodTable("sbab2", f"{_LR} (SBAB_2)", 2, 2, True, "ab", (("1/6",), ())
 SBAB3 = MethodTable("sbab3", f"{_LR} (SBAB_3)", 2, 3, True, "ab", (("1/12",), ("1/2 - sqrt(5)/10",)),
                     takes_word=False, first=2, structure="near-integrable", generalized=(6, 2), exact=True)
 
+#: Blanes, Casas, Farres, Laskar, Makazaga & Murua's ABA864 and ABA1064 for A + eps B: the published 16-digit
+#: coefficients alpha_1.. of the form chi*(alpha_1) chi(alpha_2) chi*(alpha_3) ... (chi = exp(alpha A) exp(alpha B) and
+#: its adjoint), as transcribed in a public Python integrator; merged here into the ABA form, a_1 = alpha_1,
+#: b_i = alpha_(2i-1) + alpha_(2i), a_(i+1) = alpha_(2i) + alpha_(2i+1) (exact sums of the decimals).  ABA864: A outer
+#: a_1..a_3 (middle pair a_4 = 1/2 - sum), B outer b_1..b_3 (middle b_4 = 1 - 2 sum); ABA1064: A outer a_1..a_4 (middle
+#: a_5 = 1 - 2 sum), B outer b_1..b_3 (middle pair b_4 = 1/2 - sum).  Their generalised orders (8, 6, 4) and (10, 6, 4)
+#: are checked by tests/test_families_on_systems.py to the decimals' accuracy.
+_BCFLMM = "Blanes, Casas, Farres, Laskar, Makazaga & Murua, Appl. Numer. Math. 68 (2013) 58"
+ABA864 = MethodTable("aba864", f"{_BCFLMM} (ABA864)", 4, 7, True, "ab",
+                     (("0.07113342649822312", "0.2411534279566401", "0.5214117617728147"),
+                      ("0.18308368747219722", "0.3107828598985748", "-0.0265646185119588")),
+                     takes_word=False, structure="near-integrable", generalized=(8, 6, 4))
+ABA1064 = MethodTable("aba1064", f"{_BCFLMM} (ABA1064)", 4, 8, True, "ab",
+                      (("0.03809449742241219", "0.14529871611691375", "0.2076276957255412", "0.4359097036515261"),
+                       ("0.0958588808370752", "0.20444615314299874", "0.2170703479789911")),
+                      takes_word=False, structure="near-integrable", generalized=(10, 6, 4))
+
 #: Every table by name.
 TABLES = {t.name: t for t in (TRIPLE_JUMP, SUZUKI, KAHAN_LI, YOSHIDA6, BLANES_MOAN, BLANES_MOAN_S10, MCLACHLAN_S2,
                               MCLACHLAN_S4, MCLACHLAN_S5, BM_SRKN6, BM_SRKN11, BM_SRKN14, MCLACHLAN_SB3A4, PEFRL,
-                              SABA2, SABA3, SABA4, SBAB2, SBAB3)}
+                              SABA2, SABA3, SABA4, SBAB2, SBAB3, ABA864, ABA1064)}
 #: The tables built by :mod:`.methods` (published decimals, or exact formulas); the jumps are built in :mod:`.composition`.
 DECIMAL = tuple(name for name, t in TABLES.items() if t.kind != "jump")

@@ -13,6 +13,8 @@ from .codegen import StepProgram, step_program
 from .diagnostics import (CheckResult, DriftFit, OrderFit, RunningStats, check, drift_rate, fit_order, observed_order,
                           quantities)
 from .figures import FigureSet, paper_figures
+from .force_gradient import iterate_gradient, iterate_processed
+from .gradient_check import GradientCheck, gradient_check
 from .hmc import Estimate, MonteCarloRun, hybrid_monte_carlo
 from .iterate import iterate, iterate_chunks
 from .kernels import Kernel, cache_dir, kernel, numba_available
@@ -27,6 +29,7 @@ __all__ = [
     "DriftFit",
     "Estimate",
     "FigureSet",
+    "GradientCheck",
     "HScan",
     "Kernel",
     "MonteCarloRun",
@@ -42,10 +45,13 @@ __all__ = [
     "check",
     "drift_rate",
     "fit_order",
+    "gradient_check",
     "h_scan",
     "hybrid_monte_carlo",
     "iterate",
     "iterate_chunks",
+    "iterate_gradient",
+    "iterate_processed",
     "kernel",
     "n_samples",
     "numba_available",

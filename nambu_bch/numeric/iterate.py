@@ -155,6 +155,10 @@ def iterate(system, word, h, steps, x0=None, params=None, every=1, *, kahan=Fals
         check_flag(check_stable, "check_stable")  # no stability interval to check: Newton's failure is the guard
         check_flag(progress, "progress", none=True)
         return iterate_runge_kutta(system, tableau, h, steps, x0, params, every, kahan=kahan, backend=backend, out=out)
+    from .force_gradient import is_gradient_method
+
+    if is_gradient_method(word):  # a force-gradient composition or a processed kernel: its own numpy loop
+        return _gradient_run(system, word, h, steps, x0, params, every, kahan, dps, out, fma)
     x0, origin = initial_state(system, x0)
     check_work(check_count(steps, "steps", 0), x0, mpmath=dps is not None)  # from the request, before any work
     kahan, check_stable = check_flag(kahan, "kahan"), check_flag(check_stable, "check_stable")
@@ -215,6 +219,19 @@ def iterate(system, word, h, steps, x0=None, params=None, every=1, *, kahan=Fals
     if count > 1:  # sample 0 is x0, checked before the run
         check_result(out[1:], sample_steps(steps, every)[1:], what, start=0)
     return out
+
+
+def _gradient_run(system, word, h, steps, x0, params, every, kahan, dps, out, fma):
+    """A force-gradient composition (:func:`~nambu_bch.numeric.force_gradient.iterate_gradient`) or a catalogue kernel
+    run processed (:func:`~nambu_bch.numeric.force_gradient.iterate_processed`); float64 without the kernel options."""
+    from .force_gradient import is_processed_kernel, iterate_gradient, iterate_processed
+
+    for flag, name in ((kahan, "kahan"), (dps is not None, "dps"), (out is not None, "out"), (fma, "fma")):
+        if flag:
+            raise InvalidRunError(f"{name}= applies to the compiled splitting kernels; force-gradient methods run in a "
+                                  f"float64 numpy loop without it")
+    run = iterate_processed if is_processed_kernel(word) else iterate_gradient
+    return run(system, word, h, steps, x0, params, every)
 
 
 def _run_single(kern, state, K, steps, every, out, kahan, comp, be, fallback, what, fma=False):
