@@ -15,7 +15,8 @@ Per word:
   ``log(error)`` against ``log(evaluations)`` over the points above round-off: ``-order``.
 
 Runge--Kutta and Kahan methods (a name of :data:`~nambu_bch.integrators.runge_kutta.TABLEAUX` or a
-``ButcherTableau``) are compared on the same runs: ``order`` is the tableau's, ``error_constant`` None,
+``ButcherTableau``; a partitioned pair of :data:`~nambu_bch.integrators.runge_kutta.PARTITIONED` on a canonical
+system) are compared on the same runs: ``order`` is the tableau's, ``error_constant`` None,
 ``leading_power`` / ``leading_size`` those of the first non-zero ``h^j Z_j`` of the modified field
 (:func:`~nambu_bch.bseries.modified_equation`), and ``cost`` the *measured* field evaluations per step:
 an explicit method pays its ``s`` stages; an implicit one pays ``s`` evaluations at the start of each step and
@@ -176,9 +177,10 @@ def _words(words) -> list:
     """The integrators to compare as a non-empty list (a single word or Composition is a list of one)."""
     from ..integrators.composition import Composition
 
-    from ..integrators.runge_kutta import ButcherTableau
+    from ..integrators.runge_kutta import ButcherTableau, PartitionedTableau
 
-    if isinstance(words, (str, Composition, ButcherTableau)):
+    methods = (str, Composition, ButcherTableau, PartitionedTableau)
+    if isinstance(words, methods):
         return [words]
     try:
         out = list(words)
@@ -190,9 +192,9 @@ def _words(words) -> list:
     if len(out) > MAX_WORDS:
         raise InvalidRunError(f"compare takes at most {MAX_WORDS} integrators, got {len(out)}")
     for w in out:
-        if not isinstance(w, (str, Composition, ButcherTableau)):
-            raise InvalidCompositionError(f"each integrator must be a word, alias, Composition, Runge-Kutta method name "
-                                          f"or ButcherTableau, got {show(w)}")
+        if not isinstance(w, methods):
+            raise InvalidCompositionError(f"each integrator must be a word, alias, Composition, Runge-Kutta method name, "
+                                          f"ButcherTableau or PartitionedTableau, got {show(w)}")
     return out
 
 
