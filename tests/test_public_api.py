@@ -40,9 +40,10 @@ SURFACE = {
         "tree_to_latex", "witt_dimension",
     ),
     "nambu_bch.bseries": (
-        "EulerTopClosedForms", "KahanMap", "ModifiedEquation", "density", "elementary_weight", "euler_top_closed_forms",
-        "euler_top_coefficients", "euler_top_density", "graft", "kahan_map", "modified_coefficients",
-        "modified_equation", "modified_equation_by_taylor", "order", "runge_kutta_shadow", "symmetry", "trees",
+        "ColouredTrees", "EulerTopClosedForms", "KahanMap", "ModifiedEquation", "density", "elementary_weight",
+        "euler_top_closed_forms", "euler_top_coefficients", "euler_top_density", "graft", "kahan_map",
+        "modified_coefficients", "modified_equation", "modified_equation_by_taylor", "order",
+        "p_series_modified_equation", "runge_kutta_shadow", "symmetry", "trees",
     ),
     "nambu_bch.cli": (
         "SUBCOMMANDS", "UsageError", "build_parser", "main",
