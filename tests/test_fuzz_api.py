@@ -209,6 +209,7 @@ def _base_table():
         # design
         "nambu_bch.compare": lambda v: dict(system=v["ho3"], words=("12321",), t_end=1.0, steps=(4, 8), samples=5),
         "nambu_bch.composition_order": lambda v: dict(spec="12321"),
+        "nambu_bch.design.runge_kutta_error_constant": lambda v: dict(method="midpoint"),
         "nambu_bch.error_constant": lambda v: dict(spec="121", parts=2),
         "nambu_bch.leading_error": lambda v: dict(system=v["ho3"], word="12321", samples=5),
         "nambu_bch.optimize_composition": lambda v: dict(spec="strang", parts=2, order=4, stages=3, starts=1, dps=15),

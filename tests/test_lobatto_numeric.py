@@ -72,3 +72,5 @@ def test_cli_shadow_check_compare(capsys):
                  "--step-counts", "10,20", "--t-end", "2", "--format", "json"]) == 0
     rows = json.loads(capsys.readouterr().out)["integrators"]
     assert [r["order"] for r in rows] == [4, 2] and rows[0]["leading_power"] == 4
+    # the pair's principal error norm over the bi-coloured trees of order 5 (computed; no published value)
+    assert rows[0]["error_constant_exact"] == "sqrt(2530)/1440" and rows[0]["error_constant_kind"] == "A^(p+1)"

@@ -52,7 +52,7 @@ SURFACE = {
         "CatalogComposition", "Comparison", "DesignedComposition", "ErrorConstant", "LeadingError",
         "NoSolutionError", "OrderConditions", "Template", "compare", "composition_order", "cost", "error_analysis",
         "error_constant", "field_size", "leading_error", "methods", "optimize_composition", "order_conditions",
-        "template",
+        "runge_kutta_error_constant", "template",
     ),
     "nambu_bch.exact": (
         "ConservedQuantities", "ExactShadow", "F", "F_series", "LinearCore", "ModifiedSolution",

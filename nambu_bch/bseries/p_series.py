@@ -158,6 +158,15 @@ def p_series_coefficients(tableaux, upto: int) -> dict:
     return {t: elementary_weight(t, tableaux) for n in range(1, upto + 1) for t in family.trees(n)}
 
 
+def error_coefficients(tableaux, n: int) -> dict:
+    """``{t: (Phi(t) - 1/gamma(t)) / sigma(t)}`` over the coloured trees with ``n`` vertices (colour ``c`` staged by
+    ``tableaux[c]``): the coefficients of ``h^n F(t)`` in the local error of the partitioned method, exact (the
+    P-series analogue of :func:`~nambu_bch.bseries.rooted_trees.error_coefficients`)."""
+    family = ColouredTrees(len(tableaux))
+    return {t: sympy.radsimp(sympy.expand((elementary_weight(t, tableaux) - sympy.Rational(1, family.density(t)))
+                                          / family.symmetry(t))) for t in family.trees(n)}
+
+
 def p_series_modified_equation(system, method, order: int = 2):
     """The modified field of a partitioned Runge--Kutta pair through ``h**order`` by P-series (bi-coloured trees).
 

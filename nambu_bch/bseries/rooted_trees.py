@@ -113,6 +113,19 @@ def rk_coefficients(tableau, upto: int) -> dict:
     return {t: elementary_weight(t, tableau) for n in range(1, upto + 1) for t in trees(n)}
 
 
+def error_coefficients(tableau, n: int) -> dict:
+    """``{t: (Phi(t) - 1/gamma(t)) / sigma(t)}`` over the trees with ``n`` vertices: the coefficients of
+    ``h^n F(t)(y)`` in the local error (numerical minus exact step), exact.
+
+    For a method of order ``p`` the norm of the ``n = p + 1`` coefficients is Butcher's principal error measure
+    ``A^(p+1)`` (Kennedy, Carpenter, Lewis, *Appl. Numer. Math.* 35 (2000) 177; the same coefficients as
+    NodePy's ``error_coefficient``).  Hairer, Norsett, Wanner I, Sect. II.3 write them as ``alpha(t) e(t)/(p+1)!``
+    with ``e(t) = 1 - gamma(t) Phi(t)`` and ``alpha(t) = (p+1)!/(sigma(t) gamma(t))``: the same up to sign.
+    """
+    return {t: sympy.radsimp(sympy.expand((elementary_weight(t, tableau) - sympy.Rational(1, density(t)))
+                                          / symmetry(t))) for t in trees(n)}
+
+
 def _lie_derivative(series, field, upto, family):
     """``d`` applied as the Lie derivative ``(h f~ . d/dy)`` to a B-series function (plain coefficients), to ``upto``.
 
