@@ -63,7 +63,7 @@ RECORDS = (
     "OrderFit", "PrecisionStudy", "StepProgram", "TruncationStudy", "DirectResult", "Existence", "FICommutator",
     "FINested", "FIOrder", "FIRepresentation", "FIResult", "OrderSolution", "Piece", "FieldBackend",
     "ExpressionBackend", "PolynomialBackend", "ShadowTrajectory", "ButcherTableau", "SeparableShadow", "ContractionSum",
-    "Contraction", "NumericalShadow", "ModifiedEquation",
+    "Contraction", "NumericalShadow", "ModifiedEquation", "DensityBrackets",
 )
 
 
@@ -190,6 +190,7 @@ def _base_table():
         "nambu_bch.shadow.separable_shadow": lambda v: dict(word="212", order=2, d=2),
         "nambu_bch.algebra.CoefficientField": lambda v: dict(domain=v["sympy"].QQ),
         "nambu_bch.shadow.density_shadow": lambda v: dict(system=v["ho3"], method="midpoint", density=1, order=2),
+        "nambu_bch.shadow.density_brackets": lambda v: dict(system=v["ho3"], method="midpoint", order=2, density=1),
         # exact
         "nambu_bch.exact.F": lambda v: dict(x=0.5),
         "nambu_bch.exact.F_series": lambda v: dict(x=v["sympy"].Symbol("z"), order=4),

@@ -73,9 +73,9 @@ SURFACE = {
         "sample_times", "shadow_along", "step_program", "truncation_study",
     ),
     "nambu_bch.shadow": (
-        "Contraction", "ContractionSum", "DirectResult", "Existence", "FICommutator", "FINested", "FIOrder",
+        "Contraction", "ContractionSum", "DensityBrackets", "DirectResult", "Existence", "FICommutator", "FINested", "FIOrder",
         "FIRepresentation", "FIResult", "FI_LABELS", "JetAlgebra", "LiouvilleSum", "LiouvilleTerm", "OrderSolution",
-        "SeparableShadow", "ShadowFamily", "commutator_terms", "count_brackets", "decide", "density_shadow",
+        "SeparableShadow", "ShadowFamily", "commutator_terms", "count_brackets", "decide", "density_brackets", "density_shadow",
         "direct_route", "double_commutator_terms", "fi_brackets", "fi_route", "representations", "separable_shadow",
         "shadow_hamiltonians",
     ),
