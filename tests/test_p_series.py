@@ -16,7 +16,7 @@ from nambu_bch import model
 from nambu_bch.bch.concrete import effective_field_by_cost
 from nambu_bch.bseries import ColouredTrees, modified_coefficients, modified_equation, p_series_modified_equation
 from nambu_bch.bseries.modified import modified_equation_by_taylor
-from nambu_bch.bseries.p_series import MAX_P_ORDER, density, elementary_weight, leaf
+from nambu_bch.bseries.p_series import MAX_P_ORDER, MAX_VERTICES, density, elementary_weight, leaf
 from nambu_bch.errors import NambuBCHError
 from nambu_bch.integrators.runge_kutta import PARTITIONED, TABLEAUX, PartitionedTableau
 
@@ -81,3 +81,5 @@ def test_refusals_are_one_line():
         p_series_modified_equation("ho", "lobatto-iiia-iiib-2", MAX_P_ORDER + 1)
     with pytest.raises(NambuBCHError, match="unknown partitioned"):
         p_series_modified_equation("ho", "gauss4", 2)
+    with pytest.raises(NambuBCHError, match=f"n must be an integer from 1 to {MAX_VERTICES}"):
+        ColouredTrees(2).trees(MAX_VERTICES + 1)  # refused before enumerating (18996 trees at 8 vertices)

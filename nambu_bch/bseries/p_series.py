@@ -46,6 +46,11 @@ from . import rooted_trees as T
 #: Highest order of ``h`` the P-series route accepts: h^6 needs the 4116 bi-coloured trees of 7 vertices (and the
 #: 916 of 6); each further order multiplies them by about 4.5.
 MAX_P_ORDER = 6
+#: Most vertices of the coloured trees listed (the modified field at h^MAX_P_ORDER needs MAX_P_ORDER + 1; with two
+#: colours 4116 trees, 18996 at 8 vertices): larger requests are refused before any work.
+MAX_VERTICES = MAX_P_ORDER + 1
+#: Most colours (each multiplies the trees of n vertices by about colours^n).
+MAX_COLOURS = 4
 
 
 def leaf(colour: int) -> tuple:
@@ -95,7 +100,7 @@ class ColouredTrees:
     graft = staticmethod(graft)
 
     def __init__(self, colours: int = 2):
-        self.colours = check_int(colours, "colours", 1)
+        self.colours = check_int(colours, "colours", 1, MAX_COLOURS)
         self._trees: dict = {}
         self._memo: dict = {}  # (function, tree) -> value: the recursion asks for the same trees many times
 
@@ -116,8 +121,8 @@ class ColouredTrees:
         return self._memoised(density, t)
 
     def trees(self, n: int) -> tuple:
-        """All coloured trees with ``n`` vertices, once each, in a fixed order."""
-        n = check_int(n, "n", 1)
+        """All coloured trees with ``n`` vertices (``n <= MAX_VERTICES``), once each, in a fixed order."""
+        n = check_int(n, "n", 1, MAX_VERTICES)
         if n not in self._trees:
             pool = [t for k in range(1, n) for t in self.trees(k)]
             forests = self._forests(n - 1, pool, 0)

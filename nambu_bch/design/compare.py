@@ -303,7 +303,8 @@ def compare(system, words, t_end: float = 10.0, steps=(20, 40, 80, 160, 320, 640
     return Comparison(system.name, t_end, x0, params, rows, curves, ref_name, ref_err)
 
 
-#: Most vertices of the trees searched for a non-vanishing error coefficient (the modified equation's limit, h^8).
+#: Most vertices of the trees searched for a non-vanishing error coefficient (the modified equation's limit, h^8;
+#: for a partitioned pair the P-series' limit, :data:`nambu_bch.bseries.p_series.MAX_VERTICES`).
 MAX_ERROR_TREES = 9
 
 
@@ -338,7 +339,8 @@ def runge_kutta_error_constant(method) -> tuple:
     from ..integrators.runge_kutta import PartitionedTableau, butcher_tableau
 
     tableau = runge_kutta_method(method) or butcher_tableau(method)  # the latter's message names what is accepted
-    for n in range(tableau.order + 1, MAX_ERROR_TREES + 1):
+    top = p_series.MAX_VERTICES if isinstance(tableau, PartitionedTableau) else MAX_ERROR_TREES
+    for n in range(tableau.order + 1, top + 1):
         if isinstance(tableau, PartitionedTableau):
             tau = p_series.error_coefficients((tableau.q, tableau.p), n)
         else:
@@ -346,8 +348,8 @@ def runge_kutta_error_constant(method) -> tuple:
         square = sympy.radsimp(sympy.expand(sum((v ** 2 for v in tau.values()), sympy.Integer(0))))
         if square != 0:
             return n - 1, sympy.sqrt(square)
-    raise NambuBCHError(f"{tableau.name}: no non-vanishing error coefficient on the trees of at most {MAX_ERROR_TREES} "
-                        "vertices (the method agrees with the exact flow that far)")
+    raise NambuBCHError(f"{tableau.name}: no non-vanishing error coefficient on the trees of at most {top} vertices "
+                        "(the method agrees with the exact flow that far)")
 
 
 def _runge_kutta_row(system, tableau, label, t_end, steps, x0, params, x_ref, ref_err, box, samples) -> dict:
