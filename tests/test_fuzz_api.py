@@ -63,8 +63,8 @@ RECORDS = (
     "OrderFit", "PrecisionStudy", "StepProgram", "TruncationStudy", "DirectResult", "Existence", "FICommutator",
     "FINested", "FIOrder", "FIRepresentation", "FIResult", "OrderSolution", "Piece", "FieldBackend",
     "ExpressionBackend", "PolynomialBackend", "ShadowTrajectory", "ButcherTableau", "SeparableShadow", "ContractionSum",
-    "Contraction", "NumericalShadow", "ModifiedEquation", "MonteCarloRun", "Estimate",
-    "Contraction", "NumericalShadow", "ModifiedEquation", "GradientField", "GradientShadow", "GradientCheck",
+    "Contraction", "NumericalShadow", "ModifiedEquation", "MonteCarloRun", "Estimate", "GradientField", "GradientShadow",
+    "GradientCheck", "DensityBrackets",
 )
 
 
@@ -191,6 +191,7 @@ def _base_table():
         "nambu_bch.shadow.separable_shadow": lambda v: dict(word="212", order=2, d=2),
         "nambu_bch.algebra.CoefficientField": lambda v: dict(domain=v["sympy"].QQ),
         "nambu_bch.shadow.density_shadow": lambda v: dict(system=v["ho3"], method="midpoint", density=1, order=2),
+        "nambu_bch.shadow.density_brackets": lambda v: dict(system=v["ho3"], method="midpoint", order=2, density=1),
         # exact
         "nambu_bch.exact.F": lambda v: dict(x=0.5),
         "nambu_bch.exact.F_series": lambda v: dict(x=v["sympy"].Symbol("z"), order=4),
@@ -210,6 +211,7 @@ def _base_table():
         # design
         "nambu_bch.compare": lambda v: dict(system=v["ho3"], words=("12321",), t_end=1.0, steps=(4, 8), samples=5),
         "nambu_bch.composition_order": lambda v: dict(spec="12321"),
+        "nambu_bch.design.runge_kutta_error_constant": lambda v: dict(method="midpoint"),
         "nambu_bch.error_constant": lambda v: dict(spec="121", parts=2),
         "nambu_bch.leading_error": lambda v: dict(system=v["ho3"], word="12321", samples=5),
         "nambu_bch.optimize_composition": lambda v: dict(spec="strang", parts=2, order=4, stages=3, starts=1, dps=15),

@@ -93,26 +93,23 @@ def test_refusals():
         PartitionedTableau("x", "gauss4", TABLEAUX["gauss4"], 2, "")
 
 
-def test_cli_refuses_the_pair_as_a_composition(capsys):
-    """The CLI takes compositions and plain tableaux: a partitioned pair's name is refused in one line that says where
-    it lives."""
-    from nambu_bch.cli import main
+def test_cli_refuses_the_pair_where_only_compositions_are_taken(capsys):
+    """The composition-only subcommands (bch, ...) refuse a pair's name in one line that says where it runs."""
+    from nambu_bch.cli._main import main
 
-    assert main(["shadow", "--model", "ho", "--integrator", "lobatto-iiia-iiib-3"]) == 2
+    assert main(["bch", "--model", "ho", "--integrator", "lobatto-iiia-iiib-3"]) == 2
     err = capsys.readouterr().err.strip()
     assert "\n" not in err and "'lobatto-iiia-iiib-3' is a partitioned Runge-Kutta pair" in err
-    assert "runge_kutta_shadow" in err
+    assert "on canonical systems" in err
 
 
-def test_a_pair_where_only_plain_tableaux_are_taken_says_where_pairs_are_available():
-    """The partitioned pairs are not stepped in float64 nor taken by shadow_hamiltonians: the refusal says so
-    (instead of the plain tableaux' message, which lists those entry points as accepting it)."""
+def test_a_pair_is_refused_off_canonical_systems_and_on_the_fi_route():
     import pytest
 
     import nambu_bch as nb
-    from nambu_bch.errors import InvalidCompositionError
+    from nambu_bch.errors import NambuBCHError
 
-    for call in (lambda: nb.shadow_hamiltonians("ho", "lobatto-iiia-iiib-2", order=2),
-                 lambda: nb.iterate("ho", "lobatto-iiia-iiib-2", 0.1, 3)):
-        with pytest.raises(InvalidCompositionError, match="partitioned Runge-Kutta pair.*runge_kutta_shadow"):
-            call()
+    with pytest.raises(NambuBCHError, match="partitioned method for canonical systems"):
+        nb.shadow_hamiltonians("rigid-body", "lobatto-iiia-iiib-2", order=2)
+    with pytest.raises(NambuBCHError, match="FI route"):
+        nb.shadow_hamiltonians("ho", "lobatto-iiia-iiib-2", order=2, route="fi")

@@ -47,6 +47,7 @@ BUILDERS = {
     "EffectiveField": lambda: nb.effective_field(_ho3().splitting, "12321", order=4),
     "FormalBCH": lambda: nb.formal_bch("12321", 3),
     "ButcherTableau": lambda: nb.butcher_tableau("gauss4"),
+    "DensityBrackets": lambda: importlib.import_module("nambu_bch.shadow").density_brackets("ho3", "midpoint", 2, density=1),
     "BCHReport": lambda: importlib.import_module("nambu_bch.bch.report").bch_report(_ho3(), nb.composition("12321"), 2,
                                                                                      field=True, terms=True),
     "CatalogComposition": lambda: nb.composition("kahan-li:121"),

@@ -40,9 +40,10 @@ SURFACE = {
         "tree_to_latex", "witt_dimension",
     ),
     "nambu_bch.bseries": (
-        "EulerTopClosedForms", "KahanMap", "ModifiedEquation", "density", "elementary_weight", "euler_top_closed_forms",
-        "euler_top_coefficients", "euler_top_density", "graft", "kahan_map", "modified_coefficients",
-        "modified_equation", "modified_equation_by_taylor", "order", "runge_kutta_shadow", "symmetry", "trees",
+        "ColouredTrees", "EulerTopClosedForms", "KahanMap", "ModifiedEquation", "density", "elementary_weight",
+        "euler_top_closed_forms", "euler_top_coefficients", "euler_top_density", "graft", "kahan_map",
+        "modified_coefficients", "modified_equation", "modified_equation_by_taylor", "order",
+        "p_series_modified_equation", "runge_kutta_shadow", "symmetry", "trees",
     ),
     "nambu_bch.cli": (
         "SUBCOMMANDS", "UsageError", "build_parser", "main",
@@ -51,7 +52,7 @@ SURFACE = {
         "CatalogComposition", "Comparison", "DesignedComposition", "ErrorConstant", "GradientField", "GradientShadow",
         "LeadingError", "NoSolutionError", "OrderConditions", "Template", "compare", "composition_order", "cost",
         "error_analysis", "error_constant", "field_size", "gradient_effective_field", "gradient_shadow",
-        "leading_error", "methods", "optimize_composition", "order_conditions", "template",
+        "leading_error", "methods", "optimize_composition", "order_conditions", "runge_kutta_error_constant", "template",
     ),
     "nambu_bch.exact": (
         "ConservedQuantities", "ExactShadow", "F", "F_series", "LinearCore", "ModifiedSolution",
@@ -74,9 +75,9 @@ SURFACE = {
         "sample_times", "shadow_along", "step_program", "truncation_study",
     ),
     "nambu_bch.shadow": (
-        "Contraction", "ContractionSum", "DirectResult", "Existence", "FICommutator", "FINested", "FIOrder",
+        "Contraction", "ContractionSum", "DensityBrackets", "DirectResult", "Existence", "FICommutator", "FINested", "FIOrder",
         "FIRepresentation", "FIResult", "FI_LABELS", "JetAlgebra", "LiouvilleSum", "LiouvilleTerm", "OrderSolution",
-        "SeparableShadow", "ShadowFamily", "commutator_terms", "count_brackets", "decide", "density_shadow",
+        "SeparableShadow", "ShadowFamily", "commutator_terms", "count_brackets", "decide", "density_brackets", "density_shadow",
         "direct_route", "double_commutator_terms", "fi_brackets", "fi_route", "representations", "separable_shadow",
         "shadow_hamiltonians",
     ),

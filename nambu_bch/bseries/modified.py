@@ -94,34 +94,44 @@ def elementary_differentials(field: VectorField, upto: int) -> dict:
     ``f^(m)(v_1, .., v_m)^k = sum_{i_1..i_m} d^m f^k / dx_{i_1}..dx_{i_m} v_1^{i_1} .. v_m^{i_m}``: the
     derivatives act on ``f`` only, each partial derivative computed once.
     """
-    alg = field.algebra
-    n, zero = alg.n, alg.zero
+    ordered = [t for m in range(1, upto + 1) for t in T.trees(m)]
+    return differentials(field.algebra, {None: field.components}, ordered, lambda t: (None, t))
+
+
+def differentials(algebra, parts: dict, ordered, split) -> dict:
+    """``{t: F(t)}`` for the trees ``ordered`` (children before parents): ``F(t) = f_c^(m)(F(t_1), .., F(t_m))`` with
+    ``(c, (t_1, .., t_m)) = split(t)`` and ``f_c = parts[c]`` (the components of one field).
+
+    One field (``parts = {None: f}``) gives the elementary differentials of B-series; one field per colour those of
+    P-series (HLW Sect. III.2), each partial derivative of each ``f_c`` computed once.
+    """
+    n, zero = algebra.n, algebra.zero
     partial: dict = {}
 
-    def derivative(k, index):
-        key = (k, index)
+    def derivative(c, k, index):
+        key = (c, k, index)
         value = partial.get(key)
         if value is None:
-            value = field.components[k] if not index else alg.diff(derivative(k, index[:-1]), index[-1])
+            value = parts[c][k] if not index else algebra.diff(derivative(c, k, index[:-1]), index[-1])
             partial[key] = value
         return value
 
-    def contract(k, vectors, index):
+    def contract(c, k, vectors, index):
         if not vectors:
-            return derivative(k, tuple(sorted(index)))
+            return derivative(c, k, tuple(sorted(index)))
         total = zero
         for i in range(n):
             if vectors[0][i]:
-                inner = contract(k, vectors[1:], index + (i,))
+                inner = contract(c, k, vectors[1:], index + (i,))
                 if inner:
                     total = total + vectors[0][i] * inner
         return total
 
     out: dict = {}
-    for m in range(1, upto + 1):
-        for t in T.trees(m):
-            children = [out[c] for c in t]
-            out[t] = tuple(contract(k, children, ()) for k in range(n))
+    for t in ordered:
+        c, children = split(t)
+        vectors = [out[child] for child in children]
+        out[t] = tuple(contract(c, k, vectors, ()) if parts[c][k] else zero for k in range(n))
     return out
 
 
@@ -134,7 +144,9 @@ def modified_equation(system, method, order: int = 2) -> ModifiedEquation:
     method : name of :data:`~nambu_bch.integrators.runge_kutta.TABLEAUX` (``"midpoint"``, ``"gauss4"``,
         ``"kahan"`` ...) or a :class:`~nambu_bch.integrators.runge_kutta.ButcherTableau`; or a partitioned pair
         (:data:`~nambu_bch.integrators.runge_kutta.PARTITIONED`, ``"lobatto-iiia-iiib-3"``) on a canonical system,
-        expanded by the Taylor route (:func:`modified_equation_by_taylor`; ``tree_coefficients`` is then empty)
+        expanded by the Taylor route (:func:`modified_equation_by_taylor`; ``tree_coefficients`` is then empty; the
+        P-series route, :func:`~nambu_bch.bseries.p_series.p_series_modified_equation`, gives the same field with the
+        bi-coloured trees' coefficients)
     order : int -- the highest power of ``h`` kept, at most :data:`MAX_RK_ORDER`
 
     Examples
@@ -148,7 +160,7 @@ def modified_equation(system, method, order: int = 2) -> ModifiedEquation:
 
     system = as_system(system)
     pair = _partitioned(method)
-    if pair is not None:  # bi-coloured trees are not implemented: the Taylor route gives the same exact field
+    if pair is not None:  # the Taylor route: faster here than the P-series (the same exact field, tested)
         order = check_order(order, MAX_RK_ORDER)
         return ModifiedEquation(tuple(modified_equation_by_taylor(system, pair, order)), order, pair, system, {})
     tableau = butcher_tableau(method)

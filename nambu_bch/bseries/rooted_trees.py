@@ -20,6 +20,7 @@ Hairer, Lubich, Wanner, *Geometric Numerical Integration*, 2nd ed., Sects. III.1
 
 from __future__ import annotations
 
+import sys
 from functools import lru_cache
 from math import factorial
 
@@ -112,7 +113,20 @@ def rk_coefficients(tableau, upto: int) -> dict:
     return {t: elementary_weight(t, tableau) for n in range(1, upto + 1) for t in trees(n)}
 
 
-def _lie_derivative(series, field, upto):
+def error_coefficients(tableau, n: int) -> dict:
+    """``{t: (Phi(t) - 1/gamma(t)) / sigma(t)}`` over the trees with ``n`` vertices: the coefficients of
+    ``h^n F(t)(y)`` in the local error (numerical minus exact step), exact.
+
+    For a method of order ``p`` the norm of the ``n = p + 1`` coefficients is Butcher's principal error measure
+    ``A^(p+1)`` (Kennedy, Carpenter, Lewis, *Appl. Numer. Math.* 35 (2000) 177; the same coefficients as
+    NodePy's ``error_coefficient``).  Hairer, Norsett, Wanner I, Sect. II.3 write them as ``alpha(t) e(t)/(p+1)!``
+    with ``e(t) = 1 - gamma(t) Phi(t)`` and ``alpha(t) = (p+1)!/(sigma(t) gamma(t))``: the same up to sign.
+    """
+    return {t: sympy.radsimp(sympy.expand((elementary_weight(t, tableau) - sympy.Rational(1, density(t)))
+                                          / symmetry(t))) for t in trees(n)}
+
+
+def _lie_derivative(series, field, upto, family):
     """``d`` applied as the Lie derivative ``(h f~ . d/dy)`` to a B-series function (plain coefficients), to ``upto``.
 
     ``series`` is ``(c0, {t: c(t)})`` for ``c0 y + sum h^|t| c(t) F(t)``; ``field`` is ``{s: d(s)}`` for
@@ -125,14 +139,14 @@ def _lie_derivative(series, field, upto):
             out[s] = out.get(s, 0) + c0 * ds
     for t, ct in coeffs.items():
         for s, ds in field.items():
-            if order(t) + order(s) > upto or not ct or not ds:
+            if family.order(t) + family.order(s) > upto or not ct or not ds:
                 continue
-            for tau in graft(t, s):
+            for tau in family.graft(t, s):
                 out[tau] = out.get(tau, 0) + ct * ds
     return 0, out
 
 
-def modified_coefficients(a: dict, upto: int) -> dict:
+def modified_coefficients(a: dict, upto: int, family=None) -> dict:
     """The modified equation of the B-series ``B(a, y)`` (``a(∅) = 1``): ``{t: b(t)}`` with
     ``f~ = sum_t h^(|t|-1) b(t)/sigma(t) F(t)``, defined by: the time-``h`` flow of ``f~`` has the
     B-series ``a`` (HLW Sect. IX.9, modified equations of B-series methods).
@@ -142,20 +156,25 @@ def modified_coefficients(a: dict, upto: int) -> dict:
     ``d(t) = a(t)/sigma(t) - [t] sum_{k>=2} L^k y / k!``, whose right side uses only ``d(s)`` with
     ``|s| < |t|`` (the recursion ``b = a - sum_{j>=2} (1/j!) ∂_b^{j-1} b`` of HLW Sect. IX.9, in plain
     coefficients).
+
+    ``family`` (default: this module's rooted trees) is any set of trees with ``trees(n)``, ``order``, ``symmetry``
+    and ``graft``: the coloured trees of P-series (:class:`nambu_bch.bseries.p_series.ColouredTrees`) take the same
+    recursion, since ``F(t)' F(s) = sum_v F(t o_v s)`` holds for them too (HLW Sect. IX.10).
     """
     upto = check_int(upto, "upto", 1)
+    family = sys.modules[__name__] if family is None else family
     d: dict = {}
     for n in range(1, upto + 1):
         # sum_{k>=2} L^k y / k! at order n, from the coefficients of lower orders
-        power = _lie_derivative((1, {}), d, n)  # L y
+        power = _lie_derivative((1, {}), d, n, family)  # L y
         rest: dict = {}
         for k in range(2, n + 1):
-            power = _lie_derivative(power, d, n)
+            power = _lie_derivative(power, d, n, family)
             for t, v in power[1].items():
-                if order(t) == n:
+                if family.order(t) == n:
                     rest[t] = rest.get(t, 0) + sympy.Rational(1, factorial(k)) * v
-        for t in trees(n):
-            value = sympy.radsimp(sympy.expand(a[t] / symmetry(t) - rest.get(t, 0)))
+        for t in family.trees(n):
+            value = sympy.radsimp(sympy.expand(a[t] / family.symmetry(t) - rest.get(t, 0)))
             if value != 0:
                 d[t] = value
-    return {t: sympy.radsimp(sympy.expand(v * symmetry(t))) for t, v in d.items()}
+    return {t: sympy.radsimp(sympy.expand(v * family.symmetry(t))) for t, v in d.items()}

@@ -226,7 +226,8 @@ def integrator_from_args(args, system, runge_kutta=False):
 
     ``runge_kutta``: the subcommand also takes Runge--Kutta methods -- ``--integrator midpoint|gauss4|..|kahan`` or
     ``--tableau FILE.toml`` (:func:`~nambu_bch.integrators.tableau_file.load_tableau`) -- returned as
-    ``(name, ButcherTableau)``.
+    ``(name, ButcherTableau)``; the partitioned pairs (``--integrator lobatto-iiia-iiib-3``) as
+    ``(name, PartitionedTableau)``.
     """
     from ..integrators.composition import composition_for, strang_word
 
@@ -254,7 +255,8 @@ def runge_kutta_options(parser):
     parser.add_argument("--tableau", metavar="FILE",
                         help="a Runge-Kutta method from a TOML file (name, order, A, b, optional c and reference; "
                              "coefficients as exact strings); --integrator also takes built-in methods such as "
-                             "midpoint, gauss4, gauss6, rk4 or kahan")
+                             "midpoint, gauss4, gauss6, rk4 or kahan, and on canonical systems the partitioned "
+                             "pairs lobatto-iiia-iiib-2 and lobatto-iiia-iiib-3")
 
 
 def numeric_inputs(args, system, values):

@@ -5,7 +5,8 @@
 * :func:`template`, :func:`order_conditions` -- polynomial order conditions of templates;
 * :func:`optimize_composition` -- the template solution with the smallest error constant (:mod:`.optimize`);
 * :func:`leading_error` -- the system's own leading error term and its size (:mod:`.system_error`);
-* :func:`compare` -- work-precision comparison on a system (:mod:`.compare`);
+* :func:`compare` -- work-precision comparison on a system (:mod:`.compare`); :func:`runge_kutta_error_constant`
+  -- the principal error norm of a tableau or partitioned pair, exactly;
 * :mod:`.catalog` -- literature methods (Suzuki, Kahan-Li, Yoshida 6, Blanes-Moan, McLachlan, SRKN, PEFRL,
   SABA/SBAB) by name;
 * :mod:`.structure` -- order and error constants on the RKN quotient (``structure="rkn"``) and the generalised
@@ -16,7 +17,7 @@
 """
 
 from .catalog import CatalogComposition, methods
-from .compare import Comparison, compare, cost
+from .compare import Comparison, compare, cost, runge_kutta_error_constant
 from .conditions import (
     ErrorConstant,
     OrderConditions,
@@ -54,5 +55,6 @@ __all__ = [
     "methods",
     "optimize_composition",
     "order_conditions",
+    "runge_kutta_error_constant",
     "template",
 ]

@@ -20,7 +20,9 @@ RKN-optimised methods are designed and ranked.  Force-gradient compositions and 
 (:mod:`nambu_bch.numeric.force_gradient`) have rows of their own (``family``, their cost counted as there).
 
 Runge--Kutta and Kahan methods (a name of :data:`~nambu_bch.integrators.runge_kutta.TABLEAUX` or a
-``ButcherTableau``) are compared on the same runs: ``order`` is the tableau's, ``error_constant`` None,
+``ButcherTableau``; a partitioned pair of :data:`~nambu_bch.integrators.runge_kutta.PARTITIONED` on a canonical
+system) are compared on the same runs: ``order`` is the tableau's, ``error_constant`` its principal error norm
+``A^(p+1)`` (:func:`runge_kutta_error_constant`, exact in ``error_constant_exact``; not the LEM of a composition),
 ``leading_power`` / ``leading_size`` those of the first non-zero ``h^j Z_j`` of the modified field
 (:func:`~nambu_bch.bseries.modified_equation`), and ``cost`` the *measured* field evaluations per step:
 an explicit method pays its ``s`` stages; an implicit one pays ``s`` evaluations at the start of each step and
@@ -123,6 +125,9 @@ class Comparison:
             power = "-" if r["leading_power"] is None else r["leading_power"]
             lines.append(f"{r['integrator']:<24} {order:>5} {r['cost']:>5} {lem:>10} {power:>4} "
                          f"{r['leading_size']:>10.3g} {r['slope']:>7.2f} {r['best_error']:>11.2e}")
+        if any(r.get("error_constant_kind") == "A^(p+1)" for r in self.rows):
+            lines.append("LEM of a Runge-Kutta method: its principal error norm A^(p+1) over the trees of order p+1 "
+                         "(Kennedy-Carpenter-Lewis 2000), not comparable with a composition's LEM")
         return "\n".join(lines)
 
     def __str__(self):
@@ -183,11 +188,12 @@ def _words(words) -> list:
     """The integrators to compare as a non-empty list (a single word or Composition is a list of one)."""
     from ..integrators.composition import Composition
 
-    from ..integrators.runge_kutta import ButcherTableau
+    from ..integrators.runge_kutta import ButcherTableau, PartitionedTableau
 
     from .generalized import GradientComposition
 
-    if isinstance(words, (str, Composition, ButcherTableau, GradientComposition)):
+    methods = (str, Composition, ButcherTableau, PartitionedTableau, GradientComposition)
+    if isinstance(words, methods):
         return [words]
     try:
         out = list(words)
@@ -199,9 +205,9 @@ def _words(words) -> list:
     if len(out) > MAX_WORDS:
         raise InvalidRunError(f"compare takes at most {MAX_WORDS} integrators, got {len(out)}")
     for w in out:
-        if not isinstance(w, (str, Composition, ButcherTableau, GradientComposition)):
-            raise InvalidCompositionError(f"each integrator must be a word, alias, Composition, Runge-Kutta method name "
-                                          f"or ButcherTableau, got {show(w)}")
+        if not isinstance(w, methods):
+            raise InvalidCompositionError(f"each integrator must be a word, alias, Composition, Runge-Kutta method name, "
+                                          f"ButcherTableau or PartitionedTableau, got {show(w)}")
     return out
 
 
@@ -400,6 +406,55 @@ def _gradient_row(system, word, t_end, steps, x0, params, x_ref, ref_err, box, s
     }
 
 
+#: Most vertices of the trees searched for a non-vanishing error coefficient (the modified equation's limit, h^8;
+#: for a partitioned pair the P-series' limit, :data:`nambu_bch.bseries.p_series.MAX_VERTICES`).
+MAX_ERROR_TREES = 9
+
+
+def runge_kutta_error_constant(method) -> tuple:
+    """``(p, A)``: the order ``p`` at which the local error starts and its principal error norm ``A^(p+1)``, exact.
+
+    ``A^(p+1) = ( sum_{|t| = p+1} tau(t)^2 )^(1/2)`` with ``tau(t) = (Phi(t) - 1/gamma(t)) / sigma(t)``, the
+    coefficient of ``h^(p+1) F(t)`` in the local error (:func:`nambu_bch.bseries.rooted_trees.error_coefficients`),
+    over the first tree order ``p + 1`` where some ``tau(t) != 0`` (decided exactly; ``p`` is the method's true
+    order, at least the order its tableau states).  A partitioned pair sums over the bi-coloured trees
+    (:func:`nambu_bch.bseries.p_series.error_coefficients`), a different, larger set: its value is not comparable
+    with a plain tableau's.  Kahan's tableau is taken as a B-series on every field (on quadratic fields the trees
+    with a vertex of three or more children do not contribute).
+
+    Parameters
+    ----------
+    method : a name of :data:`~nambu_bch.integrators.runge_kutta.TABLEAUX` or
+        :data:`~nambu_bch.integrators.runge_kutta.PARTITIONED`, a ButcherTableau or a PartitionedTableau
+
+    References
+    ----------
+    C. A. Kennedy, M. H. Carpenter, R. M. Lewis, *Low-storage, explicit Runge--Kutta schemes for the compressible
+    Navier--Stokes equations*, Appl. Numer. Math. 35 (2000) 177 (``A^(p+1)``, the 2-norm of the leading error
+    coefficients); Hairer, Norsett, Wanner, *Solving ODEs I*, Sect. II.3 (the local error as a sum over trees).
+
+    >>> runge_kutta_error_constant("rk4")      # Kennedy et al.'s A^(5) of the classical method (NodePy: the same)
+    (4, sqrt(1745)/2880)
+    """
+    import sympy
+
+    from ..bseries import p_series, rooted_trees
+    from ..integrators.runge_kutta import PartitionedTableau, butcher_tableau
+
+    tableau = runge_kutta_method(method) or butcher_tableau(method)  # the latter's message names what is accepted
+    top = p_series.MAX_VERTICES if isinstance(tableau, PartitionedTableau) else MAX_ERROR_TREES
+    for n in range(tableau.order + 1, top + 1):
+        if isinstance(tableau, PartitionedTableau):
+            tau = p_series.error_coefficients((tableau.q, tableau.p), n)
+        else:
+            tau = rooted_trees.error_coefficients(tableau, n)
+        square = sympy.radsimp(sympy.expand(sum((v ** 2 for v in tau.values()), sympy.Integer(0))))
+        if square != 0:
+            return n - 1, sympy.sqrt(square)
+    raise NambuBCHError(f"{tableau.name}: no non-vanishing error coefficient on the trees of at most {top} vertices "
+                        "(the method agrees with the exact flow that far)")
+
+
 def _runge_kutta_row(system, tableau, label, t_end, steps, x0, params, x_ref, ref_err, box, samples) -> dict:
     """The row of a Runge--Kutta method (module docstring): measured cost, error, and the modified field's leading term."""
     from ..bseries import modified_equation
@@ -408,6 +463,7 @@ def _runge_kutta_row(system, tableau, label, t_end, steps, x0, params, x_ref, re
     from .system_error import field_size
 
     s = tableau.stages
+    _, norm = runge_kutta_error_constant(tableau)
     top = min(tableau.order + 1, MAX_RK_ORDER)
     try:
         M = modified_equation(system, tableau, top)
@@ -435,7 +491,8 @@ def _runge_kutta_row(system, tableau, label, t_end, steps, x0, params, x_ref, re
         pts.append({"steps": N, "h": h, "evaluations": N * per_step, "error": err})
     good = [p for p in pts if np.isfinite(p["error"]) and p["error"] > max(FLOOR, 100 * ref_err)]
     return {
-        "integrator": label, "name": tableau.name, "order": tableau.order, "error_constant": None,
+        "integrator": label, "name": tableau.name, "order": tableau.order, "error_constant": float(norm),
+        "error_constant_exact": str(norm), "error_constant_kind": "A^(p+1)",
         "cost": round(float(np.mean(per_steps)), 2) if per_steps else float("nan"), "fsal_extra": 0,
         "leading_power": power, "leading_size": size,
         "slope": slope([p["evaluations"] for p in good], [p["error"] for p in good]),

@@ -569,9 +569,8 @@ def _generic(text) -> Composition:
     # a Runge-Kutta method is no word over the pieces: say where it is available
     if text.lower() in PARTITIONED:
         raise InvalidCompositionError(
-            f"{text!r} is a partitioned Runge-Kutta pair, not a composition of the pieces; its modified equation and "
-            "shadow question are available from Python on canonical systems (modified_equation, runge_kutta_shadow); "
-            "shadow_hamiltonians, check, iterate, compare and the command line do not take pairs")
+            f"{text!r} is a partitioned Runge-Kutta pair, not a composition of the pieces; shadow_hamiltonians, "
+            "check, iterate and compare accept it on canonical systems; the composition routes (BCH, FI, exact) do not")
     if text.lower() in TABLEAUX:
         raise InvalidCompositionError(
             f"{text!r} is a Runge-Kutta method, not a composition of the pieces; shadow_hamiltonians, check, iterate "

@@ -149,9 +149,31 @@ class PartitionedTableau:
             raise InvalidCompositionError(f"the tableaux of a partitioned pair need the same number of stages, got "
                                           f"{self.q.stages} and {self.p.stages}")
 
+    #: Kahan's restriction never applies to a pair (the attribute the entry points read off any tableau).
+    quadratic_only = False
+
     @property
     def stages(self) -> int:
         return self.q.stages
+
+    @property
+    def is_explicit(self) -> bool:
+        return self.q.is_explicit and self.p.is_explicit
+
+    @property
+    def symmetric(self) -> bool:
+        """Both tableaux symmetric (``b_i = b_{s+1-i}``, ``a_ij + a_{s+1-i,s+1-j} = b_j``): the pair is a symmetric
+        method (HLW Sect. V.2), so its modified field has only even powers of ``h``.  Sufficient, decided exactly."""
+        return self.q.symmetric and self.p.symmetric
+
+    def remainder_power(self, order: int) -> int:
+        """The first power of ``h`` after ``h**order`` the modified field can contain (skips odd ones if symmetric)."""
+        return order + 2 if self.symmetric and order % 2 == 0 else order + 1
+
+    def per_coordinate(self, n: int) -> list:
+        """The tableau of each of ``n = 2d`` canonical coordinates: ``q`` (the first ``d``) by :attr:`q`, ``p`` by
+        :attr:`p`."""
+        return [self.q] * (n // 2) + [self.p] * (n // 2)
 
     def __str__(self):
         return self.name
@@ -196,15 +218,20 @@ def butcher_tableau(method) -> ButcherTableau:
 
 
 def runge_kutta_method(method):
-    """The :class:`ButcherTableau` if ``method`` is one (or names one of :data:`TABLEAUX`, any case), else None.
+    """The :class:`ButcherTableau` or :class:`PartitionedTableau` if ``method`` is one (or names one of
+    :data:`TABLEAUX` or :data:`PARTITIONED`, any case), else None.
 
     The one test the entry points use to tell a Runge--Kutta method from a composition.
 
-    >>> runge_kutta_method("Gauss4").name, runge_kutta_method("12321")
-    ('gauss4', None)
+    >>> runge_kutta_method("Gauss4").name, runge_kutta_method("lobatto-iiia-iiib-3").order, runge_kutta_method("12321")
+    ('gauss4', 4, None)
     """
-    if isinstance(method, ButcherTableau):
+    if isinstance(method, (ButcherTableau, PartitionedTableau)):
         return method
-    if isinstance(method, str) and method.strip().lower() in TABLEAUX:
-        return TABLEAUX[method.strip().lower()]
+    if isinstance(method, str):
+        key = method.strip().lower()
+        if key in TABLEAUX:
+            return TABLEAUX[key]
+        if key in PARTITIONED:
+            return PARTITIONED[key]
     return None

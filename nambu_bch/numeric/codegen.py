@@ -851,7 +851,7 @@ def source_hash(source: str) -> str:
 
 # -- Runge--Kutta steps -------------------------------------------------------------------------------------------
 #: Bump when the generated Runge--Kutta source changes meaning.
-RK_TEMPLATE_VERSION = "2"
+RK_TEMPLATE_VERSION = "3"
 
 _RK_TEMPLATE = '''
 
@@ -891,7 +891,8 @@ def rk_solve(M, r, m):
 def rk_newton(x, h, P, A, K, Y, F, J, M, r, maxit, tol):
     """The stages K_i = f(x + h sum_j a_ij K_j) by Newton's method, from K_i = f(x), until the residual no
     longer shrinks (round-off); the iterations used, -1 when the Newton matrix is singular, -2 when the
-    residual did not reach tol * (1 + max|K|) within maxit iterations."""
+    residual did not reach tol * (1 + max|K|) within maxit iterations.  A[k] is the tableau of component k
+    (one tableau for all, or a partitioned pair's two)."""
     s = K.shape[0]
     n = x.shape[0]
     m = s * n
@@ -906,7 +907,7 @@ def rk_newton(x, h, P, A, K, Y, F, J, M, r, maxit, tol):
             for k in range(n):
                 acc = 0.0
                 for j in range(s):
-                    acc += A[i, j] * K[j, k]
+                    acc += A[k, i, j] * K[j, k]
                 Y[i, k] = x[k] + h * acc
             rk_field(Y[i], P, F[i])
         size = 0.0
@@ -930,9 +931,8 @@ def rk_newton(x, h, P, A, K, Y, F, J, M, r, maxit, tol):
             rk_jacobian(Y[i], P, J)
             for a in range(n):
                 for j in range(s):
-                    q = h * A[i, j]
                     for c in range(n):
-                        M[i * n + a, j * n + c] = (1.0 if (i == j and a == c) else 0.0) - q * J[a, c]
+                        M[i * n + a, j * n + c] = (1.0 if (i == j and a == c) else 0.0) - h * A[c, i, j] * J[a, c]
         if not rk_solve(M, r, m):
             return -1
         for i in range(s):
@@ -949,7 +949,7 @@ def rk_explicit(x, h, P, A, K, Y):
         for k in range(n):
             acc = 0.0
             for j in range(i):
-                acc += A[i, j] * K[j, k]
+                acc += A[k, i, j] * K[j, k]
             Y[i, k] = x[k] + h * acc
         rk_field(Y[i], P, K[i])
 
@@ -959,8 +959,8 @@ def rk_run(x, c, compensated, mode, h, P, A, b, steps, every, out, maxit, tol, i
     mode: 1 -- Kahan's step x' = x + h (I - h/2 f'(x))^-1 f(x), one linear solve; 2 -- an explicit method,
     its stages in order; 0 -- the Runge--Kutta step with Newton's method.  info[0] += Newton iterations
     (mode 1: solves); on failure info[1] = 1 (singular), 2 (no convergence) or 3 (not finite) and info[2] = the
-    step; returns the steps done."""
-    s = b.shape[0]
+    step; returns the steps done.  A[k] (s x s) and b[k] (s) are the tableau of component k."""
+    s = b.shape[1]
     n = x.shape[0]
     m = s * n
     K = np.zeros((s, n))
@@ -977,7 +977,7 @@ def rk_run(x, c, compensated, mode, h, P, A, b, steps, every, out, maxit, tol, i
             for k in range(n):
                 acc = 0.0
                 for i in range(s):
-                    acc += b[i] * K[i, k]
+                    acc += b[k, i] * K[i, k]
                 inc[k] = h * acc
         elif mode == 1:
             rk_field(x, P, r)
@@ -1002,7 +1002,7 @@ def rk_run(x, c, compensated, mode, h, P, A, b, steps, every, out, maxit, tol, i
             for k in range(n):
                 acc = 0.0
                 for i in range(s):
-                    acc += b[i] * K[i, k]
+                    acc += b[k, i] * K[i, k]
                 inc[k] = h * acc
         finite = True
         for k in range(n):

@@ -26,7 +26,6 @@ Blanes, Casas & Ros, SIAM J. Sci. Comput. 21 (1999) 711.
 
 from __future__ import annotations
 
-
 import numpy as np
 import sympy
 

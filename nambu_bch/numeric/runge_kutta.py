@@ -33,21 +33,23 @@ MAX_NEWTON = 50
 
 
 def rk_step_function(system, method, params=None):
-    """``step(y, h) -> y1`` (float64 arrays of shape ``(N,)``) for the Runge--Kutta ``method`` on ``system``."""
+    """``step(y, h) -> y1`` (float64 arrays of shape ``(N,)``) for the Runge--Kutta ``method`` on ``system``
+    (a tableau, or a partitioned pair on a canonical system: coordinate ``k`` staged by its own tableau)."""
     from ..integrators.step import parameter_values
     from ..systems.spec import as_system
 
     system = as_system(system)
-    tableau = butcher_tableau(method)
+    tableau = _method(method)
+    per_coordinate = _per_coordinate(system, tableau)
     values = parameter_values(system, params)
     f_exprs = [sympy.sympify(e, strict=True).subs(values) for e in system.vector_field.to_sympy()]
     coords = system.coordinates
     jac = sympy.Matrix(f_exprs).jacobian(coords)
     f_num = sympy.lambdify(coords, f_exprs, modules="numpy")
     j_num = sympy.lambdify(coords, jac, modules="numpy")
-    A = np.array([[float(a) for a in row] for row in tableau.A])
-    b = np.array([float(x) for x in tableau.b])
-    s, n = len(b), system.N
+    A = np.array([[[float(a) for a in row] for row in t.A] for t in per_coordinate])  # (N, s, s)
+    b = np.array([[float(x) for x in t.b] for t in per_coordinate])  # (N, s)
+    n, s = b.shape
 
     def f(y):
         return np.asarray(f_num(*y), dtype=np.float64)
@@ -56,7 +58,7 @@ def rk_step_function(system, method, params=None):
         K = np.tile(f(y), (s, 1))
         best = np.inf
         for _ in range(MAX_NEWTON):
-            Y = y + h * (A @ K)
+            Y = y + h * np.einsum("kij,jk->ik", A, K)
             F = np.array([f(Yi) for Yi in Y])
             residual = (K - F).ravel()
             size = np.max(np.abs(residual))
@@ -68,8 +70,8 @@ def rk_step_function(system, method, params=None):
             J = np.eye(s * n)
             for i in range(s):
                 Ji = np.asarray(j_num(*Y[i]), dtype=np.float64)
-                for j in range(s):
-                    J[i * n:(i + 1) * n, j * n:(j + 1) * n] -= h * A[i, j] * Ji
+                for j in range(s):  # d f(Y_i) / d K_j: column c of J_i scaled by coordinate c's a_ij
+                    J[i * n:(i + 1) * n, j * n:(j + 1) * n] -= h * Ji * A[:, i, j]
             try:
                 K = K - np.linalg.solve(J, residual).reshape(s, n)
             except np.linalg.LinAlgError:
@@ -78,7 +80,7 @@ def rk_step_function(system, method, params=None):
         else:
             raise NumericalRangeError(f"Newton's method for {tableau.name} did not settle in {MAX_NEWTON} iterations "
                                       f"at h = {h}, y = {y.tolist()}; lower h")
-        return y + h * (b @ K)
+        return y + h * np.einsum("ki,ik->k", b, K)
 
     return step
 
@@ -124,6 +126,26 @@ def is_linearly_implicit(tableau) -> bool:
 
 #: The functions of the generated Runge--Kutta module, callees first.
 _RK_FUNCTIONS = ("rk_field", "rk_jacobian", "rk_solve", "rk_newton", "rk_explicit", "rk_run")
+
+
+def _method(method):
+    """The tableau or partitioned pair ``method`` names (:func:`~nambu_bch.integrators.runge_kutta.runge_kutta_method`)."""
+    from ..integrators.runge_kutta import runge_kutta_method
+
+    return runge_kutta_method(method) or butcher_tableau(method)  # the latter names what is accepted
+
+
+def _per_coordinate(system, tableau) -> list:
+    """The tableau of each coordinate: one for all, or a partitioned pair's ``q`` and ``p`` tableaux on a canonical
+    system (refused on any other)."""
+    from ..integrators.runge_kutta import PartitionedTableau
+
+    if isinstance(tableau, PartitionedTableau):
+        from ..bseries.modified import _canonical_half
+
+        _canonical_half(system, tableau)
+        return tableau.per_coordinate(system.N)
+    return [tableau] * system.N
 
 
 def _module(system, backend):
@@ -173,7 +195,9 @@ def iterate_runge_kutta(system, method, h, steps, x0=None, params=None, every=1,
     Parameters
     ----------
     system, h, steps, x0, params, every, out : as for :func:`~nambu_bch.numeric.iterate`
-    method : a name of :data:`~nambu_bch.integrators.runge_kutta.TABLEAUX` or a ButcherTableau
+    method : a name of :data:`~nambu_bch.integrators.runge_kutta.TABLEAUX` or a ButcherTableau; or a partitioned
+        pair (:data:`~nambu_bch.integrators.runge_kutta.PARTITIONED`) on a canonical system: the stages of the ``q``
+        coordinates use its first tableau, those of ``p`` its second, in the same Newton iteration (HLW Sect. II.2)
     kahan : bool -- compensated summation of the increments
     backend : ``"auto"`` | ``"numba"`` | ``"numpy"`` -- compiled, or the same generated source interpreted (the same
         bits); ``"auto"``: compiled, except runs of at most :data:`INTERPRET_STEPS` trajectory-steps before the module
@@ -205,7 +229,8 @@ def iterate_runge_kutta(system, method, h, steps, x0=None, params=None, every=1,
     if stats is not None and not isinstance(stats, dict):
         raise InvalidRunError(f"stats must be a dict to receive the run's work, got {type(stats).__name__}")
     system = as_system(system)
-    tableau = butcher_tableau(method)
+    tableau = _method(method)
+    per_coordinate = _per_coordinate(system, tableau)
     x0, origin = initial_state(system, x0)
     kahan = check_flag(kahan, "kahan")
     auto = check_backend(backend) == "auto"
@@ -227,8 +252,8 @@ def iterate_runge_kutta(system, method, h, steps, x0=None, params=None, every=1,
         backend = "numpy"  # compiling costs seconds; a short run is done sooner by the interpreter (the same bits)
     module = _module(system, backend)
     P = np.array([float(values[p]) for p in system.parameters], dtype=np.float64)
-    A = np.array([[float(a) for a in row] for row in tableau.A], dtype=np.float64)
-    b = np.array([float(x) for x in tableau.b], dtype=np.float64)
+    A = np.array([[[float(a) for a in row] for row in t.A] for t in per_coordinate], dtype=np.float64)
+    b = np.array([[float(x) for x in t.b] for t in per_coordinate], dtype=np.float64)
     single = X.ndim == 1
     batch = 1 if single else X.shape[1]
     count = n_samples(steps, every)

@@ -1,7 +1,7 @@
 """Shadow Hamiltonians: Liouville-term algebra, the fundamental identity, the FI and direct routes, ``ShadowFamily``."""
 
 from .api import shadow_hamiltonians
-from .density_bracket import density_shadow
+from .density_bracket import DensityBrackets, density_brackets, density_shadow
 from .direct_route import DirectResult, OrderSolution, direct_route
 from .existence import Existence, decide
 from .family import ShadowFamily
@@ -14,6 +14,7 @@ from .liouville_terms import LiouvilleSum, LiouvilleTerm
 __all__ = [
     "Contraction",
     "ContractionSum",
+    "DensityBrackets",
     "FI_LABELS",
     "DirectResult",
     "Existence",
@@ -31,6 +32,7 @@ __all__ = [
     "commutator_terms",
     "count_brackets",
     "decide",
+    "density_brackets",
     "density_shadow",
     "direct_route",
     "double_commutator_terms",

@@ -26,10 +26,14 @@ Wanner, *Geometric Numerical Integration*, Sect. IX.9 (modified equations of B-s
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import sympy
 
 from ..algebra import VectorField, liouville_field
 from ..errors import NambuBCHError
+from ..printing import Printable
+from ..values import ValueEquality
 
 H = sympy.Symbol("h")
 
@@ -125,3 +129,125 @@ def density_shadow(system, method, density, order: int = 2, degree=None, max_unk
     fields = divided_by_density(M.coefficients, density, M.order, system.name)
     return direct_route(system, M.method, M.order, degree=degree, max_unknowns=max_unknowns, progress=False,
                         effective=fields)
+
+
+@dataclass(frozen=True, eq=False)
+class DensityBrackets(Printable, ValueEquality):
+    """The shadow question of one method in two Nambu brackets: the standard one and ``{f, g, k}_rho``.
+
+    Attributes
+    ----------
+    system : System
+    method : the method's tableau
+    order : int
+    density : sympy expression -- ``rho`` (for Kahan's method on an Euler top, the ``phi`` of its invariant measure
+        ``dx / phi``)
+    standard : ShadowFamily -- ``f~ = X_{H_S,G_S} + O(h^{order+1})``: the family, or the certificate
+    weighted : ShadowFamily -- ``f~ = rho X_{H_S,G_S} + O(h^{order+1})``: the family, or the certificate
+    """
+
+    system: object
+    method: object
+    order: int
+    density: object
+    standard: object
+    weighted: object
+
+    def _value(self) -> tuple:
+        """The exact data (``==``, ``hash``): the system, method, order, density and the two families."""
+        return self.system, self.method, self.order, self.density, self.standard, self.weighted
+
+    @property
+    def admits(self) -> tuple:
+        """The brackets with a pair through the order: a subset of ``("standard", "density")``."""
+        return tuple(name for name, family in (("standard", self.standard), ("density", self.weighted))
+                     if family.exists)
+
+    def _headline(self) -> str:
+        return ("a pair in " + " and ".join(f"the {name} bracket" for name in self.admits) if self.admits
+                else "a pair in neither bracket")
+
+    def to_text(self) -> str:
+        """Both answers, the density, and which bracket admits a pair."""
+        name = self.method.name
+        return "\n".join([
+            f"{name} on {self.system.name}, order {self.order}: {self._headline()}",
+            f"density rho = {self.density}  ({{f, g, k}}_rho = rho d(f, g, k)/d(x); the method keeps dx/rho)",
+            "standard bracket:", self.standard.to_text(),
+            "density bracket (f~ = rho X_{H_S,G_S}):", self.weighted.to_text()])
+
+    def to_latex(self) -> str:
+        r"""The two families' ``aligned`` blocks under a ``gathered`` headline (display math, amsmath)."""
+        from ..printing import latex_text
+
+        return "\n".join([
+            r"\begin{gathered}",
+            latex_text(f"{self.method.name} on {self.system.name}: {self._headline()}") + r" \\",
+            r"\text{standard bracket:} \\", self.standard.to_latex() + r" \\",
+            r"\text{density bracket } \{f, g, k\}_{\rho} = \rho\, \partial(f, g, k)/\partial(x),\ \rho = "
+            + sympy.latex(self.density) + r": \\",
+            self.weighted.to_latex(),
+            r"\end{gathered}"])
+
+    def to_dict(self) -> dict:
+        """JSON-ready (docs/json.md, ``$defs/density_bracket``): ``kind``, ``model``, ``integrator``, ``order``,
+        ``density``, ``admits`` and the two families' shadow documents under ``brackets``."""
+        return {"kind": "density-bracket", "model": self.system.name, "integrator": self.method.name,
+                "order": self.order, "density": str(self.density), "admits": list(self.admits),
+                "brackets": {"standard": self.standard.to_dict(), "density": self.weighted.to_dict()}}
+
+    def __repr__(self):
+        return f"DensityBrackets({self.method.name!r}, order={self.order}, system={self.system.name!r})"
+
+
+def density_brackets(system, method="kahan", order: int = 2, density=None, degree=None,
+                     max_unknowns=None) -> DensityBrackets:
+    """Which Nambu bracket admits a pair for the modified field of ``method``: standard, or with density ``rho``.
+
+    The standard question is :func:`~nambu_bch.shadow.shadow_hamiltonians` (with its divergence test for
+    non-existence); the density one is :func:`density_shadow` on ``f~ / rho``, whose non-existence is certified the
+    same way (every ``X_{H,G}`` is divergence-free, so ``div(Z_j / rho)_j != 0`` at the failed order rules out every
+    pair, polynomial or not) or by the direct route's functional.
+
+    Parameters
+    ----------
+    system : System or model name (three coordinates, two Hamiltonians)
+    method : a Runge--Kutta method (name or tableau); default Kahan's
+    order : int
+    density : ``rho`` (as :func:`density_shadow` takes it); default the method's invariant density where it is
+        known: Kahan's method on an Euler top ``x_i' = a_i x_j x_k``
+        (:func:`~nambu_bch.bseries.kahan.euler_top_density`)
+    degree, max_unknowns : as for the direct route
+
+    Returns
+    -------
+    DensityBrackets -- ``.admits``, ``.standard`` and ``.weighted`` (ShadowFamily each, with the certificate where
+    there is no pair)
+
+    Examples
+    --------
+    >>> density_brackets("rigid-body", "kahan", 2).admits      # docs/runge_kutta.md, the density bracket
+    ('density',)
+    """
+    from ..bseries.kahan import euler_top_density
+    from ..integrators.runge_kutta import TABLEAUX, butcher_tableau
+    from ..systems.system import as_system
+    from .api import _divergence_decision, shadow_hamiltonians
+    from .family import ShadowFamily
+
+    system = as_system(system)
+    tableau = butcher_tableau(method.strip().lower() if isinstance(method, str) else method)
+    if density is None:
+        if tableau != TABLEAUX["kahan"]:
+            raise NambuBCHError(f"the invariant density of {tableau.name} is not known here (it is for Kahan's method "
+                                f"on an Euler top); pass density=")
+        density = euler_top_density(system)
+    standard = shadow_hamiltonians(system, tableau, order=order, degree=degree, max_unknowns=max_unknowns)
+    R = density_shadow(system, tableau, density, order, degree=degree, max_unknowns=max_unknowns)
+    # where the polynomial solve fails, a non-zero divergence of Z_j / rho rules out every pair; otherwise the
+    # direct route's functional is the certificate (the orbit averages measure drift in the standard bracket only)
+    decision = None if R.exists else _divergence_decision(system, R)
+    weighted = ShadowFamily.from_direct(system, tableau, R.order, R, decision, max_unknowns=max_unknowns)
+    alg = R.effective[0].algebra
+    return DensityBrackets(system, tableau, R.order, sympy.expand(alg.to_sympy(alg.convert(density))), standard,
+                           weighted)
