@@ -357,19 +357,25 @@ class Kernel:
         body = self.source.partition("\ndef run_numpy(")[2]
         return not (set(re.findall(r"\b_np_(\w+)\(", body)) - {"isfinite", "sqrt"})
 
-    def scan(self, X):
+    def scan(self, X, workers=1):
         """One compiled pass over a batch ``X`` (N, B): ``(non-finite count, subnormal count, columns)``.
 
         ``columns`` are the extreme states of :func:`~nambu_bch.numeric.guards.extreme_states`
         (largest / smallest max-norm and product of magnitudes, smallest non-zero component).
-        The pass does not depend on the system: :func:`nambu_bch.numeric.scan.scan`, compiled once
-        for all kernels.
+        The pass does not depend on the system: :func:`nambu_bch.numeric.scan.scan_range`, compiled once
+        for all kernels.  ``workers``: threads, each scanning the column range it will advance
+        (:func:`column_ranges`); their results combine into the one-pass result exactly
+        (:func:`nambu_bch.numeric.scan.combine`).
         """
-        from .scan import scan
+        from .scan import RESULT_SIZE, combine, scan_range
 
-        res = np.zeros(7, dtype=np.int64)
-        scan(X, res)
-        return int(res[0]), int(res[1]), np.unique(np.concatenate([res[2:], [0, X.shape[1] - 1]]))
+        def part(lo, hi):
+            res = np.zeros(RESULT_SIZE, dtype=np.int64)
+            scan_range(X, lo, hi, res)
+            return res
+
+        res = combine(_on_threads(part, column_ranges(X.shape[1], NUMBA_CHUNK, workers)))
+        return int(res[0]), int(res[1]), np.unique(np.concatenate([res[2:7], [0, X.shape[1] - 1]]))
 
     def compile(self, kahan: bool = False, batch: bool = False, fma: bool = False) -> float:
         """Compile (or load from the disk cache) one loop now; the wall time in seconds."""
@@ -465,13 +471,23 @@ class Kernel:
         fn = self.function(self.loop_name(kahan, True, fma))
         chunk = int(chunk or NUMBA_CHUNK)
         call = lambda lo, hi: int(fn(*args, K, int(steps), int(every), out, chunk, *flags, lo, hi))  # noqa: E731
-        ranges = column_ranges(B, chunk, workers)
-        if len(ranges) <= 1:
-            return call(0, B)
-        from concurrent.futures import ThreadPoolExecutor
+        return sum(_on_threads(call, column_ranges(B, chunk, workers)))
 
-        with ThreadPoolExecutor(len(ranges)) as pool:
-            return sum(pool.map(lambda r: call(*r), ranges))
+
+def _on_threads(call, ranges) -> list:
+    """``[call(lo, hi) for lo, hi in ranges]``, the first range on the calling thread and each other one on a
+    thread of its own (``call`` must release the GIL to gain: the compiled loops do, ``nogil=True``).
+
+    The calling thread works instead of waiting, so ``w`` ranges start ``w - 1`` threads.
+    """
+    if len(ranges) <= 1:
+        return [call(*r) for r in ranges]
+    from concurrent.futures import ThreadPoolExecutor
+
+    with ThreadPoolExecutor(len(ranges) - 1) as pool:
+        rest = [pool.submit(call, *r) for r in ranges[1:]]
+        first = call(*ranges[0])
+        return [first] + [f.result() for f in rest]
 
 
 def column_ranges(batch: int, chunk: int, workers: int) -> list:
