@@ -118,8 +118,10 @@ def iterate(system, word, h, steps, x0=None, params=None, every=1, *, kahan=Fals
         returned, C-contiguous, writeable, sharing no memory with ``x0`` (:func:`~nambu_bch.numeric.guards.check_out`).
         Every element is written (``np.empty`` suffices), so repeated runs allocate nothing.  float64 runs only.
     fma : bool -- let the compiled loops fuse ``a*b + c`` into one rounding (faster, chiefly for one
-        trajectory; docs/numerics.md).  The samples are then close to the default ones, not equal, and
-        depend on the machine; the interpreter and numpy never fuse.  Default False: the same bits on
+        trajectory; docs/numerics.md).  One trajectory: every increment that is a product is added by an
+        explicit fused multiply-add (correctly rounded on every machine), other operations may be contracted
+        where the CPU has FMA; batches: contraction where the CPU has it.  The samples are then close to the
+        default ones, not equal; the interpreter and numpy never fuse.  Default False: the same bits on
         every backend.  float64 runs only.
     workers : int >= 1 or None -- threads advancing a batch with the compiled loop, each on its own range of
         states (the loop releases the GIL).  The samples are the same bits for every value.  None: the

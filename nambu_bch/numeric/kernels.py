@@ -66,14 +66,14 @@ from pathlib import Path
 
 import numpy as np
 
-from ..compiled import cache_variant, enable_private_cache
+from ..compiled import cache_variant, enable_private_cache, fused_multiply_add
 from ..compiled import numba_available  # noqa: F401  (re-exported: nambu_bch.numeric.numba_available)
 from ..errors import InvalidRunError, NumericalRangeError
 from ..atomic import write_atomic
 from ..private_dirs import cache_root, private_directory, read_private, untrusted
 from ..integrators.composition import composition_for
 from ..integrators.step import parameter_values
-from .codegen import PAIR_FUNCTION, TEMPLATE_VERSION, python_source, source_hash, step_program
+from .codegen import FMA_FUNCTION, PAIR_FUNCTION, TEMPLATE_VERSION, python_source, source_hash, step_program
 
 BACKENDS = ("auto", "numba", "numpy")
 #: numba's fast-math flags of a run with ``fma=True``: contraction of ``a*b + c`` into one fused
@@ -133,7 +133,7 @@ MAX_CACHE_FILE = 4 * 2**20
 _MODULE_NAME = re.compile(r"nambu_bch_kernel_[0-9a-f]{20}")
 _INDEX_FIELDS = {"template": str, "module": str, "sha256": str, "N": int, "n_constants": int,
                  "n_parameters": int, "linear": list}
-_FUNCTIONS = ("constants", "run", "run_kahan", "run_batch", "run_batch_kahan", "run_numpy", "run_numpy_kahan")
+_FUNCTIONS = ("constants", "run", "run_fma", "run_kahan", "run_batch", "run_batch_kahan", "run_numpy", "run_numpy_kahan")
 
 
 def input_key(system, comp) -> str:
@@ -311,7 +311,8 @@ class Kernel:
 
     def function(self, name: str, backend: str = "numba"):
         """The loop ``name`` (``run``, ``run_kahan``, ``run_batch``, ``run_batch_kahan``, each optionally with the
-        suffix ``+contract`` of :meth:`loop_name`: compiled with :data:`CONTRACT`) for ``backend``."""
+        suffix ``+contract`` of :meth:`loop_name`: compiled with :data:`CONTRACT`; ``run+contract`` is the generated
+        ``run_fma``, whose fused multiply-adds are written out) for ``backend``."""
         name, plus, _ = name.partition("+")
         fma = bool(plus)
         if backend == "numpy":  # the interpreter never contracts
@@ -326,11 +327,15 @@ class Kernel:
             if name.startswith("run_batch") and hasattr(self.module, PAIR_FUNCTION):
                 # the batch loops' redo calls the shared-exponential function: compiled, it is a global of theirs
                 self.module.__dict__[PAIR_FUNCTION] = self.function(PAIR_FUNCTION)
-            py = getattr(self.module, name)
+            source = name
+            if fma and name == "run":  # one trajectory: the fused multiply-adds written out (codegen.fused_product)
+                source = "run_fma"
+                self.module.__dict__[FMA_FUNCTION] = fused_multiply_add()
+            py = getattr(self.module, source)
             py = getattr(py, "py_func", py)  # the compiled pair function stands in the module once bound
             fn = numba.njit(nogil=True, fastmath=set(CONTRACT) if fma else False, error_model="numpy")(py)
             if self.path.is_file():  # numba caches next to a source file; without one, compile in memory
-                enable_private_cache(fn, self.directory / "__pycache__")
+                enable_private_cache(fn, self.directory / "__pycache__", name)
             self._jitted[key] = fn
         return fn
 
