@@ -666,7 +666,7 @@ def {name}({args}):
             # the loop of ``fma=True`` for one trajectory: the fused multiply-adds written out.  Contraction
             # alone (fastmath "contract") left LLVM free to compute a product shared by two consecutive steps
             # once (the loop unrolled four times), and a shared product is not fused: the chain through the
-            # state got longer than gcc's, which fuses every update (measured 1.07-1.10x gcc, now 1.03x)
+            # state got longer than gcc's, which fuses every update (docs/numerics.md, "Why fma=True stayed above gcc")
             src.append(f"""
 def run_fma(x, K, steps, every, out):
 {_indent(consts, 4)}
