@@ -133,7 +133,8 @@ MAX_CACHE_FILE = 4 * 2**20
 _MODULE_NAME = re.compile(r"nambu_bch_kernel_[0-9a-f]{20}")
 _INDEX_FIELDS = {"template": str, "module": str, "sha256": str, "N": int, "n_constants": int,
                  "n_parameters": int, "linear": list}
-_FUNCTIONS = ("constants", "run", "run_fma", "run_kahan", "run_batch", "run_batch_kahan", "run_numpy", "run_numpy_kahan")
+_FUNCTIONS = ("constants", "run", "run_fma", "run_kahan", "run_batch", "run_batch_kahan", "run_numpy",
+              "run_numpy_kahan")
 
 
 def input_key(system, comp) -> str:

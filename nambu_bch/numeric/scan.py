@@ -12,7 +12,8 @@ It was part of every generated kernel module (compiled once per kernel, 1-1.4 s 
 depends on nothing but the batch, so it lives here, compiled once and cached by numba in the
 package's private cache (:func:`nambu_bch.compiled.njit`); :func:`~nambu_bch.numeric.kernels.Kernel.scan`
 calls it, on the column ranges of a threaded run each in its own thread (:func:`scan_range`, :func:`combine`:
-the same result as one pass, so a threaded run's guards see what a one-thread run's see).  The numpy twin is :func:`~nambu_bch.numeric.guards.scan_states`.
+the same result as one pass, so a threaded run's guards see what a one-thread run's see).  The numpy twin
+is :func:`~nambu_bch.numeric.guards.scan_states`.
 """
 
 import math
