@@ -15,6 +15,7 @@ load average is printed with the numbers.  The contenders:
       thread, batch allocating its result, and the batch kernel alone,
   both sides' batches split across the cores (``--threads``, default all): iterate(workers=T, out=) and the
       default C build called on T contiguous blocks of states from T threads (ctypes releases the GIL),
+  the part of iterate() before a batch runs: the guards' scan of x0, on one thread and on T,
   our numpy fallback                                 -- batch (vectorised) and single (scalar Python loop),
   a plain Python loop over nambu_bch.integrators.step_function,
 the ratios with the targets (one trajectory, fma=True, <= 1.05x the default C build; batch through
@@ -113,6 +114,8 @@ LABELS = {
     "numba_batch_fma": "iterate(out=, fma=True), batch",
     "numba_batch_alloc": "iterate(), batch (allocates its result)",
     "numba_batch_kernel": "numba batch kernel alone",
+    "numba_scan": "of iterate(): the guards' scan of x0, 1 thread",
+    "numba_scan_threads": "of iterate(): the same scan on T threads",
     "numpy_batch": "numpy fallback iterate(), batch",
     "numpy_batch_kernel": "numpy fallback kernel alone, batch",
     "numpy_single_python": "numpy fallback, single (scalar Python loop)",
@@ -257,6 +260,11 @@ def main(argv=None):
             k.run_batch(Xk, K, args.batch_steps, args.batch_steps, out)
 
         work["numba_batch_kernel"] = (kernel_batch, batch_work)
+        # the one pass over x0 that iterate() makes before a batch runs (non-finite, subnormal, extreme states):
+        # per trajectory-step of the batch, to read against the rows above
+        work["numba_scan"] = (lambda: k.scan(X0, 1), batch_work)
+        if threads > 1:
+            work["numba_scan_threads"] = (lambda: k.scan(X0, threads), batch_work)
 
     work["numpy_batch"] = (lambda: iterate(system, args.word, args.h, args.numpy_steps, X0, every=args.numpy_steps,
                                            backend="numpy"), args.numpy_steps * args.batch)

@@ -89,8 +89,11 @@ def cache_variant(fastmath) -> str:
     return "+" + "+".join(sorted(fastmath) if isinstance(fastmath, (set, frozenset, list, tuple)) else ["fast"])
 
 
-def enable_private_cache(dispatcher, directory=None) -> bool:
+def enable_private_cache(dispatcher, directory=None, name=None) -> bool:
     """Give a numba dispatcher a disk cache in ``directory`` (default :func:`numba_cache_directory`); whether it got one.
+
+    ``name``: the name its cache files carry (default the function's qualified name), followed by
+    :func:`cache_variant` of its ``fastmath`` option.
 
     The cache is used only while the directory is private (:func:`nambu_bch.private_dirs.untrusted`,
     checked again before every read and write); each file is written atomically with a SHA-256 of its
@@ -111,10 +114,39 @@ def enable_private_cache(dispatcher, directory=None) -> bool:
         if directory is None or untrusted(directory) is not None or not os.path.exists(py_file):
             return False
         variant = cache_variant(getattr(dispatcher, "targetoptions", {}).get("fastmath"))
-        dispatcher._cache = _cache_class()(dispatcher.py_func, str(directory), variant)
+        dispatcher._cache = _cache_class()(dispatcher.py_func, str(directory), variant, name)
     except (ImportError, AttributeError, TypeError, OSError):
         return False
     return True
+
+
+_FMA = None
+
+
+def fused_multiply_add():
+    """A numba intrinsic ``fma(a, b, c)``: ``a*b + c`` rounded once (LLVM's ``llvm.fma.f64``, one instruction on
+    a CPU with an FMA unit, else the C library's correctly rounded ``fma``), made on first use (importing
+    numba costs ~0.3 s).  The fused kernels bind it to the name their source calls
+    (:data:`nambu_bch.numeric.codegen.FMA_FUNCTION`).
+
+    References: IEEE 754-2008, fusedMultiplyAdd; LLVM Language Reference, ``llvm.fma.*``.
+    """
+    global _FMA
+    if _FMA is None:
+        from numba import types
+        from numba.extending import intrinsic
+
+        @intrinsic
+        def fma(typingctx, a, b, c):
+            sig = types.float64(types.float64, types.float64, types.float64)
+
+            def codegen(context, builder, signature, args):
+                return builder.fma(*args)
+
+            return sig, codegen
+
+        _FMA = fma
+    return _FMA
 
 
 def _verified(path):
@@ -188,9 +220,9 @@ def _define_cache_class():
             return hashlib.sha256(read_private(self._py_file, MAX_NUMBA_FILE, owned=False)).digest()
 
     class PrivateImpl(caching.CompileResultCacheImpl):
-        def __init__(self, py_func, directory, variant):  # numba's __init__ without its search for a locator
+        def __init__(self, py_func, directory, variant, name=None):  # numba's __init__ without its locator search
             self._lineno = py_func.__code__.co_firstlineno
-            qualname = getattr(py_func, "__qualname__", py_func.__name__)
+            qualname = name or getattr(py_func, "__qualname__", py_func.__name__)
             filename = inspect.getfile(py_func)
             self._locator = PrivateLocator(py_func, filename, directory)
             modname = os.path.splitext(os.path.basename(filename))[0]
@@ -237,10 +269,10 @@ def _define_cache_class():
                 raise OSError(f"{self._cache_path} is no longer private")
 
     class PrivateFunctionCache(caching.FunctionCache):
-        def __init__(self, py_func, directory, variant=""):  # numba's Cache.__init__ with the classes above
+        def __init__(self, py_func, directory, variant="", name=None):  # numba's Cache.__init__, the classes above
             self._name = repr(py_func)
             self._py_func = py_func
-            self._impl = PrivateImpl(py_func, directory, variant)
+            self._impl = PrivateImpl(py_func, directory, variant, name)
             self._cache_path = directory
             self._cache_file = VerifiedFile(cache_path=directory, filename_base=self._impl.filename_base,
                                             source_stamp=self._impl.locator.get_source_stamp())

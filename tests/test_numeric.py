@@ -116,12 +116,12 @@ def test_exponential_flows_use_expm1():
     assert all("expm1" in str(d) for u in prog.updates for _, d in u.expanded())
     # one expm1 per sub-flow: each Lotka-Volterra piece scales one coordinate by e^u, another by e^-u
     assert all(len(u.pairs) == 1 and len(u.increments) == 2 for u in prog.updates)
-    # run and run_kahan: one library call per sub-flow, only above the series range; the batch loops'
+    # run, run_fma and run_kahan: one library call per sub-flow, only above the series range; the batch loops'
     # redo (and only it) calls the one generated pair function, which holds the last library call
     from nambu_bch.numeric.codegen import PAIR_FUNCTION
 
     src = python_source(prog)
-    assert src.count("    e0 = _expm1(_au0)") == 3 and src.count("= _expm1(") == 2 * len(prog.updates) + 1
+    assert src.count("    e0 = _expm1(_au0)") == 4 and src.count("= _expm1(") == 3 * len(prog.updates) + 1
     assert src.count(f"def {PAIR_FUNCTION}(") == 1 and src.count(f" = {PAIR_FUNCTION}(") == 2 * len(prog.updates)
     assert src.count("_np_expm1(") == 2 * len(prog.updates)        # run_numpy and its Kahan form
 
@@ -139,7 +139,7 @@ def test_numba_loops_copy_rows_element_by_element(name, word):
     tree = ast.parse(python_source(step_program(model(name), word)))
     compiled = [f for f in tree.body if isinstance(f, ast.FunctionDef) and not f.name.startswith(("run_numpy", "constants"))]
     pairs = {"_expm1_pair"} if name == "lotka-volterra" else set()  # the shared-exponential function (compiled too)
-    assert {f.name for f in compiled} == {"run", "run_kahan", "run_batch", "run_batch_kahan"} | pairs
+    assert {f.name for f in compiled} == {"run", "run_fma", "run_kahan", "run_batch", "run_batch_kahan"} | pairs
     compiled += [f for f in ast.parse(Path(scan_module.__file__).read_text()).body if isinstance(f, ast.FunctionDef)]
     assert [f.name for f in compiled][-1:] == ["scan"]
     sliced = [ast.unparse(t) for f in compiled for node in ast.walk(f) if isinstance(node, (ast.Assign, ast.AugAssign))

@@ -79,3 +79,24 @@ def test_sweep_tasks_and_numba_num_threads_limit_the_default(monkeypatch):
     assert parallel._apply_in_worker(iterate_module.available_threads, ()) == 1
     with iterate_module.single_threaded():
         assert iterate_module.batch_workers(None, 10**6, 10**3) == 1
+
+
+def test_threads_scan_their_own_ranges_and_find_the_one_pass_extremes():
+    """The guards' scan of a threaded batch runs on each thread's range of states; combined, the counts and the
+    extreme states are those of one pass over the whole batch (the first state reaching an extreme wins, also
+    when the tie spans two ranges), so the range check sees the same states for every number of threads."""
+    from nambu_bch.numeric import kernel
+    from nambu_bch.numeric.guards import scan_states
+
+    rng = np.random.default_rng(11)
+    X = rng.uniform(0.5, 1.5, (3, 5000)) * 10.0 ** rng.integers(-60, 60, (3, 5000))
+    X[:, 4000] = X[:, 17]  # a tie across ranges: column 17 must win
+    X[:, 2600] = X[:, 4900] = 0.0
+    want = scan_states(X)
+    kern = kernel("ho3", "32123")
+    for workers in (1, 2, 3, 8):
+        got = kern.scan(X, workers)
+        assert got[:2] == want[:2] and np.array_equal(got[2], want[2])
+    Y = X.copy()
+    Y[0, 10], Y[2, 4999], Y[1, 3000] = np.nan, 1e-310, np.inf  # in the first, the last and a middle range
+    assert kern.scan(Y, 3)[:2] == scan_states(Y)[:2] == (2, 1)

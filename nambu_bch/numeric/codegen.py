@@ -58,7 +58,7 @@ from ..integrators.flows import TIME, exact_flow
 STEP = sympy.Symbol("h")
 
 #: Bump when the generated source changes meaning (part of the cache key).
-TEMPLATE_VERSION = "7"
+TEMPLATE_VERSION = "8"
 
 _FUNCTIONS = ("exp", "expm1", "log", "sin", "cos", "tan", "sinh", "cosh", "tanh", "sqrt", "atan", "asin", "acos")
 
@@ -469,14 +469,16 @@ def expm1_pair(u: float) -> tuple:
 
 
 def body_lines(program: StepProgram, printer, kahan=False, c_syntax=False, vector=False, prefix="_", select=False,
-               pair_call=None):
+               pair_call=None, fused=False):
     """Statements of one step, ``s_i`` / ``k_j`` / ``d_j`` / ``c_i`` named as in the generated kernels.
 
     ``vector``: numpy arrays (the shared-exponential swap is a ``np.where``); ``prefix``: of the
     function names (``_``, ``_np_``, ``_mp_``); ``c_syntax``: C99; ``select``: shared exponentials
     without branches (:func:`pair_lines` style ``"select"``, for the vectorised batch loop);
     ``pair_call``: the name of a function computing a shared pair (``e_j, f_j = pair_call(u_j)``,
-    :data:`PAIR_FUNCTION`) instead of its statements inline.
+    :data:`PAIR_FUNCTION`) instead of its statements inline; ``fused``: each increment that is a product
+    ``p*q`` is added by one fused multiply-add ``s_i = _fma(p, q, s_i)`` (:func:`fused_product`), the
+    operands of an update taken before any of its coordinates moves (Python syntax, no Kahan).
     """
     end = ";" if c_syntax else ""
     decl = "double " if c_syntax else ""
@@ -490,10 +492,17 @@ def body_lines(program: StepProgram, printer, kahan=False, c_syntax=False, vecto
             lines += pair_lines(str(us), str(es), str(fs), printer(ue), prefix, style)
         names = []
         for j, (i, d) in enumerate(u.increments):
+            split = fused_product(d, printer) if fused else None
+            if split is not None:
+                lines += [f"p{j} = {split[0]}", f"t{j} = {split[1]}"]  # t: unused outside Kahan's lines
+                names.append((i, (f"p{j}", f"t{j}")))
+                continue
             lines.append(f"{decl}d{j} = {printer(d)}{end}")
             names.append((i, f"d{j}"))
         for i, d in names:
-            if kahan:
+            if isinstance(d, tuple):
+                lines.append(f"s{i} = {FMA_FUNCTION}({d[0]}, {d[1]}, s{i})")
+            elif kahan:
                 lines += [f"{decl}y{i} = {d} - c{i}{end}", f"{decl}t{i} = s{i} + y{i}{end}",
                           f"c{i} = (t{i} - s{i}) - y{i}{end}", f"s{i} = t{i}{end}"]
             else:
@@ -501,6 +510,33 @@ def body_lines(program: StepProgram, printer, kahan=False, c_syntax=False, vecto
     if c_syntax:  # C declares each temporary once per scope: one brace block per update
         return _c_scoped(program, lines, kahan, "cselect" if select else "c")
     return lines
+
+
+#: The fused multiply-add the ``fused`` lines call: ``llvm.fma`` in the compiled loop
+#: (:func:`nambu_bch.compiled.fused_multiply_add`); the interpreter never runs them.
+FMA_FUNCTION = "_fma"
+
+
+def fused_product(d, printer):
+    """``(p, q)`` printed so that ``p*q`` is ``d`` printed (the same operations), or None.
+
+    ``d`` a product ``p*q`` whose printed form is exactly ``<p>*<q>``: Python evaluates a chain of
+    ``*`` and ``/`` from the left, so the default loop computes ``p`` first and multiplies by ``q``
+    last -- that last multiply and the addition of the increment are what a fused multiply-add
+    merges, as gcc's contraction does (``-ffp-contract=fast``).  Anything else (a sum, a function,
+    a printed form that does not split this way) is added unfused.
+    """
+    import sympy
+
+    if not isinstance(d, sympy.Mul):
+        return None
+    factors = d.as_ordered_factors()
+    if len(factors) < 2:
+        return None
+    head, last = printer(sympy.Mul(*factors[:-1])), printer(factors[-1])
+    if printer(d) != f"{head}*{last}" or "+" in head or " - " in head:
+        return None
+    return head, last
 
 
 def _c_scoped(program, lines, kahan, style="c"):
@@ -531,7 +567,12 @@ _np_exp, _np_expm1, _np_log, _np_sqrt = np.exp, np.expm1, np.log, np.sqrt
 _np_sin, _np_cos, _np_tan, _np_sinh, _np_cosh, _np_tanh = np.sin, np.cos, np.tan, np.sinh, np.cosh, np.tanh
 _np_atan, _np_asin, _np_acos, _np_isfinite = np.arctan, np.arcsin, np.arccos, np.isfinite
 _INF, _MAX, _TINY = math.inf, 1.7976931348623157e308, 2.2250738585072014e-308
+_fma = None
 '''
+
+
+# ``_fma = None`` in the header: run_fma's ``a*b + c`` rounded once is ``llvm.fma``, bound when run_fma is compiled
+# (:meth:`nambu_bch.numeric.kernels.Kernel.function`); the generated source carries no comment (no ``#`` at all).
 
 
 def _indent(lines, n):
@@ -577,6 +618,8 @@ def python_source(program: StepProgram) -> str:
 
     * ``run(x, K, steps, every, out)`` and ``run_kahan(x, c, K, steps, every, out)`` --
       one trajectory, ``x`` of shape (N,), ``out`` of shape (n_samples, N);
+    * ``run_fma(x, K, steps, every, out)`` -- ``run`` with every product increment added by one fused
+      multiply-add (:func:`fused_product`; compiled only, for ``fma=True``);
     * ``run_batch(X, K, steps, every, out, chunk, start, back, lo, hi)`` and ``run_batch_kahan(X, C, ...)`` --
       ``X`` of shape (N, batch) holds the start states, ``out`` of shape (n_samples, N, batch);
       the columns ``lo <= b < hi`` are processed (disjoint ranges may run in parallel threads: the
@@ -598,6 +641,8 @@ def python_source(program: StepProgram) -> str:
     for kahan in (False, True):
         body = body_lines(program, scalar, kahan)
         src.append(_run_source(program, body, consts, kahan))
+        if not kahan:
+            src.append(_run_fma_source(program, scalar, consts))
         src.append(_run_batch_source(program, body, scalar, consts, kahan))
         src.append(_run_numpy_source(program, consts, kahan))
     return "\n".join(src)
@@ -623,6 +668,28 @@ def {name}({args}):
 {_indent(_sampling_loop(body, [sample], [f"if not ({finite}):", "    break"]), 4)}
     {store}
     {comp_store if kahan else ''}
+    return n
+"""
+
+
+def _run_fma_source(program: StepProgram, scalar, consts) -> str:
+    """``run_fma``: ``run`` with the fused multiply-adds written out, the loop of ``fma=True`` for one trajectory.
+
+    Contraction alone (fastmath "contract") left LLVM free to compute a product shared by two consecutive steps
+    once (the loop unrolled four times), and a shared product is not fused: the chain through the state got longer
+    than gcc's, which fuses every update (docs/numerics.md, "Why fma=True stayed above gcc").
+    """
+    s = [f"s{i}" for i in range(program.N)]
+    load = "; ".join(f"{v} = x[{i}]" for i, v in enumerate(s))
+    store = "; ".join(f"x[{i}] = {v}" for i, v in enumerate(s))
+    finite = " and ".join(f"_isfinite({v})" for v in s)
+    sample = "; ".join(f"out[j, {i}] = {v}" for i, v in enumerate(s))
+    return f"""
+def run_fma(x, K, steps, every, out):
+{_indent(consts, 4)}
+    {load}
+{_indent(_sampling_loop(body_lines(program, scalar, fused=True), [sample], [f"if not ({finite}):", "    break"]), 4)}
+    {store}
     return n
 """
 

@@ -110,8 +110,10 @@ def iterate(system, word, h, steps, x0=None, params=None, every=1, *, kahan=Fals
         returned, C-contiguous, writeable, sharing no memory with ``x0`` (:func:`~nambu_bch.numeric.guards.check_out`).
         Every element is written (``np.empty`` suffices), so repeated runs allocate nothing.  float64 runs only.
     fma : bool -- let the compiled loops fuse ``a*b + c`` into one rounding (faster, chiefly for one
-        trajectory; docs/numerics.md).  The samples are then close to the default ones, not equal, and
-        depend on the machine; the interpreter and numpy never fuse.  Default False: the same bits on
+        trajectory; docs/numerics.md).  One trajectory: every increment that is a product is added by an
+        explicit fused multiply-add (correctly rounded on every machine), other operations may be contracted
+        where the CPU has FMA; batches: contraction where the CPU has it.  The samples are then close to the
+        default ones, not equal; the interpreter and numpy never fuse.  Default False: the same bits on
         every backend.  float64 runs only.
     workers : int >= 1 or None -- threads advancing a batch with the compiled loop, each on its own range of
         states (the loop releases the GIL).  The samples are the same bits for every value.  None: the
@@ -183,7 +185,7 @@ def iterate(system, word, h, steps, x0=None, params=None, every=1, *, kahan=Fals
         with reporter:
             return run_mpmath(kern, X, h, steps, every, params, dps, reporter.update if reporter.enabled else None)
 
-    run = _prepare(system, kern, h, steps, every, x0, params, backend, chunk, check_stable, kahan, fma)
+    run = _prepare(system, kern, h, steps, every, x0, params, backend, chunk, check_stable, kahan, fma, workers)
     h, steps, every, X, be, K = run.h, run.steps, run.every, run.X, run.backend, run.K
     chunk = run.chunk
 
@@ -198,8 +200,7 @@ def iterate(system, word, h, steps, x0=None, params=None, every=1, *, kahan=Fals
     segment = steps if not reporter.enabled else max(every, (_SEGMENT_WORK // batch) // every * every)
     if not single:
         with reporter:
-            _run_batch(kern, X, K, steps, every, out, kahan, be, chunk, segment, reporter, what, fma,
-                       batch_workers(workers, batch, steps))
+            _run_batch(kern, X, K, steps, every, out, kahan, be, chunk, segment, reporter, what, fma, run.workers)
         return out
     state = X  # check_inputs made a fresh float64 copy: advanced in place
     out[0] = state
@@ -304,15 +305,20 @@ SMALL_BATCH_STEPS, SMALL_BATCH_STATES = 100, 16384
 class _Run:
     """The validated inputs of one float64 run."""
 
-    __slots__ = ("h", "steps", "every", "X", "backend", "K", "chunk", "fallback")
+    __slots__ = ("h", "steps", "every", "X", "backend", "K", "chunk", "fallback", "workers")
 
     def __init__(self, **kw):
         for k, v in kw.items():
             setattr(self, k, v)
 
 
-def _prepare(system, kern, h, steps, every, x0, params, backend, chunk, check_stable, kahan=False, fma=False) -> _Run:
-    """Validate a float64 run, choose the backend, compute the constants, check stability and range."""
+def _prepare(system, kern, h, steps, every, x0, params, backend, chunk, check_stable, kahan=False, fma=False,
+             workers=None) -> _Run:
+    """Validate a float64 run, choose the backend, compute the constants, check stability and range.
+
+    ``workers`` as in :func:`iterate`: a batch's threads (:func:`batch_workers`) scan their own ranges of
+    states for the guards, the ranges they then advance, so no serial pass precedes the threaded run.
+    """
     be = resolve_backend(backend)
     steps = check_count(steps, "steps", 0)
     shape = np.shape(x0)
@@ -322,9 +328,10 @@ def _prepare(system, kern, h, steps, every, x0, params, backend, chunk, check_st
     # a large batch: one pass (compiled on numba, blocked numpy otherwise) finds non-finite, subnormal and
     # extreme states; the batch itself is only read by the run, so it is not copied
     batch = len(shape) == 2
+    threads = batch_workers(workers, shape[1], steps) if batch else 1
     scanned = {}
     if batch and shape[1] > SCAN_BATCH:
-        scanner = kern.scan if be == "numba" else scan_states
+        scanner = (lambda arr: kern.scan(arr, threads)) if be == "numba" else scan_states
 
         def scan(arr):
             scanned["result"] = scanner(arr)
@@ -338,7 +345,7 @@ def _prepare(system, kern, h, steps, every, x0, params, backend, chunk, check_st
     if check_stable:
         check_stability(kern, h, K, params)
     check_range(kern, X, K, columns=scanned["result"][2] if scanned else None)
-    return _Run(h=h, steps=steps, every=every, X=X, backend=be, K=K, chunk=chunk, fallback=fallback)
+    return _Run(h=h, steps=steps, every=every, X=X, backend=be, K=K, chunk=chunk, fallback=fallback, workers=threads)
 
 
 def _interpret_small(kern, steps, shape, kahan, fma=False):

@@ -66,14 +66,14 @@ from pathlib import Path
 
 import numpy as np
 
-from ..compiled import cache_variant, enable_private_cache
+from ..compiled import cache_variant, enable_private_cache, fused_multiply_add
 from ..compiled import numba_available  # noqa: F401  (re-exported: nambu_bch.numeric.numba_available)
 from ..errors import InvalidRunError, NumericalRangeError
 from ..atomic import write_atomic
 from ..private_dirs import cache_root, private_directory, read_private, untrusted
 from ..integrators.composition import composition_for
 from ..integrators.step import parameter_values
-from .codegen import PAIR_FUNCTION, TEMPLATE_VERSION, python_source, source_hash, step_program
+from .codegen import FMA_FUNCTION, PAIR_FUNCTION, TEMPLATE_VERSION, python_source, source_hash, step_program
 
 from .guards import BACKENDS, linear_part  # the accepted names live with the other checks of a run's inputs
 #: numba's fast-math flags of a run with ``fma=True``: contraction of ``a*b + c`` into one fused
@@ -133,7 +133,8 @@ MAX_CACHE_FILE = 4 * 2**20
 _MODULE_NAME = re.compile(r"nambu_bch_kernel_[0-9a-f]{20}")
 _INDEX_FIELDS = {"template": str, "module": str, "sha256": str, "N": int, "n_constants": int,
                  "n_parameters": int, "linear": list}
-_FUNCTIONS = ("constants", "run", "run_kahan", "run_batch", "run_batch_kahan", "run_numpy", "run_numpy_kahan")
+_FUNCTIONS = ("constants", "run", "run_fma", "run_kahan", "run_batch", "run_batch_kahan", "run_numpy",
+              "run_numpy_kahan")
 
 
 def input_key(system, comp) -> str:
@@ -310,7 +311,8 @@ class Kernel:
 
     def function(self, name: str, backend: str = "numba"):
         """The loop ``name`` (``run``, ``run_kahan``, ``run_batch``, ``run_batch_kahan``, each optionally with the
-        suffix ``+contract`` of :meth:`loop_name`: compiled with :data:`CONTRACT`) for ``backend``."""
+        suffix ``+contract`` of :meth:`loop_name`: compiled with :data:`CONTRACT`; ``run+contract`` is the generated
+        ``run_fma``, whose fused multiply-adds are written out) for ``backend``."""
         name, plus, _ = name.partition("+")
         fma = bool(plus)
         if backend == "numpy":  # the interpreter never contracts
@@ -325,11 +327,15 @@ class Kernel:
             if name.startswith("run_batch") and hasattr(self.module, PAIR_FUNCTION):
                 # the batch loops' redo calls the shared-exponential function: compiled, it is a global of theirs
                 self.module.__dict__[PAIR_FUNCTION] = self.function(PAIR_FUNCTION)
-            py = getattr(self.module, name)
+            source = name
+            if fma and name == "run":  # one trajectory: the fused multiply-adds written out (codegen.fused_product)
+                source = "run_fma"
+                self.module.__dict__[FMA_FUNCTION] = fused_multiply_add()
+            py = getattr(self.module, source)
             py = getattr(py, "py_func", py)  # the compiled pair function stands in the module once bound
             fn = numba.njit(nogil=True, fastmath=set(CONTRACT) if fma else False, error_model="numpy")(py)
             if self.path.is_file():  # numba caches next to a source file; without one, compile in memory
-                enable_private_cache(fn, self.directory / "__pycache__")
+                enable_private_cache(fn, self.directory / "__pycache__", name)
             self._jitted[key] = fn
         return fn
 
@@ -356,19 +362,25 @@ class Kernel:
         body = self.source.partition("\ndef run_numpy(")[2]
         return not (set(re.findall(r"\b_np_(\w+)\(", body)) - {"isfinite", "sqrt"})
 
-    def scan(self, X):
+    def scan(self, X, workers=1):
         """One compiled pass over a batch ``X`` (N, B): ``(non-finite count, subnormal count, columns)``.
 
         ``columns`` are the extreme states of :func:`~nambu_bch.numeric.guards.extreme_states`
         (largest / smallest max-norm and product of magnitudes, smallest non-zero component).
-        The pass does not depend on the system: :func:`nambu_bch.numeric.scan.scan`, compiled once
-        for all kernels.
+        The pass does not depend on the system: :func:`nambu_bch.numeric.scan.scan_range`, compiled once
+        for all kernels.  ``workers``: threads, each scanning the column range it will advance
+        (:func:`column_ranges`); their results combine into the one-pass result exactly
+        (:func:`nambu_bch.numeric.scan.combine`).
         """
-        from .scan import scan
+        from .scan import RESULT_SIZE, combine, scan_range
 
-        res = np.zeros(7, dtype=np.int64)
-        scan(X, res)
-        return int(res[0]), int(res[1]), np.unique(np.concatenate([res[2:], [0, X.shape[1] - 1]]))
+        def part(lo, hi):
+            res = np.zeros(RESULT_SIZE, dtype=np.int64)
+            scan_range(X, lo, hi, res)
+            return res
+
+        res = combine(_on_threads(part, column_ranges(X.shape[1], NUMBA_CHUNK, workers)))
+        return int(res[0]), int(res[1]), np.unique(np.concatenate([res[2:7], [0, X.shape[1] - 1]]))
 
     def compile(self, kahan: bool = False, batch: bool = False, fma: bool = False) -> float:
         """Compile (or load from the disk cache) one loop now; the wall time in seconds."""
@@ -464,13 +476,23 @@ class Kernel:
         fn = self.function(self.loop_name(kahan, True, fma))
         chunk = int(chunk or NUMBA_CHUNK)
         call = lambda lo, hi: int(fn(*args, K, int(steps), int(every), out, chunk, *flags, lo, hi))  # noqa: E731
-        ranges = column_ranges(B, chunk, workers)
-        if len(ranges) <= 1:
-            return call(0, B)
-        from concurrent.futures import ThreadPoolExecutor
+        return sum(_on_threads(call, column_ranges(B, chunk, workers)))
 
-        with ThreadPoolExecutor(len(ranges)) as pool:
-            return sum(pool.map(lambda r: call(*r), ranges))
+
+def _on_threads(call, ranges) -> list:
+    """``[call(lo, hi) for lo, hi in ranges]``, the first range on the calling thread and each other one on a
+    thread of its own (``call`` must release the GIL to gain: the compiled loops do, ``nogil=True``).
+
+    The calling thread works instead of waiting, so ``w`` ranges start ``w - 1`` threads.
+    """
+    if len(ranges) <= 1:
+        return [call(*r) for r in ranges]
+    from concurrent.futures import ThreadPoolExecutor
+
+    with ThreadPoolExecutor(len(ranges) - 1) as pool:
+        rest = [pool.submit(call, *r) for r in ranges[1:]]
+        first = call(*ranges[0])
+        return [first] + [f.result() for f in rest]
 
 
 def column_ranges(batch: int, chunk: int, workers: int) -> list:
