@@ -193,7 +193,7 @@ def p_series_modified_equation(system, method, order: int = 2):
     [False, True, False]
     """
     from ..integrators.runge_kutta import partitioned_tableau
-    from ..systems.system import as_system
+    from ..systems.spec import as_system
     from .modified import ModifiedEquation, _canonical_half, _polynomial_field, differentials
 
     system = as_system(system)

@@ -231,7 +231,7 @@ def density_brackets(system, method="kahan", order: int = 2, density=None, degre
     """
     from ..bseries.kahan import euler_top_density
     from ..integrators.runge_kutta import TABLEAUX, butcher_tableau
-    from ..systems.system import as_system
+    from ..systems.spec import as_system
     from .api import _divergence_decision, shadow_hamiltonians
     from .family import ShadowFamily
 
