@@ -66,7 +66,7 @@ SURFACE = {
     "nambu_bch.numeric": (
         "CheckResult", "DriftFit", "FigureSet", "HScan", "Kernel", "NumericalShadow", "OrderFit", "PrecisionStudy",
         "Progress", "RunningStats", "ShadowTrajectory", "StepProgram", "TruncationStudy", "cache_dir", "check",
-        "drift_rate", "fit_order", "h_scan", "iterate", "iterate_chunks", "kernel", "n_samples", "numba_available",
+        "drift_rate", "fit_order", "h_scan", "iterate", "iterate_chunks", "iterate_complex", "kernel", "n_samples", "numba_available",
         "numerical_shadow", "observed_order",
         "paper_figures", "precision_study", "quantities", "rk_iterate", "rk_step_function", "sample_steps",
         "sample_times", "shadow_along", "step_program", "truncation_study",

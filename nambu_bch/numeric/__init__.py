@@ -3,12 +3,14 @@
 ``iterate`` runs a scheme (numba kernels generated once from the exact sub-flows, numpy and
 mpmath fallbacks, optional Kahan summation); ``check`` measures every error the package
 predicts; ``paper_figures`` redraws Figs. 1-4; ``shadow_along``
-evaluates the shadow pair along any trajectory, ``numerical_shadow`` the Skeel-Hardy shadow Hamiltonian
+evaluates the shadow pair along any trajectory, ``iterate_complex`` runs compositions with complex coefficients in
+complex128, ``numerical_shadow`` the Skeel-Hardy shadow Hamiltonian
 from a canonical trajectory alone; the studies answer speed-versus-accuracy questions.
 """
 
 from ..progress import Progress
 from .codegen import StepProgram, step_program
+from .complex_iterate import iterate_complex
 from .diagnostics import (CheckResult, DriftFit, OrderFit, RunningStats, check, drift_rate, fit_order, observed_order,
                           quantities)
 from .figures import FigureSet, paper_figures
@@ -41,6 +43,7 @@ __all__ = [
     "h_scan",
     "iterate",
     "iterate_chunks",
+    "iterate_complex",
     "kernel",
     "n_samples",
     "numba_available",

@@ -503,7 +503,8 @@ def fi_route(system, word, order: int = 2, degree=None, terms=None) -> FIResult:
         )
     if terms is not None and order != power:
         raise InvalidOrderError(f"terms= gives the h^{power} brackets only; got order={order!r}")
-    alg = system.algebra
+    # the commutators' coefficients lie in the composition's field (QQ(i), QQ(2^(1/3)), ...): solve over it
+    alg = system.algebra.with_constants(extension=comp.extension)
     atoms, per_slot = _atoms(system)
     ctx = {"algebra": alg, "atoms": atoms, "per_slot": per_slot}
     if terms is None:
