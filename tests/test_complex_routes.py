@@ -128,6 +128,16 @@ def test_complex_shadow_pair_prints_i_and_reads_back(ho3_families):
     assert "I" in data["series"]["G_S"]["3"]
 
 
+def test_a_complex_coefficient_is_printed_as_real_and_imaginary_parts():
+    """``factor`` would pull ``I`` out of ``a + b I`` (``I*(b - a I)``); the layout keeps ``factor(a) + I factor(b)``."""
+    from nambu_bch.printing import laid_out
+
+    x, mass = sympy.symbols("x m")
+    [(k, c)] = laid_out({4: sympy.expand((3 + 2 * sympy.I) * (mass + 1) * x**2 / (2 * sympy.cbrt(2)))}, [x])
+    assert k == 4 and sympy.expand(c - (3 + 2 * sympy.I) * (mass + 1) * x**2 / (2 * sympy.cbrt(2))) == 0
+    assert str(c) == "x**2*(3*2**(2/3)*(m + 1)/4 + 2**(2/3)*I*(m + 1)/2)"     # real part + I * imaginary part
+
+
 def test_fi_route_over_an_algebraic_field():
     """The FI route solves over the composition's field: yoshida:121 (QQ(2^(1/3))) and S2 (QQ(i)) match the direct
     route (before, it converted the commutators' coefficients into QQ(params) and failed)."""
