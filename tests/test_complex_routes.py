@@ -188,6 +188,8 @@ def test_complex_runs_refuse_what_they_cannot_do():
         nb.iterate("ho", S2, 0.1, 10, [1.0, 0.0], kahan=True)
     with pytest.raises(InvalidRunError, match="branch cut or a pole"):
         iterate_complex("kepler", "1:1/2+I/2,2:1,1:1/2-I/2", 0.01, 2, None)
+    with pytest.raises(InvalidRunError, match="compiled float64 kernels take real ones"):
+        list(nb.numeric.iterate_chunks("ho", S2, 0.1, 10, [1.0, 0.0]))
 
 
 def test_check_of_a_complex_method_measures_the_complex_shadow_pair():

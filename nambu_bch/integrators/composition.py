@@ -142,8 +142,8 @@ class Composition:
 
     @property
     def is_complex(self) -> bool:
-        """Some coefficient is not real (``1/4 + I/4``): supported by the error constants, the order and formal BCH
-        so far; :meth:`check` refuses it on a system."""
+        """Some coefficient is not real (``1/4 + I/4``): the exact routes then work over ``QQ(i)`` (:attr:`extension`
+        holds ``I``), the numerics in complex128 (:mod:`nambu_bch.numeric.complex_iterate`)."""
         return any(c.has(sympy.I) and not c.is_real for c in self.coefficients)
 
     def remainder_power(self, order: int) -> int:
