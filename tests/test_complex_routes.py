@@ -128,6 +128,15 @@ def test_complex_shadow_pair_prints_i_and_reads_back(ho3_families):
     assert "I" in data["series"]["G_S"]["3"]
 
 
+def test_results_over_qq_i_pickle_to_equal_values(ho3_families):
+    """Rings over QQ(i) reduce to their description (docs/architecture.md): a worker's result equals the original."""
+    import pickle
+
+    D = ho3_families["direct"]
+    X = effective_field(nb.model("ho").splitting, S2, 3)
+    assert pickle.loads(pickle.dumps(D)) == D and pickle.loads(pickle.dumps(X)) == X
+
+
 def test_a_complex_coefficient_is_printed_as_real_and_imaginary_parts():
     """``factor`` would pull ``I`` out of ``a + b I`` (``I*(b - a I)``); the layout keeps ``factor(a) + I factor(b)``."""
     from nambu_bch.printing import laid_out
