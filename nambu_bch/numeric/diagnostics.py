@@ -366,6 +366,9 @@ def check(system, word, h, steps, x0=None, params=None, *, order=2, alpha=0.5, e
         :data:`QUANTITY_NAMES`) -- and solution kinds ``"o"``, ``"c"``, ``"s"``
     chunk_samples : int, optional -- samples per streamed block (tuning and tests)
 
+    A composition with complex coefficients runs in complex128 instead
+    (:func:`~nambu_bch.numeric.complex_iterate.complex_check`: ``H``, ``G``, ``H_S``, ``G_S``, errors as moduli).
+
     Returns
     -------
     CheckResult -- ``.to_dict()["max_abs_error"]`` has ``H, G, H_c, G_c, H_S, G_S``,

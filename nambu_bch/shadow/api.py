@@ -123,8 +123,7 @@ def _complex_supported(system, comp) -> None:
     if bad is not None:
         raise NambuBCHError(
             f"composition {comp.name[:60]!r} has complex coefficients; its shadow Hamiltonians are computed over "
-            f"QQ(i) for polynomial Hamiltonians only, and {system.name} has {bad} (effective_field and the numerics "
-            "accept it)")
+            f"QQ(i) for polynomial Hamiltonians only, and {system.name} has {bad} (effective_field accepts it)")
 
 
 def _runge_kutta_family(system, tableau, order, route, degree, existence, params, max_unknowns) -> ShadowFamily:
