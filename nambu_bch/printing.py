@@ -96,12 +96,25 @@ def _coefficients(expr, gens):
     return sorted(((m, c) for m, c in out if c != 0), reverse=True)
 
 
+def _factored(c):
+    """``factor(c)``; a complex coefficient as ``factor(a) + I*factor(b)`` (``a``, ``b`` free of ``I``), so that
+    ``factor`` does not pull ``I`` out of ``a + b I`` and print ``I*(b - a I)``."""
+    if not c.has(sympy.I):
+        return sympy.factor(c)
+    c = sympy.expand(c)
+    b = c.coeff(sympy.I)
+    a = sympy.expand(c - sympy.I * b)
+    if a.has(sympy.I) or b.has(sympy.I):
+        return sympy.factor(c)
+    return sympy.factor(a) + sympy.I * sympy.factor(b)
+
+
 def _by_monomial(expr, coordinates):
     """The expanded ``expr`` as a sum over monomials of the coordinates, each coefficient factored (unevaluated Add)."""
     coefficients = _coefficients(expr, coordinates) if coordinates else None
     if coefficients is None:
         return sympy.factor(expr)
-    terms = [sympy.factor(c) * sympy.Mul(*(x**e for x, e in zip(coordinates, m))) for m, c in coefficients]
+    terms = [_factored(c) * sympy.Mul(*(x**e for x, e in zip(coordinates, m))) for m, c in coefficients]
     if not terms:
         return sympy.Integer(0)
     return sympy.Add(*terms, evaluate=False) if len(terms) > 1 else terms[0]

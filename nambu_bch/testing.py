@@ -267,7 +267,8 @@ def _shadow_residuals(system, hams, X_eff, order):
 
     allowed = set(system.coordinates) | set(system.parameters) | {STEP}
     extra = sorted(set().union(*(Hk.free_symbols for Hk in hams)) - allowed, key=str)
-    algebra = system.algebra.with_constants(STEP, *extra)
+    # complex or radical coefficients (1/4 + I/4, 2^(1/3)): the ring over the composition's field
+    algebra = system.algebra.with_constants(STEP, *extra, extension=X_eff.composition.extension)
     converted = [algebra.convert(Hk) for Hk in hams]
     if all(algebra.is_polynomial(c) for c in converted):
         X_S = liouville_field(algebra, *converted)

@@ -158,9 +158,11 @@ def test_complex_formal_bch_agrees_with_the_defects():
     assert B.terms(2) == [(sympy.I / 2, (1, 2))]
 
 
-def test_complex_coefficients_refused_on_a_system():
-    with pytest.raises(InvalidCompositionError, match="complex coefficients.*not yet on a system"):
-        nb.effective_field(nb.model("ho").splitting, "1:1/2+I/2,2:1,1:1/2-I/2", order=2)
+def test_complex_coefficients_on_a_system():
+    """X_eff over QQ(i): Z_1 = (i/2) [X_1, X_2] on ho (tests/test_complex_routes.py checks the routes)."""
+    X = nb.effective_field(nb.model("ho").splitting, "1:1/2+I/2,2:1,1:1/2-I/2", order=2)
+    omega, x1, x2 = sympy.symbols("omega x1 x2")
+    assert X[1].to_sympy() == (sympy.I * omega**2 * x1 / 2, -sympy.I * omega**2 * x2 / 2)   # [X1, X2] = (w^2 x1, -w^2 x2)
 
 
 def test_ab_column_of_blanes_moan_s10():

@@ -232,6 +232,8 @@ def _base_table():
                                                               x0=(1.0, 0.0)),
         "nambu_bch.numeric.gradient_check": lambda v: dict(system=v["ho"], method="chin-4a", h=0.2, steps=5, x0=(1.0, 0.0),
                                                            halvings=1),
+        "nambu_bch.numeric.iterate_complex": lambda v: dict(system=v["ho"], word="1:1/2+I/2,2:1,1:1/2-I/2", h=0.1,
+                                                           steps=10, x0=(1.0, 0.0)),
         "nambu_bch.numeric.sample_times": lambda v: dict(h=0.1, steps=10),
         "nambu_bch.shadow_along": lambda v: dict(system=v["ho3"], word="12321", trajectory=[[1.0, 1.0, 1.0]] * 4, h=0.1,
                                                  which=("H", "H_S")),

@@ -64,6 +64,8 @@ ENTRIES = {
     "iterate": (numeric.iterate, dict(system=S, word="32123", h=0.1, steps=10, x0=[1.0, 1.0, 1.0], params=None,
                                        every=1, kahan=False, dps=None, backend="auto", progress=False, chunk=None,
                                        check_stable=True, out=None, fma=False, workers=None)),
+    "iterate_complex": (numeric.iterate_complex, dict(system="ho", word="1:1/2+I/2,2:1,1:1/2-I/2", h=0.1, steps=10,
+                                                      x0=[1.0, 0.0], params=None, every=1, project=False)),
     "iterate_chunks": (_chunks, dict(system=S, word="32123", h=0.1, steps=10, x0=[1.0, 1.0, 1.0], every=1,
                                      chunk_samples=4)),
     "check": (numeric.check, dict(system=S, word="32123", h=0.1, steps=10, x0=[1.0, 1.0, 1.0], params=None, order=2,

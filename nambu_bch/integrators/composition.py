@@ -137,12 +137,13 @@ class Composition:
         for c in self.coefficients:
             if not c.is_Rational:
                 atoms |= {sympy.root(a.base, a.exp.q) for a in c.atoms(sympy.Pow) if a.exp.is_Rational and not a.exp.is_Integer}
-        return tuple(sorted(atoms, key=str))
+        # complex coefficients a + b*I: the field QQ(i, ...) -- I is no power, so it is added by name
+        return tuple(sorted(atoms, key=str)) + ((sympy.I,) if self.is_complex else ())
 
     @property
     def is_complex(self) -> bool:
-        """Some coefficient is not real (``1/4 + I/4``): supported by the error constants, the order and formal BCH
-        so far; :meth:`check` refuses it on a system."""
+        """Some coefficient is not real (``1/4 + I/4``): the exact routes then work over ``QQ(i)`` (:attr:`extension`
+        holds ``I``), the numerics in complex128 (:mod:`nambu_bch.numeric.complex_iterate`)."""
         return any(c.has(sympy.I) and not c.is_real for c in self.coefficients)
 
     def remainder_power(self, order: int) -> int:
@@ -184,12 +185,6 @@ class Composition:
             )
         n = len(splitting)
         name = getattr(splitting.system, "name", "the system")
-        if self.is_complex:
-            raise InvalidCompositionError(
-                f"composition {_shown(self.name)} has complex coefficients; they are supported by error_constant, "
-                "error_analysis, composition_order and formal_bch so far, not yet on a system (X_eff, shadow "
-                "Hamiltonians, numerics)"
-            )
         extra = sorted({k for k in self.pieces if k > n})
         if extra:
             raise UnknownPieceError(

@@ -3,13 +3,15 @@
 ``iterate`` runs a scheme (numba kernels generated once from the exact sub-flows, numpy and
 mpmath fallbacks, optional Kahan summation); ``check`` measures every error the package
 predicts; ``paper_figures`` redraws Figs. 1-4; ``shadow_along``
-evaluates the shadow pair along any trajectory, ``numerical_shadow`` the Skeel-Hardy shadow Hamiltonian
-from a canonical trajectory alone; ``hybrid_monte_carlo`` samples exp(-H) or the shadow exp(-H_S) with
-the schemes, canonical or Nambu; the studies answer speed-versus-accuracy questions.
+evaluates the shadow pair along any trajectory, ``iterate_complex`` runs compositions with complex coefficients in
+complex128, ``numerical_shadow`` the Skeel-Hardy shadow Hamiltonian from a canonical trajectory alone;
+``hybrid_monte_carlo`` samples exp(-H) or the shadow exp(-H_S) with the schemes, canonical or Nambu; the studies
+answer speed-versus-accuracy questions.
 """
 
 from ..progress import Progress
 from .codegen import StepProgram, step_program
+from .complex_iterate import iterate_complex
 from .diagnostics import (CheckResult, DriftFit, OrderFit, RunningStats, check, drift_rate, fit_order, observed_order,
                           quantities)
 from .figures import FigureSet, paper_figures
@@ -50,6 +52,7 @@ __all__ = [
     "hybrid_monte_carlo",
     "iterate",
     "iterate_chunks",
+    "iterate_complex",
     "iterate_gradient",
     "iterate_processed",
     "kernel",

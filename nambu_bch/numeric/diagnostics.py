@@ -249,6 +249,8 @@ class CheckResult:
     seconds: float = 0.0
     skipped: dict = field(default_factory=dict)
     system: object = field(default=None, repr=False, compare=False)  # for the JSON head (coordinates, parameters)
+    #: how the run computed: float64, or complex128 for complex coefficients (:mod:`.complex_iterate`)
+    arithmetic: str = "float64"
 
     def to_dict(self) -> dict:
         """JSON-ready: ``{"model", "integrator", "h", "steps", ..., "max_abs_error": {...}, "drift_rate": {...}}``,
@@ -266,10 +268,12 @@ class CheckResult:
             "max_abs_error": {k: _json_float(v) for k, v in self.max_abs_error.items()},
             "drift_rate": {k: _json_float(v) for k, v in self.drift_rate.items()},
             **({"skipped": dict(self.skipped)} if self.skipped else {}),
+            **({"arithmetic": self.arithmetic} if self.arithmetic != "float64" else {}),
         }
 
     def __str__(self):
-        lines = [f"{self.model} {self.integrator}: h = {self.h}, {self.steps} steps"]
+        complex_run = f" ({self.arithmetic}; |Q(t) - Q(0)| of complex Q)" if self.arithmetic != "float64" else ""
+        lines = [f"{self.model} {self.integrator}: h = {self.h}, {self.steps} steps{complex_run}"]
         lines += [f"  max |{_label(k)}| = {v:.3e}" for k, v in self.max_abs_error.items()]
         lines += [f"  {k}: not evaluated ({why})" for k, why in self.skipped.items()]
         return "\n".join(lines)
@@ -362,6 +366,9 @@ def check(system, word, h, steps, x0=None, params=None, *, order=2, alpha=0.5, e
         :data:`QUANTITY_NAMES`) -- and solution kinds ``"o"``, ``"c"``, ``"s"``
     chunk_samples : int, optional -- samples per streamed block (tuning and tests)
 
+    A composition with complex coefficients runs in complex128 instead
+    (:func:`~nambu_bch.numeric.complex_iterate.complex_check`: ``H``, ``G``, ``H_S``, ``G_S``, errors as moduli).
+
     Returns
     -------
     CheckResult -- ``.to_dict()["max_abs_error"]`` has ``H, G, H_c, G_c, H_S, G_S``,
@@ -400,6 +407,13 @@ def check(system, word, h, steps, x0=None, params=None, *, order=2, alpha=0.5, e
 
     comp = runge_kutta_method(word) or make_composition(word, len(system.splitting))  # a Runge-Kutta method runs too
     name = word if isinstance(word, str) else str(comp)
+    if getattr(comp, "is_complex", False):  # a complex map: complex128 on its own path
+        if kahan:
+            raise InvalidRunError(f"kahan=True applies to float64 runs; {name!r} has complex coefficients and runs in "
+                                  "complex128")
+        from .complex_iterate import complex_check
+
+        return complex_check(system, word, h, steps, x0, params, order=order, alpha=alpha, every=every, include=include)
     alpha = finite_float(alpha, "alpha")
     order = check_order(order)
     given, (x0, _) = x0, initial_state(system, x0)  # the run resolves None itself, and names it as the default

@@ -157,6 +157,8 @@ def iterate(system, word, h, steps, x0=None, params=None, every=1, *, kahan=Fals
         check_flag(check_stable, "check_stable")  # no stability interval to check: Newton's failure is the guard
         check_flag(progress, "progress", none=True)
         return iterate_runge_kutta(system, tableau, h, steps, x0, params, every, kahan=kahan, backend=backend, out=out)
+    if _complex(system, word):  # a complex map: complex128 on its own path (numeric/complex_iterate.py)
+        return _iterate_complex(system, word, h, steps, x0, params, every, kahan, dps, out, fma)
     from .force_gradient import is_gradient_method
 
     if is_gradient_method(word):  # a force-gradient composition or a processed kernel: its own numpy loop
@@ -427,6 +429,25 @@ def iterate_chunks(system, word, h, steps, x0=None, params=None, every=1, *, kah
             check_result(out, numbers, what)
             done += seg
             yield numbers[1:], out[1:]
+
+
+def _complex(system, word) -> bool:
+    """``word`` is a composition with complex coefficients (checked against the system's splitting)."""
+    from ..integrators.composition import composition_for
+
+    return composition_for(word, system.splitting).is_complex
+
+
+def _iterate_complex(system, word, h, steps, x0, params, every, kahan, dps, out, fma):
+    """:func:`~nambu_bch.numeric.complex_iterate.iterate_complex`, the float64-only options refused in one line."""
+    from .complex_iterate import iterate_complex
+
+    for flag, given in (("kahan=True", check_flag(kahan, "kahan")), ("dps=...", dps is not None),
+                        ("out=...", out is not None), ("fma=True", check_flag(fma, "fma"))):
+        if given:
+            raise InvalidRunError(f"{flag} applies to float64 runs; {str(word)[:60]!r} has complex coefficients and "
+                                  "runs in complex128 (numeric.complex_iterate)")
+    return iterate_complex(system, word, h, steps, x0, params, every)
 
 
 def _runge_kutta_options(tableau, dps, fma) -> None:

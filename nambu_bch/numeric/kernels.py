@@ -538,4 +538,8 @@ def _kernel_for_word(system, word, directory):
 
 @lru_cache(maxsize=64)
 def _kernel(system, comp, directory):
+    if comp.is_complex:  # the generated loops are float64: complex coefficients run on their own complex128 path
+        raise InvalidRunError(
+            f"composition {comp.name[:60]!r} has complex coefficients; the compiled float64 kernels take real ones: "
+            "iterate and check run it in complex128 (nambu_bch.numeric.iterate_complex)")
     return Kernel(system, comp)

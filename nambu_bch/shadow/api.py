@@ -99,6 +99,8 @@ def shadow_hamiltonians(system, word, order: int = 2, route: str = "direct", deg
     if tableau is not None:
         return _runge_kutta_family(system, tableau, order, route, degree, existence, params, max_unknowns)
     comp = composition_for(word, system.splitting)
+    if comp.is_complex:
+        _complex_supported(system, comp)
     if route == "direct":
         R = direct_route(system, comp, order, degree, max_unknowns, progress=progress)
         return ShadowFamily.from_direct(system, comp, order, R, _decision(R, existence, params), max_unknowns=max_unknowns)
@@ -108,6 +110,20 @@ def shadow_hamiltonians(system, word, order: int = 2, route: str = "direct", deg
     # the FI ansatz failing is no certificate: the direct route and the orbit averages decide
     D = direct_route(system, comp, order, None, max_unknowns) if existence and not R.exists else None
     return ShadowFamily.from_fi(system, comp, order, R, _decision(D, existence, params), direct=D)
+
+
+def _complex_supported(system, comp) -> None:
+    """Complex coefficients reach the routes over ``QQ(i)(parameters)[x]``: polynomial Hamiltonians only.
+
+    The non-polynomial routes (the extended ring of exp/trig/radical atoms, the generic BCH series on the pieces'
+    Hamiltonians) keep rational scalars, so they are refused here in one line rather than failing inside.
+    """
+    alg = system.algebra
+    bad = next((H for H in system.hamiltonians if not alg.is_polynomial(alg.convert(H))), None)
+    if bad is not None:
+        raise NambuBCHError(
+            f"composition {comp.name[:60]!r} has complex coefficients; its shadow Hamiltonians are computed over "
+            f"QQ(i) for polynomial Hamiltonians only, and {system.name} has {bad} (effective_field accepts it)")
 
 
 def _runge_kutta_family(system, tableau, order, route, degree, existence, params, max_unknowns) -> ShadowFamily:

@@ -494,7 +494,8 @@ def fi_route(system, word, order: int = 2, degree=None, terms=None) -> FIResult:
     """
     system = as_system(system)
     comp, power = _checked_request(system, word, order, terms)
-    alg = system.algebra
+    # the commutators' coefficients lie in the composition's field (QQ(i), QQ(2^(1/3)), ...): solve over it
+    alg = system.algebra.with_constants(extension=comp.extension)
     atoms, per_slot = _atoms(system)
     ctx = {"algebra": alg, "atoms": atoms, "per_slot": per_slot}
     commutators = _commutators(system, comp, power, terms, atoms)
