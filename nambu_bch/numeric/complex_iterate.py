@@ -39,8 +39,7 @@ import cmath
 import numpy as np
 import sympy
 
-from ..bch.backward import check_order
-from ..checks import check_flag, finite_float
+from ..checks import check_flag
 from ..errors import InvalidRunError, NumericalRangeError
 from ..integrators.composition import composition_for
 from ..integrators.flows import TIME, exact_flow
@@ -114,7 +113,7 @@ def iterate_complex(system, word, h, steps, x0=None, params=None, every=1, *, pr
     >>> x.dtype, x.shape, bool(abs(x[-1].imag).max() > 0)
     (dtype('complex128'), (11, 2), True)
     """
-    from .iterate import as_system
+    from ..systems.spec import as_system
 
     system = as_system(system)
     project = check_flag(project, "project")
@@ -151,62 +150,3 @@ def iterate_complex(system, word, h, steps, x0=None, params=None, every=1, *, pr
                         "a smaller h")
                 j += 1
     return out
-
-
-def complex_check(system, word, h, steps, x0=None, params=None, *, order=2, alpha=0.5, every=1, project=False,
-                  include=None):
-    """:func:`nambu_bch.numeric.check` for a composition with complex coefficients: errors of ``H``, ``G`` and the
-    complex shadow pair ``H_S, G_S`` along :func:`iterate_complex`.
-
-    ``include`` takes the names :func:`~nambu_bch.numeric.check` takes; of them ``H``, ``G``, ``H_S``, ``G_S`` are
-    evaluated.  Each quantity ``Q`` (complex in general: ``H_S`` has imaginary coefficients) is evaluated in complex128 on
-    every sample; ``max_abs_error[Q] = max_n |Q(x_n) - Q(x_0)|`` (the modulus) and ``drift_rate[Q]`` is the
-    least-squares slope of ``|Q(x_n) - Q(x_0)|`` against ``t_n``.  With ``project=True`` (the real run
-    ``Re Phi_h``) ``Q`` is replaced by its real part ``Re Q`` (the states are real; the imaginary terms of
-    ``H_S`` describe the complex map, which the projection discards).  The conserved quantities and exact solutions of
-    :mod:`nambu_bch.exact` are real constructions and are not evaluated.
-
-    Returns
-    -------
-    CheckResult -- with ``arithmetic`` ``"complex128"`` or ``"complex128, real part after every step"``.
-    """
-    import time
-
-    from .diagnostics import QUANTITY_NAMES, CheckResult, RunningStats, _names, quantities
-    from .iterate import as_system
-
-    start = time.perf_counter()
-    system = as_system(system)
-    alpha, order = finite_float(alpha, "alpha"), check_order(order)
-    # the names check() accepts; of them the complex run evaluates H, G, H_S, G_S (the rest are real constructions)
-    everything = QUANTITY_NAMES + tuple("ocs")
-    include = _names(include, everything, "include") if include is not None else everything
-    include = [q for q in include if q in ("H", "G", "H_S", "G_S")]
-    samples = iterate_complex(system, word, h, steps, x0, params, every, project=project)
-    skipped = {}
-    exprs = quantities(system, word, h, params, order, alpha, which=include, skipped=skipped)
-    t = float(h) * sample_steps(steps, every).astype(np.float64)
-    comp = composition_for(word, system.splitting)
-    result = CheckResult(system.name, word if isinstance(word, str) else comp.name, float(h), int(steps), int(every),
-                         [float(v) for v in samples[0].real],
-                         {p.name: v for p, v in parameter_values(system, params).items()}, int(order), float(alpha),
-                         system=system,
-                         arithmetic="complex128, real part after every step" if project else "complex128")
-    with np.errstate(all="ignore"):
-        for name, expr in exprs.items():
-            fn = sympy.lambdify(system.coordinates, expr, modules="numpy")
-            cols = [np.asarray(samples[:, i], dtype=np.complex128) for i in range(system.N)]
-            values = np.broadcast_to(np.asarray(fn(*cols), dtype=np.complex128), cols[0].shape)
-            if project:  # a real run: the real part of Q (H_S's imaginary terms belong to the complex map)
-                values = values.real
-            err = np.abs(values - values[0])
-            if not np.isfinite(err).all():
-                raise NumericalRangeError(f"{name} is not finite along the complex run of {comp.name} on {system.name}; "
-                                          "rescale the initial state or the parameters")
-            acc = RunningStats()
-            acc.add(t, err)
-            result.max_abs_error[name] = acc.max_abs
-            result.drift_rate[name] = acc.rate
-    result.skipped = skipped
-    result.seconds = time.perf_counter() - start
-    return result

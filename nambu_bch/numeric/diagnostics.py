@@ -40,7 +40,7 @@ from ..integrators.composition import composition as make_composition
 from ..integrators.step import parameter_values
 from .guards import MAX_RUN_STEPS, check_count, finite_array, initial_state
 from .iterate import as_system, iterate
-from .samples import sample_times
+from .samples import sample_steps, sample_times
 from ..symbols import ALPHA, STEP
 
 
@@ -367,7 +367,7 @@ def check(system, word, h, steps, x0=None, params=None, *, order=2, alpha=0.5, e
     chunk_samples : int, optional -- samples per streamed block (tuning and tests)
 
     A composition with complex coefficients runs in complex128 instead
-    (:func:`~nambu_bch.numeric.complex_iterate.complex_check`: ``H``, ``G``, ``H_S``, ``G_S``, errors as moduli).
+    (:func:`complex_check`: ``H``, ``G``, ``H_S``, ``G_S``, errors as moduli).
 
     Returns
     -------
@@ -411,8 +411,6 @@ def check(system, word, h, steps, x0=None, params=None, *, order=2, alpha=0.5, e
         if kahan:
             raise InvalidRunError(f"kahan=True applies to float64 runs; {name!r} has complex coefficients and runs in "
                                   "complex128")
-        from .complex_iterate import complex_check
-
         return complex_check(system, word, h, steps, x0, params, order=order, alpha=alpha, every=every, include=include)
     alpha = finite_float(alpha, "alpha")
     order = check_order(order)
@@ -602,3 +600,62 @@ def observed_order(system, word, hs, T, x0=None, params=None, quantity="x", back
             samples = iterate(system, word, h, n, x0, params, 1, backend=backend)
             errors.append(float(np.max(np.abs(errors_along(samples, exprs, system.coordinates)[quantity]))))
     return fit_order(hs_eff, errors, quantity)
+
+
+def complex_check(system, word, h, steps, x0=None, params=None, *, order=2, alpha=0.5, every=1, project=False,
+                  include=None):
+    """:func:`nambu_bch.numeric.check` for a composition with complex coefficients: errors of ``H``, ``G`` and the
+    complex shadow pair ``H_S, G_S`` along :func:`iterate_complex`.
+
+    ``include`` takes the names :func:`~nambu_bch.numeric.check` takes; of them ``H``, ``G``, ``H_S``, ``G_S`` are
+    evaluated.  Each quantity ``Q`` (complex in general: ``H_S`` has imaginary coefficients) is evaluated in complex128 on
+    every sample; ``max_abs_error[Q] = max_n |Q(x_n) - Q(x_0)|`` (the modulus) and ``drift_rate[Q]`` is the
+    least-squares slope of ``|Q(x_n) - Q(x_0)|`` against ``t_n``.  With ``project=True`` (the real run
+    ``Re Phi_h``) ``Q`` is replaced by its real part ``Re Q`` (the states are real; the imaginary terms of
+    ``H_S`` describe the complex map, which the projection discards).  The conserved quantities and exact solutions of
+    :mod:`nambu_bch.exact` are real constructions and are not evaluated.
+
+    Returns
+    -------
+    CheckResult -- with ``arithmetic`` ``"complex128"`` or ``"complex128, real part after every step"``.
+    """
+    import time
+
+    from ..integrators.composition import composition_for
+    from .complex_iterate import iterate_complex
+
+    start = time.perf_counter()
+    system = as_system(system)
+    alpha, order = finite_float(alpha, "alpha"), check_order(order)
+    # the names check() accepts; of them the complex run evaluates H, G, H_S, G_S (the rest are real constructions)
+    everything = QUANTITY_NAMES + tuple("ocs")
+    include = _names(include, everything, "include") if include is not None else everything
+    include = [q for q in include if q in ("H", "G", "H_S", "G_S")]
+    samples = iterate_complex(system, word, h, steps, x0, params, every, project=project)
+    skipped = {}
+    exprs = quantities(system, word, h, params, order, alpha, which=include, skipped=skipped)
+    t = float(h) * sample_steps(steps, every).astype(np.float64)
+    comp = composition_for(word, system.splitting)
+    result = CheckResult(system.name, word if isinstance(word, str) else comp.name, float(h), int(steps), int(every),
+                         [float(v) for v in samples[0].real],
+                         {p.name: v for p, v in parameter_values(system, params).items()}, int(order), float(alpha),
+                         system=system,
+                         arithmetic="complex128, real part after every step" if project else "complex128")
+    with np.errstate(all="ignore"):
+        for name, expr in exprs.items():
+            fn = sympy.lambdify(system.coordinates, expr, modules="numpy")
+            cols = [np.asarray(samples[:, i], dtype=np.complex128) for i in range(system.N)]
+            values = np.broadcast_to(np.asarray(fn(*cols), dtype=np.complex128), cols[0].shape)
+            if project:  # a real run: the real part of Q (H_S's imaginary terms belong to the complex map)
+                values = values.real
+            err = np.abs(values - values[0])
+            if not np.isfinite(err).all():
+                raise NumericalRangeError(f"{name} is not finite along the complex run of {comp.name} on {system.name}; "
+                                          "rescale the initial state or the parameters")
+            acc = RunningStats()
+            acc.add(t, err)
+            result.max_abs_error[name] = acc.max_abs
+            result.drift_rate[name] = acc.rate
+    result.skipped = skipped
+    result.seconds = time.perf_counter() - start
+    return result

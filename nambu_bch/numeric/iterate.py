@@ -157,12 +157,12 @@ def iterate(system, word, h, steps, x0=None, params=None, every=1, *, kahan=Fals
         check_flag(check_stable, "check_stable")  # no stability interval to check: Newton's failure is the guard
         check_flag(progress, "progress", none=True)
         return iterate_runge_kutta(system, tableau, h, steps, x0, params, every, kahan=kahan, backend=backend, out=out)
-    if _complex(system, word):  # a complex map: complex128 on its own path (numeric/complex_iterate.py)
-        return _iterate_complex(system, word, h, steps, x0, params, every, kahan, dps, out, fma)
     from .force_gradient import is_gradient_method
 
     if is_gradient_method(word):  # a force-gradient composition or a processed kernel: its own numpy loop
         return _gradient_run(system, word, h, steps, x0, params, every, kahan, dps, out, fma)
+    if _complex(system, word):  # a complex map: complex128 on its own path (numeric/complex_iterate.py)
+        return _iterate_complex(system, word, h, steps, x0, params, every, kahan, dps, out, fma)
     x0, origin = initial_state(system, x0)
     check_work(check_count(steps, "steps", 0), x0, mpmath=dps is not None)  # from the request, before any work
     kahan, check_stable = check_flag(kahan, "kahan"), check_flag(check_stable, "check_stable")
