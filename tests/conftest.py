@@ -16,7 +16,11 @@ tests run in both: in the fast tier at a quarter of their example counts, in the
 
 from __future__ import annotations
 
+import contextlib
+import io
 import math
+import os
+import subprocess
 import sys
 import zlib
 from pathlib import Path
@@ -150,7 +154,7 @@ DEEP = (
      ("ho-121", "ho-212", "ho-12", "ho-21", "ho-forest-ruth", "ho3-12321", "ho3-13231", "ho3-31213", "ho3-21312",
       "ho3-23132", "ho3-32123", "ho3-123", "ho3-321", "ho3-composite-121", "ho3-composite-212", "ho3-composite-12",
       "lotka-volterra-123", "rigid-body-123")),
-    ("test_exact_solutions.py", "test_shadow_solution_at_t_equal_h_is_the_map", ("ho3-12321", "ho3-31213", "ho-121")),
+    ("test_exact_solutions.py", "test_shadow_solution_at_t_equal_h_is_the_map", ("ho3-12321", "ho-121")),
     ("test_integrators.py", "test_condition1_rigid_body_all_words", ("12321", "31213")),
     ("test_bseries.py", "test_bseries_equals_taylor_backward_analysis",
      ("euler-ho", "implicit-euler-rigid-body", "midpoint-lotka-volterra", "trapezoid-ho3", "rk4-ho", "kahan-ho3")),
@@ -186,7 +190,61 @@ DEEP = (
     ("test_numeric_parallel.py", "test_threads_give_the_one_thread_bits", ("False-ho3-32123", "True-ho3-32123")),
     # the generic T|V answer against the concrete systems: d = 1 and 2 in the fast tier, the d = 3 quartic (4-6 s)
     ("test_generic_separable.py", "test_substituted_equals_the_concrete_shadow_hamiltonian_d3", ()),
+    # the command line as a subprocess (cli_run): the fast tier runs the same assertions on main(argv) in process; the
+    # process start is test_cli's one subprocess per subcommand (1.4-2.2 s each)
+    ("test_runge_kutta_cli.py", "test_shadow_integrator_gauss4_json_subprocess", ("in-process",)),
+    ("test_runge_kutta_cli.py", "test_shadow_tableau_file_subprocess", ("in-process",)),
+    ("test_runge_kutta_cli.py", "test_check_integrator_midpoint_subprocess", ("in-process",)),
+    ("test_runge_kutta_cli.py", "test_compare_across_families_subprocess", ("in-process",)),
+    ("test_numerical_shadow.py", "test_cli_check_adds_the_numerical_shadow_in_a_subprocess", ("in-process",)),
+    ("test_generic_separable.py", "test_cli_prints_the_generic_answer_as_json", ("in-process",)),
+    # the rigid body (over QQ(I1, I2, I3)) and the other 1.2-3 s rows of tables whose lighter rows stay in the fast tier
+    # (the parametric field: test_elimination's QQ(a,b) row, test_direct_route_flint; the rigid body's numerics and
+    # families: test_numeric, test_shadow, test_any_system's Lie-Poisson member)
+    ("test_any_system.py", "test_new_system_numerics",
+     ("pendulum", "exp-well", "rational", "henon-heiles", "toda", "ho3-pair")),
+    ("test_any_system.py", "test_new_system_shadow_equals_X_eff_two_routes",
+     ("pendulum", "exp-well", "rational", "henon-heiles", "fpu-beta", "toda", "ho3-pair")),
+    ("test_any_system.py", "test_concrete_equals_generic_substituted_to_h4", ("pendulum-Tc0-Vc0", "exp-well-Tc1-Vc1")),
+    ("test_field_backend.py", "test_three_backends_agree_with_plain_sympy", ("ho3", "lotka-volterra", "ho")),
+    ("test_design.py", "test_designed_composition_has_order_four_numerically", ("ho3-None",)),
+    ("test_bseries.py", "test_shadow_pair_field_equals_modified_field", ("ho3-midpoint", "lotka-volterra-midpoint")),
+    ("test_bch_concrete.py", "test_fast_and_plain_representations_agree",
+     ("ho3-12321", "lotka-volterra-123", "ho-forest-ruth")),
 )
+
+#: The two ways :func:`cli_run` runs the command line; the fast tier keeps ``in-process`` (DEEP).
+CLI_RUNNERS = ("in-process", "subprocess")
+REPO = Path(__file__).resolve().parents[1]
+
+
+@pytest.fixture(params=CLI_RUNNERS)
+def cli_run(request, monkeypatch):
+    """``run(*argv, cwd=...)``: ``nambu-bch ARGV`` in the directory ``cwd``, as a ``CompletedProcess``.
+
+    Two cases of every test that asks for it: ``main(argv)`` in this process (stdout and stderr captured, the working
+    directory changed for the call), and ``python -m nambu_bch ARGV`` in a subprocess (the package from this checkout).
+    The same assertions run on both.  The subprocess case is deep (:data:`DEEP`): a process start adds only the
+    interpreter start and the imports, which ``test_cli.py``'s one subprocess per subcommand checks in the fast tier.
+    """
+    def in_process(*args, cwd):
+        from nambu_bch.cli import main
+
+        argv = [str(a) for a in args]
+        out, err = io.StringIO(), io.StringIO()
+        with monkeypatch.context() as m:
+            m.chdir(cwd)
+            with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
+                code = main(argv)
+        return subprocess.CompletedProcess(argv, code, out.getvalue(), err.getvalue())
+
+    def in_subprocess(*args, cwd):
+        env = {**os.environ, "PYTHONPATH": str(REPO)}
+        return subprocess.run([sys.executable, "-m", "nambu_bch", *map(str, args)], cwd=cwd, env=env,
+                              capture_output=True, text=True, timeout=600)
+
+    return in_process if request.param == "in-process" else in_subprocess
+
 
 #: Plugin distributions whose modules pytest marks for assertion rewriting (every module of a distribution with a
 #: ``pytest11`` entry point).  None of them has an ``assert`` the suite relies on (the package has none at all), but

@@ -268,17 +268,9 @@ def test_result_type():
 
 
 # -- the command line ------------------------------------------------------------------------------------
-def test_cli_prints_the_generic_answer_as_json():
-    import os
-    import subprocess
-    import sys
-    from pathlib import Path
-
-    repo = Path(__file__).resolve().parents[1]
-    env = {**os.environ, "PYTHONPATH": str(repo)}
-    run = subprocess.run([sys.executable, "-m", "nambu_bch", "shadow", "--generic-separable", "--integrator", "212",
-                          "--order", "4", "--dim", "2", "--format", "json"],
-                         cwd=repo, env=env, capture_output=True, text=True, timeout=600)
+def test_cli_prints_the_generic_answer_as_json(cli_run, tmp_path):
+    run = cli_run("shadow", "--generic-separable", "--integrator", "212", "--order", "4", "--dim", "2",
+                  "--format", "json", cwd=tmp_path)
     assert run.returncode == 0, run.stderr
     data = json.loads(run.stdout)
     assert data["kind"] == "generic-separable" and data["dimension"] == 2

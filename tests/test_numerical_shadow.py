@@ -10,10 +10,7 @@ potential energies, gives the same values as the system's own run.
 from __future__ import annotations
 
 import json
-import os
 import pickle
-import subprocess
-import sys
 from fractions import Fraction
 
 import numpy as np
@@ -206,11 +203,9 @@ def test_one_dimensional_arrays_are_one_degree_of_freedom():
     assert r.values.size == 57 and r.max_abs_error["H~"] < 1e-2 * r.max_abs_error["H"]
 
 
-def test_cli_check_adds_the_numerical_shadow_in_a_subprocess():
-    env = {**os.environ, "PYTHONPATH": os.pathsep.join(sys.path)}
-    done = subprocess.run([sys.executable, "-m", "nambu_bch", "check", "--model", "ho", "--integrator", "212",
-                           "--x0", "1,0", "--steps", "200", "--numerical-shadow", "6", "--format", "json"],
-                          capture_output=True, text=True, timeout=600, env=env)
+def test_cli_check_adds_the_numerical_shadow_in_a_subprocess(cli_run, tmp_path):
+    done = cli_run("check", "--model", "ho", "--integrator", "212", "--x0", "1,0", "--steps", "200",
+                   "--numerical-shadow", "6", "--format", "json", cwd=tmp_path)
     assert done.returncode == 0, done.stderr
     data = json.loads(done.stdout)
     shadow = data["numerical_shadow"]

@@ -1,4 +1,5 @@
-"""Runge--Kutta methods on the command line and in tableau files: one subprocess per new path, bad input in process.
+"""Runge--Kutta methods on the command line and in tableau files: each new path in process and as a subprocess
+(conftest's ``cli_run``), bad input in process.
 
 Tableau file: Lobatto IIIC with s = 2 (Hairer, Wanner, *Solving ODEs II*, Table IV.5.11: A = [[1/2, -1/2], [1/2, 1/2]],
 b = (1/2, 1/2), order 2); its order conditions of order 3 fail, so claiming 3 is refused.
@@ -7,9 +8,6 @@ b = (1/2, 1/2), order 2); its order conditions of order 3 fail, so claiming 3 is
 from __future__ import annotations
 
 import json
-import subprocess
-import sys
-from pathlib import Path
 
 import pytest
 
@@ -19,7 +17,6 @@ from nambu_bch.integrators.runge_kutta import TABLEAUX
 from nambu_bch.integrators.tableau_file import load_tableau
 from nambu_bch.shadow import shadow_hamiltonians
 
-REPO = Path(__file__).resolve().parents[1]
 LOBATTO = '''name = "lobatto3c"
 reference = "Lobatto IIIC, s = 2; Hairer-Wanner II, Table IV.5.11"
 order = 2
@@ -34,45 +31,37 @@ b = ["1/2", "1/2"]
 '''
 
 
-def _sub(*args, cwd):
-    import os
-
-    env = {**os.environ, "PYTHONPATH": str(REPO)}
-    return subprocess.run([sys.executable, "-m", "nambu_bch", *map(str, args)], cwd=cwd, env=env, capture_output=True,
-                          text=True, timeout=600)
-
-
 def _file(tmp_path, text, name="t.toml"):
     path = tmp_path / name
     path.write_text(text)
     return path
 
 
-def test_shadow_integrator_gauss4_json_subprocess(tmp_path):
-    r = _sub("shadow", "--integrator", "gauss4", "--model", "ho3", "--order", "4", "--format", "json", cwd=tmp_path)
+def test_shadow_integrator_gauss4_json_subprocess(tmp_path, cli_run):
+    r = cli_run("shadow", "--integrator", "gauss4", "--model", "ho3", "--order", "4", "--format", "json", cwd=tmp_path)
     assert r.returncode == 0, r.stderr
     data = json.loads(r.stdout)
     assert data["integrator"] == "gauss4" and data["exists"] is True and data["free_parameters"] == ["alpha"]
 
 
-def test_shadow_tableau_file_subprocess(tmp_path):
+def test_shadow_tableau_file_subprocess(tmp_path, cli_run):
     path = _file(tmp_path, LOBATTO)
-    r = _sub("shadow", "--tableau", path, "--model", "ho", "--format", "text", cwd=tmp_path)
+    r = cli_run("shadow", "--tableau", path, "--model", "ho", "--format", "text", cwd=tmp_path)
     assert r.returncode == 0, r.stderr
     assert "lobatto3c on ho, order 2" in r.stdout and "H_S = H + h**2*(" in r.stdout
 
 
-def test_check_integrator_midpoint_subprocess(tmp_path):
-    r = _sub("check", "--model", "rigid-body", "--integrator", "midpoint", "--steps", "100", "--format", "json",
+def test_check_integrator_midpoint_subprocess(tmp_path, cli_run):
+    r = cli_run("check", "--model", "rigid-body", "--integrator", "midpoint", "--steps", "100", "--format", "json",
              cwd=tmp_path)
     assert r.returncode == 0, r.stderr
     errors = json.loads(r.stdout)["max_abs_error"]
     assert errors["H"] < 1e-13 and errors["G"] < 1e-13          # quadratic invariants: kept to round-off
 
 
-def test_compare_across_families_subprocess(tmp_path):
+def test_compare_across_families_subprocess(tmp_path, cli_run):
     path = _file(tmp_path, LOBATTO)
-    r = _sub("compare", "--model", "ho", "--integrator", "121", "--integrator", "gauss4", "--integrator", "kahan",
+    r = cli_run("compare", "--model", "ho", "--integrator", "121", "--integrator", "gauss4", "--integrator", "kahan",
              "--tableau", path, "--t-end", "1", "--step-counts", "10,20", "--format", "json", cwd=tmp_path)
     assert r.returncode == 0, r.stderr
     rows = {row["integrator"]: row for row in json.loads(r.stdout)["integrators"]}
