@@ -11,6 +11,7 @@ from dataclasses import dataclass
 import numpy as np
 import sympy
 
+from ..checks import show
 from ..errors import ResourceLimitError
 from ..values import ValueEquality
 from .force_gradient import (MAX_GRADIENT_STEPS, GradientStep, _values, is_processed_kernel, iterate_gradient,
@@ -108,8 +109,8 @@ def gradient_check(system, method, h, steps, x0=None, params=None, halvings: int
     if h == 0:
         raise InvalidRunError("h must be non-zero")
     if steps * 2**halvings > MAX_GRADIENT_STEPS:  # the finest run, refused before any work
-        raise ResourceLimitError(f"steps = {steps} with {halvings} halvings needs {steps * 2**halvings} steps, more "
-                                 f"than the {MAX_GRADIENT_STEPS:.0e} a force-gradient run accepts")
+        raise ResourceLimitError(f"steps = {show(steps)} with {halvings} halvings is more than the "
+                                 f"{MAX_GRADIENT_STEPS:.0e} steps a force-gradient run accepts")
     step = GradientStep(system, method, params)
     S = step.system
     processed = is_processed_kernel(method)

@@ -64,7 +64,7 @@ from ..integrators.composition import composition as make_composition
 from ..integrators.step import parameter_values
 from ..values import ValueEquality
 from .diagnostics import numpy_function, quantities
-from .guards import check_work, finite_array, initial_state
+from .guards import MAX_RUN_STEPS, finite_array, initial_state
 from .iterate import as_system
 from .kernels import kernel, resolve_backend
 
@@ -236,18 +236,22 @@ def hybrid_monte_carlo(system, word, h, steps, *, refresh=None, flip=None, targe
     burn = check_int(burn, "burn", 0)
     if seed is not None:
         seed = check_int(seed, "seed", 0)
-    if target not in TARGETS:
+    if not (isinstance(target, str) and target in TARGETS):
         raise InvalidRunError(f"target must be one of {', '.join(TARGETS)}, got {show(target)}")
     coords = [str(c) for c in system.coordinates]
     refresh = _default_refresh(system) if refresh is None else _names(refresh, coords, "refresh")
     flip = refresh if flip is None else _names(flip, coords, "flip")
+    if not isinstance(backend, str):
+        raise InvalidRunError(f"backend must be 'auto', 'numba' or 'numpy', got {show(backend)}")
     be = resolve_backend(backend)
-    x0, _ = initial_state(system, x0)
-    X = _start(x0, system.N, chains)
-    check_work((iterations + burn) * steps, X)
-    if iterations * system.N * chains > MAX_KEPT_VALUES:
+    if iterations * system.N * chains > MAX_KEPT_VALUES:  # from the request, before any array is made
         raise ResourceLimitError(f"{iterations} iterations x {system.N} coordinates x {chains} chains is more than the "
                                  f"{MAX_KEPT_VALUES:.0e} values one run keeps; take fewer chains or iterations")
+    if (iterations + burn) * steps * chains > MAX_RUN_STEPS:
+        raise ResourceLimitError(f"{iterations + burn} iterations x {steps} steps x {chains} chains is more than the "
+                                 f"{MAX_RUN_STEPS:.0e} trajectory-steps one run accepts; take fewer of them")
+    x0, _ = initial_state(system, x0)
+    X = _start(x0, system.N, chains)
 
     signs = np.array([-1.0 if c in flip else 1.0 for c in coords])
     _check_pieces(system, comp, signs)
