@@ -15,8 +15,12 @@ Two measurements per row, the sides interleaved:
 * warm, the call alone: on the C side the library routine called in this process through ctypes on
   ``libbch.so`` (the Lie series built and freed, nothing printed); on ours ``formal_bch`` in this process
   with numba started and every in-memory cache of the package cleared before each call
-  (``nambu_bch.clear_caches``: Lyndon tables rebuilt, as the C routine rebuilds its own).  One untimed
-  call on each side first; then ``--repeat`` calls each, alternating, the median CPU seconds reported.
+  (``nambu_bch.clear_caches``: Lyndon tables rebuilt, as the C routine rebuilds its own).  Where the
+  shipped table serves the series (``12`` and ``121`` to its top degree, column ``by`` = ``table``) that
+  call reads the table file again each time (from the page cache), checks the SHA-256 of what it reads and
+  builds the result's Python objects; the column ``engine`` is the same call with the table bypassed
+  (``formal._formal_engine``: what the engine alone costs).  One untimed call on each side first; then
+  ``--repeat`` calls each, alternating, the median CPU seconds reported.
 * cold, whole processes: the ``bch`` process (``table_output=1``, its table written to a file) and
   ``python -c`` importing ``nambu_bch`` and calling ``formal_bch`` (interpreter start and imports
   included, numba's machine code from its on-disk cache, the series written to a file as
@@ -242,7 +246,17 @@ def main(argv=None):
     args.work.mkdir(parents=True, exist_ok=True)
 
     from nambu_bch import clear_caches
-    from nambu_bch.bch import formal_bch
+    from nambu_bch.bch import formal, formal_bch, table
+    from nambu_bch.integrators import composition
+
+    def engine(spec, n):
+        return formal._formal_engine(composition(spec), n)
+
+    def by(spec, n):
+        comp = composition(spec)
+        values = [int(c * 2) for c in comp.coefficients]  # the three series' coefficients are in (1/2)Z
+        served = table._request([k - 1 for k in comp.pieces], values, 2) is not None
+        return "table" if served and n <= table.max_degree() else "engine"
 
     peer = Peer(checkout)
     c_env = dict(os.environ, OMP_NUM_THREADS="1", LD_LIBRARY_PATH=str(checkout))
@@ -256,7 +270,8 @@ def main(argv=None):
     print(f"# C: {exe} (CFLAGS '{CFLAGS}' with --build), OMP_NUM_THREADS=1; ours: {sys.executable}")
     print("# warm = the call alone, in-process, median CPU s of --repeat; cold = whole process, CPU s (wall s), "
           "peak RSS MB; ratio = ours / C")
-    print(f"{'series':>6} {'N':>3} {'terms':>6} | {'C warm':>8} {'ours warm':>9} {'ratio':>6} | "
+    print(f"{'series':>6} {'N':>3} {'terms':>6} | {'C warm':>8} {'ours warm':>9} {'by':>6} {'ratio':>6} "
+          f"{'engine':>8} {'ratio':>6} | "
           f"{'C cold':>15} {'ours cold':>15} {'ratio':>6} | {'C MB':>6} {'ours MB':>7} {'ratio':>6} | same  load")
     rows = []
     for series, n in jobs:
@@ -264,15 +279,24 @@ def main(argv=None):
         peer.call(series, n)  # untimed: pages touched, code loaded
         clear_caches()
         formal_bch(spec, n)
-        c_warm, ours_warm = [], []
+        source = by(spec, n)
+        if source == "table":
+            engine(spec, n)
+        c_warm, ours_warm, engine_warm = [], [], []
         for _ in range(args.repeat):
             t = time.process_time()
             peer.call(series, n)
             c_warm.append(time.process_time() - t)
             clear_caches()
             t = time.process_time()
-            formal_bch(spec, n)
+            served = formal_bch(spec, n)
             ours_warm.append(time.process_time() - t)
+            if source == "table":
+                clear_caches()
+                t = time.process_time()
+                computed = engine(spec, n)
+                engine_warm.append(time.process_time() - t)
+                assert served == computed, (spec, n)  # the table's series is the engine's, numerator by numerator
         clear_caches()
         c_table, our_table = args.work / f"c_{series}_{n}.txt", args.work / f"ours_{series}_{n}.txt"
         c_args = [str(exe), f"N={n}", "table_output=1"] + ([f"expression={expression}"] if expression else [])
@@ -283,12 +307,15 @@ def main(argv=None):
         ours = our_terms(our_table)
         same = c_terms(c_table, letters) == ours
         cw, ow = statistics.median(c_warm), statistics.median(ours_warm)
+        ew = statistics.median(engine_warm) if engine_warm else ow
         load = os.getloadavg()
-        row = dict(series=series, degree=n, terms=len(ours), c_warm=cw, ours_warm=ow, c_cold=c_cold[:2],
+        row = dict(series=series, degree=n, terms=len(ours), c_warm=cw, ours_warm=ow, by=source, engine_warm=ew,
+                   c_cold=c_cold[:2],
                    ours_cold=ours_cold[:2], c_rss_mb=c_cold[2] / 1024, ours_rss_mb=ours_cold[2] / 1024,
                    identical=same, load=load)
         rows.append(row)
-        print(f"{series:>6} {n:>3} {len(ours):>6} | {cw:>8.4f} {ow:>9.4f} {ow / cw:>5.2f}x | "
+        print(f"{series:>6} {n:>3} {len(ours):>6} | {cw:>8.4f} {ow:>9.4f} {source:>6} {ow / cw:>5.2f}x "
+              f"{ew:>8.4f} {ew / cw:>5.2f}x | "
               f"{c_cold[0]:>6.3f} ({c_cold[1]:>5.2f}) {ours_cold[0]:>6.3f} ({ours_cold[1]:>5.2f}) "
               f"{ours_cold[0] / max(c_cold[0], 0.005):>5.1f}x | {c_cold[2] / 1024:>6.1f} {ours_cold[2] / 1024:>7.1f} "
               f"{ours_cold[2] / c_cold[2]:>5.1f}x | {str(same):5} {load[0]:.2f}", flush=True)

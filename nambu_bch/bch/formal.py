@@ -7,6 +7,10 @@ degree ``d``.  With the step, ``Phi_h = exp(h X_eff)`` and
 ``X_eff = sum_d h^(d-1) L_d``, so ``L_{j+1}`` is the coefficient ``Z_j``
 (Eqs. eL1, eL2).
 
+Table.  The two-generator products ``12``, ``21``, ``121`` and ``212`` (``log(e^A e^B)``, its reverse,
+the symmetric series) are read from a verified table shipped with the package,
+:mod:`nambu_bch.bch.table`, up to its top degree; the result is the engines' to the last numerator.
+
 Engines (exact, no floats).  Rational compositions run the sparse engine of
 :mod:`nambu_bch.bch.modular`: coefficients of ``log Phi`` on Lyndon words only
 (a walk of the prefix tree), a unitriangular solve per content class whose
@@ -61,6 +65,7 @@ from ..integrators.composition import composition as make_composition
 from ..compiled import numba_available
 from ..printing import Printable, bracket_sum
 from ..values import ValueEquality
+from . import table as _table
 from .lyndon import (
     divisors,
     lyndon_expansion,
@@ -180,14 +185,8 @@ def check_degree(max_degree, n_generators: int, dense: bool = False) -> int:
     algebraic coefficients) the ``g^n`` associative words and the Lyndon expansions.  An
     order too high to finish is refused instead of hanging.
     """
-    if isinstance(max_degree, sympy.Integer):
-        max_degree = int(max_degree)
-    if isinstance(max_degree, bool) or not isinstance(max_degree, (int, np.integer)):
-        raise InvalidOrderError(f"BCH degree must be a positive integer, got {max_degree!r}")
-    max_degree = int(max_degree)
+    max_degree = _positive_degree(max_degree)
     g = n_generators
-    if max_degree < 1:
-        raise InvalidOrderError(f"BCH degree must be a positive integer (1 = X_1 + X_2 + ...), got {max_degree}")
     fits = _fits_dense if dense else _fits
     if not fits(g, max_degree):
         if max_degree <= _HARD_DEGREE:
@@ -211,6 +210,18 @@ def check_degree(max_degree, n_generators: int, dense: bool = False) -> int:
             f"BCH to degree {max_degree} in {g} generators needs {detail}, too many to finish in reasonable time; "
             f"the largest accepted degree for {g} generators is {best} (X_eff to h^{best - 1})"
         )
+    return max_degree
+
+
+def _positive_degree(max_degree) -> int:
+    """``max_degree`` as an int ``>= 1`` (an int, numpy or sympy integer), else :class:`InvalidOrderError`."""
+    if isinstance(max_degree, sympy.Integer):
+        max_degree = int(max_degree)
+    if isinstance(max_degree, bool) or not isinstance(max_degree, (int, np.integer)):
+        raise InvalidOrderError(f"BCH degree must be a positive integer, got {max_degree!r}")
+    max_degree = int(max_degree)
+    if max_degree < 1:
+        raise InvalidOrderError(f"BCH degree must be a positive integer (1 = X_1 + X_2 + ...), got {max_degree}")
     return max_degree
 
 
@@ -599,9 +610,30 @@ def formal_bch(comp, max_degree: int, n_pieces: int | None = None) -> FormalBCH:
     comp = make_composition(comp, n_pieces)
     if not isinstance(comp, Composition) or not comp.pieces:
         raise InvalidCompositionError(f"formal_bch needs a composition with at least one factor, got {comp!r}")
+    return _formal(comp, max_degree, True)
+
+
+def _formal_engine(comp: Composition, max_degree: int) -> FormalBCH:
+    """:func:`formal_bch` computed by the engines, never read from the table (the table's tool and tests)."""
+    return _formal(comp, max_degree, False)
+
+
+def _formal(comp: Composition, max_degree, use_table: bool) -> FormalBCH:
     generators = tuple(sorted(set(comp.pieces)))
     g = len(generators)
     scalars = _Scalars(tuple(comp.coefficients))
+    if use_table and scalars.K is None and g == 2 and len(comp.pieces) <= 3:
+        # the two-generator series of the shipped table (nambu_bch.bch.table): a degree it holds is served
+        # whatever the engines' size limits (without numba the dense engine stops at degree 19)
+        n = _positive_degree(max_degree)
+        if n <= _table.max_degree():
+            big = lcm(*range(1, n + 1))
+            dens = [factorial(d) * big * scalars.q**d for d in range(n + 1)]
+            letters = [generators.index(k) for k in comp.pieces]
+            with _no_full_collection():  # acyclic tuples and ints, as in the sparse engine below
+                served = _table.serve(letters, scalars.values, scalars.q, generators, n, dens)
+            if served is not None:
+                return FormalBCH(comp, generators, n, served, None)
     sparse = scalars.K is None and numba_available()
     n = check_degree(max_degree, g, dense=not sparse)
     # low degrees: the dense engine answers in milliseconds without loading numba (~0.4 s in a fresh process)

@@ -1,0 +1,226 @@
+"""The two-generator BCH series served from a verified table shipped with the package.
+
+A composition of two pieces with two factors or three symmetric ones (each piece's coefficients
+sum to one, :class:`~nambu_bch.integrators.composition.Composition`) is one of four products:
+``Z = log(e^A e^B)`` (``12``), its reverse ``log(e^B e^A)`` (``21``), ``S = log(e^{A/2} e^B e^{A/2})``
+(``121``) and ``S' = log(e^{B/2} e^A e^{B/2})`` (``212``; the middle letter the smaller one, a
+different expansion in the Lyndon basis over ``A < B``, not a renaming).  These series are
+universal, so three of them are computed once and stored; the reverse follows from ``Z`` by
+``log(e^B e^A) = -log(e^{-A} e^{-B})``, whose degree-``d`` part is ``(-1)^(d+1) Z_d``.
+
+The table (``data/bch_series.bin``, written by ``tools/build_bch_table.py`` with the engine of
+:mod:`nambu_bch.bch.formal`) holds, per degree ``d``: the Lyndon words of length ``d`` in
+lexicographic order as their standard factors (``P_w = [P_u, P_v]``, indices of shorter words), and
+per series the numerators ``n_w`` over the least common denominator ``T_d`` of the degree, as
+fixed-width little-endian integers.  A request to degree ``n`` rescales ``n_w`` to the denominators
+``D_d = d! lcm(1..n) q^d`` of :func:`~nambu_bch.bch.formal.formal_bch` (``q`` the common denominator
+of the coefficients) and builds the Python objects of the degrees asked only: the result is equal,
+numerator by numerator, to the engine's.
+
+Integrity.  The header (JSON: per degree the number of words, where its blocks lie, the denominators
+and the SHA-256 of the degree's bytes) is trusted only when its own SHA-256 equals
+:data:`TABLE_SHA256`, written into this module by the tool; a degree's bytes are decoded only when
+their SHA-256 equals the header's.  A missing, damaged or replaced file is not used: the engine
+computes the series, and one warning line says why.
+
+File format: ``b"NBCHTAB1"``, the header's length (4 bytes, little-endian), the header, then degree
+by degree the standard factors (int32: left indices, then right indices, into the flat list of the
+Lyndon words of all degrees) and the three series' numerators, each block zlib-compressed.
+
+References
+----------
+Casas & Murua, J. Math. Phys. 50 (2009) 033513 (the BCH series in the Lyndon basis, its
+multidegree structure); Hofstätter, *Computing the BCH series* (arXiv:2102.06570), Sect. 2
+(``log(e^A e^B)`` and the symmetric ``log(e^{A/2} e^B e^{A/2})``); Reutenauer, *Free Lie
+Algebras* (1993), Thm. 5.1 (Lyndon basis, standard factorisation).
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import os
+import sys
+import threading
+import warnings
+import zlib
+from array import array
+from fractions import Fraction
+
+#: SHA-256 of the table's header (which holds the SHA-256 of each degree's bytes); written by tools/build_bch_table.py.
+TABLE_SHA256 = "eb0531b5d621fd793d0d06a1dc0d4ccb4b40bb7053b1c4d7684ba7499faa3737"
+#: The table file shipped with the package.
+TABLE_PATH = os.path.join(os.path.dirname(__file__), "data", "bch_series.bin")
+MAGIC = b"NBCHTAB1"
+#: The series of the table: name -> ``(letters of the factors, their coefficients)``, letter 0 the smaller piece.
+SERIES = {
+    "12": ((0, 1), (Fraction(1), Fraction(1))),
+    "121": ((0, 1, 0), (Fraction(1, 2), Fraction(1), Fraction(1, 2))),
+    "212": ((1, 0, 1), (Fraction(1, 2), Fraction(1), Fraction(1, 2))),
+}
+
+#: array typecodes of the signed integer widths that convert in bulk
+_TYPECODES = {array(code).itemsize: code for code in "bhiq"}
+_HEADER: list = []  # [header dict] once read and verified; [None] when the table is unusable in this process
+_TREES: dict = {}  # generators -> [flat list of the trees, degrees done]
+_FACTORS: list = []  # per degree decoded so far: the standard factors (left indices + right indices)
+_NUMERATORS: dict = {}  # (series, degree) -> the stored numerators n_w as Python ints
+_LOCK = threading.Lock()
+
+
+def clear_cache() -> None:
+    """Forget the table's header, trees and decoded numerators (the next request reads the file again)."""
+    _HEADER.clear()
+    _TREES.clear()
+    _FACTORS.clear()
+    _NUMERATORS.clear()
+
+
+def _unusable(reason: str) -> None:
+    warnings.warn(f"nambu_bch: the BCH table {TABLE_PATH} is not used ({reason}); the series is computed instead",
+                  RuntimeWarning, stacklevel=4)
+    _HEADER[:] = [None]
+
+
+def _header():
+    """The verified header, or ``None`` (then a warning has been given once in this process)."""
+    if _HEADER:
+        return _HEADER[0]
+    try:
+        with open(TABLE_PATH, "rb") as fh:
+            start = fh.read(len(MAGIC) + 4)
+            size = int.from_bytes(start[len(MAGIC):], "little")
+            raw = fh.read(size) if start[: len(MAGIC)] == MAGIC and size < 2**20 else b""
+    except OSError as exc:
+        _unusable(f"cannot read it: {exc.strerror or exc}")
+        return None
+    if hashlib.sha256(raw).hexdigest() != TABLE_SHA256:
+        _unusable("its SHA-256 does not match the package's")
+        return None
+    header = json.loads(raw)
+    header["base"] = len(MAGIC) + 4 + size
+    _HEADER[:] = [header]
+    return header
+
+
+def _decode(data: bytes, width: int) -> list:
+    """Python ints from ``width``-byte little-endian two's-complement integers."""
+    code = _TYPECODES.get(width)
+    if code is not None:  # in bulk, without numpy (not imported on this path)
+        values = array(code)
+        values.frombytes(data)
+        if sys.byteorder == "big":
+            values.byteswap()
+        return values.tolist()
+    from_bytes = int.from_bytes
+    return [from_bytes(data[i : i + width], "little", signed=True) for i in range(0, len(data), width)]
+
+
+def _load(header, series: str, n: int) -> bool:
+    """Decode the standard factors and the numerators of ``series`` for the degrees ``<= n`` not decoded yet.
+
+    The degrees' bytes are read in one piece, from the first degree missing something to ``n``, and each
+    degree's bytes are checked against its SHA-256 in the header before anything of it is decoded."""
+    degrees = header["degrees"]
+    first = next((d for d in range(1, n + 1) if d > len(_FACTORS) or (series, d) not in _NUMERATORS), None)
+    if first is None:
+        return True
+    start = degrees[first - 2]["end"] if first > 1 else 0
+    try:
+        with open(TABLE_PATH, "rb") as fh:
+            fh.seek(header["base"] + start)
+            data = fh.read(degrees[n - 1]["end"] - start)
+    except OSError as exc:
+        _unusable(f"cannot read it: {exc.strerror or exc}")
+        return False
+    view = memoryview(data)
+    for d in range(first, n + 1):
+        entry = degrees[d - 1]
+        low = (degrees[d - 2]["end"] if d > 1 else 0) - start
+        if hashlib.sha256(view[low : entry["end"] - start]).hexdigest() != entry["sha256"]:
+            _unusable(f"the bytes of degree {d} do not match their SHA-256")
+            return False
+
+        def block(offset, size):
+            return zlib.decompress(view[offset - start : offset - start + size]) if size else b""
+
+        if d > len(_FACTORS):
+            _FACTORS.append(_decode(block(*entry["lyndon"]), 4))
+        if (series, d) not in _NUMERATORS:
+            offset, size, width, _ = entry[series]
+            _NUMERATORS[series, d] = _decode(block(offset, size), width) if width else []
+    return True
+
+
+def _trees(generators: tuple, n: int) -> list:
+    """The standard bracketings of the Lyndon words of degrees ``1..n`` as one flat list (degree by degree,
+    lexicographic within a degree), leaves named by ``generators``, from the decoded standard factors."""
+    state = _TREES.get(generators)
+    if state is None:
+        state = _TREES[generators] = [[generators[0], generators[1]], 1]
+    trees = state[0]
+    for d in range(state[1] + 1, n + 1):
+        factors = _FACTORS[d - 1]
+        m = len(factors) // 2
+        trees.extend([(trees[left], trees[right]) for left, right in zip(factors[:m], factors[m:])])
+        state[1] = d
+    return trees
+
+
+def _request(letters, values, q: int):
+    """``(series, reversed)`` when the product is a stored series or the reverse of ``log(e^A e^B)``, else ``None``."""
+    letters = tuple(letters)
+    coefficients = tuple(Fraction(v, q) for v in values)
+    for name, stored in SERIES.items():
+        if (letters, coefficients) == stored:
+            return name, False
+    if (letters[::-1], coefficients[::-1]) == SERIES["12"]:
+        return "12", True
+    return None
+
+
+def max_degree() -> int:
+    """The highest degree the table holds (0 when it is unusable in this process)."""
+    header = _header()
+    return 0 if header is None else header["max_degree"]
+
+
+def serve(letters, values, q: int, generators: tuple, n: int, denominators):
+    """``{degree: (D_d, ((numerator, tree), ...))}`` of the product from the table, or ``None`` if not served.
+
+    ``letters`` (``0`` for the smaller generator) and ``values`` (integers, coefficients
+    ``values / q``) describe the factors, ``denominators[d] = D_d``; the numerators are
+    ``D_d`` times the coefficients, the same Python ints the engine returns, non-zero ones only,
+    Lyndon words of each degree in lexicographic order.
+    """
+    if len(generators) != 2 or n < 1:
+        return None
+    request = _request(letters, values, q)
+    if request is None:
+        return None
+    header = _header()
+    if header is None or n > header["max_degree"]:
+        return None
+    series, flip = request
+    with _LOCK:  # the decoded degrees are appended in order: one request at a time extends them
+        if not _load(header, series, n):
+            return None
+        trees = _trees(tuple(generators), n)
+    out = {}
+    start = 0
+    for d in range(1, n + 1):
+        entry = header["degrees"][d - 1]
+        stored = _NUMERATORS[series, d]
+        if stored:
+            # D_d / T_d is an integer: T_d is the least common denominator of the degree, and D_d times every
+            # coefficient is an integer (the engines' denominators, nambu_bch.bch.formal)
+            factor, rest = divmod(denominators[d], int(entry[series][3]))
+            if rest:
+                raise ArithmeticError(f"internal error: the BCH table's degree-{d} denominator does not divide "
+                                      f"{denominators[d]}")
+            if flip and d % 2 == 0:
+                factor = -factor
+            window = range(start, start + entry["count"])
+            out[d] = (denominators[d], tuple((v * factor, trees[k]) for v, k in zip(stored, window) if v))
+        start += entry["count"]
+    return out

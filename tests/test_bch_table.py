@@ -1,0 +1,153 @@
+"""The shipped BCH table (nambu_bch.bch.table): served series equal the engine's exactly; a damaged,
+replaced or missing table is not trusted (one warning, then the engine); the tool rebuilds it."""
+
+from __future__ import annotations
+
+import importlib.util
+import shutil
+import warnings
+from pathlib import Path
+
+import pytest
+
+from nambu_bch.bch import formal, table
+from nambu_bch.bch.formal import formal_bch
+from nambu_bch.integrators import composition
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+@pytest.fixture(autouse=True)
+def fresh_table():
+    table.clear_cache()
+    yield
+    table.clear_cache()
+
+
+def _engine(spec, n):
+    return formal._formal_engine(composition(spec), n)
+
+
+@pytest.mark.parametrize("spec", ["12", "21", "121", "212", "TVT", "VTV", "13", "31", "1:1/2,3:1,1:1/2"])
+@pytest.mark.parametrize("n", [1, 2, 7, 11])
+def test_served_series_equal_the_engine(spec, n):
+    """Numerators, denominators D_d = d! lcm(1..n) q^d and trees, degree by degree (FormalBCH equality)."""
+    served = formal_bch(spec, n)
+    assert table._HEADER and table._HEADER[0] is not None  # read from the table
+    computed = _engine(spec, n)
+    assert served == computed
+    assert served.to_text() == computed.to_text()
+    for d in range(1, n + 1):
+        assert served.scaled_terms(d) == computed.scaled_terms(d)
+
+
+def test_eq_bch1_from_the_table():
+    """Eq. (BCH1) for TVT and Lie-Trotter's [X1, X2]/2, served from the table."""
+    assert formal_bch("121", 3).terms(3) == _engine("121", 3).terms(3)
+    assert str(formal_bch("12", 2).terms(2)) == "[(1/2, (1, 2))]"
+
+
+@pytest.mark.parametrize("spec", ["123", "1:1/3,2:1,1:2/3", "1:1/2,2:1/2,1:1/2,2:1/2", "12321"])
+def test_other_compositions_are_not_served(spec):
+    comp = composition(spec)
+    generators = tuple(sorted(set(comp.pieces)))
+    letters = [generators.index(k) for k in comp.pieces]
+    scalars = formal._Scalars(tuple(comp.coefficients))
+    assert table.serve(letters, scalars.values, scalars.q, generators, 4, [1] * 5) is None
+
+
+def test_beyond_the_table_is_not_served():
+    n = table.max_degree() + 1
+    assert n > 1
+    assert table.serve([0, 1], [1, 1], 1, (1, 2), n, [1] * (n + 1)) is None
+
+
+def _damaged(tmp_path, monkeypatch, edit):
+    path = tmp_path / "bch_series.bin"
+    shutil.copyfile(table.TABLE_PATH, path)
+    data = bytearray(path.read_bytes())
+    edit(data)
+    path.write_bytes(bytes(data))
+    monkeypatch.setattr(table, "TABLE_PATH", str(path))
+
+
+def _offsets():
+    """``(start of the blocks, start of the degree-3 block of log(e^A e^B))`` in the shipped file."""
+    header = table._header()
+    return header["base"], header["base"] + header["degrees"][2]["12"][0]
+
+
+def _flip(index):
+    return lambda data: data.__setitem__(index, data[index] ^ 1)
+
+
+@pytest.mark.parametrize("what", ["block", "header", "truncated", "missing"])
+def test_a_damaged_or_replaced_table_is_not_trusted(tmp_path, monkeypatch, what):
+    """A flipped bit in a block (its SHA-256 in the header fails) or in the header (the package's SHA-256
+    fails), a cut or a missing file: one warning line, then the engine's series."""
+    base, block = _offsets()
+    table.clear_cache()
+    if what == "block":
+        _damaged(tmp_path, monkeypatch, _flip(block))
+    elif what == "header":
+        _damaged(tmp_path, monkeypatch, _flip(base - 2))
+    elif what == "truncated":
+        _damaged(tmp_path, monkeypatch, lambda data: data.__delitem__(slice(40, None)))
+    else:
+        monkeypatch.setattr(table, "TABLE_PATH", str(tmp_path / "absent.bin"))
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        assert formal_bch("12", 6) == _engine("12", 6)
+        assert formal_bch("21", 5) == _engine("21", 5)  # not read again in this process: no second warning
+    messages = [str(w.message) for w in caught if issubclass(w.category, RuntimeWarning)]
+    assert len(messages) == 1 and "\n" not in messages[0] and "is not used" in messages[0], messages
+    assert table._HEADER == [None]
+
+
+def test_the_tool_rebuilds_the_low_degrees_exactly(tmp_path):
+    """tools/build_bch_table.py at degree 9 (formal_bch's engines at that degree: the dense one) writes the same
+    blocks as the shipped table (built at its top degree by the sparse engine)."""
+    spec = importlib.util.spec_from_file_location("build_bch_table", ROOT / "tools" / "build_bch_table.py")
+    tool = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(tool)
+    path = tmp_path / "low.bin"
+    tool.build(9, path)
+    shipped = table._header()
+    with open(path, "rb") as fh:
+        fh.read(len(table.MAGIC))
+        size = int.from_bytes(fh.read(4), "little")
+    import json
+
+    low = json.loads(path.read_bytes()[len(table.MAGIC) + 4 : len(table.MAGIC) + 4 + size])
+    assert low["degrees"] == shipped["degrees"][:9]  # block places, widths, denominators, SHA-256 of each degree
+    end = shipped["degrees"][8]["end"]
+    with open(table.TABLE_PATH, "rb") as fh:
+        fh.seek(shipped["base"])
+        assert path.read_bytes()[len(table.MAGIC) + 4 + size :] == fh.read(end)
+
+
+def test_threads_share_the_decoded_table():
+    from concurrent.futures import ThreadPoolExecutor
+
+    with ThreadPoolExecutor(4) as pool:
+        results = list(pool.map(lambda spec: formal_bch(spec, 9), ["12", "21", "121", "212"] * 2))
+    for spec, result in zip(["12", "21", "121", "212"] * 2, results):
+        assert result == _engine(spec, 9), spec
+
+
+def test_a_fresh_process_serves_without_numba_or_the_effective_field_modules(tmp_path):
+    """The cold path: the table's series in a fresh interpreter imports neither numba nor the compiled engine,
+    nor bch.backward / bch.concrete (costs about a second: the interpreter and sympy)."""
+    import os
+    import subprocess
+    import sys
+
+    code = ("import sys; from nambu_bch.bch import formal_bch; B = formal_bch('12', 20); "
+            "print(len(B), sorted(m for m in ('numba', 'nambu_bch.bch.modular', 'nambu_bch.bch.backward', "
+            "'nambu_bch.bch.concrete') if m in sys.modules))")
+    env = {**os.environ, "PYTHONPATH": str(ROOT), "NAMBU_BCH_CACHE": str(tmp_path / "cache")}
+    run = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=tmp_path, env=env,
+                         timeout=300)
+    assert run.returncode == 0, run.stderr
+    assert run.stdout.split(None, 1) == ["76760", "[]\n"]  # the C program's count for degree 20 (bch_c_reference)
+    assert "Warning" not in run.stderr

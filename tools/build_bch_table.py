@@ -1,0 +1,154 @@
+"""Build the BCH table of :mod:`nambu_bch.bch.table` with the package's own engine, and pin its SHA-256.
+
+Computes ``log(e^A e^B)``, ``log(e^{A/2} e^B e^{A/2})`` and ``log(e^{B/2} e^A e^{B/2})`` to
+``--degree`` with the engines of :func:`nambu_bch.bch.formal.formal_bch` (the table bypassed), writes
+``nambu_bch/bch/data/bch_series.bin`` (format: :mod:`nambu_bch.bch.table`) and sets
+``TABLE_SHA256`` in ``nambu_bch/bch/table.py`` to the SHA-256 of its header.  Then it reads the new
+table back through the package and checks that every series it serves to ``--degree`` equals the
+engine's result exactly.  Prints the bytes each degree costs (compressed).
+
+Run:  python tools/build_bch_table.py [--degree 20]
+"""
+
+from __future__ import annotations
+
+import argparse
+import hashlib
+import json
+import re
+import sys
+import zlib
+from math import gcd
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT))
+
+
+def _width(values) -> int:
+    """Bytes per entry: 1, 2, 4 or 8 when the values fit (numpy reads those in bulk), else the least that fits."""
+    if not any(values):
+        return 0
+    bits = max(v.bit_length() if v >= 0 else (-v - 1).bit_length() for v in values) + 1  # two's complement
+    nbytes = (bits + 7) // 8
+    for w in (1, 2, 4, 8):
+        if nbytes <= w:
+            return w
+    return nbytes
+
+
+def series_numerators(name: str, n: int, words: list) -> dict:
+    """``{degree: (T_d, [n_w over the degree's Lyndon words in lexicographic order])}`` of a stored series,
+    computed by :func:`nambu_bch.bch.formal.formal_bch`'s engines (never read from a table)."""
+    from nambu_bch.bch import formal, table
+    from nambu_bch.bch.lyndon import tree_leaves
+    from nambu_bch.integrators import composition
+
+    letters, coefficients = table.SERIES[name]
+    spec = ",".join(f"{a + 1}:{c}" for a, c in zip(letters, coefficients))  # letter a is piece a + 1
+    result = formal._formal_engine(composition(spec), n)
+    out = {}
+    for d in range(1, n + 1):
+        rank = {w: k for k, w in enumerate(words[d])}
+        den, items = result.scaled_terms(d)
+        column = [0] * len(words[d])
+        for numerator, tree in items:
+            column[rank[tuple(k - 1 for k in tree_leaves(tree))]] = numerator
+        common = den
+        for v in column:
+            common = gcd(common, v)
+        out[d] = (den // common, [v // common for v in column])
+    return out
+
+
+def build(n: int, path: Path) -> tuple:
+    """Write the table to degree ``n`` at ``path``; ``(SHA-256 of the header, {degree: bytes}, header bytes)``."""
+    from nambu_bch.bch import table
+    from nambu_bch.bch.lyndon import lyndon_words, standard_factorization
+
+    words = {d: lyndon_words(2, d) for d in range(1, n + 1)}
+    index, k = {}, 0
+    for d in range(1, n + 1):  # global index: degree by degree, lexicographic within a degree
+        for w in words[d]:
+            index[w] = k
+            k += 1
+    columns = {name: series_numerators(name, n, words) for name in table.SERIES}
+    blocks, header = [], {"format": 2, "letters": 2, "max_degree": n, "series": list(table.SERIES), "degrees": []}
+    offset = 0
+    costs = {}
+    for d in range(1, n + 1):  # degree by degree: a request to degree n reads one contiguous piece
+        start = offset
+        entry = {"count": len(words[d])}
+
+        def add(data: bytes) -> list:
+            nonlocal offset
+            data = zlib.compress(data, 9) if data else data
+            blocks.append(data)
+            offset += len(data)
+            return [offset - len(data), len(data)]
+
+        factors = [standard_factorization(w) for w in words[d]] if d > 1 else []
+        entry["lyndon"] = add(b"".join(index[u].to_bytes(4, "little") for u, _ in factors)
+                              + b"".join(index[v].to_bytes(4, "little") for _, v in factors))
+        for name in table.SERIES:
+            T, column = columns[name][d]
+            w = _width(column)
+            data = b"".join(v.to_bytes(w, "little", signed=True) for v in column) if w else b""
+            entry[name] = add(data) + [w, str(T)]
+        entry["end"] = offset
+        entry["sha256"] = hashlib.sha256(b"".join(blocks)[start:]).hexdigest()
+        header["degrees"].append(entry)
+        costs[d] = offset - start
+    raw = json.dumps(header, sort_keys=True, separators=(",", ":")).encode()
+    path.parent.mkdir(parents=True, exist_ok=True)
+    path.write_bytes(table.MAGIC + len(raw).to_bytes(4, "little") + raw + b"".join(blocks))
+    return hashlib.sha256(raw).hexdigest(), costs, len(raw)
+
+
+def pin(digest: str) -> None:
+    source = ROOT / "nambu_bch" / "bch" / "table.py"
+    text = source.read_text()
+    new, count = re.subn(r'^TABLE_SHA256 = "[0-9a-f]{64}"$', f'TABLE_SHA256 = "{digest}"', text, flags=re.M)
+    assert count == 1, "TABLE_SHA256 line not found in nambu_bch/bch/table.py"
+    source.write_text(new)
+
+
+def check(n: int) -> int:
+    """Every series the table serves, to degree ``n``, equals the engine's."""
+    from nambu_bch.bch import formal, table
+
+    table.clear_cache()
+    assert table.max_degree() == n
+    specs = ["12", "21", "121", "212"]
+    for spec in specs:
+        served = formal.formal_bch(spec, n)
+        computed = formal._formal_engine(formal.make_composition(spec, None), n)
+        assert served == computed, spec
+    return len(specs)
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--degree", type=int, default=20)
+    args = ap.parse_args(argv)
+    from nambu_bch.bch import table
+
+    path = Path(table.TABLE_PATH)
+    digest, costs, header_bytes = build(args.degree, path)
+    pin(digest)
+    import importlib
+
+    importlib.reload(table)
+    checked = check(args.degree)
+    total = 0
+    print(f"# {path.relative_to(ROOT)}: header {header_bytes} bytes, SHA-256 {digest}")
+    print("# degree  bytes (Lyndon factors + numerators of the three series)  cumulative")
+    for d, b in costs.items():
+        total += b
+        print(f"{d:>8} {b:>10} {total:>12}")
+    print(f"# {path.stat().st_size} bytes in all; {checked} series checked against the engine at degree {args.degree}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
