@@ -198,6 +198,15 @@ DEEP = (
     ("test_runge_kutta_cli.py", "test_compare_across_families_subprocess", ("in-process",)),
     ("test_numerical_shadow.py", "test_cli_check_adds_the_numerical_shadow_in_a_subprocess", ("in-process",)),
     ("test_generic_separable.py", "test_cli_prints_the_generic_answer_as_json", ("in-process",)),
+    # the new method families: one case of each concern stays fast (ABA864's generalised order, the two routes on ho,
+    # the compare rows and their CLI); the costlier repeats (2-5 s each, measured under load) are deep
+    ("test_families_on_systems.py", "test_aba_methods_have_their_published_generalized_order", ("aba864-orders0",)),
+    ("test_families_on_systems.py", "test_chin_4a_effective_field_two_routes_agree_exactly", ("ho", "henon-heiles")),
+    ("test_families_on_systems.py", "test_work_precision_figure_with_the_new_families", ()),
+    ("test_complex_routes.py", "test_effective_field_over_qq_i_two_routes", lambda pid: not pid.startswith("rigid-body")),
+    ("test_complex_routes.py", "test_complex_triple_jump_has_order_four_on_a_system", ()),
+    # the table served in a fresh process (a process start; the in-process serving is fast-tier)
+    ("test_bch_table.py", "test_a_fresh_process_serves_without_numba_or_the_effective_field_modules", ()),
     # the rigid body (over QQ(I1, I2, I3)) and the other 1.2-3 s rows of tables whose lighter rows stay in the fast tier
     # (the parametric field: test_elimination's QQ(a,b) row, test_direct_route_flint; the rigid body's numerics and
     # families: test_numeric, test_shadow, test_any_system's Lie-Poisson member)
