@@ -66,6 +66,7 @@ import sympy
 
 from ..algebra import VectorField, liouville_field
 from ..algebra.ansatz import Ansatz, Rows
+from ..algebra.canonical import canonical_add
 from ..algebra import elimination, frac_rref
 from ..algebra.elimination import SparseMatrix, elimination_cost, rank, signed_sums
 from ..algebra.flint_ring import polynomial_ring
@@ -203,14 +204,15 @@ class DirectResult:
     def shadow(self, upto=None) -> tuple:
         """``(H_S, G_S, ...)`` as sympy expressions in ``h`` and ``alpha`` through ``h^upto``."""
         upto = self.order if upto is None else upto
-        out = []
+        out, memo = [], {}  # canonical_add's sort keys, shared by the shadows
         for a, Ha in enumerate(self.hamiltonians):
             # term by term: the same expression as sympy.expand of the sum (PolynomialAlgebra.expanded_terms),
-            # without expand's walk over the rational-function coefficients
+            # without expand's walk over the rational-function coefficients, and sorted by a key (the distinct
+            # powers of h and monomials never combine) instead of sympy's comparison function
             parts = [(Ha, ())] + [(self.corrections[(a, j)], (H_STEP**j,)) for j in range(1, upto + 1)
                                   if self.corrections.get((a, j))]
             if all(self.algebra.is_polynomial(p) for p, _ in parts):
-                out.append(sympy.Add(*[t for p, f in parts for t in self.algebra.expanded_terms(p, f)]))
+                out.append(canonical_add([t for p, f in parts for t in self.algebra.expanded_terms(p, f, memo)], memo))
             else:  # non-polynomial pieces (the BCH series of _non_polynomial): sympy expands the sum, but not
                 # the powers of sums (a denominator (q1**2 + q2**2)**4 stays one factor instead of nine terms)
                 out.append(sympy.expand(sympy.Add(*[sympy.Mul(self.algebra.to_sympy(p), *f) for p, f in parts]),
