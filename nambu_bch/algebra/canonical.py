@@ -60,7 +60,7 @@ def sort_key(expr, memo: dict | None = None) -> tuple:
     _NoKey -- the expression's content holds something compared otherwise (a ``frozenset``)
 
     >>> x, y = sympy.symbols("x y")
-    >>> terms = [y**2, 3*x, x*y, 2, x**3*y]
+    >>> terms = [y**2, 3*x, x*y, sympy.Integer(2), x**3*y]
     >>> from functools import cmp_to_key
     >>> sorted(terms, key=sort_key) == sorted(terms, key=cmp_to_key(sympy.Basic.compare))
     True
@@ -108,7 +108,7 @@ def canonical_add(terms, memo: dict | None = None):
     sympy.Expr -- equal to ``sympy.Add(*terms)``, with the same arguments in the same order
 
     >>> x, y = sympy.symbols("x y")
-    >>> terms = [x*y/2, 3, y**2, x**3]
+    >>> terms = [x*y/2, sympy.Integer(3), y**2, x**3]
     >>> canonical_add(terms).args == sympy.Add(*terms).args
     True
     """
@@ -116,6 +116,8 @@ def canonical_add(terms, memo: dict | None = None):
     coeff = sympy.S.Zero
     rest, seen = [], set()
     for t in terms:
+        if not isinstance(t, sympy.Expr):  # Python numbers, sets, matrices: sympy decides
+            return sympy.Add(*terms)
         if t.is_Number:
             coeff += t
             if not coeff.is_finite:
