@@ -137,3 +137,15 @@ def test_exact_series_is_the_expanded_layout(name, word):
         assert list(exact) == list(expanded)
         for k, c in exact.items():
             assert str(c) == str(expanded[k]) and c == sympy.Add(*sympy.Add.make_args(expanded[k]))
+
+
+def test_symbolic_rigid_body_h10_is_solved_within_the_budget():
+    """The rigid body with symbolic I at h^10 (910 unknowns over QQ(I1, I2, I3), elimination estimate 3.5e9) is solved
+    exactly under the default bounded work (about 7 s) instead of being refused for the existence decision (about
+    116 s, benchmarks/bench_shadow.py --targets, row b)."""
+    from nambu_bch import model
+    from nambu_bch.shadow.api import SOLVE_UNKNOWNS
+    from nambu_bch.shadow.direct_route import direct_route
+
+    R = direct_route(model("rigid-body"), "12321", 10, max_unknowns=SOLVE_UNKNOWNS)
+    assert R.exists and [o.status for o in R.orders][-1] == "solved" and R.orders[-1].degree is not None
