@@ -4,6 +4,7 @@ Run:  /work/venv/bin/python benchmarks/bench_shadow.py --targets  (the targets o
       /work/venv/bin/python benchmarks/bench_shadow.py --targets --rows=ab  (target rows a and b only)
       /work/venv/bin/python benchmarks/bench_shadow.py            (the rows below, then the issue-14 rows)
       /work/venv/bin/python benchmarks/bench_shadow.py --issue14  (the issue-14 rows only)
+      /work/venv/bin/python benchmarks/bench_shadow.py --printing (text/LaTeX/JSON: flint factors vs sympy.factor)
       /work/venv/bin/python benchmarks/bench_shadow.py --issue14 --rows=ab  (rows a and b only)
 
 Prints, measured in this one run (process CPU time, best of a few repeats):
@@ -411,6 +412,41 @@ def targets(limit: float = 600.0, only=None):
     return ok
 
 
+def _timed_printing(args, queue):
+    """The text, LaTeX and JSON of one family in a fresh process, CPU seconds of the three outputs only: the
+    coefficients factored by python-flint (``"flint"``, the package's way) or by ``sympy.factor`` per coefficient
+    (``"sympy"``: ``NAMBU_BCH_DISABLE_FLINT=1`` switched on after the solve, which the printing reads)."""
+    import os
+
+    how, name, word, order = args
+    fam = shadow_hamiltonians(make_system(name), word, order)
+    if how == "sympy":
+        os.environ["NAMBU_BCH_DISABLE_FLINT"] = "1"
+    t = time.process_time()
+    outputs = (fam.to_text(), fam.to_latex(), str(fam.to_dict()))
+    queue.put((time.process_time() - t, outputs))
+
+
+PRINTING = [("rigid-body", "12321", 4), ("rigid-body", "12321", 6), ("ho3", "12321", 8), ("lotka-volterra", "12321", 8)]
+
+
+def printing(limit: float = 900.0):
+    """Text + LaTeX + JSON of a family, coefficients factored by flint against ``sympy.factor``: each side cold in a
+    fresh process, interleaved, the outputs compared byte for byte (CPU seconds of the printing alone)."""
+    print(f"printing: text + LaTeX + JSON, flint factors vs sympy.factor (CPU s of the outputs; {_load()})", flush=True)
+    same = True
+    for name, word, order in PRINTING:
+        ours = _child(_timed_printing, ("flint", name, word, order), limit)
+        plain = _child(_timed_printing, ("sympy", name, word, order), limit)
+        line = f"{name}, {word}, h^{order}: flint {'stopped' if ours is None else f'{ours[0]:.2f} s'}, " \
+               f"sympy.factor {'stopped' if plain is None else f'{plain[0]:.2f} s'}"
+        if ours and plain:
+            line += f", ratio {plain[0] / ours[0]:.1f}x, outputs identical: {ours[1] == plain[1]}"
+            same = same and ours[1] == plain[1]
+        print(line + f"  [{_load()}]", flush=True)
+    return same
+
+
 def _same_members(name, u, v):
     """The members printed differently: equal as expressions (algebraic fields have no unique normal form)."""
     return all(sympy.expand(sympy.together(sympy.sympify(p) - sympy.sympify(q))) == 0
@@ -442,6 +478,8 @@ def main(limit: float = 60.0):
 
 if __name__ == "__main__":
     ok = True
+    if "--printing" in sys.argv:
+        sys.exit(0 if printing() else 1)
     if "--targets" in sys.argv:
         only = next((a.split("=", 1)[1] for a in sys.argv if a.startswith("--rows=")), None)
         sys.exit(0 if targets(only=only) else 1)

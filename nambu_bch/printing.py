@@ -114,7 +114,13 @@ def _by_monomial(expr, coordinates):
     coefficients = _coefficients(expr, coordinates) if coordinates else None
     if coefficients is None:
         return sympy.factor(expr)
-    terms = [_factored(c) * sympy.Mul(*(x**e for x, e in zip(coordinates, m))) for m, c in coefficients]
+    return by_monomials([(m, _factored(c)) for m, c in coefficients], coordinates)
+
+
+def by_monomials(rows, coordinates):
+    """``sum c_m x^m`` as an unevaluated ``Add`` in the order of ``rows`` (``[(exponent tuple, factored c_m)]``,
+    highest monomial first): the layout of :func:`h_coefficients` from coefficients already factored."""
+    terms = [c * sympy.Mul(*(x**e for x, e in zip(coordinates, m))) for m, c in rows]
     if not terms:
         return sympy.Integer(0)
     return sympy.Add(*terms, evaluate=False) if len(terms) > 1 else terms[0]

@@ -205,6 +205,8 @@ DEEP = (
     ("test_families_on_systems.py", "test_work_precision_figure_with_the_new_families", ()),
     ("test_complex_routes.py", "test_effective_field_over_qq_i_two_routes", lambda pid: not pid.startswith("rigid-body")),
     ("test_complex_routes.py", "test_complex_triple_jump_has_order_four_on_a_system", ()),
+    # the symbolic rigid body at h^10 (7 s): the orders h^6 and more are deep; its h^8 rows stay in the fast tier
+    ("test_shadow_exact_data.py", "test_symbolic_rigid_body_h10_is_solved_within_the_budget", ()),
     # the table served in a fresh process (a process start; the in-process serving is fast-tier)
     ("test_bch_table.py", "test_a_fresh_process_serves_without_numba_or_the_effective_field_modules", ()),
     # the rigid body (over QQ(I1, I2, I3)) and the other 1.2-3 s rows of tables whose lighter rows stay in the fast tier

@@ -18,7 +18,6 @@ from __future__ import annotations
 from functools import cached_property
 
 import sympy
-from sympy.core.mul import _mulsort
 from sympy.polys.domains import QQ, ZZ, FractionField
 from sympy.polys.fields import FracElement, FracField
 from sympy.polys.polyerrors import CoercionFailed, GeneratorsError, PolynomialError
@@ -30,6 +29,7 @@ from ..checks import check_sequence
 from ..errors import InvalidSystemError
 from ..parsing import as_expression, as_symbols
 from .backend import ExpressionBackend, PolynomialBackend
+from .canonical import canonical_add, product_key, sort_key
 from .fields import CoefficientField
 from .ring import declare
 from .zero import is_zero
@@ -52,14 +52,15 @@ def _symbol_powers(factors) -> dict | None:
     return out
 
 
-def _monomial_denominator_terms(c, gens, m, params, powers) -> list:
+def _monomial_denominator_terms(c, gens, m, params, powers, memo, factors) -> list:
     """The terms of ``expand(c x^m prod(powers))`` for ``c = p / (d P^k)`` in ``QQ(params)``, a monomial denominator.
 
     Each term of ``p`` gives one product of a rational number and powers of distinct symbols (the
     parameters' exponents minus ``k``, the generators', ``powers``), which is how ``Mul`` flattens
     ``r P^e x^m / (d P^k)``: its canonical form is the coefficient (left out when it is one) followed
-    by the powers sorted by ``Basic.compare`` (``sympy.core.mul._mulsort``), so the object is built
-    directly with ``Mul._from_args`` -- the same expression, without ``Mul.flatten``.
+    by the powers sorted by ``Basic.compare`` (``sympy.core.mul._mulsort``; here by the equivalent key), so the
+    object is built directly with ``Mul._from_args`` -- the same expression, without ``Mul.flatten``
+    (:func:`_rational_term`; ``memo``, ``factors`` its memos).
     """
     [(dexp, d)] = c.denom.items()
     base = dict(powers)
@@ -72,13 +73,40 @@ def _monomial_denominator_terms(c, gens, m, params, powers) -> list:
         for s, k, j in zip(params, e, dexp):
             if k != j:
                 exps[s] = exps.get(s, 0) + k - j
-        args = [s if k == 1 else sympy.Pow(s, k) for s, k in exps.items() if k]
-        _mulsort(args)
-        coeff = QQ.to_sympy(a / d)
-        if coeff != 1:
-            args.insert(0, coeff)
-        out.append(args[0] if len(args) == 1 else sympy.Mul._from_args(args) if args else coeff)
+        out.append(_rational_term(QQ.to_sympy(a / d), exps, memo, factors))
     return out
+
+
+def _rational_term(coeff, exps: dict, memo: dict, factors: dict):
+    """``coeff * prod(s^k)`` (a sympy rational, ``{symbol: integer exponent}``) as ``Mul`` keeps it: the coefficient
+    (left out when it is one) followed by the powers in the order of ``Basic.compare``, without ``Mul.flatten``.
+
+    The order is that of the powers' :func:`~nambu_bch.algebra.canonical.sort_key`; the term's own key (the
+    product's class, its number of arguments, the arguments' keys) is recorded in ``memo`` (the sort-key memo of
+    :func:`~nambu_bch.algebra.canonical.canonical_add`), and ``factors`` keeps ``(s, k) -> (key, power)``.
+    """
+    pairs = []
+    for s, k in exps.items():
+        if k:
+            hit = factors.get((s, k))
+            if hit is None:
+                power = s if k == 1 else sympy.Pow(s, k)
+                hit = factors[(s, k)] = (sort_key(power, memo), power)
+            pairs.append(hit)
+    pairs.sort(key=_first)
+    if coeff is not sympy.S.One:
+        pairs.insert(0, (sort_key(coeff, memo), coeff))
+    if not pairs:
+        return coeff
+    if len(pairs) == 1:
+        return pairs[0][1]
+    term = sympy.Mul._from_args([f for _, f in pairs], True)  # the ring's generators and parameters commute
+    memo[term] = product_key(term, [k for k, _ in pairs])
+    return term
+
+
+def _first(pair):
+    return pair[0]
 
 
 # -- pickling -----------------------------------------------------------------------------
@@ -378,7 +406,7 @@ class PolynomialAlgebra:
             return expr_from_dict(coefficients, *value.ring.symbols)
         return as_expression(value, self.symbol_table, "expression")
 
-    def expanded_terms(self, value, factors=()) -> list:
+    def expanded_terms(self, value, factors=(), memo=None) -> list:
         """The terms of ``sympy.expand(to_sympy(value) * factors[0] * ...)``, built without ``expand``.
 
         A coefficient ``c = p/q`` of the monomial ``x^m`` (``p, q`` polynomials in the
@@ -399,6 +427,8 @@ class PolynomialAlgebra:
         ----------
         value : ring element or sympy expression
         factors : sequence of sympy expressions -- powers of symbols multiplying every term
+        memo : dict, optional -- receives the sort keys of the terms built directly (the memo of
+            :func:`~nambu_bch.algebra.canonical.canonical_add`, which then sorts them without recomputing)
 
         Returns
         -------
@@ -423,11 +453,20 @@ class PolynomialAlgebra:
             ground, params = domain.domain, domain.field.ring.symbols
             inverses: dict = {}
             wholes: dict = {}
-        powers = _symbol_powers(factors) if fraction and ground.is_QQ else None
+        powers = _symbol_powers(factors) if (ground if fraction else domain).is_QQ else None
         terms = []
+        memo = {} if memo is None else memo
+        built: dict = {}  # (symbol, exponent) -> (sort key, power), for _rational_term
         for m, c in value.items():
+            if powers is not None and not fraction:  # a rational times a monomial: one term
+                exps = dict(powers)
+                for s, e in zip(gens, m):
+                    if e:
+                        exps[s] = exps.get(s, 0) + e
+                terms.append(_rational_term(QQ.to_sympy(c), exps, memo, built))
+                continue
             if powers is not None and len(c.denom) == 1:
-                terms.extend(_monomial_denominator_terms(c, gens, m, params, powers))
+                terms.extend(_monomial_denominator_terms(c, gens, m, params, powers, memo, built))
                 continue
             mono = [s**e for s, e in zip(gens, m) if e] + factors
             if not fraction:
@@ -458,7 +497,7 @@ class PolynomialAlgebra:
 
     def to_sympy_expanded(self, value, factors=()) -> sympy.Expr:
         """``sympy.expand(to_sympy(value) * prod(factors))``, identical, from :meth:`expanded_terms` (no ``expand``)."""
-        return sympy.Add(*self.expanded_terms(value, factors))
+        return canonical_add(self.expanded_terms(value, factors))
 
     @cached_property
     def coefficient_field(self) -> CoefficientField:

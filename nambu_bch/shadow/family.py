@@ -20,8 +20,10 @@ from dataclasses import dataclass, field
 import sympy
 
 from ..algebra.ansatz import Ansatz
+from ..algebra.canonical import canonical_add, coordinate_coefficients
 from ..parsing import as_expression
-from ..printing import Printable, aligned, h_coefficients, laid_out, latex_text, series_text, series_tokens
+from ..printing import (Printable, aligned, by_monomials, h_coefficients, laid_out, latex_text, series_text,
+                        series_tokens)
 from ..symbols import ALPHA, STEP
 from ..values import ValueEquality
 
@@ -128,22 +130,63 @@ def _exact_layout(result, slot: int, hamiltonian, coordinates, with_base: bool):
     """``[(k, c_k)]`` of the shadow ``H^slot + sum_k h^k dH_k`` (:func:`~nambu_bch.printing.h_coefficients` with base
     ``0`` when ``with_base``, else the Hamiltonian) from the direct route's exact per-order corrections.
 
-    Each correction is converted on its own (``PolynomialAlgebra.expanded_terms``, the terms ``sympy.expand``
-    gives), so the shadow's whole sum is neither expanded nor regrouped by powers of ``h``.  None when a piece is not
-    a polynomial or the system's Hamiltonian is not the ring's own expanded form (the caller then lays out the sum).
+    Each correction is laid out on its own from its ring element: the coefficient of each coordinate monomial
+    factored by python-flint into the expression ``sympy.factor`` gives
+    (:func:`~nambu_bch.algebra.canonical.coordinate_coefficients`); without that path, each correction's expanded
+    sympy form (``PolynomialAlgebra.expanded_terms``, the terms ``sympy.expand`` gives) is laid out by
+    :func:`~nambu_bch.printing.laid_out`.  Either way the shadow's whole sum is neither expanded nor regrouped by
+    powers of ``h``.  None when a piece is not a polynomial or the system's Hamiltonian is not the ring's own
+    expanded form (the caller then lays out the sum).
     """
     alg = result.algebra
     Ha = result.hamiltonians[slot]
     parts = {k: result.corrections[(slot, k)] for k in range(1, result.order + 1) if result.corrections.get((slot, k))}
     if not all(alg.is_polynomial(p) for p in (Ha, *parts.values())):
         return None
-    base = sympy.Add(*alg.expanded_terms(Ha, ()))
+    memo: dict = {}  # canonical_add's sort keys, shared by the orders
+    base = canonical_add(alg.expanded_terms(Ha, (), memo), memo)
     if base != sympy.expand(hamiltonian):
         return None
-    by_power = {k: sympy.Add(*alg.expanded_terms(p, ())) for k, p in parts.items()}
+    pieces = {0: Ha, **parts} if with_base else parts
+    if tuple(alg.ring.symbols[: alg.n]) == tuple(coordinates):
+        rows = {k: coordinate_coefficients(p, alg.n) for k, p in pieces.items()}
+        if all(r is not None for r in rows.values()):
+            return [(k, by_monomials(rows[k], coordinates)) for k in sorted(rows) if rows[k]]
+    by_power = {k: canonical_add(alg.expanded_terms(p, (), memo), memo) for k, p in parts.items()}
     if with_base:
         by_power[0] = base
     return laid_out(by_power, coordinates)
+
+
+def _exact_series(result, slot: int, hamiltonian):
+    """``{k: c_k}`` of :meth:`ShadowFamily.series` (``c_0`` the Hamiltonian, ``c_k`` the correction of ``h^k``, each
+    expanded) from the exact corrections, or None.
+
+    ``series`` expands each laid-out ``c_k`` (:func:`_exact_layout`: monomials times factored coefficients).  When
+    every coefficient's denominator is a monomial in the parameters (or a number), that expansion multiplies out
+    the numerators into distinct products of rational numbers and integer powers of symbols, the canonical form of
+    the Laurent polynomial -- which is the correction's own expanded form (``PolynomialAlgebra.expanded_terms``
+    splits a monomial denominator into powers the same way), so it is taken from there without expanding.  A
+    sum in a denominator is kept whole by ``expand`` in factored form and expanded otherwise: None then (the
+    caller expands the layout).
+    """
+    alg = result.algebra
+    Ha = result.hamiltonians[slot]
+    pieces = {0: Ha, **{k: result.corrections[(slot, k)] for k in range(1, result.order + 1)
+                        if result.corrections.get((slot, k))}}
+    if not all(alg.is_polynomial(p) for p in pieces.values()):
+        return None
+    domain = alg.domain
+    if getattr(domain, "is_FractionField", False):
+        if not domain.domain.is_QQ or any(len(c.denom) != 1 for p in pieces.values() for c in p.values()):
+            return None
+    elif not domain.is_QQ:
+        return None
+    memo: dict = {}
+    out = {k: canonical_add(alg.expanded_terms(p, (), memo), memo) for k, p in sorted(pieces.items())}
+    if out[0] != sympy.expand(hamiltonian):
+        return None
+    return out
 
 
 @dataclass(frozen=True, eq=False)
@@ -462,6 +505,12 @@ class ShadowFamily(Printable, ValueEquality):
         """``{"H_S": {k: c_k}, "G_S": {...}}``: the coefficient of ``h^k`` of each shadow Hamiltonian (k = 0 is H)."""
         out = {}
         for slot, (_, name) in enumerate(self._names()[:self._n_shadows()]):
+            exact = None
+            if self.route == "direct" and self.exists and self.details is not None:
+                exact = _exact_series(self.details, slot, self.system.hamiltonians[slot])
+            if exact is not None:  # the expanded layout, read off the exact corrections
+                out[f"{name}_S"] = {k: c for k, c in exact.items() if c != 0}
+                continue
             coefficients = self._layout(slot, with_base=True) or []
             out[f"{name}_S"] = {k: sympy.expand(c) for k, c in coefficients}
         return out
