@@ -4,6 +4,7 @@ replaced or missing table is not trusted (one warning, then the engine); the too
 from __future__ import annotations
 
 import importlib.util
+import os
 import shutil
 import warnings
 from pathlib import Path
@@ -81,7 +82,7 @@ def _flip(index):
     return lambda data: data.__setitem__(index, data[index] ^ 1)
 
 
-@pytest.mark.parametrize("what", ["block", "header", "truncated", "missing"])
+@pytest.mark.parametrize("what", ["block", "header", "truncated", "missing", "fifo", "symlink"])
 def test_a_damaged_or_replaced_table_is_not_trusted(tmp_path, monkeypatch, what):
     """A flipped bit in a block (its SHA-256 in the header fails) or in the header (the package's SHA-256
     fails), a cut or a missing file: one warning line, then the engine's series."""
@@ -93,6 +94,12 @@ def test_a_damaged_or_replaced_table_is_not_trusted(tmp_path, monkeypatch, what)
         _damaged(tmp_path, monkeypatch, _flip(base - 2))
     elif what == "truncated":
         _damaged(tmp_path, monkeypatch, lambda data: data.__delitem__(slice(40, None)))
+    elif what == "fifo":  # refused before it is opened: reading it would wait for a writer
+        os.mkfifo(tmp_path / "fifo.bin")
+        monkeypatch.setattr(table, "TABLE_PATH", str(tmp_path / "fifo.bin"))
+    elif what == "symlink":  # never followed, even to the genuine table
+        (tmp_path / "link.bin").symlink_to(table.TABLE_PATH)
+        monkeypatch.setattr(table, "TABLE_PATH", str(tmp_path / "link.bin"))
     else:
         monkeypatch.setattr(table, "TABLE_PATH", str(tmp_path / "absent.bin"))
     with warnings.catch_warnings(record=True) as caught:

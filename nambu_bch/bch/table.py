@@ -40,6 +40,7 @@ from __future__ import annotations
 import hashlib
 import json
 import os
+import stat
 import sys
 import threading
 import warnings
@@ -82,12 +83,27 @@ def _unusable(reason: str) -> None:
     _HEADER[:] = [None]
 
 
+def _open_table():
+    """The table file opened for reading: a regular file, never a link, FIFO or device (refused before it is opened,
+    so opening cannot block), and the very file checked (same device and inode after opening)."""
+    before = os.lstat(TABLE_PATH)
+    if not stat.S_ISREG(before.st_mode):
+        raise OSError(f"{TABLE_PATH} is not a regular file")
+    flags = os.O_RDONLY | getattr(os, "O_NOFOLLOW", 0) | getattr(os, "O_NONBLOCK", 0) | getattr(os, "O_CLOEXEC", 0)
+    fh = os.fdopen(os.open(TABLE_PATH, flags), "rb")
+    st = os.fstat(fh.fileno())
+    if (st.st_dev, st.st_ino) != (before.st_dev, before.st_ino) or not stat.S_ISREG(st.st_mode):
+        fh.close()
+        raise OSError(f"{TABLE_PATH} was replaced while it was opened")
+    return fh
+
+
 def _header():
     """The verified header, or ``None`` (then a warning has been given once in this process)."""
     if _HEADER:
         return _HEADER[0]
     try:
-        with open(TABLE_PATH, "rb") as fh:
+        with _open_table() as fh:
             start = fh.read(len(MAGIC) + 4)
             size = int.from_bytes(start[len(MAGIC):], "little")
             raw = fh.read(size) if start[: len(MAGIC)] == MAGIC and size < 2**20 else b""
@@ -127,7 +143,7 @@ def _load(header, series: str, n: int) -> bool:
         return True
     start = degrees[first - 2]["end"] if first > 1 else 0
     try:
-        with open(TABLE_PATH, "rb") as fh:
+        with _open_table() as fh:
             fh.seek(header["base"] + start)
             data = fh.read(degrees[n - 1]["end"] - start)
     except OSError as exc:
