@@ -229,15 +229,15 @@ def test_private_numba_cache_unpickles_only_verified_files(tmp_path, warm):
     numba's format, a truncated entry) is compiled over and rewritten in the verified format, never unpickled.
 
     Every index gets a planted pickle; the probe (:data:`SMALL`) then recompiles one loop of each directory, the
-    ho/121 kernel's ``run`` (``kernels/``) and ``scan`` (``numba/``), over their planted index and truncated data."""
+    ho/121 kernel's ``run`` (``kernels/``) and ``scan_range`` (``numba/``), over their planted index and truncated data."""
     root, env = _copy_warm(warm, tmp_path)
     indexes = sorted(root.rglob("*.nbi"))
     data = sorted(root.rglob("*.nbc"))
     assert {p.relative_to(root).parts[0] for p in indexes} == {"kernels", "numba"}
     for path in indexes + data:
         assert path.read_bytes().startswith(compiled._MAGIC) and stat.S_IMODE(path.stat().st_mode) == 0o600
-    read = sorted(root.rglob("*.run-*.nbi")) + sorted((root / "numba").rglob("scan.scan-*.nbi"))
-    truncated = sorted(root.rglob("*.run-*.nbc")) + sorted((root / "numba").rglob("scan.scan-*.nbc"))
+    read = sorted(root.rglob("*.run-*.nbi")) + sorted((root / "numba").rglob("scan.scan_range-*.nbi"))
+    truncated = sorted(root.rglob("*.run-*.nbc")) + sorted((root / "numba").rglob("scan.scan_range-*.nbc"))
     assert {p.relative_to(root).parts[0] for p in read} == {p.relative_to(root).parts[0] for p in truncated} \
         == {"kernels", "numba"}
     markers = []
@@ -250,7 +250,7 @@ def test_private_numba_cache_unpickles_only_verified_files(tmp_path, warm):
     assert not any(m.exists() for m in markers)
     assert all(p.read_bytes().startswith(compiled._MAGIC) for p in read + truncated)  # compiled over, rewritten
     # a planted entry *with* a valid digest is refused too once the directory is not private
-    fn = next(f for f in _functions(root) if f.__name__ == "scan")
+    fn = next(f for f in _functions(root) if f.__name__ == "scan_range")
     index = _private_index(fn, _numba_dir(root, fn))
     assert index.exists()
     marker = tmp_path / "ran-digest"
