@@ -169,20 +169,28 @@ def modified_equation(system, method, order: int = 2) -> ModifiedEquation:
     alg = f.algebra
     b = T.modified_coefficients(T.rk_coefficients(tableau, order + 1), order + 1)
     F = elementary_differentials(f, order + 1)
+    coefficients = series_fields(alg, b, F, T.trees, T.symmetry, order, tableau.name, "B-series")
+    return ModifiedEquation(tuple(coefficients), order, tableau, system, b)
+
+
+def series_fields(alg, b, F, trees, symmetry, order, name, kind) -> list:
+    """``[f_1, ..., f_(order+1)]``: ``f_j = sum_{|t| = j} b(t) / sigma(t) F(t)``, the modified field's coefficient of
+    ``h^(j-1)`` from the series coefficients ``b`` and the elementary differentials ``F`` (B- or P-series, HLW IX.1,
+    IX.10); rational coefficients only."""
     coefficients = []
     for j in range(order + 1):
         comps = [alg.zero] * alg.n
-        for t in T.trees(j + 1):
+        for t in trees(j + 1):
             value = b.get(t, 0)
             if value == 0:
                 continue
             if not value.is_rational:
-                raise NambuBCHError(f"the modified equation of {tableau.name!r} has the irrational coefficient {value} "
-                                    f"(tree {t}); only rational B-series coefficients are supported")
-            scale = alg.domain.convert(value / T.symmetry(t))
+                raise NambuBCHError(f"the modified equation of {name!r} has the irrational coefficient {value} "
+                                    f"(tree {t}); only rational {kind} coefficients are supported")
+            scale = alg.domain.convert(value / symmetry(t))
             comps = [c + scale * e for c, e in zip(comps, F[t])]
         coefficients.append(VectorField(alg, comps))
-    return ModifiedEquation(tuple(coefficients), order, tableau, system, b)
+    return coefficients
 
 
 def modified_equation_by_taylor(system, method, order: int = 2) -> tuple:

@@ -37,10 +37,8 @@ from math import factorial
 
 import sympy
 
-from ..algebra import VectorField
 from ..bch.backward import check_order
 from ..checks import check_int
-from ..errors import NambuBCHError
 from . import rooted_trees as T
 
 #: Highest order of ``h`` the P-series route accepts: h^6 needs the 4116 bi-coloured trees of 7 vertices (and the
@@ -194,7 +192,7 @@ def p_series_modified_equation(system, method, order: int = 2):
     """
     from ..integrators.runge_kutta import partitioned_tableau
     from ..systems.spec import as_system
-    from .modified import ModifiedEquation, _canonical_half, _polynomial_field, differentials
+    from .modified import ModifiedEquation, _canonical_half, _polynomial_field, differentials, series_fields
 
     system = as_system(system)
     pair = partitioned_tableau(method)
@@ -208,17 +206,5 @@ def p_series_modified_equation(system, method, order: int = 2):
     b = T.modified_coefficients(p_series_coefficients((pair.q, pair.p), order + 1), order + 1, family)
     ordered = [t for n in range(1, order + 2) for t in family.trees(n)]
     F = differentials(alg, parts, ordered, lambda t: t)
-    coefficients = []
-    for j in range(order + 1):
-        comps = [alg.zero] * alg.n
-        for t in family.trees(j + 1):
-            value = b.get(t, 0)
-            if value == 0:
-                continue
-            if not value.is_rational:
-                raise NambuBCHError(f"the modified equation of {pair.name!r} has the irrational coefficient {value} "
-                                    f"(tree {t}); only rational P-series coefficients are supported")
-            scale = alg.domain.convert(value / family.symmetry(t))
-            comps = [c + scale * e for c, e in zip(comps, F[t])]
-        coefficients.append(VectorField(alg, comps))
+    coefficients = series_fields(alg, b, F, family.trees, family.symmetry, order, pair.name, "P-series")
     return ModifiedEquation(tuple(coefficients), order, pair, system, b)
