@@ -62,8 +62,9 @@ from ..checks import check_int, check_sequence, finite_float, show
 from ..errors import InvalidCompositionError, InvalidRunError, NumericalRangeError, ResourceLimitError
 from ..integrators.composition import composition as make_composition
 from ..integrators.step import parameter_values
+from ..symbols import STEP
 from ..values import ValueEquality
-from .diagnostics import numpy_function, quantities
+from .diagnostics import numpy_function
 from .guards import MAX_RUN_STEPS, finite_array, initial_state
 from .iterate import as_system
 from .kernels import kernel, resolve_backend
@@ -259,14 +260,22 @@ def hybrid_monte_carlo(system, word, h, steps, *, refresh=None, flip=None, targe
     exact_params = {p: sympy.nsimplify(v, rational=True) for p, v in values.items()}
     scale = _gaussian_scales(system.H, system.coordinates, refresh, coords, exact_params)
     _check_invariant(system.H, system.coordinates, signs, "H")
+    # the values the run evaluates with: the parameters, h and alpha as their exact binary values (as check does)
+    given = {**{p: sympy.Float(v, 60) for p, v in values.items()}, STEP: sympy.Float(h, 60)}
+    exprs = {"H": sympy.sympify(system.H, strict=True).xreplace(given)}
     if target == "H_S":
         order, alpha = check_int(order, "order", 2), finite_float(alpha, "alpha")
-        _check_invariant(_shadow_member(system, comp, order, alpha, exact_params), system.coordinates, signs, "H_S")
+        H_S, free = _shadow_family(system, comp, order)  # derived once: checked exactly, then evaluated
+        exact_alpha = sympy.nsimplify(alpha, rational=True)
+        _check_invariant(H_S.xreplace({s: exact_alpha for s in free}).xreplace(exact_params), system.coordinates, signs,
+                         "H_S")
+        exprs["H_S"] = H_S.xreplace({s: sympy.Float(alpha, 60) for s in free}).xreplace(given)
     else:
         order = alpha = None
-    names = ("H", "H_S") if target == "H_S" else ("H",)
-    exprs = quantities(system, comp, h, params, order or 2, 0.5 if alpha is None else alpha, which=names)
-    energy = {n: numpy_function(exprs[n], system.coordinates) for n in names}
+    for name, expr in exprs.items():
+        if expr.has(sympy.zoo, sympy.nan, sympy.oo, -sympy.oo):
+            raise InvalidRunError(f"{name} is singular at these parameter values; give others")
+    energy = {n: numpy_function(e, system.coordinates) for n, e in exprs.items()}
 
     kern = kernel(system, comp)
     K = kern.constants(h, params)
@@ -385,14 +394,12 @@ def _gaussian_scales(H, coordinates, refresh, coords, exact_params) -> np.ndarra
     return np.array(out)
 
 
-def _shadow_member(system, comp, order, alpha, exact_params):
-    """The exact ``H_S`` of order ``order`` with every family parameter at ``alpha`` (a rational, as given)."""
+def _shadow_family(system, comp, order):
+    """``(H_S, family parameters)``: the exact shadow Hamiltonian of order ``order``, refused where there is none."""
     from ..shadow.api import shadow_hamiltonians
 
     family = shadow_hamiltonians(system, comp, order=order)
     if not family.exists or family.H_S is None:
         raise InvalidRunError(f"{system.name} with {comp} has no shadow pair at order {order}, so exp(-H_S) "
                               f"cannot be sampled; use target='H'")
-    value = sympy.nsimplify(alpha, rational=True)
-    free = {sympy.Symbol(str(s)): value for s in family.free_parameters}
-    return sympy.sympify(family.H_S, strict=True).xreplace(free).xreplace(exact_params)
+    return sympy.sympify(family.H_S, strict=True), [sympy.Symbol(str(s)) for s in family.free_parameters]
