@@ -157,7 +157,7 @@ def test_catalog_methods_orders_and_bounds():
         comp = nb.composition(f"{name}:121" if takes_word else name)
         assert comp.citation.startswith(citation.split(";")[0])
         structure = "rkn" if TABLES[name].structure == "rkn" else None   # RKN orders hold on the RKN quotient
-        assert composition_order(comp, 2 if structure is None else None, structure) == order == comp.order
+        assert composition_order(comp, comp.n_pieces if structure is None else None, structure) == order == comp.order
         if isinstance(comp, CatalogComposition):
             assert 0 <= comp.error_bound < 1e-12                      # decimals: stated bound (0: met exactly)
     suzuki = nb.composition("suzuki:12321")

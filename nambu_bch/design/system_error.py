@@ -100,7 +100,8 @@ def _box(system, box):
 
 
 def field_size(components, system, box=None, samples: int = 2000, params=None, seed: int = 0) -> float:
-    """``max ||F(x)||_2`` of a polynomial field over a seeded uniform sample of ``box`` (default ``[-1, 1]^N``)."""
+    """``max ||F(x)||_2`` of a polynomial field over a seeded uniform sample of ``box`` (default ``[-1, 1]^N``); the
+    Hermitian norm ``sqrt(sum |F_i|^2)`` when the field has complex coefficients."""
     system = as_system(system)
     box = _box(system, box)
     if not is_int(samples, 1, MAX_SAMPLES):
@@ -114,8 +115,9 @@ def field_size(components, system, box=None, samples: int = 2000, params=None, s
     f = sympy.lambdify(system.coordinates, exprs, modules="numpy")
     rng = np.random.RandomState(seed)
     pts = [rng.uniform(lo, hi, samples) for lo, hi in box]
-    cols = [np.broadcast_to(np.asarray(v, dtype=float), (samples,)) for v in f(*pts)]
-    return float(np.sqrt(sum(c * c for c in cols)).max())
+    # complex-coefficient methods have complex error fields: the size is the Hermitian norm sqrt(sum |F_i|^2)
+    cols = [np.broadcast_to(np.asarray(v, dtype=complex), (samples,)) for v in f(*pts)]
+    return float(np.sqrt(sum(c.real**2 + c.imag**2 for c in cols)).max())
 
 
 def leading_error(system, word, box=None, samples: int = 2000, params=None, seed: int = 0,

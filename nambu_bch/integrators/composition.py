@@ -47,6 +47,7 @@ Hairer, Lubich, Wanner, *Geometric Numerical Integration*, Sect. II.4.
 
 from __future__ import annotations
 
+import re
 from dataclasses import dataclass
 from fractions import Fraction
 from functools import lru_cache
@@ -685,7 +686,7 @@ def with_error_bound(comp: Composition, parts: int, structure: str = "") -> Cata
     # Below degree 4 the RKN quotient is the free Lie algebra, and a symmetric method has E_4 = 0 exactly: there the
     # defects of the general order conditions measure only the rounding of the decimals, and count in the bound.
     general = comp.order if structure != "rkn" else min(comp.order, 4 if comp.symmetric else 3)
-    bound = max(abs(float(field.K.to_sympy(v))) for q in range(1, general + 1) for v in field.defects(parts, q).values())
+    bound = max(abs(complex(field.K.to_sympy(v))) for q in range(1, general + 1) for v in field.defects(parts, q).values())
     if structure == "rkn":
         bound = max(bound, structured_bound(comp, comp.order, structure))
     return CatalogComposition(comp.pieces, comp.coefficients, comp.name,
@@ -705,14 +706,19 @@ def _base(word: str | None, n_pieces, name):
     return base
 
 
+#: A published complex decimal ``re+im*I`` of a table.
+_COMPLEX_DECIMAL = re.compile(r"([+-]?[0-9.]+)([+-][0-9.]+)\*I")
+
+
 def _number(text: str, exact: bool):
-    """A table entry: a published decimal as the rational it denotes, or an exact formula read by the package's
-    whitelist parser (numbers, + - * / ** and sqrt)."""
+    """A table entry: a published decimal (or complex decimal ``re+im*I``) as the exact number it denotes, or an exact
+    formula read by the package's whitelist parser (numbers, + - * / **, sqrt, cbrt and the imaginary unit I)."""
     if not exact:
-        return sympy.Rational(text)
+        pair = _COMPLEX_DECIMAL.fullmatch(text)
+        return sympy.Rational(pair[1]) + sympy.I * sympy.Rational(pair[2]) if pair else sympy.Rational(text)
     from ..parsing import parse_expression
 
-    return parse_expression(text, {}, what="table coefficient")
+    return parse_expression(text, {"I": sympy.I}, what="table coefficient")
 
 
 def _ab(table) -> Composition:
@@ -739,9 +745,32 @@ def _ab(table) -> Composition:
     return Composition(tuple(pieces), tuple(coeffs), table.name, table.order, table.reference)
 
 
+def _word(table) -> Composition:
+    """The composition of a ``"word"`` table: its factors as listed (mirrored when symmetric); for decimals the
+    innermost factor of each piece is rebuilt from the others, ``1 - sum`` (symmetric: ``1 - 2 sum`` for the middle
+    factor, ``1/2 - sum`` for another piece's innermost one), so that the scheme is exactly consistent."""
+    pieces = [int(k) for k in table.word]
+    values = [_number(v, table.exact) for v in table.values]
+    if not table.exact:
+        for k in set(pieces):
+            inner = max(i for i, p in enumerate(pieces) if p == k)
+            rest = sum(v for i, (p, v) in enumerate(zip(pieces, values)) if p == k and i != inner)
+            if not table.symmetric:
+                values[inner] = 1 - rest
+            else:
+                values[inner] = 1 - 2 * rest if inner == len(pieces) - 1 else sympy.Rational(1, 2) - rest
+    values = [sympy.expand(v) for v in values]
+    if table.symmetric:
+        pieces, values = pieces + pieces[-2::-1], values + values[-2::-1]
+    return Composition(tuple(pieces), tuple(values), table.name, table.order, table.reference)
+
+
 @lru_cache(maxsize=64)
 def _catalog_build(kind: str, word, n_pieces):
     table = TABLES[kind]
+    if table.kind == "word":
+        comp = _word(table)
+        return comp if table.exact else with_error_bound(comp, comp.n_pieces, table.structure)
     if table.kind == "ab":
         if table.exact:
             return _ab(table)
@@ -766,7 +795,7 @@ def lookup(text: str, n_pieces=None):
         return None
     if not TABLES[kind].takes_word:
         if sep:
-            raise InvalidCompositionError(f"{kind!r} is a method for two pieces (1 = A, 2 = B) and takes no base word")
+            raise InvalidCompositionError(f"{kind!r} is a method of fixed pieces (1 = A, 2 = B, ...) and takes no base word")
         return _catalog_build(kind, None, None)
     return _catalog_build(kind, word or None, None if sep else n_pieces)
 

@@ -1,4 +1,6 @@
-"""Compositions from the published decimal tables of :mod:`.tables` (``kahan-li:WORD``, ``yoshida6:WORD``, ``blanes-moan``).
+"""Compositions from the published decimal tables of :mod:`.tables` (``kahan-li:WORD``, ``yoshida6:WORD``, ``blanes-moan``,
+and the methods of Auzinger, Hofstaetter & Koch's tables that SplittingOrderConditions.jl's CheckMethods rates, such
+as ``emb-43-ak-s``, the complex ``milne-22-c-i`` and the three-part ``ak-114``).
 
 Exactness.  Decimal coefficients are taken as the exact rationals they denote; the last (middle) coefficient of each
 piece is the complement to one, so the scheme is exactly consistent.  Such a composition is a
