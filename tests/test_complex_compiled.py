@@ -17,6 +17,7 @@ import numpy as np
 import pytest
 import sympy
 
+import nambu_bch as nb
 from nambu_bch import model
 from nambu_bch.errors import InvalidRunError, NumericalRangeError
 from nambu_bch.integrators.composition import composition_for
@@ -55,6 +56,16 @@ def test_compiled_ho3_run_gives_the_reference_bits(ho3_loop, project):
     # once the loop is compiled in this process, "auto" takes it even for a short run: the same samples
     short = iterate_complex("ho3", W, 0.1, 10, X0, project=project)
     np.testing.assert_array_equal(short, iterate_complex("ho3", W, 0.1, 10, X0, project=project, backend="numpy"))
+
+
+@numba_only
+def test_iterate_and_check_pass_the_backend_on(ho3_loop):
+    """``iterate`` and ``check`` hand a complex word and their ``backend`` to the complex run."""
+    fast = nb.iterate("ho3", W, 0.1, 200, X0, every=50, backend="numba")
+    np.testing.assert_array_equal(fast, iterate_complex("ho3", W, 0.1, 200, X0, every=50, backend="numpy"))
+    r1 = nb.check("ho3", W, 0.1, 200, X0, include=("H", "G"), backend="numba")
+    r2 = nb.check("ho3", W, 0.1, 200, X0, include=("H", "G"), backend="numpy")
+    assert r1.max_abs_error == r2.max_abs_error and r1.arithmetic == "complex128"
 
 
 @numba_only
