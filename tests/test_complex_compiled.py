@@ -147,6 +147,22 @@ def test_generated_source_holds_no_model_name():
                                                                  sympy.Rational(1, 2)}
 
 
+def test_generated_step_of_a_user_system_with_constants(tmp_path, monkeypatch):
+    """A user's H = p^2/2 + sqrt(k) q^2/2 + pi q: the hoisted factors -sqrt(k) and -pi evaluate in the generated module,
+    whose loop, run on the interpreter here (plain Python on cmath), follows the reference to rounding."""
+    monkeypatch.setenv("NAMBU_BCH_CACHE", str(tmp_path / "cache"))
+    S = nb.System("q p", ["p**2/2 + sqrt(k)*q**2/2 + pi*q"], name="spring", parameters="k")
+    word = "1:1/2+I/2,2:1,1:1/2-I/2"
+    kern = complex_kernel(S, word)
+    T, K = kern.constants(0.1, {"k": 2.0})
+    assert sorted(K.tolist()) == [-np.pi, -np.sqrt(2.0)]
+    out = np.empty((21, 2), dtype=np.complex128)
+    out[0] = x = np.array([1.0, 0.0], dtype=np.complex128)
+    assert kern.module.run(x, T, K, 20, 1, out, False) == 20
+    ref = iterate_complex(S, word, 0.1, 20, [1.0, 0.0], {"k": 2.0}, backend="numpy")
+    assert np.abs(out - ref).max() <= 1e-14 * np.abs(ref).max() and np.abs(ref[-1].imag).max() > 1e-4
+
+
 def test_complex_kernel_source_is_verified_in_the_cache(tmp_path, monkeypatch):
     """The complex module goes through the kernels' verified cache: read back when intact, regenerated when modified."""
     monkeypatch.setenv("NAMBU_BCH_CACHE", str(tmp_path / "cache"))

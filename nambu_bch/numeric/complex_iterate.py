@@ -24,9 +24,8 @@ Two implementations of the step (``backend=``):
   rationals their float values are, so the parameter factors are rounded once), run on ``cmath`` for one
   trajectory and on numpy arrays for a batch;
 * the compiled loop (``"numba"``, :mod:`~nambu_bch.numeric.complex_codegen`): the same exact sub-flows generated
-  as straight-line complex128 source, compiled by numba and cached on disk like the float64 kernels, some
-  thousand times faster; one trajectory gets the reference's bits (where the parameter factors are exact in
-  float64, as for the defaults);
+  as straight-line complex128 source, compiled by numba and cached on disk like the float64 kernels; one
+  trajectory gets the reference's bits (where the parameter factors round alike in float64, as the defaults do);
 * ``"auto"``: the compiled loop, except short runs whose loop is not compiled yet, which step each state on
   ``cmath`` (:data:`INTERPRET_FACTOR_STEPS`).
 
