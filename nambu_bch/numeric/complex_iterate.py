@@ -115,7 +115,7 @@ def coefficient_value(comp, c) -> complex:
 
 #: ``backend="auto"`` interprets a run while its compiled loop is not in this process and the run is small: at most
 #: this many factor-steps (steps x sub-flows of the step x states).  The interpreter takes ~8 us a factor-step
-#: (cmath, ho3), so this costs at most ~0.2 s, less than compiling the loop (1-3 s, of which importing numba
+#: (cmath, ho3), so this costs at most ~0.2 s, less than compiling the loop (1-4 s, of which importing numba
 #: 0.3-0.5 s).  The interpreter then steps one state at a time (each column of a batch alone): the compiled bits.
 INTERPRET_FACTOR_STEPS = 25_000
 
