@@ -16,7 +16,7 @@ Two runs are offered (Blanes, Casas & Murua 2010, Sect. 4; Castella et al. 2009)
 * ``project=True``: the real projection ``x_{n+1} = Re Phi_h(x_n)``, the real method a user of a
   complex-coefficient scheme for a real problem runs; its order is that of ``Phi_h``, but it is no
   longer a composition of real flows, so no real shadow pair is conserved: what holds is measured by
-  :func:`check_complex` and reported in docs/integrators.md.
+  :func:`~nambu_bch.numeric.diagnostics.complex_check` and reported in docs/integrators.md.
 
 Two implementations of the step (``backend=``):
 
