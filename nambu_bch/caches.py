@@ -60,6 +60,8 @@ CACHES = (
     ("nambu_bch.systems.piece_flows", "piece_flow"),
     ("nambu_bch.integrators.composition", "_catalog_build"),
     ("nambu_bch.numeric.codegen", "_step_program"),
+    ("nambu_bch.numeric.complex_codegen", "_KERNELS"),
+    ("nambu_bch.numeric.complex_codegen", "_complex_program"),
     ("nambu_bch.numeric.kernels", "_CACHE_DIRS"),
     ("nambu_bch.numeric.kernels", "_generator_digest"),
     ("nambu_bch.numeric.kernels", "_kernel_for_word"),

@@ -411,7 +411,8 @@ def check(system, word, h, steps, x0=None, params=None, *, order=2, alpha=0.5, e
         if kahan:
             raise InvalidRunError(f"kahan=True applies to float64 runs; {name!r} has complex coefficients and runs in "
                                   "complex128")
-        return complex_check(system, word, h, steps, x0, params, order=order, alpha=alpha, every=every, include=include)
+        return complex_check(system, word, h, steps, x0, params, order=order, alpha=alpha, every=every, include=include,
+                             backend=backend)
     alpha = finite_float(alpha, "alpha")
     order = check_order(order)
     given, (x0, _) = x0, initial_state(system, x0)  # the run resolves None itself, and names it as the default
@@ -603,7 +604,7 @@ def observed_order(system, word, hs, T, x0=None, params=None, quantity="x", back
 
 
 def complex_check(system, word, h, steps, x0=None, params=None, *, order=2, alpha=0.5, every=1, project=False,
-                  include=None):
+                  include=None, backend="auto"):
     """:func:`nambu_bch.numeric.check` for a composition with complex coefficients: errors of ``H``, ``G`` and the
     complex shadow pair ``H_S, G_S`` along :func:`iterate_complex`.
 
@@ -613,7 +614,8 @@ def complex_check(system, word, h, steps, x0=None, params=None, *, order=2, alph
     least-squares slope of ``|Q(x_n) - Q(x_0)|`` against ``t_n``.  With ``project=True`` (the real run
     ``Re Phi_h``) ``Q`` is replaced by its real part ``Re Q`` (the states are real; the imaginary terms of
     ``H_S`` describe the complex map, which the projection discards).  The conserved quantities and exact solutions of
-    :mod:`nambu_bch.exact` are real constructions and are not evaluated.
+    :mod:`nambu_bch.exact` are real constructions and are not evaluated.  ``backend``: of the run
+    (:func:`~nambu_bch.numeric.complex_iterate.iterate_complex`).
 
     Returns
     -------
@@ -631,7 +633,7 @@ def complex_check(system, word, h, steps, x0=None, params=None, *, order=2, alph
     everything = QUANTITY_NAMES + tuple("ocs")
     include = _names(include, everything, "include") if include is not None else everything
     include = [q for q in include if q in ("H", "G", "H_S", "G_S")]
-    samples = iterate_complex(system, word, h, steps, x0, params, every, project=project)
+    samples = iterate_complex(system, word, h, steps, x0, params, every, project=project, backend=backend)
     skipped = {}
     exprs = quantities(system, word, h, params, order, alpha, which=include, skipped=skipped)
     t = float(h) * sample_steps(steps, every).astype(np.float64)

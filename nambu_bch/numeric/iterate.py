@@ -162,7 +162,7 @@ def iterate(system, word, h, steps, x0=None, params=None, every=1, *, kahan=Fals
     if is_gradient_method(word):  # a force-gradient composition or a processed kernel: its own numpy loop
         return _gradient_run(system, word, h, steps, x0, params, every, kahan, dps, out, fma)
     if _complex(system, word):  # a complex map: complex128 on its own path (numeric/complex_iterate.py)
-        return _iterate_complex(system, word, h, steps, x0, params, every, kahan, dps, out, fma)
+        return _iterate_complex(system, word, h, steps, x0, params, every, kahan, dps, out, fma, backend)
     x0, origin = initial_state(system, x0)
     check_work(check_count(steps, "steps", 0), x0, mpmath=dps is not None)  # from the request, before any work
     kahan, check_stable = check_flag(kahan, "kahan"), check_flag(check_stable, "check_stable")
@@ -438,7 +438,7 @@ def _complex(system, word) -> bool:
     return composition_for(word, system.splitting).is_complex
 
 
-def _iterate_complex(system, word, h, steps, x0, params, every, kahan, dps, out, fma):
+def _iterate_complex(system, word, h, steps, x0, params, every, kahan, dps, out, fma, backend):
     """:func:`~nambu_bch.numeric.complex_iterate.iterate_complex`, the float64-only options refused in one line."""
     from .complex_iterate import iterate_complex
 
@@ -447,7 +447,7 @@ def _iterate_complex(system, word, h, steps, x0, params, every, kahan, dps, out,
         if given:
             raise InvalidRunError(f"{flag} applies to float64 runs; {str(word)[:60]!r} has complex coefficients and "
                                   "runs in complex128 (numeric.complex_iterate)")
-    return iterate_complex(system, word, h, steps, x0, params, every)
+    return iterate_complex(system, word, h, steps, x0, params, every, backend=backend)
 
 
 def _runge_kutta_options(tableau, dps, fma) -> None:

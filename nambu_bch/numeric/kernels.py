@@ -215,6 +215,12 @@ class Kernel:
         (:func:`~nambu_bch.numeric.iterate.iterate` with ``backend="auto"``), by function name
     """
 
+    #: The template version an index records (checked when the module is read back) and the functions the
+    #: module must define; a subclass generating other loops into this same verified cache sets its own
+    #: (:class:`nambu_bch.numeric.complex_codegen.ComplexKernel`) and its :meth:`_render`.
+    template = TEMPLATE_VERSION
+    functions = _FUNCTIONS
+
     def __init__(self, system, comp):
         self.system = system
         self.composition = comp
@@ -236,7 +242,7 @@ class Kernel:
             meta = json.loads(_read_small(self.index_path).decode("utf-8"))
             if not isinstance(meta, dict) or any(not isinstance(meta.get(k), t) for k, t in _INDEX_FIELDS.items()):
                 return False
-            if meta["template"] != TEMPLATE_VERSION or not _MODULE_NAME.fullmatch(meta["module"]):
+            if meta["template"] != self.template or not _MODULE_NAME.fullmatch(meta["module"]):
                 return False
             if meta["N"] != self.N or meta["n_parameters"] != len(self.system.parameters):
                 return False
@@ -248,7 +254,7 @@ class Kernel:
             if f"nambu_bch_kernel_{source_hash(source)}" != meta["module"]:
                 return False
             linear = tuple(int(i) for i in meta["linear"] if isinstance(i, int) and 0 <= i < self.N)
-            module = _load_module(meta["module"], path, source)
+            module = _load_module(meta["module"], path, source, self.functions)
         except (OSError, ValueError, SyntaxError, UnicodeDecodeError):  # absent, corrupt or modified: regenerate
             return False
         self.source, self.path, self.module = source, path, module
@@ -257,13 +263,11 @@ class Kernel:
 
     def _generate(self):
         """Generate the source from the exact sub-flows (sympy), write it and its index, load it."""
-        program = self.program
-        self.source = python_source(program)
+        self.source, self.n_constants, self.linear = self._render(self.program)
         name = f"nambu_bch_kernel_{source_hash(self.source)}"
         self.path = self.directory / f"{name}.py"
         data = self.source.encode("utf-8")
-        self.n_constants, self.linear = len(program.constants), tuple(linear_part(program))
-        meta = {"template": TEMPLATE_VERSION, "module": name, "sha256": hashlib.sha256(data).hexdigest(),
+        meta = {"template": self.template, "module": name, "sha256": hashlib.sha256(data).hexdigest(),
                 "N": self.N, "n_constants": self.n_constants, "n_parameters": len(self.system.parameters),
                 "linear": list(self.linear)}
         try:
@@ -271,7 +275,12 @@ class Kernel:
             _write_file(self.index_path, json.dumps(meta, sort_keys=True).encode("utf-8"))
         except OSError:  # a read-only cache still runs: the module below comes from memory, not the file
             pass
-        self.module = _load_module(name, self.path, self.source)
+        self.module = _load_module(name, self.path, self.source, self.functions)
+
+    @staticmethod
+    def _render(program) -> tuple:
+        """``(source, number of constants, coordinates of the stability check)`` of a program."""
+        return python_source(program), len(program.constants), tuple(linear_part(program))
 
     @property
     def program(self):
