@@ -517,6 +517,9 @@ def body_lines(program: StepProgram, printer, kahan=False, c_syntax=False, vecto
 #: The fused multiply-add the ``fused`` lines call: ``llvm.fma`` in the compiled loop
 #: (:func:`nambu_bch.compiled.fused_multiply_add`); the interpreter never runs them.
 FMA_FUNCTION = "_fma"
+#: The name the batch loops call the guards' scan by (:func:`nambu_bch.numeric.scan.scan_into`, bound when they are
+#: compiled; ``None`` in the interpreted module, whose batches run the numpy loops).
+SCAN_FUNCTION = "_scan_into"
 
 
 def fused_product(d, printer):
@@ -629,22 +632,24 @@ def python_source(program: StepProgram) -> str:
       one trajectory, ``x`` of shape (N,), ``out`` of shape (n_samples, N);
     * ``run_fma(x, K, steps, every, out)`` -- ``run`` with every product increment added by one fused
       multiply-add (:func:`fused_product`; compiled only, for ``fma=True``);
-    * ``run_batch(X, K, steps, every, out, chunk, start, back, lo, hi)`` and ``run_batch_kahan(X, C, ...)`` --
+    * ``run_batch(X, K, steps, every, out, chunk, start, back, lo, hi, res)`` and ``run_batch_kahan(X, C, ...)`` --
       ``X`` of shape (N, batch) holds the start states, ``out`` of shape (n_samples, N, batch);
       the columns ``lo <= b < hi`` are processed (disjoint ranges may run in parallel threads: the
       compiled loops release the GIL), in chunks that stay in cache, the inner loop over the chunk.
       ``start``: also copy ``X`` into ``out[0]`` (in the same pass that loads the chunk);
       ``back``: write the final states back into ``X`` (without it ``X`` is only read, and the
       final states are ``out[-1]``).  ``C`` (Kahan compensation) is always updated in place.
-      They return the number of non-finite values among the samples written (``out[1:]``), so
-      the caller checks the result without another pass over it;
+      ``res``: an empty int64 array, or the guards' scan result to extend chunk by chunk as the states are
+      loaded (:func:`nambu_bch.numeric.scan.scan_into`; -1 is returned at a non-finite or subnormal start state,
+      before any step).  They return the number of non-finite values among the samples written (``out[1:]``),
+      so the caller checks the result without another pass over it;
     * ``run_numpy(...)`` and ``run_numpy_kahan(...)`` -- the vectorised numpy fallback for
-      batches (same arguments, same operations in the same order; it returns a positive number
+      batches (the same arguments but ``res``, the same operations in the same order; it returns a positive number
       when a sample is not finite, 0 otherwise).
     """
     consts = [f"k{j} = K[{j}]" for j in range(len(program.constants))] or ["pass"]
     scalar = lambda e: print_python(e, "_")  # noqa: E731
-    src = [_HEADER.format(version=TEMPLATE_VERSION), constants_source(program)]
+    src = [_HEADER.format(version=TEMPLATE_VERSION), f"{SCAN_FUNCTION} = None\n", constants_source(program)]
     if any(u.pairs for u in program.updates):
         src.append(pair_function_source())
     for kahan in (False, True):
@@ -709,8 +714,8 @@ def _run_batch_source(program: StepProgram, body, scalar, consts, kahan) -> str:
     X only when ``back``; the sample pass counts non-finite values (the result check)."""
     N = program.N
     name = "run_batch_kahan" if kahan else "run_batch"
-    args = ("X, C, K, steps, every, out, chunk, start, back, lo, hi" if kahan else
-            "X, K, steps, every, out, chunk, start, back, lo, hi")
+    args = ("X, C, K, steps, every, out, chunk, start, back, lo, hi, res" if kahan else
+            "X, K, steps, every, out, chunk, start, back, lo, hi, res")
     # the chunk's rows in one buffer, each row 64-byte aligned: an allocation only 16- or 32-byte aligned
     # splits every 8-wide (AVX-512) load across two cache lines, measured 1.8x slower
     rows = [f"S{i}" for i in range(N)] + ([f"Q{i}" for i in range(N)] if kahan else [])
@@ -718,6 +723,7 @@ def _run_batch_source(program: StepProgram, body, scalar, consts, kahan) -> str:
     alloc = ["W = (chunk + 7) // 8 * 8", f"buf = np.empty({len(rows) + len(spare)} * W + 8)",
              "off = (8 - (buf.ctypes.data // 8) % 8) % 8"]
     alloc += [f"{r} = buf[off + {q} * W:off + {q} * W + chunk]" for q, r in enumerate(rows + spare)]
+    alloc += ["scanning = res.shape[0] > 0", "acc = np.empty((2, 3, chunk if scanning else 1))"]
     # the memory passes as one element loop per row (numba vectorises each; a slice assignment
     # ``S0[:nb] = X[0, b0:b0 + nb]`` runs as fast but makes numba compile its broadcasting error
     # path, which doubled the kernel's compile time; one loop over all rows at once measured 3-4x slower)
@@ -726,6 +732,9 @@ def _run_batch_source(program: StepProgram, body, scalar, consts, kahan) -> str:
     first = [line for i in range(N) for line in _row_copy(f"out[0, {i}, b0:b0 + nb]", f"S{i}")]
     scatter = [line for i in range(N) for line in _row_copy(f"X[{i}, b0:b0 + nb]", f"S{i}")]
     comp_back = [line for i in range(N) for line in _row_copy(f"C[{i}, b0:b0 + nb]", f"Q{i}")] if kahan else []
+    # ``res`` non-empty: the guards' scan of the start states (:func:`nambu_bch.numeric.scan.scan_into`, bound
+    # to SCAN_FUNCTION when the loop is compiled) extended by each chunk just before it is loaded -- the batch
+    # is read from memory once; a non-finite or subnormal start state stops the loop (-1) before any step
     chunk_step = _chunk_step(program, body, scalar, kahan, rows)
     jammed = _chunk_step(program, body, scalar, kahan, rows, JAM_STEPS)
     chunk_sample = []
@@ -739,6 +748,9 @@ def {name}({args}):
 {_indent(alloc, 4)}
     for b0 in range(lo, hi, chunk):
         nb = min(chunk, hi - b0)
+        if scanning:
+            if {SCAN_FUNCTION}(X, b0, b0 + nb, acc, res):
+                return -1
 {_indent(gather, 8)}
         if start:
 {_indent(first, 12)}

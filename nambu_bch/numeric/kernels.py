@@ -73,7 +73,8 @@ from ..atomic import write_atomic
 from ..private_dirs import cache_root, private_directory, read_private, untrusted
 from ..integrators.composition import composition_for
 from ..integrators.step import parameter_values
-from .codegen import FMA_FUNCTION, PAIR_FUNCTION, TEMPLATE_VERSION, python_source, source_hash, step_program
+from .codegen import (FMA_FUNCTION, PAIR_FUNCTION, SCAN_FUNCTION, TEMPLATE_VERSION, python_source, source_hash,
+                      step_program)
 
 from .guards import BACKENDS, linear_part  # the accepted names live with the other checks of a run's inputs
 #: numba's fast-math flags of a run with ``fma=True``: contraction of ``a*b + c`` into one fused
@@ -327,6 +328,10 @@ class Kernel:
             if name.startswith("run_batch") and hasattr(self.module, PAIR_FUNCTION):
                 # the batch loops' redo calls the shared-exponential function: compiled, it is a global of theirs
                 self.module.__dict__[PAIR_FUNCTION] = self.function(PAIR_FUNCTION)
+            if name.startswith("run_batch"):  # the guards' scan they extend as they load the states
+                from .scan import scan_into
+
+                self.module.__dict__[SCAN_FUNCTION] = scan_into
             source = name
             if fma and name == "run":  # one trajectory: the fused multiply-adds written out (codegen.fused_product)
                 source = "run_fma"
@@ -379,8 +384,7 @@ class Kernel:
             scan_range(X, lo, hi, res)
             return res
 
-        res = combine(_on_threads(part, column_ranges(X.shape[1], NUMBA_CHUNK, workers)))
-        return int(res[0]), int(res[1]), np.unique(np.concatenate([res[2:7], [0, X.shape[1] - 1]]))
+        return _scan_triple(combine(_on_threads(part, column_ranges(X.shape[1], NUMBA_CHUNK, workers))), X.shape[1])
 
     def compile(self, kahan: bool = False, batch: bool = False, fma: bool = False) -> float:
         """Compile (or load from the disk cache) one loop now; the wall time in seconds."""
@@ -407,7 +411,7 @@ class Kernel:
             X = np.zeros((N, 1))
             out = np.zeros((2, N, 1))
             args = (X, np.zeros((N, 1))) if kahan else (X,)
-            fn(*args, K, 1, 1, out, NUMBA_CHUNK, 1, 1, 0, 1)
+            fn(*args, K, 1, 1, out, NUMBA_CHUNK, 1, 1, 0, 1, _NO_SCAN)
         else:
             x = np.zeros(N)
             out = np.zeros((2, N))
@@ -453,7 +457,7 @@ class Kernel:
         return int(n)
 
     def run_batch(self, X, K, steps, every, out, *, kahan=False, comp=None, backend="numba", chunk=None,
-                  start=False, back=True, fma=False, workers=1) -> int:
+                  start=False, back=True, fma=False, workers=1, scanned=None) -> int:
         """Advance states ``X`` (shape (N, batch), float64); ``out`` of shape (n, N, batch), ``out[1:]`` is filled.
 
         ``start``: also copy ``X`` into ``out[0]`` (fused with the pass that loads the states);
@@ -461,8 +465,11 @@ class Kernel:
         read (the caller's array can be passed as it is) and the final states are ``out[-1]``.
         ``fma`` as in :meth:`run`.  ``workers``: threads running the compiled loop on disjoint column
         ranges (:func:`column_ranges`; the loop releases the GIL, every state is advanced by the same
-        operations, so the bits do not depend on it).  Returns 0 when every sample written is finite,
-        a positive number otherwise.
+        operations, so the bits do not depend on it).  ``scanned``: a dict (compiled loop only) that receives,
+        under ``"result"``, the guards' scan of ``X`` (:meth:`scan`'s triple) taken as each chunk is loaded, so
+        ``X`` is read from memory once; the loop stops before any step at a non-finite or subnormal state of
+        ``X`` and -1 is returned (``"result"`` then holds that scan so far).  Returns 0 when every sample written
+        is finite, a positive number otherwise.
         """
         name = "run_batch_kahan" if kahan else "run_batch"
         args = (X, comp) if kahan else (X,)
@@ -475,8 +482,27 @@ class Kernel:
         self.compile(kahan=kahan, batch=True, fma=fma)
         fn = self.function(self.loop_name(kahan, True, fma))
         chunk = int(chunk or NUMBA_CHUNK)
-        call = lambda lo, hi: int(fn(*args, K, int(steps), int(every), out, chunk, *flags, lo, hi))  # noqa: E731
-        return sum(_on_threads(call, column_ranges(B, chunk, workers)))
+        ranges = column_ranges(B, chunk, workers)
+        if scanned is None:
+            call = lambda lo, hi: int(fn(*args, K, int(steps), int(every), out, chunk, *flags, lo, hi, _NO_SCAN))  # noqa: E731
+            return sum(_on_threads(call, ranges))
+        from .scan import START, combine
+
+        parts = [np.array(START, dtype=np.int64) for _ in ranges]
+        bad = _on_threads(lambda lo, hi, res: int(fn(*args, K, int(steps), int(every), out, chunk, *flags, lo, hi, res)),
+                          [(lo, hi, res) for (lo, hi), res in zip(ranges, parts)])
+        scanned["result"] = _scan_triple(combine(parts), B)
+        return -1 if min(bad) < 0 else sum(bad)
+
+
+#: The ``res`` argument of a batch loop that does not scan its start states.
+_NO_SCAN = np.zeros(0, dtype=np.int64)
+
+
+def _scan_triple(res, B: int) -> tuple:
+    """``(non-finite count, subnormal count, columns)`` of a combined scan result of ``B`` states (the first and
+    last state among the columns)."""
+    return int(res[0]), int(res[1]), np.unique(np.concatenate([res[2:7], [0, B - 1]]))
 
 
 def _on_threads(call, ranges) -> list:
