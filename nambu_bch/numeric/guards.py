@@ -295,8 +295,15 @@ def step_matrix(kernel, K, S):
     return X[S, 1:] - X[S, :1]
 
 
+#: Most constants vectors a kernel remembers as stable (:func:`check_stability`; a few kB each at most).
+MAX_REMEMBERED = 1024
+
+
 def check_stability(kernel, h, K, params=None):
     """Raise :class:`UnstableStepError` if the linear part of the step is not power-bounded.
+
+    The verdict depends on the constants ``K`` alone, so a stable ``K`` is remembered by the kernel
+    (``kernel.stable_constants``): repeated runs with one step and one set of parameters check it once.
 
     Examples
     --------
@@ -310,7 +317,9 @@ def check_stability(kernel, h, K, params=None):
     nambu_bch.errors.UnstableStepError: h = 2.0 is outside the stability interval of 32123 on ho3 (omega*h = 2, must be < 2): ...
     """
     S = kernel.linear
-    if not S:
+    passed = getattr(kernel, "stable_constants", None)  # the verdict depends on K alone: each K checked once
+    key = np.asarray(K, dtype=np.float64).tobytes()
+    if not S or (passed is not None and key in passed):
         return
     M = step_matrix(kernel, K, S)
     if not np.all(np.isfinite(M)):
@@ -341,6 +350,8 @@ def check_stability(kernel, h, K, params=None):
         hint = f" (omega*h = {omega * float(h):.6g}, must be < 2)" if omega is not None else ""
         raise UnstableStepError(f"h = {h!r} is outside the stability interval of {kernel.word} on "
                                 f"{kernel.system.name}{hint}: {reason}; take a smaller step")
+    if passed is not None and len(passed) < MAX_REMEMBERED:
+        passed.add(key)
 
 
 def _names(kernel, S):

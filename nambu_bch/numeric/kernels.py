@@ -230,6 +230,8 @@ class Kernel:
         self._jitted = {}
         self.compile_seconds = {}
         self.interpreted = {}
+        #: the constants ``K`` (bytes) whose step passed :func:`~nambu_bch.numeric.guards.check_stability`
+        self.stable_constants = set()
 
     def _load_cached(self) -> bool:
         """Use the cached source if its index is intact and the file matches the recorded digest."""
@@ -288,18 +290,21 @@ class Kernel:
         ``constants``); a coefficient that is not a finite float64 raises :class:`NumericalRangeError`."""
         values = parameter_values(self.system, params)
         P = [values[p] for p in self.system.parameters]
-        given = ", ".join(f"{p} = {v:g}" for p, v in values.items())
-        where = f"h = {float(h):g}" + (f" with {given}" if given else "")
+
+        def where():  # the run named in a message (formatting the parameters costs more than the constants)
+            given = ", ".join(f"{p} = {v:g}" for p, v in values.items())
+            return f"h = {float(h):g}" + (f" with {given}" if given else "")
+
         try:
             K = np.array([float(v) for v in self.module.constants(float(h), P)], dtype=np.float64)
         except ZeroDivisionError:
-            raise NumericalRangeError(f"{where}: a coefficient of the step divides by zero; "
+            raise NumericalRangeError(f"{where()}: a coefficient of the step divides by zero; "
                                       "give non-zero values to the parameters in denominators") from None
         except (OverflowError, ValueError) as exc:
-            raise NumericalRangeError(f"{where}: a coefficient of the step is out of the float64 range ({exc}); "
+            raise NumericalRangeError(f"{where()}: a coefficient of the step is out of the float64 range ({exc}); "
                                       "rescale the parameters or the step") from None
         if not np.all(np.isfinite(K)):
-            raise NumericalRangeError(f"{where}: a coefficient of the step overflows float64; "
+            raise NumericalRangeError(f"{where()}: a coefficient of the step overflows float64; "
                                       "rescale the parameters or the step")
         return K
 
