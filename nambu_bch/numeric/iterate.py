@@ -102,7 +102,9 @@ def iterate(system, word, h, steps, x0=None, params=None, every=1, *, kahan=Fals
     kahan : bool -- compensated summation of the increments (float64 only)
     dps : int, optional -- decimal digits of an mpmath run (a reference; ~10^3x slower)
     backend : ``"auto"`` | ``"numba"`` | ``"numpy"`` -- ``"auto"``: compiled, except runs too small to pay for
-        compiling their loop (:data:`INTERPRET_STEPS`), which take the interpreter (the same bits)
+        compiling their loop (:data:`INTERPRET_STEPS`), which take the interpreter (the same bits); one
+        trajectory (no ``kahan``, no ``fma``) runs through the kernel's C library when one is cached and
+        verifies (:mod:`~nambu_bch.numeric.clib`: the same bits, numba not imported)
     progress : bool or None -- a progress line on stderr; None: only on a terminal and for long runs
     chunk : int, optional -- states per cache block of a batch (tuning only)
     check_stable : bool -- refuse steps outside the stability interval (:func:`~nambu_bch.numeric.guards.check_stability`)
@@ -344,7 +346,9 @@ def _prepare(system, kern, h, steps, every, x0, params, backend, chunk, check_st
     steps = check_count(steps, "steps", 0)
     shape = np.shape(x0)
     fallback = False  # the interpreter chosen for speed: on an arithmetic exception the compiled loop takes over
-    if backend == "auto" and be == "numba":
+    if backend == "auto" and be == "numba" and len(shape) == 1 and not (kahan or fma) and kern.library() is not None:
+        be = "c"  # the kernel's cached C library (numeric.clib): numba's bits without importing numba
+    elif backend == "auto" and be == "numba":
         be, fallback = _interpret_small(kern, steps, shape, kahan, fma)
     # a large batch: one pass (compiled on numba, blocked numpy otherwise) finds non-finite, subnormal and
     # extreme states; the batch itself is only read by the run, so it is not copied

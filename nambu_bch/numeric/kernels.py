@@ -232,6 +232,7 @@ class Kernel:
         self.interpreted = {}
         #: the constants ``K`` (bytes) whose step passed :func:`~nambu_bch.numeric.guards.check_stability`
         self.stable_constants = set()
+        self._library = None  # the C library's run (numeric.clib): None not tried yet, False absent
 
     def _load_cached(self) -> bool:
         """Use the cached source if its index is intact and the file matches the recorded digest."""
@@ -407,7 +408,24 @@ class Kernel:
             start = time.perf_counter()
             self._first_call(fn, kahan, batch)
         self.compile_seconds[name] = time.perf_counter() - start
+        if name == "run" and not self.from_cache and self.library() is None:
+            # the step program is at hand (generated in this process): build the C library that later processes
+            # run without importing numba (numeric.clib)
+            from . import clib
+
+            if clib.build(self):
+                self._library = None
         return self.compile_seconds[name]
+
+    def library(self):
+        """The ``run`` loop of the kernel's cached C library (:mod:`~nambu_bch.numeric.clib`), verified and loaded
+        once per process, or None."""
+        if self._library is None:
+            from . import clib
+
+            fn = clib.load(self)
+            self._library = fn if fn is not None else False
+        return self._library or None
 
     def _first_call(self, fn, kahan, batch):
         N = self.N
@@ -446,6 +464,10 @@ class Kernel:
         Returns the number of steps done (less than ``steps`` only if a sample became non-finite).
         """
         name = "run_kahan" if kahan else "run"
+        if backend == "c":  # the cached C library (iterate's backend="auto" chooses it only when it loaded)
+            from .clib import run
+
+            return run(self.library(), x, K, steps, every, out)
         if backend == "numba":
             self.compile(kahan=kahan, fma=fma)
             fn = self.function(self.loop_name(kahan, False, fma))
