@@ -350,8 +350,8 @@ def _prepare(system, kern, h, steps, every, x0, params, backend, chunk, check_st
         be = "c"  # the kernel's cached C library (numeric.clib): numba's bits without importing numba
     elif backend == "auto" and be == "numba":
         be, fallback = _interpret_small(kern, steps, shape, kahan, fma)
-    # a large batch: one pass (compiled on numba, blocked numpy otherwise) finds non-finite, subnormal and
-    # extreme states; the batch itself is only read by the run, so it is not copied
+    # a large batch: non-finite, subnormal and extreme states are found by the compiled loop as it loads the
+    # states (deferred), by one blocked numpy pass otherwise; the batch itself is only read, so it is not copied
     batch = len(shape) == 2
     threads = batch_workers(workers, shape[1], steps) if batch else 1
     scanned = {}
