@@ -140,6 +140,9 @@ def test_the_c_source_holds_no_user_text():
                      "k0", "k1", "s0", "s1", "d0"}, words
     with pytest.raises(nb.NambuBCHError):
         kernel('ho3"; system("id', "121")  # an unknown model is refused before any source exists
+    for params in ({'omega"); system("id': 1.0}, {"omega": "1); system(2"}):  # hostile names and values
+        with pytest.raises(nb.NambuBCHError):
+            nb.iterate("ho", "121", 0.1, 10, [1.0, 0.0], params=params)
 
 
 @needs_cc
