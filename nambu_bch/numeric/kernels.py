@@ -25,7 +25,10 @@ What is cached, and how it is trusted (docs/hardening.md):
 * ``__pycache__/*.nbi, *.nbc`` -- numba's machine code, kept here whatever
   ``$NUMBA_CACHE_DIR`` says, each file carrying a SHA-256 of its content that is
   checked before numba unpickles it (:func:`nambu_bch.compiled.enable_private_cache`);
-  an entry that fails the check, or that numba cannot load, is compiled again.
+  an entry that fails the check, or that numba cannot load, is compiled again;
+* ``nambu_bch_clib_<key>.so`` / ``.json`` -- the single-trajectory loop as a C shared library and its record,
+  built when numba compiles a freshly generated ``run`` and a C compiler is present, verified before it is
+  loaded (:mod:`~nambu_bch.numeric.clib`).
 
 Every cache file is read through :func:`nambu_bch.private_dirs.read_private` (a
 private regular file: never a symlink, FIFO or device, size bounded) and written
