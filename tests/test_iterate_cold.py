@@ -35,7 +35,7 @@ def test_an_unstable_step_is_refused_every_time():
 
 
 def test_a_coefficient_out_of_range_still_names_the_run():
-    with pytest.raises(nb.NambuBCHError, match=r"h = 0\.1 with m = 1, omega = 1e\+200: a coefficient of the step overflows"):
+    with pytest.raises(nb.NambuBCHError, match=r"h = 0\.1 with m = 1, omega = 1e\+200: a coefficient of the step"):
         nb.iterate("ho", "121", 0.1, 5, [1.0, 0.0], params={"omega": 1e200}, backend="numpy")
     assert np.isfinite(kernel("ho", "121").constants(0.1)).all()
 
@@ -50,7 +50,8 @@ from nambu_bch.numeric import clib  # noqa: E402
 from nambu_bch.numeric.codegen import c_run_source  # noqa: E402
 
 needs_cc = pytest.mark.skipif(clib.compiler() is None, reason="no C compiler on the PATH")
-#: one flow of each kind: polynomial (ho3), shared exponentials with their series branch (lotka-volterra), sin (pendulum)
+#: one flow of each kind: polynomial (ho3), shared exponentials with their series branch (lotka-volterra),
+#: sin (pendulum)
 CASES = [("ho3", "32123", 0.1), ("lotka-volterra", "12321", 0.01), ("pendulum", "121", 0.05)]
 
 

@@ -513,14 +513,15 @@ class Kernel:
         fn = self.function(self.loop_name(kahan, True, fma))
         chunk = int(chunk or NUMBA_CHUNK)
         ranges = column_ranges(B, chunk, workers)
+        def call(lo, hi, res=_NO_SCAN):
+            return int(fn(*args, K, int(steps), int(every), out, chunk, *flags, lo, hi, res))
+
         if scanned is None:
-            call = lambda lo, hi: int(fn(*args, K, int(steps), int(every), out, chunk, *flags, lo, hi, _NO_SCAN))  # noqa: E731
             return sum(_on_threads(call, ranges))
         from .scan import START, combine
 
         parts = [np.array(START, dtype=np.int64) for _ in ranges]
-        bad = _on_threads(lambda lo, hi, res: int(fn(*args, K, int(steps), int(every), out, chunk, *flags, lo, hi, res)),
-                          [(lo, hi, res) for (lo, hi), res in zip(ranges, parts)])
+        bad = _on_threads(call, [(lo, hi, res) for (lo, hi), res in zip(ranges, parts)])
         scanned["result"] = _scan_triple(combine(parts), B)
         return -1 if min(bad) < 0 else sum(bad)
 
