@@ -13,6 +13,13 @@ first process filled (a temporary ``NAMBU_BCH_CACHE``, so the machine's own cach
   the run with numba imported first -- the same, numba's import moved before the timer
   a short run                    -- the same with ``--short`` steps (within ``INTERPRET_STEPS``: interpreted,
                                     numba not imported)
+  a C library (prototype)        -- what the run would cost without numba: the same phases, then the run's
+                                    guards (``iterate._prepare``, numpy backend), the SHA-256 check of a shared
+                                    library built beforehand from the same step program (``codegen.c_source``,
+                                    ``-O3 -march=native -ffp-contract=off``), ``ctypes.CDLL`` and its loop of
+                                    ``--steps`` steps; its final state is compared bit for bit with ``iterate()``'s.
+                                    Not a package feature: the measurement of what one would take
+                                    (docs/numerics.md, "The first compiled run of a process").
 
 Usage (from the repository root):
     python benchmarks/bench_iterate_cold.py                  # ho3, 32123, 10^6 steps
@@ -53,6 +60,32 @@ print(json.dumps({"marks": marks, "load": k.compile_seconds.get("run"), "interpr
                   "from_cache": k.from_cache, "numba_import": NUMBA_IMPORT[0] if NUMBA_IMPORT else None}))
 """
 
+CTYPES_CHILD = """
+import ctypes, hashlib, json, sys, time
+clock = lambda: (time.perf_counter(), time.process_time())
+marks = {"start": clock()}
+import numpy as np
+from nambu_bch import model
+from nambu_bch.numeric import kernel
+from nambu_bch.numeric.iterate import _prepare
+marks["import"] = clock()
+system = model(sys.argv[2])
+marks["model"] = clock()
+steps, path, digest = int(sys.argv[4]), sys.argv[5], sys.argv[6]
+k = kernel(system, sys.argv[3])
+run = _prepare(system, k, 0.1, steps, 1, [0.7] * system.N, None, "numpy", None, True)
+with open(path, "rb") as fh:
+    assert hashlib.sha256(fh.read()).hexdigest() == digest
+lib = ctypes.CDLL(path)
+P = ctypes.POINTER(ctypes.c_double)
+x = np.array(run.X, dtype=np.float64)
+lib.run.argtypes, lib.run.restype = [P, P, ctypes.c_long], ctypes.c_long
+lib.run(x.ctypes.data_as(P), run.K.ctypes.data_as(P), steps)
+marks["iterate"] = clock()
+print(json.dumps({"marks": marks, "load": None, "final": x.tolist(), "numba": "numba" in sys.modules,
+                  "numba_import": None}))
+"""
+
 #: Prefix of the run's child: times the first ``import numba`` statement wherever it runs (``__import__``
 #: wrapped; ``importlib.util.find_spec``, which locates numba without importing it, does not pass here).
 HOOK = """
@@ -82,7 +115,8 @@ def child(kind, args, env):
         return {"wall": time.perf_counter() - start,
                 "cpu": (after.children_user - before.children_user) + (after.children_system - before.children_system)}
     steps = args.short if kind == "short" else args.steps
-    res = subprocess.run([sys.executable, "-c", HOOK + CHILD, kind, args.system, args.word, str(steps)],
+    code, extra = (CTYPES_CHILD, list(args.library)) if kind == "ctypes" else (HOOK + CHILD, [])
+    res = subprocess.run([sys.executable, "-c", code, kind, args.system, args.word, str(steps), *extra],
                          env=env, capture_output=True, text=True, check=True)
     return json.loads(res.stdout.strip().splitlines()[-1])
 
@@ -102,11 +136,16 @@ def main(argv=None):
         env["NAMBU_BCH_CACHE"] = cache
         filled = child("run", args, env)  # compiles and caches the kernel
         rows = {"pass": [], "numba": [], "run": [], "numba_first": [], "short": []}
+        cref = _c_library(args, cache)
+        if cref is not None:
+            rows["ctypes"] = []
         load_before = os.getloadavg()
         for _ in range(args.repeats):
             for kind in rows:
                 rows[kind].append(child(kind, args, env))
         load_after = os.getloadavg()
+        if cref is not None:
+            cref.close()
     print(f"# first iterate() of a fresh process: {args.system} {args.word}, {args.steps} steps, kernel cached "
           f"(the filling process compiled in {filled['load']:.2f} s); {args.repeats} rounds")
     print(f"load average (1, 5, 15 min) before {load_before[0]:.2f} {load_before[1]:.2f} {load_before[2]:.2f}, "
@@ -120,8 +159,14 @@ def main(argv=None):
                         ("numba", "python -c 'import numba' (whole process)")):
         print(f"{label:58s} {stat([r['wall'] for r in rows[kind]])}  {stat([r['cpu'] for r in rows[kind]])}")
     summary = {}
+    if "ctypes" in rows:
+        same = all(r["final"] == args.reference for r in rows["ctypes"]) and not any(r["numba"] for r in rows["ctypes"])
+        print(f"C library prototype: final state == iterate() bit for bit, numba never imported: {same}")
     for kind, title in (("run", "the run"), ("numba_first", "the run, numba imported before the timer"),
-                        ("short", f"a short run, {args.short} steps")):
+                        ("short", f"a short run, {args.short} steps"),
+                        ("ctypes", "prototype: the same loop as a verified C library through ctypes (no numba)")):
+        if kind not in rows:
+            continue
         phases = {}
         for r in rows[kind]:
             m = r["marks"]
@@ -135,7 +180,8 @@ def main(argv=None):
         print(f"{title}:")
         labels = {"numba": "import numba", "import": "import nambu_bch.numeric (sympy, numpy)",
                   "model": f"model({args.system!r})",
-                  "iterate": f"first iterate(), {args.short if kind == 'short' else args.steps} steps"}
+                  "iterate": (f"kernel, guards, digest, CDLL, {args.steps} steps" if kind == "ctypes" else
+                              f"first iterate(), {args.short if kind == 'short' else args.steps} steps")}
         for name, values in phases.items():
             wall = [w for w, _ in values]
             cpu = [c for _, c in values]
@@ -145,6 +191,30 @@ def main(argv=None):
     if args.json:
         print(json.dumps({"system": args.system, "word": args.word, "steps": args.steps,
                           "load_average": [round(v, 2) for v in load_before + load_after], "phases": summary}))
+
+
+def _c_library(args, cache):
+    """Build the C loop of the kernel (``-ffp-contract=off``: the numba kernel's bits) for the prototype row; sets
+    ``args.library`` (path, SHA-256) and ``args.reference`` (``iterate()``'s final state); None without a compiler."""
+    import hashlib
+
+    sys.path.insert(0, str(ROOT))
+    sys.path.insert(0, str(Path(__file__).resolve().parent))
+    os.environ["NAMBU_BCH_CACHE"] = cache
+    from bench_iterate_c import EXACT_FLAGS, CReference, c_compiler
+
+    from nambu_bch import model
+    from nambu_bch.numeric import iterate, kernel
+
+    if c_compiler() is None:
+        return None
+    system = model(args.system)
+    cref = CReference(kernel(system, args.word).program, EXACT_FLAGS)
+    path = os.path.join(cref.dir, "step.so")
+    with open(path, "rb") as fh:
+        args.library = (path, hashlib.sha256(fh.read()).hexdigest())
+    args.reference = iterate(system, args.word, 0.1, args.steps, [0.7] * system.N, every=args.steps)[-1].tolist()
+    return cref
 
 
 if __name__ == "__main__":

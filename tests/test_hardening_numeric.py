@@ -68,7 +68,7 @@ def _exact_verlet(steps, h, x):
 _INTERNAL = re.compile(r"(?:[skpcdytSQRefu]\d+|_[A-Za-z_0-9]*|a|abs|max|big|prod|small|nonfinite|subnormal|res|i|c|x|X|K|P|C|h|n|j|m|b|b0|b1|B|nb|chunk|lo|hi|steps|every|out|"
                        r"math|np|range|min|constants|run\w*|progress|"
                        # the batch loops' flags and the compiled scan's block reductions
-                       r"start|back|bad|buf|off|over|v\d*|N|W|row|g|nf|sb|top|I[bps]|i?[bps]m(?:ax|in)|m\d)")
+                       r"start|back|bad|buf|off|over|scanning|acc|v\d*|N|W|row|g|nf|sb|top|I[bps]|i?[bps]m(?:ax|in)|m\d)")
 
 
 def _identifiers(source):

@@ -100,3 +100,43 @@ def test_threads_scan_their_own_ranges_and_find_the_one_pass_extremes():
     Y = X.copy()
     Y[0, 10], Y[2, 4999], Y[1, 3000] = np.nan, 1e-310, np.inf  # in the first, the last and a middle range
     assert kern.scan(Y, 3)[:2] == scan_states(Y)[:2] == (2, 1)
+
+
+def test_the_batch_loop_scans_x0_as_it_loads_it():
+    """A large compiled batch makes no pass of its own over x0: the loop extends the guards' scan chunk by chunk
+    (numeric.scan.scan_into) and finds the one-pass counts and extreme states for every chunk size and number of
+    threads -- so the range check sees the states a separate pass would give it, and the samples keep their bits."""
+    from nambu_bch.numeric import kernel
+    from nambu_bch.numeric.guards import scan_states
+
+    rng = np.random.default_rng(12)
+    X = rng.uniform(0.5, 1.5, (3, 5000)) * 10.0 ** rng.integers(-60, 60, (3, 5000))
+    X[:, 4000] = X[:, 17]
+    X[:, 2600] = 0.0
+    want = scan_states(X)
+    kern = kernel("ho3", "32123")
+    K = kern.constants(0.01)
+    for chunk, workers in ((256, 1), (100, 3), (5000, 2)):
+        scanned, out = {}, np.empty((2, 3, 5000))
+        kern.run_batch(X, K, 1, 1, out, chunk=chunk, start=True, back=False, workers=workers, scanned=scanned)
+        assert scanned["result"][:2] == want[:2] and np.array_equal(scanned["result"][2], want[2])
+        assert np.array_equal(out, nb.iterate("ho3", "32123", 0.01, 1, X, backend="numpy", check_stable=False))
+
+
+def test_a_large_batch_runs_without_a_separate_scan(monkeypatch):
+    """The compiled batch path never calls Kernel.scan (the pass the fused loop replaces); bad states of x0 are
+    still refused with the message of the checked-up-front path, wherever they are."""
+    from nambu_bch.numeric.kernels import Kernel
+
+    X = RNG.uniform(0.5, 1.5, (3, iterate_module.SCAN_BATCH + 300))
+    want = nb.iterate("ho3", "32123", 0.1, 20, X, every=5, backend="numpy")
+    monkeypatch.setattr(Kernel, "scan", lambda *a, **k: pytest.fail("a separate scan of x0"))
+    for workers in (1, 2):
+        assert np.array_equal(nb.iterate("ho3", "32123", 0.1, 20, X, every=5, backend="numba", workers=workers), want)
+    for col, value, message in ((4300, np.nan, "non-finite value nan"), (5, -np.inf, "non-finite value -inf"),
+                                (4395, 1e-310, "below the smallest normal"), (2000, 1e200, "overflows float64")):
+        Y = X.copy()
+        Y[1, col] = value
+        for workers in (1, 2):
+            with pytest.raises(NumericalRangeError, match=message):
+                nb.iterate("ho3", "32123", 0.1, 20, Y, every=5, backend="numba", workers=workers)

@@ -58,7 +58,9 @@ from ..integrators.flows import TIME, exact_flow
 STEP = sympy.Symbol("h")
 
 #: Bump when the generated source changes meaning (part of the cache key).
-TEMPLATE_VERSION = "8"
+TEMPLATE_VERSION = "9"
+#: Steps a batch kernel takes for each state of a chunk before moving to the next state (:func:`_chunk_step`).
+JAM_STEPS = 2
 
 _FUNCTIONS = ("exp", "expm1", "log", "sin", "cos", "tan", "sinh", "cosh", "tanh", "sqrt", "atan", "asin", "acos")
 
@@ -515,6 +517,9 @@ def body_lines(program: StepProgram, printer, kahan=False, c_syntax=False, vecto
 #: The fused multiply-add the ``fused`` lines call: ``llvm.fma`` in the compiled loop
 #: (:func:`nambu_bch.compiled.fused_multiply_add`); the interpreter never runs them.
 FMA_FUNCTION = "_fma"
+#: The name the batch loops call the guards' scan by (:func:`nambu_bch.numeric.scan.scan_into`, bound when they are
+#: compiled; ``None`` in the interpreted module, whose batches run the numpy loops).
+SCAN_FUNCTION = "_scan_into"
 
 
 def fused_product(d, printer):
@@ -589,19 +594,26 @@ def _row_copy(dst, src):
     return ["for b in range(nb):", f"    {dst}[b] = {src}[b]"]
 
 
-def _sampling_loop(step, sample, checks=()):
+def _sampling_loop(step, sample, checks=(), jammed=None):
     """The loop every kernel shares: ``steps`` steps, a sample into ``out[j]`` after each ``every`` of them.
 
     ``step`` are the lines of one step, ``sample`` the lines that store sample ``j``, ``checks``
-    lines run after it (finiteness, progress).  Returns lines at indent 0.
+    lines run after it (finiteness, progress).  ``jammed``: lines of :data:`JAM_STEPS` steps at once
+    (a batch's chunk loop doing them for each state in turn), run while that many steps remain before
+    the next sample, ``step`` then for the rest.  Returns lines at indent 0.
     """
+    if jammed and step:
+        advance = [f"    for _ in range(m // {JAM_STEPS}):", *("        " + line for line in jammed),
+                   f"    for _ in range(m % {JAM_STEPS}):", *("        " + line for line in step)]
+    else:
+        advance = ["    for _ in range(m):", *("        " + line for line in (step or ["pass"]))]  # every piece
+        # zero: the step is the identity
     return [
         "n = 0",
         "j = 1",
         "while n < steps:",
         "    m = every if steps - n >= every else steps - n",
-        "    for _ in range(m):",
-        *("        " + line for line in (step or ["pass"])),  # every piece zero: the step is the identity
+        *advance,
         "    n += m",
         *("    " + line for line in sample),
         "    j += 1",
@@ -620,22 +632,24 @@ def python_source(program: StepProgram) -> str:
       one trajectory, ``x`` of shape (N,), ``out`` of shape (n_samples, N);
     * ``run_fma(x, K, steps, every, out)`` -- ``run`` with every product increment added by one fused
       multiply-add (:func:`fused_product`; compiled only, for ``fma=True``);
-    * ``run_batch(X, K, steps, every, out, chunk, start, back, lo, hi)`` and ``run_batch_kahan(X, C, ...)`` --
+    * ``run_batch(X, K, steps, every, out, chunk, start, back, lo, hi, res)`` and ``run_batch_kahan(X, C, ...)`` --
       ``X`` of shape (N, batch) holds the start states, ``out`` of shape (n_samples, N, batch);
       the columns ``lo <= b < hi`` are processed (disjoint ranges may run in parallel threads: the
       compiled loops release the GIL), in chunks that stay in cache, the inner loop over the chunk.
       ``start``: also copy ``X`` into ``out[0]`` (in the same pass that loads the chunk);
       ``back``: write the final states back into ``X`` (without it ``X`` is only read, and the
       final states are ``out[-1]``).  ``C`` (Kahan compensation) is always updated in place.
-      They return the number of non-finite values among the samples written (``out[1:]``), so
-      the caller checks the result without another pass over it;
+      ``res``: an empty int64 array, or the guards' scan result to extend chunk by chunk as the states are
+      loaded (:func:`nambu_bch.numeric.scan.scan_into`; -1 is returned at a non-finite or subnormal start state,
+      before any step).  They return the number of non-finite values among the samples written (``out[1:]``),
+      so the caller checks the result without another pass over it;
     * ``run_numpy(...)`` and ``run_numpy_kahan(...)`` -- the vectorised numpy fallback for
-      batches (same arguments, same operations in the same order; it returns a positive number
+      batches (the same arguments but ``res``, the same operations in the same order; it returns a positive number
       when a sample is not finite, 0 otherwise).
     """
     consts = [f"k{j} = K[{j}]" for j in range(len(program.constants))] or ["pass"]
     scalar = lambda e: print_python(e, "_")  # noqa: E731
-    src = [_HEADER.format(version=TEMPLATE_VERSION), constants_source(program)]
+    src = [_HEADER.format(version=TEMPLATE_VERSION), f"{SCAN_FUNCTION} = None\n", constants_source(program)]
     if any(u.pairs for u in program.updates):
         src.append(pair_function_source())
     for kahan in (False, True):
@@ -700,8 +714,8 @@ def _run_batch_source(program: StepProgram, body, scalar, consts, kahan) -> str:
     X only when ``back``; the sample pass counts non-finite values (the result check)."""
     N = program.N
     name = "run_batch_kahan" if kahan else "run_batch"
-    args = ("X, C, K, steps, every, out, chunk, start, back, lo, hi" if kahan else
-            "X, K, steps, every, out, chunk, start, back, lo, hi")
+    args = ("X, C, K, steps, every, out, chunk, start, back, lo, hi, res" if kahan else
+            "X, K, steps, every, out, chunk, start, back, lo, hi, res")
     # the chunk's rows in one buffer, each row 64-byte aligned: an allocation only 16- or 32-byte aligned
     # splits every 8-wide (AVX-512) load across two cache lines, measured 1.8x slower
     rows = [f"S{i}" for i in range(N)] + ([f"Q{i}" for i in range(N)] if kahan else [])
@@ -709,6 +723,7 @@ def _run_batch_source(program: StepProgram, body, scalar, consts, kahan) -> str:
     alloc = ["W = (chunk + 7) // 8 * 8", f"buf = np.empty({len(rows) + len(spare)} * W + 8)",
              "off = (8 - (buf.ctypes.data // 8) % 8) % 8"]
     alloc += [f"{r} = buf[off + {q} * W:off + {q} * W + chunk]" for q, r in enumerate(rows + spare)]
+    alloc += ["scanning = res.shape[0] > 0", "acc = np.empty((2, 3, chunk if scanning else 1))"]
     # the memory passes as one element loop per row (numba vectorises each; a slice assignment
     # ``S0[:nb] = X[0, b0:b0 + nb]`` runs as fast but makes numba compile its broadcasting error
     # path, which doubled the kernel's compile time; one loop over all rows at once measured 3-4x slower)
@@ -717,7 +732,11 @@ def _run_batch_source(program: StepProgram, body, scalar, consts, kahan) -> str:
     first = [line for i in range(N) for line in _row_copy(f"out[0, {i}, b0:b0 + nb]", f"S{i}")]
     scatter = [line for i in range(N) for line in _row_copy(f"X[{i}, b0:b0 + nb]", f"S{i}")]
     comp_back = [line for i in range(N) for line in _row_copy(f"C[{i}, b0:b0 + nb]", f"Q{i}")] if kahan else []
+    # ``res`` non-empty: the guards' scan of the start states (:func:`nambu_bch.numeric.scan.scan_into`, bound
+    # to SCAN_FUNCTION when the loop is compiled) extended by each chunk just before it is loaded -- the batch
+    # is read from memory once; a non-finite or subnormal start state stops the loop (-1) before any step
     chunk_step = _chunk_step(program, body, scalar, kahan, rows)
+    jammed = _chunk_step(program, body, scalar, kahan, rows, JAM_STEPS)
     chunk_sample = []
     for i in range(N):  # the sample, row by row, counting non-finite values as it is written
         chunk_sample += [f"row = out[j, {i}, b0:b0 + nb]", "for b in range(nb):",
@@ -729,10 +748,13 @@ def {name}({args}):
 {_indent(alloc, 4)}
     for b0 in range(lo, hi, chunk):
         nb = min(chunk, hi - b0)
+        if scanning:
+            if {SCAN_FUNCTION}(X, b0, b0 + nb, acc, res):
+                return -1
 {_indent(gather, 8)}
         if start:
 {_indent(first, 12)}
-{_indent(_sampling_loop(chunk_step, chunk_sample), 8)}
+{_indent(_sampling_loop(chunk_step, chunk_sample, jammed=jammed), 8)}
         if back:
 {_indent(scatter, 12)}
 {_indent(comp_back, 8)}
@@ -740,13 +762,21 @@ def {name}({args}):
 """
 
 
-def _chunk_step(program: StepProgram, body, scalar, kahan, rows) -> list:
-    """One step of every state of a chunk (the batch kernel's inner loop)."""
+def _chunk_step(program: StepProgram, body, scalar, kahan, rows, steps=1) -> list:
+    """One step of every state of a chunk (the batch kernel's inner loop); ``steps > 1``: that many steps of each
+    state in turn, loaded once and stored once (None for a step with shared exponentials, whose redo is per step).
+
+    Each state still goes through the same operations in the same order, so the bits do not change; the chunk's
+    rows are read and written once per ``steps`` steps instead of once per step -- what gcc does to the C loop at
+    -O3 (unroll-and-jam of the step loop), and the L1 traffic numba's loop otherwise spends in loads and stores.
+    """
     N = program.N
     inner_load = [f"s{i} = S{i}[b]" for i in range(N)] + ([f"c{i} = Q{i}[b]" for i in range(N)] if kahan else [])
     inner_store = [f"S{i}[b] = s{i}" for i in range(N)] + ([f"Q{i}[b] = c{i}" for i in range(N)] if kahan else [])
     if not any(u.pairs for u in program.updates):
-        return ["for b in range(nb):", *("    " + line for line in inner_load + body + inner_store)]
+        return ["for b in range(nb):", *("    " + line for line in inner_load + body * steps + inner_store)]
+    if steps > 1:
+        return None
     # shared exponentials: one branch-free pass over the chunk (vectorised); if some |u| left the
     # series range, the chunk's step is undone and redone with the library branch -- the same bits
     # as the branchy loop either way.  The redo (scalar, rare) calls the pair function instead of
@@ -877,6 +907,49 @@ void run_batch(double *restrict X, const double *restrict K, long steps, long B,
         }}
         for (long b = 0; b < nb; ++b) {{ {scatter} }}
     }}
+}}
+"""
+
+
+def c_run_source(program: StepProgram) -> str:
+    """The generated ``run`` as a C translation unit: the loop of a kernel's C library
+    (:mod:`~nambu_bch.numeric.clib`).
+
+    ``long run(double *x, const double *K, long steps, long every, double *out)`` has the semantics of the
+    Python/numba ``run`` (:func:`python_source`): ``x`` (N,) advanced in place, ``out`` (n_samples, N)
+    row-major with ``out[0]`` the start, a sample after each ``every`` steps, the loop stopped at a
+    non-finite sample; returns the steps done.  The statements are :func:`body_lines` printed by the C99
+    printer -- the same operations in the same order, built without contraction (``-ffp-contract=off``),
+    so the samples are numba's bits.  Like every generated source it holds no user text: state ``s_i``,
+    constants ``k_j`` and numeric literals only (:func:`check_kernel_expression`).
+    """
+    N = program.N
+    body = body_lines(program, print_c, c_syntax=True)
+    consts = " ".join(f"const double k{j} = K[{j}];" for j in range(len(program.constants)))
+    decl = " ".join(f"double s{i} = x[{i}];" for i in range(N))
+    store = " ".join(f"x[{i}] = s{i};" for i in range(N))
+    sample = " ".join(f"out[j * {N} + {i}] = s{i};" for i in range(N))
+    finite = " && ".join(f"isfinite(s{i})" for i in range(N))
+    return f"""/* Generated by nambu_bch.numeric.codegen (template {TEMPLATE_VERSION}) */
+#include <math.h>
+
+long run(double *restrict x, const double *restrict K, long steps, long every, double *restrict out) {{
+    {consts}
+    {decl}
+    long n = 0;
+    long j = 1;
+    while (n < steps) {{
+        long m = steps - n >= every ? every : steps - n;
+        for (long r = 0; r < m; ++r) {{
+            {chr(10).join('            ' + b for b in body).strip()}
+        }}
+        n += m;
+        {sample}
+        j += 1;
+        if (!({finite})) break;
+    }}
+    {store}
+    return n;
 }}
 """
 

@@ -121,7 +121,7 @@ def check_work(steps: int, x0, mpmath: bool = False) -> None:
             f"{'mpmath' if mpmath else 'float64'} run accepts; split the run or take a larger h")
 
 
-def check_inputs(system, h, steps, every, x0, params=None, exact=False, scan=None, copy=True):
+def check_inputs(system, h, steps, every, x0, params=None, exact=False, scan=None, copy=True, deferred=False):
     """Validate a run's arguments; returns ``(h, steps, every, x0 array, params dict)``.
 
     ``x0`` must have shape ``(N,)`` or ``(N, batch)``; with ``exact=True`` (the mpmath
@@ -130,7 +130,9 @@ def check_inputs(system, h, steps, every, x0, params=None, exact=False, scan=Non
     (:meth:`~nambu_bch.numeric.kernels.Kernel.scan` or :func:`scan_states`) used instead of
     whole-array numpy passes for the finiteness and underflow checks.  ``copy``: return a fresh
     array (a float64 run advances it in place); with ``copy=False`` a C-contiguous, aligned,
-    writeable float64 ``x0`` is returned as it is (the caller only reads it).
+    writeable float64 ``x0`` is returned as it is (the caller only reads it).  ``deferred``: the values of a
+    float64 batch are left to the caller, whose compiled loop scans the states as it loads them and calls
+    :func:`check_states` if one is non-finite or subnormal -- a batch read once instead of twice.
     """
     h = _real(h, "step h")
     steps = check_count(steps, "steps", 0)
@@ -158,10 +160,20 @@ def check_inputs(system, h, steps, every, x0, params=None, exact=False, scan=Non
             f"x0 has shape {arr.shape}, but {system.name} has {system.N} coordinates "
             f"{tuple(str(c) for c in system.coordinates)}: give shape ({system.N},) or ({system.N}, batch)"
         )
-    if scan is not None and arr.ndim == 2 and not exact:
-        nonfinite, subnormal, _ = scan(arr)
-        if not (nonfinite or subnormal):
+    if arr.ndim == 2 and not exact:
+        if deferred:
             return h, steps, every, arr, values
+        if scan is not None:
+            nonfinite, subnormal, _ = scan(arr)
+            if not (nonfinite or subnormal):
+                return h, steps, every, arr, values
+    check_states(x0, arr, exact)
+    return h, steps, every, arr, values
+
+
+def check_states(x0, arr, exact=False) -> None:
+    """Refuse, in one line, initial states ``arr`` (``x0`` as given, converted) holding a non-finite value or
+    (float64 runs) a subnormal one; ``exact``: an object array of an mpmath run (strings, mpf)."""
     if exact:
         try:
             floats = np.array([float(v) for v in arr.ravel()]).reshape(arr.shape)
@@ -169,7 +181,7 @@ def check_inputs(system, h, steps, every, x0, params=None, exact=False, scan=Non
             raise NumericalRangeError(f"x0 = {show(x0)} holds a number beyond the float64 range; give finite "
                                       "real numbers") from None
         except (TypeError, ValueError):
-            raise InvalidRunError(f"x0 must hold {system.N} real numbers (floats, strings or mpf with dps), "
+            raise InvalidRunError(f"x0 must hold {arr.shape[0]} real numbers (floats, strings or mpf with dps), "
                                   f"got {show(x0)}") from None
     else:
         floats = arr
@@ -185,7 +197,6 @@ def check_inputs(system, h, steps, every, x0, params=None, exact=False, scan=Non
                 f"x0 contains {flat[sub][0]:.3g}, below the smallest normal float64 ({TINY:.3g}): it underflows; "
                 "rescale the initial state or use dps=... (mpmath)"
             )
-    return h, steps, every, arr, values
 
 
 def sample_array(out, shape, *inputs) -> np.ndarray:
@@ -284,8 +295,15 @@ def step_matrix(kernel, K, S):
     return X[S, 1:] - X[S, :1]
 
 
+#: Most constants vectors a kernel remembers as stable (:func:`check_stability`; a few kB each at most).
+MAX_REMEMBERED = 1024
+
+
 def check_stability(kernel, h, K, params=None):
     """Raise :class:`UnstableStepError` if the linear part of the step is not power-bounded.
+
+    The verdict depends on the constants ``K`` alone, so a stable ``K`` is remembered by the kernel
+    (``kernel.stable_constants``): repeated runs with one step and one set of parameters check it once.
 
     Examples
     --------
@@ -299,7 +317,9 @@ def check_stability(kernel, h, K, params=None):
     nambu_bch.errors.UnstableStepError: h = 2.0 is outside the stability interval of 32123 on ho3 (omega*h = 2, must be < 2): ...
     """
     S = kernel.linear
-    if not S:
+    passed = getattr(kernel, "stable_constants", None)  # the verdict depends on K alone: each K checked once
+    key = np.asarray(K, dtype=np.float64).tobytes()
+    if not S or (passed is not None and key in passed):
         return
     M = step_matrix(kernel, K, S)
     if not np.all(np.isfinite(M)):
@@ -330,6 +350,8 @@ def check_stability(kernel, h, K, params=None):
         hint = f" (omega*h = {omega * float(h):.6g}, must be < 2)" if omega is not None else ""
         raise UnstableStepError(f"h = {h!r} is outside the stability interval of {kernel.word} on "
                                 f"{kernel.system.name}{hint}: {reason}; take a smaller step")
+    if passed is not None and len(passed) < MAX_REMEMBERED:
+        passed.add(key)
 
 
 def _names(kernel, S):

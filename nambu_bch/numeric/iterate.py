@@ -33,7 +33,7 @@ from ..progress import Progress, progress_wanted
 from ..systems.spec import as_system  # the one reading of a system argument (numeric modules import it from here)
 from ..checks import check_flag
 from .guards import (check_backend, check_count, check_inputs, check_range, check_result, check_stability,
-                     check_work, initial_state, run_label, sample_array, scan_states)
+                     check_states, check_work, initial_state, run_label, sample_array, scan_states)
 from .kernels import kernel, resolve_backend
 from .precision import check_dps, run_mpmath
 from .runge_kutta import iterate_runge_kutta
@@ -102,7 +102,9 @@ def iterate(system, word, h, steps, x0=None, params=None, every=1, *, kahan=Fals
     kahan : bool -- compensated summation of the increments (float64 only)
     dps : int, optional -- decimal digits of an mpmath run (a reference; ~10^3x slower)
     backend : ``"auto"`` | ``"numba"`` | ``"numpy"`` -- ``"auto"``: compiled, except runs too small to pay for
-        compiling their loop (:data:`INTERPRET_STEPS`), which take the interpreter (the same bits)
+        compiling their loop (:data:`INTERPRET_STEPS`), which take the interpreter (the same bits); one
+        trajectory (no ``kahan``, no ``fma``) runs through the kernel's C library when one is cached and
+        verifies (:mod:`~nambu_bch.numeric.clib`: the same bits, numba not imported)
     progress : bool or None -- a progress line on stderr; None: only on a terminal and for long runs
     chunk : int, optional -- states per cache block of a batch (tuning only)
     check_stable : bool -- refuse steps outside the stability interval (:func:`~nambu_bch.numeric.guards.check_stability`)
@@ -202,7 +204,8 @@ def iterate(system, word, h, steps, x0=None, params=None, every=1, *, kahan=Fals
     segment = steps if not reporter.enabled else max(every, (_SEGMENT_WORK // batch) // every * every)
     if not single:
         with reporter:
-            _run_batch(kern, X, K, steps, every, out, kahan, be, chunk, segment, reporter, what, fma, run.workers)
+            _run_batch(kern, X, K, steps, every, out, kahan, be, chunk, segment, reporter, what, fma, run.workers,
+                       x0 if run.deferred else None)
         return out
     state = X  # check_inputs made a fresh float64 copy: advanced in place
     out[0] = state
@@ -258,14 +261,24 @@ def _run_single(kern, state, K, steps, every, out, kahan, comp, be, fallback, wh
                                   ) from None
 
 
-def _run_batch(kern, X, K, steps, every, out, kahan, be, chunk, segment, reporter, what, fma=False, workers=1):
+def _run_batch(kern, X, K, steps, every, out, kahan, be, chunk, segment, reporter, what, fma=False, workers=1,
+               x0=None):
     """Fill ``out`` with the samples of a batch: ``X`` (the caller's start states) is only read.
 
     The kernel copies ``X`` into ``out[0]`` while it loads each chunk, starts every later segment
     from the last sample written, and counts non-finite values as it writes the samples; only a
     positive count costs a pass over the samples (:func:`check_result` names the step).
+
+    ``x0`` (the argument as given) when the input guards were left to the first segment's loop
+    (:func:`_prepare`, ``deferred``): it scans ``X`` as it loads each chunk, stops at a non-finite or
+    subnormal state (refused by :func:`check_states`, the message of a run checked up front), and the extreme
+    states it found are then checked by :func:`check_range` before anything else is reported -- the batch
+    is read from memory once.
     """
     if steps == 0:
+        if x0 is not None:  # no loop to scan it
+            check_states(x0, X)
+            check_range(kern, X, K, columns=kern.scan(X, workers)[2])
         out[0] = X
         return
     comp = np.zeros_like(X) if kahan else None
@@ -274,8 +287,14 @@ def _run_batch(kern, X, K, steps, every, out, kahan, be, chunk, segment, reporte
         while done < steps:
             seg = min(segment, steps - done)
             nseg = n_samples(seg, every)
+            scanned = {} if x0 is not None and j == 0 else None
             bad = kern.run_batch(source, K, seg, every, out[j:j + nseg], kahan=kahan, comp=comp, backend=be,
-                                 chunk=chunk, start=j == 0, back=False, fma=fma, workers=workers)
+                                 chunk=chunk, start=j == 0, back=False, fma=fma, workers=workers, scanned=scanned)
+            if scanned is not None:
+                if bad < 0 or sum(scanned["result"][:2]):
+                    check_states(x0, X)
+                    raise NumericalRangeError(f"{what}: x0 holds a non-finite or subnormal value")  # pragma: no cover
+                check_range(kern, X, K, columns=scanned["result"][2])
             if bad:
                 grid = sample_steps(steps, every)
                 samples = out[1:j + nseg]
@@ -307,7 +326,7 @@ SMALL_BATCH_STEPS, SMALL_BATCH_STATES = 100, 16384
 class _Run:
     """The validated inputs of one float64 run."""
 
-    __slots__ = ("h", "steps", "every", "X", "backend", "K", "chunk", "fallback", "workers")
+    __slots__ = ("h", "steps", "every", "X", "backend", "K", "chunk", "fallback", "workers", "deferred")
 
     def __init__(self, **kw):
         for k, v in kw.items():
@@ -320,34 +339,40 @@ def _prepare(system, kern, h, steps, every, x0, params, backend, chunk, check_st
 
     ``workers`` as in :func:`iterate`: a batch's threads (:func:`batch_workers`) scan their own ranges of
     states for the guards, the ranges they then advance, so no serial pass precedes the threaded run.
+    A large batch on the compiled loop (``deferred`` in the result) leaves the values of ``x0`` and the
+    range check to that loop, which scans each chunk as it loads it (:func:`_run_batch`).
     """
     be = resolve_backend(backend)
     steps = check_count(steps, "steps", 0)
     shape = np.shape(x0)
     fallback = False  # the interpreter chosen for speed: on an arithmetic exception the compiled loop takes over
-    if backend == "auto" and be == "numba":
+    if backend == "auto" and be == "numba" and len(shape) == 1 and not (kahan or fma) and kern.library() is not None:
+        be = "c"  # the kernel's cached C library (numeric.clib): numba's bits without importing numba
+    elif backend == "auto" and be == "numba":
         be, fallback = _interpret_small(kern, steps, shape, kahan, fma)
-    # a large batch: one pass (compiled on numba, blocked numpy otherwise) finds non-finite, subnormal and
-    # extreme states; the batch itself is only read by the run, so it is not copied
+    # a large batch: non-finite, subnormal and extreme states are found by the compiled loop as it loads the
+    # states (deferred), by one blocked numpy pass otherwise; the batch itself is only read, so it is not copied
     batch = len(shape) == 2
     threads = batch_workers(workers, shape[1], steps) if batch else 1
     scanned = {}
-    if batch and shape[1] > SCAN_BATCH:
-        scanner = (lambda arr: kern.scan(arr, threads)) if be == "numba" else scan_states
-
+    deferred = batch and shape[1] > SCAN_BATCH and be == "numba"
+    if batch and shape[1] > SCAN_BATCH and not deferred:
         def scan(arr):
-            scanned["result"] = scanner(arr)
+            scanned["result"] = scan_states(arr)
             return scanned["result"]
     else:
         scan = None
-    h, steps, every, X, _ = check_inputs(system, h, steps, every, x0, params, scan=scan, copy=not batch)
+    h, steps, every, X, _ = check_inputs(system, h, steps, every, x0, params, scan=scan, copy=not batch,
+                                         deferred=deferred)
     if chunk is not None:
         chunk = check_count(chunk, "chunk", 1)
     K = kern.constants(float(h), params)
     if check_stable:
         check_stability(kern, h, K, params)
-    check_range(kern, X, K, columns=scanned["result"][2] if scanned else None)
-    return _Run(h=h, steps=steps, every=every, X=X, backend=be, K=K, chunk=chunk, fallback=fallback, workers=threads)
+    if not deferred:
+        check_range(kern, X, K, columns=scanned["result"][2] if scanned else None)
+    return _Run(h=h, steps=steps, every=every, X=X, backend=be, K=K, chunk=chunk, fallback=fallback, workers=threads,
+                deferred=deferred)
 
 
 def _interpret_small(kern, steps, shape, kahan, fma=False):

@@ -25,7 +25,10 @@ What is cached, and how it is trusted (docs/hardening.md):
 * ``__pycache__/*.nbi, *.nbc`` -- numba's machine code, kept here whatever
   ``$NUMBA_CACHE_DIR`` says, each file carrying a SHA-256 of its content that is
   checked before numba unpickles it (:func:`nambu_bch.compiled.enable_private_cache`);
-  an entry that fails the check, or that numba cannot load, is compiled again.
+  an entry that fails the check, or that numba cannot load, is compiled again;
+* ``nambu_bch_clib_<key>.so`` / ``.json`` -- the single-trajectory loop as a C shared library and its record,
+  built when numba compiles a freshly generated ``run`` and a C compiler is present, verified before it is
+  loaded (:mod:`~nambu_bch.numeric.clib`).
 
 Every cache file is read through :func:`nambu_bch.private_dirs.read_private` (a
 private regular file: never a symlink, FIFO or device, size bounded) and written
@@ -73,7 +76,8 @@ from ..atomic import write_atomic
 from ..private_dirs import cache_root, private_directory, read_private, untrusted
 from ..integrators.composition import composition_for
 from ..integrators.step import parameter_values
-from .codegen import FMA_FUNCTION, PAIR_FUNCTION, TEMPLATE_VERSION, python_source, source_hash, step_program
+from .codegen import (FMA_FUNCTION, PAIR_FUNCTION, SCAN_FUNCTION, TEMPLATE_VERSION, python_source, source_hash,
+                      step_program)
 
 from .guards import BACKENDS, linear_part  # the accepted names live with the other checks of a run's inputs
 #: numba's fast-math flags of a run with ``fma=True``: contraction of ``a*b + c`` into one fused
@@ -235,6 +239,9 @@ class Kernel:
         self._jitted = {}
         self.compile_seconds = {}
         self.interpreted = {}
+        #: the constants ``K`` (bytes) whose step passed :func:`~nambu_bch.numeric.guards.check_stability`
+        self.stable_constants = set()
+        self._library = None  # the C library's run (numeric.clib): None not tried yet, False absent
 
     def _load_cached(self) -> bool:
         """Use the cached source if its index is intact and the file matches the recorded digest."""
@@ -296,18 +303,21 @@ class Kernel:
         ``constants``); a coefficient that is not a finite float64 raises :class:`NumericalRangeError`."""
         values = parameter_values(self.system, params)
         P = [values[p] for p in self.system.parameters]
-        given = ", ".join(f"{p} = {v:g}" for p, v in values.items())
-        where = f"h = {float(h):g}" + (f" with {given}" if given else "")
+
+        def where():  # the run named in a message (formatting the parameters costs more than the constants)
+            given = ", ".join(f"{p} = {v:g}" for p, v in values.items())
+            return f"h = {float(h):g}" + (f" with {given}" if given else "")
+
         try:
             K = np.array([float(v) for v in self.module.constants(float(h), P)], dtype=np.float64)
         except ZeroDivisionError:
-            raise NumericalRangeError(f"{where}: a coefficient of the step divides by zero; "
+            raise NumericalRangeError(f"{where()}: a coefficient of the step divides by zero; "
                                       "give non-zero values to the parameters in denominators") from None
         except (OverflowError, ValueError) as exc:
-            raise NumericalRangeError(f"{where}: a coefficient of the step is out of the float64 range ({exc}); "
+            raise NumericalRangeError(f"{where()}: a coefficient of the step is out of the float64 range ({exc}); "
                                       "rescale the parameters or the step") from None
         if not np.all(np.isfinite(K)):
-            raise NumericalRangeError(f"{where}: a coefficient of the step overflows float64; "
+            raise NumericalRangeError(f"{where()}: a coefficient of the step overflows float64; "
                                       "rescale the parameters or the step")
         return K
 
@@ -336,6 +346,10 @@ class Kernel:
             if name.startswith("run_batch") and hasattr(self.module, PAIR_FUNCTION):
                 # the batch loops' redo calls the shared-exponential function: compiled, it is a global of theirs
                 self.module.__dict__[PAIR_FUNCTION] = self.function(PAIR_FUNCTION)
+            if name.startswith("run_batch"):  # the guards' scan they extend as they load the states
+                from .scan import scan_into
+
+                self.module.__dict__[SCAN_FUNCTION] = scan_into
             source = name
             if fma and name == "run":  # one trajectory: the fused multiply-adds written out (codegen.fused_product)
                 source = "run_fma"
@@ -388,8 +402,7 @@ class Kernel:
             scan_range(X, lo, hi, res)
             return res
 
-        res = combine(_on_threads(part, column_ranges(X.shape[1], NUMBA_CHUNK, workers)))
-        return int(res[0]), int(res[1]), np.unique(np.concatenate([res[2:7], [0, X.shape[1] - 1]]))
+        return _scan_triple(combine(_on_threads(part, column_ranges(X.shape[1], NUMBA_CHUNK, workers))), X.shape[1])
 
     def compile(self, kahan: bool = False, batch: bool = False, fma: bool = False) -> float:
         """Compile (or load from the disk cache) one loop now; the wall time in seconds."""
@@ -407,7 +420,24 @@ class Kernel:
             start = time.perf_counter()
             self._first_call(fn, kahan, batch)
         self.compile_seconds[name] = time.perf_counter() - start
+        if name == "run" and not self.from_cache and self.library() is None:
+            # the step program is at hand (generated in this process): build the C library that later processes
+            # run without importing numba (numeric.clib)
+            from . import clib
+
+            if clib.build(self):
+                self._library = None
         return self.compile_seconds[name]
+
+    def library(self):
+        """The ``run`` loop of the kernel's cached C library (:mod:`~nambu_bch.numeric.clib`), verified and loaded
+        once per process, or None."""
+        if self._library is None:
+            from . import clib
+
+            fn = clib.load(self)
+            self._library = fn if fn is not None else False
+        return self._library or None
 
     def _first_call(self, fn, kahan, batch):
         N = self.N
@@ -416,7 +446,7 @@ class Kernel:
             X = np.zeros((N, 1))
             out = np.zeros((2, N, 1))
             args = (X, np.zeros((N, 1))) if kahan else (X,)
-            fn(*args, K, 1, 1, out, NUMBA_CHUNK, 1, 1, 0, 1)
+            fn(*args, K, 1, 1, out, NUMBA_CHUNK, 1, 1, 0, 1, _NO_SCAN)
         else:
             x = np.zeros(N)
             out = np.zeros((2, N))
@@ -446,6 +476,10 @@ class Kernel:
         Returns the number of steps done (less than ``steps`` only if a sample became non-finite).
         """
         name = "run_kahan" if kahan else "run"
+        if backend == "c":  # the cached C library (iterate's backend="auto" chooses it only when it loaded)
+            from .clib import run
+
+            return run(self.library(), x, K, steps, every, out)
         if backend == "numba":
             self.compile(kahan=kahan, fma=fma)
             fn = self.function(self.loop_name(kahan, False, fma))
@@ -462,7 +496,7 @@ class Kernel:
         return int(n)
 
     def run_batch(self, X, K, steps, every, out, *, kahan=False, comp=None, backend="numba", chunk=None,
-                  start=False, back=True, fma=False, workers=1) -> int:
+                  start=False, back=True, fma=False, workers=1, scanned=None) -> int:
         """Advance states ``X`` (shape (N, batch), float64); ``out`` of shape (n, N, batch), ``out[1:]`` is filled.
 
         ``start``: also copy ``X`` into ``out[0]`` (fused with the pass that loads the states);
@@ -470,8 +504,11 @@ class Kernel:
         read (the caller's array can be passed as it is) and the final states are ``out[-1]``.
         ``fma`` as in :meth:`run`.  ``workers``: threads running the compiled loop on disjoint column
         ranges (:func:`column_ranges`; the loop releases the GIL, every state is advanced by the same
-        operations, so the bits do not depend on it).  Returns 0 when every sample written is finite,
-        a positive number otherwise.
+        operations, so the bits do not depend on it).  ``scanned``: a dict (compiled loop only) that receives,
+        under ``"result"``, the guards' scan of ``X`` (:meth:`scan`'s triple) taken as each chunk is loaded, so
+        ``X`` is read from memory once; the loop stops before any step at a non-finite or subnormal state of
+        ``X`` and -1 is returned (``"result"`` then holds that scan so far).  Returns 0 when every sample written
+        is finite, a positive number otherwise.
         """
         name = "run_batch_kahan" if kahan else "run_batch"
         args = (X, comp) if kahan else (X,)
@@ -484,8 +521,28 @@ class Kernel:
         self.compile(kahan=kahan, batch=True, fma=fma)
         fn = self.function(self.loop_name(kahan, True, fma))
         chunk = int(chunk or NUMBA_CHUNK)
-        call = lambda lo, hi: int(fn(*args, K, int(steps), int(every), out, chunk, *flags, lo, hi))  # noqa: E731
-        return sum(_on_threads(call, column_ranges(B, chunk, workers)))
+        ranges = column_ranges(B, chunk, workers)
+        def call(lo, hi, res=_NO_SCAN):
+            return int(fn(*args, K, int(steps), int(every), out, chunk, *flags, lo, hi, res))
+
+        if scanned is None:
+            return sum(_on_threads(call, ranges))
+        from .scan import START, combine
+
+        parts = [np.array(START, dtype=np.int64) for _ in ranges]
+        bad = _on_threads(call, [(lo, hi, res) for (lo, hi), res in zip(ranges, parts)])
+        scanned["result"] = _scan_triple(combine(parts), B)
+        return -1 if min(bad) < 0 else sum(bad)
+
+
+#: The ``res`` argument of a batch loop that does not scan its start states.
+_NO_SCAN = np.zeros(0, dtype=np.int64)
+
+
+def _scan_triple(res, B: int) -> tuple:
+    """``(non-finite count, subnormal count, columns)`` of a combined scan result of ``B`` states (the first and
+    last state among the columns)."""
+    return int(res[0]), int(res[1]), np.unique(np.concatenate([res[2:7], [0, B - 1]]))
 
 
 def _on_threads(call, ranges) -> list:

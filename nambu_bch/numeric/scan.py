@@ -69,17 +69,41 @@ def scan_range(X, lo, hi, res):
     whole batch's exactly (:func:`combine`): each thread of a threaded run scans its own range.  The counts
     are taken while each row is read for the extremes.
     """
+    start_result(res)
+    return scan_into(X, lo, hi, np.empty((2, 3, 1024)), res)
+
+
+_TOP = 9223372036854775807
+#: The result of scanning no state (counts 0, every extreme still to be found): what :func:`scan_into` extends.
+START = (0, 0, 0, 0, 0, 0, 0, -1, _TOP, -1, _TOP, _TOP)
+
+
+@njit(nogil=True, error_model="numpy")
+def start_result(res):
+    """``res[:] =`` :data:`START`."""
+    for i in range(12):
+        res[i] = START[i]
+
+
+@njit(nogil=True, error_model="numpy")
+def scan_into(X, lo, hi, acc, res):
+    """Extend ``res`` (the result of :func:`scan_range` over the states before ``lo``, or :func:`start_result`)
+    by the states ``lo <= b < hi``; returns the two counts' sum so far.  ``acc``: scratch of shape (2, 3, W),
+    the states are reduced in blocks of ``W``.
+
+    A batch kernel calls it on each chunk just before loading that chunk, so the guards' scan of ``x0`` reads
+    the batch from memory once with the run instead of in a pass of its own; ranges taken in order give the
+    result of one pass, because the comparisons are strict and the first state reaching an extreme is kept.
+    """
     N = X.shape[0]
-    W = 1024
+    W = acc.shape[2]
     # two sets of per-state accumulators, each row read from one set and written to the other: written in
     # place, ``big[b] = a if a > big[b] else big[b]`` became a masked store (vmaskmovpd), microcoded and
     # slow on AMD cores -- the pass ran at 1.5 ns per element in cache, 3x a plain read
-    acc = np.empty((2, 3, W))
-    nonfinite = 0
-    subnormal = 0
-    top = np.int64(9223372036854775807)
-    bmax = np.int64(-1); bmin = top; pmax = np.int64(-1); pmin = top; smin = top
-    ibmax = 0; ibmin = 0; ipmax = 0; ipmin = 0; ismin = 0
+    nonfinite = res[0]
+    subnormal = res[1]
+    ibmax = res[2]; ibmin = res[3]; ipmax = res[4]; ipmin = res[5]; ismin = res[6]
+    bmax = res[7]; bmin = res[8]; pmax = res[9]; pmin = res[10]; smin = res[11]
     for b0 in range(lo, hi, W):
         nb = min(W, hi - b0)
         row = X[0, b0:b0 + nb]
