@@ -59,6 +59,16 @@ def test_compiled_ho3_run_gives_the_reference_bits(ho3_loop, project):
 
 
 @numba_only
+def test_a_complex_loop_gets_no_c_library(ho3_loop):
+    """numeric.clib prints the real step program only: compiling a complex loop (with a C compiler present) neither
+    builds nor loads a library for it."""
+    from nambu_bch.numeric.clib import paths
+
+    assert ho3_loop.library() is None
+    assert not paths(ho3_loop)[0].exists() and not paths(ho3_loop)[1].exists()
+
+
+@numba_only
 def test_iterate_and_check_pass_the_backend_on(ho3_loop):
     """``iterate`` and ``check`` hand a complex word and their ``backend`` to the complex run."""
     fast = nb.iterate("ho3", W, 0.1, 200, X0, every=50, backend="numba")

@@ -240,6 +240,7 @@ class ComplexKernel(Kernel):
 
     template = _template()
     functions = ("constants", "times", "run", "run_batch")
+    c_library = False   # numeric.clib prints the real step program only
 
     @staticmethod
     def _render(program) -> tuple:

@@ -224,6 +224,9 @@ class Kernel:
     #: (:class:`nambu_bch.numeric.complex_codegen.ComplexKernel`) and its :meth:`_render`.
     template = TEMPLATE_VERSION
     functions = _FUNCTIONS
+    #: Whether the ``run`` loop also gets a C library (:mod:`~nambu_bch.numeric.clib`, printed from the real step
+    #: program); a subclass with other loops sets it False.
+    c_library = True
 
     def __init__(self, system, comp):
         self.system = system
@@ -420,7 +423,7 @@ class Kernel:
             start = time.perf_counter()
             self._first_call(fn, kahan, batch)
         self.compile_seconds[name] = time.perf_counter() - start
-        if name == "run" and not self.from_cache and self.library() is None:
+        if name == "run" and self.c_library and not self.from_cache and self.library() is None:
             # the step program is at hand (generated in this process): build the C library that later processes
             # run without importing numba (numeric.clib)
             from . import clib
@@ -432,6 +435,8 @@ class Kernel:
     def library(self):
         """The ``run`` loop of the kernel's cached C library (:mod:`~nambu_bch.numeric.clib`), verified and loaded
         once per process, or None."""
+        if self._library is None and not self.c_library:
+            self._library = False
         if self._library is None:
             from . import clib
 
