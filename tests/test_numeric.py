@@ -75,6 +75,29 @@ def test_matches_the_lambdified_step(name, word):
     assert np.allclose(ours, x, rtol=1e-13, atol=1e-13)
 
 
+def test_pi_and_e_in_a_users_flow_run_on_every_generated_loop():
+    """H = p^2/2 + pi q + E q^2/2: the hoisted constants hold pi and E, which the generated module defines (float64)
+    and the mpmath namespace gives at the working precision (the kernel used to raise NameError: 'pi')."""
+    import mpmath
+
+    from nambu_bch import System
+
+    system = System("q p", ["p**2/2 + pi*q + E*q**2/2"], name="constants")
+    step = step_function(system.splitting, "121")
+    x = np.array([0.3, -0.2])
+    for _ in range(20):
+        x = step(x, 0.1)
+    assert np.allclose(iterate(system, "121", 0.1, 20, [0.3, -0.2], every=20, backend="numpy")[-1], x,
+                       rtol=1e-13, atol=1e-13)
+    fine = iterate(system, "121", "0.1", 20, ["0.3", "-0.2"], every=20, dps=40)[-1]
+    assert max(abs(mpmath.mpf(a) - b) for a, b in zip(fine, x)) < 1e-13
+    # at 40 digits the constants are mpmath's, not float64's: from q = p = 0 a step of position Verlet (121) kicks p
+    # by -h (pi + E q) with q = 0, i.e. to -pi/10 at 40 digits (float64's pi is off by 1.2e-17)
+    p1 = iterate(system, "121", "0.1", 1, ["0", "0"], every=1, dps=40)[-1][1]
+    with mpmath.workdps(40):
+        assert abs(mpmath.mpf(p1) + mpmath.pi / 10) < mpmath.mpf(10) ** -35
+
+
 def test_operator_order_on_a_non_palindromic_word():
     """Word "123": piece 1 acts first, then 2, then 3 (left to right, Eqs. hX1e-hX3e)."""
     h = 0.3

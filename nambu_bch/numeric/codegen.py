@@ -58,7 +58,7 @@ from ..integrators.flows import TIME, exact_flow
 STEP = sympy.Symbol("h")
 
 #: Bump when the generated source changes meaning (part of the cache key).
-TEMPLATE_VERSION = "9"
+TEMPLATE_VERSION = "10"
 #: Steps a batch kernel takes for each state of a chunk before moving to the next state (:func:`_chunk_step`).
 JAM_STEPS = 2
 
@@ -341,6 +341,13 @@ class _KernelPrinter(_PowMixin, PythonCodePrinter):
         super().__init__({"user_functions": funcs, "fully_qualified_modules": False})
         self._prefix = prefix
 
+    # pi and E (the parser's two constants) as module globals too: ``_pi`` for float64, ``_mp_pi`` at any precision
+    def _print_Pi(self, expr):
+        return f"{self._prefix}pi"
+
+    def _print_Exp1(self, expr):
+        return f"{self._prefix}e"
+
     def _hprint_Pow(self, expr, rational=False, sqrt="math.sqrt"):
         # sqrt(x) and 1/sqrt(x) (exact radicals in designed coefficients) call the module's own sqrt
         return super()._hprint_Pow(expr, rational=rational, sqrt=f"{self._prefix}sqrt")
@@ -572,6 +579,7 @@ _np_exp, _np_expm1, _np_log, _np_sqrt = np.exp, np.expm1, np.log, np.sqrt
 _np_sin, _np_cos, _np_tan, _np_sinh, _np_cosh, _np_tanh = np.sin, np.cos, np.tan, np.sinh, np.cosh, np.tanh
 _np_atan, _np_asin, _np_acos, _np_isfinite = np.arctan, np.arcsin, np.arccos, np.isfinite
 _INF, _MAX, _TINY = math.inf, 1.7976931348623157e308, 2.2250738585072014e-308
+_pi, _e, _np_pi, _np_e = math.pi, math.e, math.pi, math.e
 _fma = None
 '''
 
@@ -991,7 +999,7 @@ def source_hash(source: str) -> str:
 
 # -- Runge--Kutta steps -------------------------------------------------------------------------------------------
 #: Bump when the generated Runge--Kutta source changes meaning.
-RK_TEMPLATE_VERSION = "3"
+RK_TEMPLATE_VERSION = "4"
 
 _RK_TEMPLATE = '''
 

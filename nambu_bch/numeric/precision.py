@@ -73,6 +73,7 @@ def _namespace():
     ns = {f"_mp_{name}": getattr(mpmath, name) for name in
           ("exp", "expm1", "log", "sin", "cos", "tan", "sinh", "cosh", "tanh", "sqrt", "atan", "asin", "acos")}
     ns["_mp_isfinite"] = mpmath.isfinite
+    ns["_mp_pi"], ns["_mp_e"] = mpmath.pi, mpmath.e   # at the working precision, not float64's
     return ns
 
 
