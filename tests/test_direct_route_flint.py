@@ -276,3 +276,15 @@ def test_parameter_names_are_not_passed_to_flint():
         elimination.FAST_PATHS = True
     assert ours.particular == plain.particular and ours.consistent
     assert all(identical(ours.particular[0][c], plain.particular[0][c]) for c in plain.particular[0])
+
+
+@pytest.mark.parametrize("numer, denom", [(0, 1), (3, 1), (-3, 4), (3, -6), (-2, -8)])
+def test_rational_constants_convert_in_the_normal_form(numer, denom):
+    """A constant of QQ(a, b), reduced or not (a negative denominator too), as the pair ``(p/q, 1)``-normal form and
+    back: the element sympy's field gives, identically (constants take a shortcut past the polynomial conversion)."""
+    R = K.field.ring
+    raw = K.field.raw_new(R.from_dict({(0, 0): QQ(numer)}), R.from_dict({(0, 0): QQ(denom)}))
+    n, d = frac_rref.from_field(raw, CTX)
+    q = sympy.Rational(numer, denom)
+    assert (n, d) == (CTX.constant(int(q.p)), CTX.constant(int(q.q)))
+    assert identical(frac_rref.to_field((n, d), K), K.from_sympy(q))

@@ -286,15 +286,17 @@ def _flint_on() -> bool:
     return elimination.FAST_PATHS and elimination.flint_available()
 
 
-def _divided(numerators: dict, denominator, domain) -> dict:
+def _divided(numerators: dict, denominator, domain, ctx=False) -> dict:
     """``{key: n / denominator}`` in ``domain = QQ(params)``, zero quotients left out.
 
     ``numerators``: ``{key: {exponent tuple: rational}}`` (polynomials in the parameters), ``denominator``
     a non-zero polynomial of the field's ring.  Each quotient is a reduced fraction, cancelled by flint's
     gcd when python-flint is available (:mod:`nambu_bch.algebra.frac_rref`, the same normal form), else by
-    sympy's field.
+    sympy's field.  ``ctx``: the flint context of ``domain`` or ``None`` (sympy's field), when the caller
+    has chosen already (:meth:`_Solver._flint_context`).
     """
-    ctx = frac_rref.context(domain) if _flint_on() else None
+    if ctx is False:
+        ctx = frac_rref.context(domain) if _flint_on() else None
     field = domain.field
     out = {}
     if ctx is None:
@@ -364,6 +366,7 @@ class _Solver:
         self.gdeg = [_total_degree(p, self.n) - 1 for p in hams]
         self._columns: dict = {}
         self._plain = None  # the polynomial ring of the fraction-free fields (_fields_cleared)
+        self._ctx = False  # the flint context of the coefficient field, or None (_flint_context), chosen once
         self._cleared: dict = {}  # id of a Hamiltonian -> (its cleared polynomial, its denominator)
         self._jacobian_rank2 = None  # H, G algebraically independent (_psi_dim), found once per solve
         self._cofactors: dict = {}  # slot -> the fields with x_j in that slot (_monomial_field), once per solve
@@ -459,26 +462,20 @@ class _Solver:
             for p in slots:
                 hit = self._cleared.get(id(p)) if any(p is q for q in self.hams) else None
                 if hit is None:
-                    D = field.ring.one
-                    for c in p.values():
-                        D = D.lcm(c.denom)
-                    terms: dict = {}
-                    for m, c in p.items():
-                        num = c.numer * D.exquo(c.denom)
-                        for e, q in num.items():
-                            terms[m + e] = q
-                    hit = (make(terms), D)
+                    hit = self._clear(p, make)
                     if any(p is q for q in self.hams):  # the Hamiltonians: cleared once per solve
                         self._cleared[id(p)] = hit
                 cleared.append(hit[0])
-                total = total * hit[1]
+                if not hit[1].is_one:
+                    total = total * hit[1]
             parts.append((liouville_field(plain, *cleared).components, total))
         T = parts[0][1]
         for _, total in parts[1:]:
-            T = T.lcm(total)
+            if total != T:
+                T = T.lcm(total)
         sums = None
         for comps, total in parts:
-            scale = T.exquo(total)
+            scale = T.exquo(total) if total != T else 1
             if scale != 1:
                 factor = make({pad + m: c for m, c in scale.items()})
                 comps = [c * factor for c in comps]
@@ -488,8 +485,31 @@ class _Solver:
             groups: dict = {}
             for m, q in plain.terms(comp).items():
                 groups.setdefault(m[:width], {})[m[width:]] = q
-            components.append(alg.ring.from_dict(_divided(groups, T, alg.domain)) if groups else alg.zero)
+            components.append(alg.ring.from_dict(_divided(groups, T, alg.domain, self._flint_context()))
+                              if groups else alg.zero)
         return VectorField(alg, components)
+
+    @staticmethod
+    def _clear(p, make):
+        """``(Q, D)`` with ``p = Q / D``: ``D`` the lcm of the coefficients' denominators (a polynomial in the
+        parameters), ``Q`` a polynomial in the coordinates, constants and parameters (``make``: the plain ring's)."""
+        if all(c.denom.is_one for c in p.values()):  # no parameter in a denominator (an ansatz monomial): Q = p
+            return make({m + e: q for m, c in p.items() for e, q in c.numer.items()}), p.ring.domain.field.ring.one
+        D = p.ring.domain.field.ring.one
+        for c in p.values():
+            D = D.lcm(c.denom)
+        terms: dict = {}
+        for m, c in p.items():
+            num = c.numer * D.exquo(c.denom)
+            for e, q in num.items():
+                terms[m + e] = q
+        return make(terms), D
+
+    def _flint_context(self):
+        """The flint context of ``QQ(params)`` when python-flint is on, else ``None`` (chosen once per solve)."""
+        if self._ctx is False:
+            self._ctx = frac_rref.context(self.alg.domain) if _flint_on() else None
+        return self._ctx
 
     def _plain_ring(self):
         """``QQ[coordinates, constants, parameters]`` of :meth:`_fields_cleared`: flint's when available, else sympy's."""
