@@ -227,8 +227,9 @@ MAX_UNKNOWNS = 4000
 #: refused up front.  The N = 4 single split at h^6 (1485 unknowns) is 2.1e8: 1.1 s multi-modular, 0.5 s flint; the
 #: rigid body with symbolic I at h^10 (910 unknowns over QQ(I1, I2, I3)) is 3.5e9, and its whole direct route took
 #: 7.3 s CPU (load 4.4) where the refusal's fallback, the existence decision by orbit averages in sympy expressions,
-#: took about 116 s: the budget admits it.
-SOLVE_COST = 5 * 10**9
+#: took about 116 s: the budget admits it.  At h^12 (estimate 8.9e9) the exact solve with its sympy sums took
+#: 20.9 s CPU (load 11) where the fallback took about 210 s (docs/performance.md): admitted too.
+SOLVE_COST = 10**10
 
 
 def _check_ansatz_size(slots, n, degree):
