@@ -643,8 +643,57 @@ class _Solver:
             sums.setdefault(tuple(i + j for i, j in zip(m, alpha)), []).append((1, c))
         coeffs = signed_sums(sums, self.alg.domain)
         if coeffs is None:
+            ctx = self._flint_context() if self._cleared_ok() else None
+            if ctx is not None:
+                return self._family_flint(m0, m1, alpha, ctx)
             return m0 + (m1 - m0).mul_monom(alpha)
         return self.alg.ring.from_dict(coeffs) if coeffs else self.alg.zero
+
+    def _family_flint(self, m0, m1, alpha, ctx):
+        """``m0 + alpha (m1 - m0)`` over ``QQ(params)`` with the coefficient differences on flint pairs
+        (:mod:`~nambu_bch.algebra.frac_rref`: gcds in C instead of sympy's per-operation cancellation).
+
+        The same ring element as sympy's ``m0 + (m1 - m0).mul_monom(alpha)``, its terms inserted in the order
+        sympy's arithmetic leaves them (``m1``'s, then ``m0``'s new ones; then ``m0``'s, then the shifted new
+        ones): field elements have one normal form, and the order is kept so that nothing downstream can tell."""
+        domain = self.alg.domain
+        memo: dict = {}
+
+        def pair(c):
+            hit = memo.get(id(c))
+            if hit is None:
+                hit = memo[id(c)] = frac_rref.from_field(c, ctx)
+            return hit
+
+        diff: dict = {}  # m1 - m0, pairs
+        for m, c in m1.items():
+            diff[m] = pair(c)
+        for m, c in m0.items():
+            b = pair(c)
+            a = diff.get(m)
+            v = frac_rref.sub(a, b) if a is not None else (-b[0], b[1])
+            if v[0].is_zero():
+                diff.pop(m, None)
+            else:
+                diff[m] = v
+        out: dict = {m: pair(c) for m, c in m0.items()}
+        for m, v in diff.items():
+            key = tuple(i + j for i, j in zip(m, alpha))
+            a = out.get(key)
+            if a is None:
+                out[key] = v
+                continue
+            w = frac_rref.sub(a, (-v[0], v[1]))
+            if w[0].is_zero():
+                del out[key]
+            else:
+                out[key] = w
+        if not out:
+            return self.alg.zero
+        # unchanged coefficients of m0 stay the very elements (no round trip)
+        unchanged = {m: c for m, c in m0.items() if out.get(m) is memo.get(id(c))}
+        return self.alg.ring.from_dict({m: unchanged[m] if m in unchanged else frac_rref.to_field(v, domain)
+                                        for m, v in out.items()})
 
     def _independent(self):
         """``H, G`` are algebraically independent (a 2 x 2 minor of their Jacobian in the coordinates is non-zero)."""
