@@ -23,7 +23,9 @@ brought back to the canonical form in which no monomial holds both (Laurent
 monomials are a basis, so the zero test stays structural), and, over QQ, each
 field's denominators are cleared once so that nested brackets run over ZZ (the
 product of the scales is carried along and divided out once in
-:meth:`PolynomialBackend.combine`).  No rational-function gcd is ever taken.
+:meth:`PolynomialBackend.combine`).  No rational-function gcd is ever taken.  With python-flint
+(:mod:`nambu_bch.algebra._flint`) the integral brackets multiply on ``fmpz_mpoly`` and ``apply`` on
+``fmpq_mpoly``: the same polynomials, products in C.
 Otherwise (``1/(m + 1)``, or ``laurent=False``) it runs in the algebra's own
 ring ``QQ(parameters)[x]`` -- which may be a :class:`~nambu_bch.shadow.jets.JetAlgebra`
 or any ring offering ``ring``, ``n``, ``domain`` and ``diff(value, i)``.
