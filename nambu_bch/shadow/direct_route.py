@@ -228,7 +228,8 @@ MAX_UNKNOWNS = 4000
 #: rigid body with symbolic I at h^10 (910 unknowns over QQ(I1, I2, I3)) is 3.5e9, and its whole direct route took
 #: 7.3 s CPU (load 4.4) where the refusal's fallback, the existence decision by orbit averages in sympy expressions,
 #: took about 116 s: the budget admits it.  At h^12 (estimate 8.9e9) the exact solve with its sympy sums took
-#: 20.9 s CPU (load 11) where the fallback took about 210 s (docs/performance.md): admitted too.
+#: 11.3 s CPU (load 10; ``benchmarks/bench_shadow.py --targets``, row d) where the fallback took about 210 s
+#: (docs/performance.md): admitted too.
 SOLVE_COST = 10**10
 
 
