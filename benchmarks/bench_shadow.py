@@ -5,6 +5,7 @@ Run:  /work/venv/bin/python benchmarks/bench_shadow.py --targets  (the targets o
       /work/venv/bin/python benchmarks/bench_shadow.py            (the rows below, then the issue-14 rows)
       /work/venv/bin/python benchmarks/bench_shadow.py --issue14  (the issue-14 rows only)
       /work/venv/bin/python benchmarks/bench_shadow.py --printing (text/LaTeX/JSON: flint factors vs sympy.factor)
+      /work/venv/bin/python benchmarks/bench_shadow.py --phases   (target b by phase: symbolic vs I = (1, 2, 3), h^8)
       /work/venv/bin/python benchmarks/bench_shadow.py --issue14 --rows=ab  (rows a and b only)
 
 Prints, measured in this one run (process CPU time, best of a few repeats):
@@ -476,8 +477,68 @@ def main(limit: float = 60.0):
     return rows
 
 
+#: the phases of a direct-route call, timed by wrapping these functions (module, attribute path, label); nested
+#: phases are counted inside their parent too (``frac_rref.rref`` inside the elimination)
+PHASES = [
+    ("nambu_bch.bch.backward", "modified_field_of_map", "backward error analysis (X_eff)"),
+    ("nambu_bch.shadow.direct_route", "operator_columns", "operator columns (Liouville fields)"),
+    ("nambu_bch.shadow.direct_route", "_Solver._cross", "cross terms"),
+    ("nambu_bch.algebra.ansatz", "Ansatz.solve_canonical", "eliminations (both members)"),
+    ("nambu_bch.algebra.frac_rref", "rref", "  of which Gauss-Jordan on flint pairs"),
+    ("nambu_bch.algebra.frac_rref", "to_field", "flint pair -> sympy field element (all)"),
+    ("nambu_bch.shadow.direct_route", "_Solver._family", "alpha-family combination"),
+    ("nambu_bch.shadow.direct_route", "DirectResult.shadow", "sympy sums of H_S, G_S"),
+]
+
+
+def _timed_phases(args, queue):
+    """One ``shadow_hamiltonians(...).shadows`` in a fresh process: ``(CPU s, {label: CPU s})`` by :data:`PHASES`."""
+    import importlib
+    from collections import Counter
+
+    name, word, order = args
+    spent: Counter = Counter()
+    for module, path, label in PHASES:
+        owner = importlib.import_module(module)
+        *outer, attr = path.split(".")
+        for part in outer:
+            owner = getattr(owner, part)
+        inner = owner.__dict__[attr]
+        wrapped = inner.__func__ if isinstance(inner, staticmethod) else inner
+
+        def timed(*a, _f=wrapped, _label=label, **k):
+            t = time.process_time()
+            try:
+                return _f(*a, **k)
+            finally:
+                spent[_label] += time.process_time() - t
+
+        setattr(owner, attr, staticmethod(timed) if isinstance(inner, staticmethod) else timed)
+    system = make_system(name)
+    t = time.process_time()
+    shadow_hamiltonians(system, word, order).shadows
+    queue.put((time.process_time() - t, dict(spent)))
+
+
+def phases(limit: float = 600.0):
+    """Target b by phase: the symbolic rigid body and I = (1, 2, 3), 12321, h^8, each cold in a fresh process."""
+    print(f"target b by phase (CPU s, each side cold in a fresh process; {_load()})", flush=True)
+    runs = [(name, _child(_timed_phases, (name, "12321", 8), limit)) for name in ("rigid-body", "rigid-body[I=1,2,3]")]
+    if not all(r for _, r in runs):
+        print("stopped at the limit", flush=True)
+        return False
+    (_, (sym, ps)), (_, (num, pn)) = runs
+    print(f"{'phase':42s} {'symbolic I':>11s} {'I = (1,2,3)':>12s}")
+    for _, _, label in PHASES:
+        print(f"{label:42s} {ps.get(label, 0.0):11.3f} {pn.get(label, 0.0):12.3f}")
+    print(f"{'whole call':42s} {sym:11.3f} {num:12.3f}   ratio {sym / num:.1f}x  [{_load()}]", flush=True)
+    return True
+
+
 if __name__ == "__main__":
     ok = True
+    if "--phases" in sys.argv:
+        sys.exit(0 if phases() else 1)
     if "--printing" in sys.argv:
         sys.exit(0 if printing() else 1)
     if "--targets" in sys.argv:

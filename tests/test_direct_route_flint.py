@@ -276,3 +276,33 @@ def test_parameter_names_are_not_passed_to_flint():
         elimination.FAST_PATHS = True
     assert ours.particular == plain.particular and ours.consistent
     assert all(identical(ours.particular[0][c], plain.particular[0][c]) for c in plain.particular[0])
+
+
+@pytest.mark.parametrize("numer, denom", [(0, 1), (3, 1), (-3, 4), (3, -6), (-2, -8)])
+def test_rational_constants_convert_in_the_normal_form(numer, denom):
+    """A constant of QQ(a, b), reduced or not (a negative denominator too), as the pair ``(p/q, 1)``-normal form and
+    back: the element sympy's field gives, identically (constants take a shortcut past the polynomial conversion)."""
+    R = K.field.ring
+    raw = K.field.raw_new(R.from_dict({(0, 0): QQ(numer)}), R.from_dict({(0, 0): QQ(denom)}))
+    n, d = frac_rref.from_field(raw, CTX)
+    q = sympy.Rational(numer, denom)
+    assert (n, d) == (CTX.constant(int(q.p)), CTX.constant(int(q.q)))
+    assert identical(frac_rref.to_field((n, d), K), K.from_sympy(q))
+
+
+def test_family_combination_on_flint_pairs_is_sympys():
+    """``m0 + alpha (m1 - m0)`` with the differences on flint pairs: sympy's ring element, the same field elements and
+    the same term order, with cancelling coefficients and a shifted term landing on one of ``m0``'s own."""
+    from types import SimpleNamespace
+
+    x, alpha = sympy.symbols("x alpha")
+    alg = PolynomialAlgebra([x], [a, b], constants=[alpha])
+    m0 = alg.convert(x**2 / a + (a - b) / (a + b) * x + alpha / (a * b) + 3)          # alpha^1 in m0 itself
+    m1 = alg.convert(x**2 / a + (a + b) * x / (a - b) + 2 * alpha * x - 7)             # x^2 cancels in m1 - m0
+    shift = (0, 1)  # alpha
+    got = dr._Solver._family_flint(SimpleNamespace(alg=alg), m0, m1, shift, frac_rref.context(alg.domain))
+    want = m0 + (m1 - m0).mul_monom(shift)
+    assert got == want and list(got) == list(want)
+    assert all(identical(got[m], want[m]) for m in want)
+    same = dr._Solver._family_flint(SimpleNamespace(alg=alg), m0, m0, shift, frac_rref.context(alg.domain))
+    assert same == m0 and list(same) == list(m0)

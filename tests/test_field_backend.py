@@ -71,6 +71,31 @@ def test_three_backends_agree_with_plain_sympy(name):
         assert sympy.expand(B.function_to_sympy(B.function(f)) - f) == 0
 
 
+@pytest.mark.parametrize("name", ["rigid-body", "ho", "lotka-volterra"])
+def test_laurent_apply_on_flint_is_the_pure_paths_polynomial(name, monkeypatch):
+    """``apply`` of the Laurent backend with its products on flint's fmpq_mpoly is the ring element of the pure
+    path (python-flint switched off), term for term -- including a function that holds ``p`` where the field holds
+    ``p_inv`` (the product is brought back to the Laurent normal form) -- and equals plain sympy ``diff``."""
+    pytest.importorskip("flint")
+    S = model(name).splitting
+    algebra, fields = S.system.algebra, {p.number: p.field for p in S.pieces}
+    coords, params = algebra.coordinates, algebra.parameters
+    f = sum(x**3 for x in coords) + coords[0] * coords[-1] * (params[0] if params else 1) + sympy.Rational(2, 3)
+    g = sympy.Integer(5)  # a constant: X g = 0
+    values = {}
+    for off in ("1", ""):
+        monkeypatch.setenv("NAMBU_BCH_DISABLE_FLINT", off)
+        B = field_backend(algebra, fields)
+        assert B.laurent and (B.flint_q is None) == (off == "1")
+        values[off] = [(B.apply(X, B.function(f)), B.apply(X, B.function(g))) for X in B.fields.values()]
+        for k, X in B.fields.items():
+            raw = fields[k].to_sympy()
+            expected = sympy.expand(sum(c * sympy.diff(f, x) for c, x in zip(raw, coords)))
+            assert sympy.expand(B.function_to_sympy(B.apply(X, B.function(f))) - expected) == 0
+    assert values["1"] == values[""]
+    assert all(not b for _, b in values[""])
+
+
 def test_bch4_bracket_value_on_ho3():
     """Eq. (BCH4): [X1, [X1, X2]] = 2 omega^2 x2 / m d/dx1 on ho3, [X1, [X1, X3]] = 0, in every backend."""
     _, _, backends = _backends(model("ho3").splitting)

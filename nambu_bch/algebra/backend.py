@@ -23,7 +23,9 @@ brought back to the canonical form in which no monomial holds both (Laurent
 monomials are a basis, so the zero test stays structural), and, over QQ, each
 field's denominators are cleared once so that nested brackets run over ZZ (the
 product of the scales is carried along and divided out once in
-:meth:`PolynomialBackend.combine`).  No rational-function gcd is ever taken.
+:meth:`PolynomialBackend.combine`).  No rational-function gcd is ever taken.  With python-flint
+(:mod:`nambu_bch.algebra._flint`) the integral brackets multiply on ``fmpz_mpoly`` and ``apply`` on
+``fmpq_mpoly``: the same polynomials, products in C.
 Otherwise (``1/(m + 1)``, or ``laurent=False``) it runs in the algebra's own
 ring ``QQ(parameters)[x]`` -- which may be a :class:`~nambu_bch.shadow.jets.JetAlgebra`
 or any ring offering ``ring``, ``n``, ``domain`` and ``diff(value, i)``.
@@ -119,7 +121,7 @@ class _Field:
     as flint ``fmpz_mpoly`` (``flint``); a field made by a flint bracket has only those, and its sympy
     ``components`` are built on first access."""
 
-    __slots__ = ("_components", "scale", "_values", "_derivatives", "flint", "_backend")
+    __slots__ = ("_components", "scale", "_values", "_derivatives", "flint", "_backend", "flint_values")
 
     def __init__(self, components, scale=1, values=None, flint=None, backend=None):
         self._components = None if components is None else tuple(components)
@@ -128,6 +130,7 @@ class _Field:
         self._derivatives = None
         self.flint = flint
         self._backend = backend
+        self.flint_values = None  # the value-ring components as fmpq_mpoly (PolynomialBackend._apply_flint)
 
     @property
     def components(self) -> tuple:
@@ -176,6 +179,7 @@ class PolynomialBackend:
         self._value_coords = value_ring.gens[: algebra.n]
         self._monomials: dict = {}  # Laurent monomial -> its canonical QQ(parameters) coefficient
         self.flint = None  # flint's fmpz_mpoly context of the bracket ring, when brackets run there (_use_flint)
+        self.flint_q = None  # flint's fmpq_mpoly context of the value ring, when apply runs there (_use_flint)
 
     # -- construction -------------------------------------------------------------
     @classmethod
@@ -303,6 +307,8 @@ class PolynomialBackend:
 
         if self._integral and FAST_PATHS and _flint.available():
             self.flint = _flint.fmpz_mpoly_context(len(self.bracket_ring.symbols))  # the bracket ring's generators
+            if _flint.qq_is_fmpq(self.domain.dtype):  # sympy's QQ is flint's fmpq: coefficients pass unconverted
+                self.flint_q = _flint.fmpq_mpoly_context(len(self.ring.symbols))
 
     def to_flint(self, X: _Field) -> tuple:
         """The components of ``X`` as ``fmpz_mpoly`` (kept with ``X``)."""
@@ -420,12 +426,36 @@ class PolynomialBackend:
         total = self.zero
         if not f:
             return total
+        if self.flint_q is not None:
+            return self._apply_flint(X, f)
         for i, c in enumerate(self.values(X)):
             if c:
                 d = self.derivative(f, i)
                 if d:
                     total = total + c * d
         return self.reduce(total)
+
+    def _apply_flint(self, X: _Field, f):
+        """:meth:`apply` with the products on flint's ``fmpq_mpoly`` (the value ring's generators, coefficients
+        sympy's own ``fmpq``): the same polynomial, brought to the Laurent form by :meth:`reduce` as there.
+
+        Backward error analysis over the parameters (the symbolic rigid body) multiplies Laurent polynomials
+        of a few hundred terms; sympy's products are Python loops over the pairs of terms."""
+        ctx = self.flint_q
+        if X.flint_values is None:
+            X.flint_values = tuple(ctx.from_dict(dict(c)) if c else None for c in self.values(X))
+        g = ctx.from_dict(dict(f))
+        total = None
+        for i, c in enumerate(X.flint_values):
+            if c is not None:
+                d = g.derivative(i)
+                if not d.is_zero():
+                    total = c * d if total is None else total + c * d
+        if total is None or total.is_zero():
+            return self.zero
+        poly = self.ring.dtype(zip(exponents(total), total.coeffs()))
+        degrees = total.degrees()  # no term holds both p and p_inv unless both occur: then no reduction to do
+        return self.reduce(poly) if any(degrees[i] > 0 and degrees[j] > 0 for i, j in self._pairs) else poly
 
     @staticmethod
     def is_zero(X: _Field) -> bool:

@@ -482,12 +482,12 @@ def _rref_flint_frac(rows: dict, ncols: int, domain):
     ctx = frac_rref.context(domain)
     if ctx is None:
         return None
-    memo: dict = {}
+    memo: dict = {}  # by identity: hashing a rational function hashes its polynomials, costlier than converting
 
     def pair(v):
-        p = memo.get(v)
+        p = memo.get(id(v))  # the values are alive in ``rows`` throughout, so their ids are theirs
         if p is None:
-            p = memo[v] = frac_rref.from_field(v, ctx)
+            p = memo[id(v)] = frac_rref.from_field(v, ctx)
         return p
 
     R, pivots = frac_rref.rref({i: {j: pair(v) for j, v in r.items()} for i, r in rows.items()}, ncols, ctx)

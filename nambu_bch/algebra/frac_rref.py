@@ -96,8 +96,12 @@ def normalize(n, d):
 
 def from_field(v, ctx):
     """A field element (sympy ``FracElement`` of ``QQ(params)``) as a normalised pair ``(n, d)`` of ``fmpz_mpoly``."""
-    n, cn = _integer_poly(v.numer, ctx)
-    d, cd = _integer_poly(v.denom, ctx)
+    numer, denom = v.numer, v.denom
+    if numer.is_ground and denom.is_ground:  # a rational number (most entries of the shadow solves)
+        q = numer.LC / denom.LC  # sympy's QQ: reduced, positive denominator -- the normal form of a constant
+        return ctx.constant(int(q.numerator)), ctx.constant(int(q.denominator))
+    n, cn = _integer_poly(numer, ctx)
+    d, cd = _integer_poly(denom, ctx)
     if cn == 1 and cd == 1:
         return normalize(n, d)  # sympy's own normal form (a gcd of one, unless built with raw_new unreduced)
     return normalize(n * cd, d * cn)
@@ -110,7 +114,12 @@ def to_field(pair, domain):
     make, coeff = field.ring.dtype, domain.domain.dtype  # PolyElement from (monomial, coefficient) pairs; QQ's type
     native = _flint.qq_is_fmpq(coeff)  # flint ground types: fmpz coefficients convert directly
 
+    zero = (0,) * len(field.ring.gens)
+
     def poly(p):
+        if p.is_constant():  # most entries of an elimination: no exponents to convert
+            c = p.leading_coefficient() if not p.is_zero() else None
+            return make([(zero, coeff(c if native else int(c)))] if c is not None else [])
         cs = p.coeffs() if native else [int(c) for c in p.coeffs()]
         return make(zip(exponents(p), map(coeff, cs)))
 

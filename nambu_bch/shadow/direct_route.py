@@ -227,8 +227,10 @@ MAX_UNKNOWNS = 4000
 #: refused up front.  The N = 4 single split at h^6 (1485 unknowns) is 2.1e8: 1.1 s multi-modular, 0.5 s flint; the
 #: rigid body with symbolic I at h^10 (910 unknowns over QQ(I1, I2, I3)) is 3.5e9, and its whole direct route took
 #: 7.3 s CPU (load 4.4) where the refusal's fallback, the existence decision by orbit averages in sympy expressions,
-#: took about 116 s: the budget admits it.
-SOLVE_COST = 5 * 10**9
+#: took about 116 s: the budget admits it.  At h^12 (estimate 8.9e9) the exact solve with its sympy sums took
+#: 11.3 s CPU (load 10; ``benchmarks/bench_shadow.py --targets``, row d) where the fallback took about 210 s
+#: (docs/performance.md): admitted too.
+SOLVE_COST = 10**10
 
 
 def _check_ansatz_size(slots, n, degree):
@@ -286,15 +288,17 @@ def _flint_on() -> bool:
     return elimination.FAST_PATHS and elimination.flint_available()
 
 
-def _divided(numerators: dict, denominator, domain) -> dict:
+def _divided(numerators: dict, denominator, domain, ctx=False) -> dict:
     """``{key: n / denominator}`` in ``domain = QQ(params)``, zero quotients left out.
 
     ``numerators``: ``{key: {exponent tuple: rational}}`` (polynomials in the parameters), ``denominator``
     a non-zero polynomial of the field's ring.  Each quotient is a reduced fraction, cancelled by flint's
     gcd when python-flint is available (:mod:`nambu_bch.algebra.frac_rref`, the same normal form), else by
-    sympy's field.
+    sympy's field.  ``ctx``: the flint context of ``domain`` or ``None`` (sympy's field), when the caller
+    has chosen already (:meth:`_Solver._flint_context`).
     """
-    ctx = frac_rref.context(domain) if _flint_on() else None
+    if ctx is False:
+        ctx = frac_rref.context(domain) if _flint_on() else None
     field = domain.field
     out = {}
     if ctx is None:
@@ -364,6 +368,7 @@ class _Solver:
         self.gdeg = [_total_degree(p, self.n) - 1 for p in hams]
         self._columns: dict = {}
         self._plain = None  # the polynomial ring of the fraction-free fields (_fields_cleared)
+        self._ctx = False  # the flint context of the coefficient field, or None (_flint_context), chosen once
         self._cleared: dict = {}  # id of a Hamiltonian -> (its cleared polynomial, its denominator)
         self._jacobian_rank2 = None  # H, G algebraically independent (_psi_dim), found once per solve
         self._cofactors: dict = {}  # slot -> the fields with x_j in that slot (_monomial_field), once per solve
@@ -459,26 +464,20 @@ class _Solver:
             for p in slots:
                 hit = self._cleared.get(id(p)) if any(p is q for q in self.hams) else None
                 if hit is None:
-                    D = field.ring.one
-                    for c in p.values():
-                        D = D.lcm(c.denom)
-                    terms: dict = {}
-                    for m, c in p.items():
-                        num = c.numer * D.exquo(c.denom)
-                        for e, q in num.items():
-                            terms[m + e] = q
-                    hit = (make(terms), D)
+                    hit = self._clear(p, make)
                     if any(p is q for q in self.hams):  # the Hamiltonians: cleared once per solve
                         self._cleared[id(p)] = hit
                 cleared.append(hit[0])
-                total = total * hit[1]
+                if not hit[1].is_one:
+                    total = total * hit[1]
             parts.append((liouville_field(plain, *cleared).components, total))
         T = parts[0][1]
         for _, total in parts[1:]:
-            T = T.lcm(total)
+            if total != T:
+                T = T.lcm(total)
         sums = None
         for comps, total in parts:
-            scale = T.exquo(total)
+            scale = T.exquo(total) if total != T else 1
             if scale != 1:
                 factor = make({pad + m: c for m, c in scale.items()})
                 comps = [c * factor for c in comps]
@@ -488,8 +487,31 @@ class _Solver:
             groups: dict = {}
             for m, q in plain.terms(comp).items():
                 groups.setdefault(m[:width], {})[m[width:]] = q
-            components.append(alg.ring.from_dict(_divided(groups, T, alg.domain)) if groups else alg.zero)
+            components.append(alg.ring.from_dict(_divided(groups, T, alg.domain, self._flint_context()))
+                              if groups else alg.zero)
         return VectorField(alg, components)
+
+    @staticmethod
+    def _clear(p, make):
+        """``(Q, D)`` with ``p = Q / D``: ``D`` the lcm of the coefficients' denominators (a polynomial in the
+        parameters), ``Q`` a polynomial in the coordinates, constants and parameters (``make``: the plain ring's)."""
+        if all(c.denom.is_one for c in p.values()):  # no parameter in a denominator (an ansatz monomial): Q = p
+            return make({m + e: q for m, c in p.items() for e, q in c.numer.items()}), p.ring.domain.field.ring.one
+        D = p.ring.domain.field.ring.one
+        for c in p.values():
+            D = D.lcm(c.denom)
+        terms: dict = {}
+        for m, c in p.items():
+            num = c.numer * D.exquo(c.denom)
+            for e, q in num.items():
+                terms[m + e] = q
+        return make(terms), D
+
+    def _flint_context(self):
+        """The flint context of ``QQ(params)`` when python-flint is on, else ``None`` (chosen once per solve)."""
+        if self._ctx is False:
+            self._ctx = frac_rref.context(self.alg.domain) if _flint_on() else None
+        return self._ctx
 
     def _plain_ring(self):
         """``QQ[coordinates, constants, parameters]`` of :meth:`_fields_cleared`: flint's when available, else sympy's."""
@@ -622,8 +644,57 @@ class _Solver:
             sums.setdefault(tuple(i + j for i, j in zip(m, alpha)), []).append((1, c))
         coeffs = signed_sums(sums, self.alg.domain)
         if coeffs is None:
+            ctx = self._flint_context() if self._cleared_ok() else None
+            if ctx is not None:
+                return self._family_flint(m0, m1, alpha, ctx)
             return m0 + (m1 - m0).mul_monom(alpha)
         return self.alg.ring.from_dict(coeffs) if coeffs else self.alg.zero
+
+    def _family_flint(self, m0, m1, alpha, ctx):
+        """``m0 + alpha (m1 - m0)`` over ``QQ(params)`` with the coefficient differences on flint pairs
+        (:mod:`~nambu_bch.algebra.frac_rref`: gcds in C instead of sympy's per-operation cancellation).
+
+        The same ring element as sympy's ``m0 + (m1 - m0).mul_monom(alpha)``, its terms inserted in the order
+        sympy's arithmetic leaves them (``m1``'s, then ``m0``'s new ones; then ``m0``'s, then the shifted new
+        ones): field elements have one normal form, and the order is kept so that nothing downstream can tell."""
+        domain = self.alg.domain
+        memo: dict = {}
+
+        def pair(c):
+            hit = memo.get(id(c))
+            if hit is None:
+                hit = memo[id(c)] = frac_rref.from_field(c, ctx)
+            return hit
+
+        diff: dict = {}  # m1 - m0, pairs
+        for m, c in m1.items():
+            diff[m] = pair(c)
+        for m, c in m0.items():
+            b = pair(c)
+            a = diff.get(m)
+            v = frac_rref.sub(a, b) if a is not None else (-b[0], b[1])
+            if v[0].is_zero():
+                diff.pop(m, None)
+            else:
+                diff[m] = v
+        out: dict = {m: pair(c) for m, c in m0.items()}
+        for m, v in diff.items():
+            key = tuple(i + j for i, j in zip(m, alpha))
+            a = out.get(key)
+            if a is None:
+                out[key] = v
+                continue
+            w = frac_rref.sub(a, (-v[0], v[1]))
+            if w[0].is_zero():
+                del out[key]
+            else:
+                out[key] = w
+        if not out:
+            return self.alg.zero
+        # unchanged coefficients of m0 stay the very elements (no round trip)
+        unchanged = {m: c for m, c in m0.items() if out.get(m) is memo.get(id(c))}
+        return self.alg.ring.from_dict({m: unchanged[m] if m in unchanged else frac_rref.to_field(v, domain)
+                                        for m, v in out.items()})
 
     def _independent(self):
         """``H, G`` are algebraically independent (a 2 x 2 minor of their Jacobian in the coordinates is non-zero)."""
