@@ -218,7 +218,7 @@ class FIOrder:
     certificate: dict | None = None
     span: FISpan | None = None
     family: AlphaFamily | None = field(default=None, repr=False)
-    _kernel_exact: tuple | None = field(default=None, repr=False)  # (ansatz, basis polynomials per slot)
+    _kernel_exact: tuple | None = field(default=None, repr=False)  # per kernel basis vector, its ring element per slot
     _direct: tuple = field(default=(), repr=False)
     _direct_dim: int | None = field(default=None, repr=False)
 
