@@ -486,12 +486,15 @@ def constant_bound(expr, memo=None):
     return found
 
 
-def _bound(e, memo):
-    inf = math.inf
-    unknown = (None, -inf, 0, False)
+#: The bound of a constant with no bound from its tree (``upper`` None; nothing known of its sign or reality).
+_UNKNOWN = (None, -math.inf, 0, False)
+
+
+def _bound_leaf(e):
+    """Bounds of a number, ``pi``, ``E`` or ``I`` (exact, from the value); ``None`` for any other node."""
     if e.is_Rational:
         if e == 0:
-            return (-inf, -inf, 0, True)
+            return (-math.inf, -math.inf, 0, True)
         v = math.log2(abs(e.p)) - math.log2(e.q)
         return (v, v, 1 if e > 0 else -1, True)
     if e is sympy.pi or e is sympy.E:
@@ -499,66 +502,127 @@ def _bound(e, memo):
         return (v, v, 1, True)
     if e is sympy.I:
         return (0.0, 0.0, 0, False)
-    args = [constant_bound(a, memo) for a in e.args]
+    return None
+
+
+def _bound_add(e, args):
+    """``|a + b + ..| <= n max |.|``; a lower bound only when every term has the same known sign."""
     ups = [a[0] for a in args]
-    real = all(a[3] for a in args)
-    if e.is_Add:
-        if None in ups:
-            return unknown
-        signs = {a[2] for a in args}
-        sign = signs.pop() if len(signs) == 1 else 0
-        lower = max(a[1] for a in args) if sign else -inf
-        return (max(ups) + math.log2(len(args)), lower, sign, real)
-    if e.is_Mul:
-        if None in ups:
-            return unknown
-        sign = math.prod(a[2] for a in args)
-        return (sum(ups), sum(a[1] for a in args), sign, real)
-    if e.is_Pow:
-        (ub, lb, sb, rb), (ue, le, se, re) = args
-        k = e.exp
-        if k.is_Integer:
-            k = int(k)
-            up, low = (k * ub, k * lb) if k > 0 else (k * lb if lb > -inf else None, k * ub if ub is not None else -inf)
-            if ub is None:
-                up = None
-            sign = (sb if k % 2 else 1) if sb else (1 if k % 2 == 0 and rb else 0)
-            return (up, low, sign, rb)
-        if ub is None or ue is None:
-            return unknown
-        reach = max(abs(ub), abs(lb))  # |log2 |b|| <= reach
-        if k.is_Rational:
-            up, low = (float(k) * ub, float(k) * lb) if k > 0 else (float(k) * lb, float(k) * ub)
-            if up != up or low != low:  # inf * 0
-                return unknown
-            return (up, low, 1 if sb == 1 and rb else 0, sb == 1 and rb)
-        # b^k = exp(k log b), |k log b| <= 2^ue (|log2 b| + 4.6): the 4.6 covers pi |Im k| / ln 2
-        up = _exp2(ue) * (reach + 4.6)
-        return (up, -up, 1 if sb == 1 and rb and re else 0, sb == 1 and rb and re)
-    func = e.func
+    if None in ups:
+        return _UNKNOWN
+    signs = {a[2] for a in args}
+    sign = signs.pop() if len(signs) == 1 else 0
+    lower = max(a[1] for a in args) if sign else -math.inf
+    return (max(ups) + math.log2(len(args)), lower, sign, all(a[3] for a in args))
+
+
+def _bound_mul(e, args):
+    """``log2 |a b ..| = sum log2 |.|`` for both bounds; the signs multiply."""
+    if any(a[0] is None for a in args):
+        return _UNKNOWN
+    return (sum(a[0] for a in args), sum(a[1] for a in args), math.prod(a[2] for a in args), all(a[3] for a in args))
+
+
+def _bound_integer_power(k, base):
+    """``b^k``, ``k`` an integer: ``k`` times the base's bounds (swapped for ``k < 0``); no upper bound from a base
+    without one (``k > 0``) or without a lower bound (``k < 0``: a base that may be tiny)."""
+    ub, lb, sb, rb = base
+    if k > 0:
+        up, low = (None if ub is None else k * ub), k * lb
+    else:
+        up, low = (k * lb if lb > -math.inf else None), (k * ub if ub is not None else -math.inf)
+        if ub is None:
+            up = None
+    sign = (sb if k % 2 else 1) if sb else (1 if k % 2 == 0 and rb else 0)
+    return (up, low, sign, rb)
+
+
+def _bound_pow(e, args):
+    """``b^k``: integer ``k`` (:func:`_bound_integer_power`), rational ``k`` (``k`` times the base's bounds),
+    else ``|b^k| = |exp(k log b)| <= exp(2^ue (|log2 b| + 4.6))`` (the 4.6 covers ``pi |Im k| / ln 2``)."""
+    base, (ue, le, se, re) = args
+    ub, lb, sb, rb = base
+    k = e.exp
+    if k.is_Integer:
+        return _bound_integer_power(int(k), base)
+    if ub is None or ue is None:
+        return _UNKNOWN
+    if k.is_Rational:
+        up, low = (float(k) * ub, float(k) * lb) if k > 0 else (float(k) * lb, float(k) * ub)
+        if up != up or low != low:  # inf * 0
+            return _UNKNOWN
+        return (up, low, 1 if sb == 1 and rb else 0, sb == 1 and rb)
+    up = _exp2(ue) * (max(abs(ub), abs(lb)) + 4.6)
+    real = sb == 1 and rb and re
+    return (up, -up, 1 if real else 0, real)
+
+
+def _bound_growing(func, arg):
+    """``exp``, ``sinh``, ``cosh``: ``|f(a)| <= e^|a|``; ``exp`` of a real ``a`` of known sign is on one side of 1."""
+    ua, la, sa, ra = arg
+    up = _exp2(ua) * _LOG2E
+    if func is sympy.exp and ra and sa:  # e^a <= 1 for a < 0, >= 1 for a > 0
+        return (0.0, -up, 1, True) if sa < 0 else (up, 0.0, 1, True)
+    return (up, 0.0 if (func is sympy.cosh and ra) else -up, 1 if ra and func is not sympy.sinh else 0, ra)
+
+
+def _bound_sin_cos(func, arg):
+    """``|sin a|, |cos a| <= 1`` for real ``a``, else ``<= e^|a|``."""
+    ua, la, sa, ra = arg
+    return (0.0 if ra else _exp2(ua) * _LOG2E, -math.inf, 0, ra)
+
+
+def _bound_tanh(func, arg):
+    """``|tanh a| <= 1`` for real ``a``."""
+    return (0.0, -math.inf, 0, True) if arg[3] else _UNKNOWN
+
+
+def _bound_atan(func, arg):
+    """``|atan a| <= pi/2 < 2`` for real ``a``."""
+    return (1.0, -math.inf, 0, True) if arg[3] else _UNKNOWN
+
+
+def _bound_asin_acos(func, arg):
+    """``|asin a|, |acos a| <= pi + 1.1 + ln |a|`` (the principal branch, any complex ``a``)."""
+    return (math.log2(math.pi + 1.1 + max(arg[0], 0.0) * math.log(2)), -math.inf, 0, False)
+
+
+def _bound_log(func, arg):
+    """``|log a| <= |ln |a|| + pi``: needs a lower bound on ``|a|`` (a value that may be tiny has none)."""
+    ua, la, sa, ra = arg
+    if not la > -math.inf:
+        return _UNKNOWN
+    return (math.log2(max(abs(ua), abs(la)) * math.log(2) + math.pi), -math.inf, 0, sa == 1 and ra)
+
+
+#: The rules for a function of one argument whose upper bound is known (``Abs`` is taken before that check).
+_FUNCTION_BOUNDS = {sympy.exp: _bound_growing, sympy.sinh: _bound_growing, sympy.cosh: _bound_growing,
+                    sympy.sin: _bound_sin_cos, sympy.cos: _bound_sin_cos, sympy.tanh: _bound_tanh,
+                    sympy.atan: _bound_atan, sympy.asin: _bound_asin_acos, sympy.acos: _bound_asin_acos,
+                    sympy.log: _bound_log}
+
+
+def _bound_function(e, args):
+    """A function of one argument by :data:`_FUNCTION_BOUNDS` (``|Abs a| = |a|``); anything else has no bound."""
     if len(args) != 1:
-        return unknown
-    ua, la, sa, ra = args[0]
-    if func is sympy.Abs:
-        return (ua, la, 1, True)
-    if ua is None:
-        return unknown
-    if func in _GROWING:
-        up = _exp2(ua) * _LOG2E
-        if func is sympy.exp and ra and sa:  # e^a <= 1 for a < 0, >= 1 for a > 0
-            return (0.0, -up, 1, True) if sa < 0 else (up, 0.0, 1, True)
-        return (up, 0.0 if (func is sympy.cosh and ra) else -up, 1 if ra and func is not sympy.sinh else 0, ra)
-    if func in (sympy.sin, sympy.cos):
-        return (0.0 if ra else _exp2(ua) * _LOG2E, -inf, 0, ra)
-    if func is sympy.tanh and ra:
-        return (0.0, -inf, 0, True)
-    if func is sympy.atan and ra:
-        return (1.0, -inf, 0, True)
-    if func in (sympy.asin, sympy.acos):
-        return (math.log2(math.pi + 1.1 + max(ua, 0.0) * math.log(2)), -inf, 0, False)
-    if func is sympy.log and la > -inf:
-        return (math.log2(max(abs(ua), abs(la)) * math.log(2) + math.pi), -inf, 0, sa == 1 and ra)
-    return unknown
+        return _UNKNOWN
+    arg = args[0]
+    if e.func is sympy.Abs:
+        return (arg[0], arg[1], 1, True)
+    rule = _FUNCTION_BOUNDS.get(e.func)
+    if rule is None or arg[0] is None:
+        return _UNKNOWN
+    return rule(e.func, arg)
+
+
+def _bound(e, memo):
+    """:func:`constant_bound` of one node from its arguments' bounds: a table of rules per kind of node."""
+    leaf = _bound_leaf(e)
+    if leaf is not None:
+        return leaf
+    args = [constant_bound(a, memo) for a in e.args]
+    rule = _bound_add if e.is_Add else _bound_mul if e.is_Mul else _bound_pow if e.is_Pow else _bound_function
+    return rule(e, args)
 
 
 class _Builder:

@@ -16,7 +16,7 @@ from hypothesis import strategies as st
 from sympy.polys.domains import QQ
 
 from nambu_bch.algebra.ansatz import MAX_COLUMNS, Ansatz, Rows
-from nambu_bch.algebra.elimination import solve_affine
+from nambu_bch.algebra.elimination import SparseMatrix, solve_affine
 from nambu_bch.errors import NambuBCHError, ResourceLimitError
 
 
@@ -107,7 +107,7 @@ def test_canonical_member_on_a_gauge_example():
     """L(a, b) = a + b with b = 2 (one equation, a one-dimensional kernel): the canonical member clears the
     first priority column it can (the normal form), computed both ways."""
     columns, rhs = [{0: QQ(1)}, {0: QQ(1)}], [{0: QQ(2)}]
-    S = solve_affine(columns, rhs, 1, QQ)
+    S = solve_affine(SparseMatrix.from_columns(columns, 1, QQ), rhs)
     for prio, expected in (([0, 1], {1: QQ(2)}), ([1, 0], {0: QQ(2)})):
         assert Ansatz.canonical(S.particular, S.kernel, prio, QQ) == [expected]
         assert Ansatz.solve_canonical(columns, rhs, 1, QQ, prio).particular == [expected]
@@ -126,7 +126,7 @@ def test_canonical_rule_two_ways_on_random_systems(nrows, ncols, data):
     b = {i: sum((L[i][j] * x0[j] for j in range(ncols)), QQ(0)) for i in range(nrows)}
     columns = [{i: L[i][j] for i in range(nrows) if L[i][j]} for j in range(ncols)]
     prio = data.draw(st.permutations(range(ncols)))
-    S = solve_affine(columns, [b], nrows, QQ)
+    S = solve_affine(SparseMatrix.from_columns(columns, nrows, QQ), [b])
     assert S.consistent
     direct = Ansatz.solve_canonical(columns, [b], nrows, QQ, list(prio)).particular[0]
     start = {j: v for j, v in enumerate(x0) if v}

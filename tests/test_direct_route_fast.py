@@ -187,10 +187,11 @@ def test_rank_over_params_equals_plain_elimination(case):
 
     rows, ncols = case
     K = ALGEBRAS["QQ(a,b)"].domain
-    ours = elimination.rank(rows, ncols, K)
+    M = elimination.SparseMatrix.from_rows(rows, ncols, K)
+    ours = elimination.rank(M)
     try:
         elimination.FAST_PATHS = False
-        plain = elimination.rank(rows, ncols, K)
+        plain = elimination.rank(M)
     finally:
         elimination.FAST_PATHS = True
     assert ours == plain

@@ -268,10 +268,11 @@ def test_parameter_names_are_not_passed_to_flint():
     Kw = QQ.frac_field(w)
     cols = [{0: Kw.from_sympy(w), 1: Kw.one}, {0: Kw.one, 1: Kw.from_sympy(1 / (w + 1))}]
     rhs = [{0: Kw.from_sympy(w**2), 1: Kw.from_sympy(sympy.Rational(1, 3))}]
-    ours = elimination.solve_affine(cols, rhs, 2, Kw)
+    L = elimination.SparseMatrix.from_columns(cols, 2, Kw)
+    ours = elimination.solve_affine(L, rhs)
     try:
         elimination.FAST_PATHS = False
-        plain = elimination.solve_affine(cols, rhs, 2, Kw)
+        plain = elimination.solve_affine(L, rhs)
     finally:
         elimination.FAST_PATHS = True
     assert ours.particular == plain.particular and ours.consistent

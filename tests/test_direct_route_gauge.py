@@ -14,7 +14,7 @@ import pytest
 
 from nambu_bch import model
 from nambu_bch.algebra.ansatz import Ansatz
-from nambu_bch.algebra.elimination import rank
+from nambu_bch.algebra.elimination import SparseMatrix, rank
 dr = importlib.import_module("nambu_bch.shadow.direct_route")  # the package exports the function of the same name
 
 
@@ -41,7 +41,7 @@ def reference_psi_dim(alg, hams, D) -> int:
                     break
             if ok and vec:
                 vecs.append(vec)
-    return rank(vecs, len(ansatz), alg.domain) if vecs else 0
+    return rank(SparseMatrix.from_rows(vecs, len(ansatz), alg.domain)) if vecs else 0
 
 
 CASES = [("ho3", "12321", 6), ("ho3", "32123", 6), ("rigid-body", "12321", 4), ("rigid-body[I=1,2,3]", "12321", 6),

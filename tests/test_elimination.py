@@ -145,8 +145,9 @@ def test_solve_affine_matches_plain_domainmatrix(domain_name, route, route_switc
     @given(systems(domain_name))
     def check(system):
         domain, nrows, columns, rhs = system
-        new = E.solve_affine(columns, rhs, nrows, domain)
-        ref = _reference(E.solve_affine, columns, rhs, nrows, domain)
+        L = E.SparseMatrix.from_columns(columns, nrows, domain)
+        new = E.solve_affine(L, rhs)
+        ref = _reference(E.solve_affine, L, rhs)
         assert (new.consistent, new.failing_rhs, new.pivots) == (ref.consistent, ref.failing_rhs, ref.pivots)
         assert len(new.kernel) == len(ref.kernel)
         for k_new, k_ref in zip(new.kernel, ref.kernel):
@@ -178,9 +179,10 @@ def test_rank_nullspace_normal_form_match_plain(domain_name, route, route_switch
         ncols = len(columns)
         vectors = [{j: col[i] for j, col in enumerate(columns) if i in col} for i in range(nrows)]
         rows = {i: v for i, v in enumerate(vectors) if v}
-        assert E.rank(vectors, ncols, domain) == _reference(E.rank, vectors, ncols, domain)
-        kern = E.nullspace(rows, nrows, ncols, domain)
-        ref = _reference(E.nullspace, rows, nrows, ncols, domain)
+        M = E.SparseMatrix(rows, nrows, ncols, domain)
+        assert E.rank(E.SparseMatrix.from_rows(vectors, ncols, domain)) == _reference(E.rank, M)
+        kern = E.nullspace(M)
+        ref = _reference(E.nullspace, M)
         assert len(kern) == len(ref) and all(_same(u, v, domain) for u, v in zip(kern, ref))
         for k in kern:
             assert all(not sum((r[j] * k[j] for j in r if j in k), domain.zero) for r in rows.values())
@@ -252,18 +254,29 @@ def test_elimination_cost_counts_blocks_and_weights_parameter_fields():
 @settings(max_examples=25, deadline=None)
 @given(st.lists(st.dictionaries(st.integers(0, 4), st.integers(-3, 3), max_size=4), min_size=1, max_size=5),
        st.dictionaries(st.integers(0, 4), st.integers(-3, 3), max_size=3))
-def test_sparse_matrix_gives_what_the_bare_shapes_give(cols, b):
-    """``SparseMatrix`` (from columns or from rows) in ``solve_affine``, ``nullspace`` and ``rank`` gives the same
-    result as the three bare-dict shapes (columns; ``{row: {col: v}}`` with shape; row vectors)."""
+def test_sparse_matrix_from_columns_and_from_rows_agree(cols, b):
+    """``SparseMatrix`` built from columns or from its rows is the same matrix: same entries (zeros dropped), same
+    ``solve_affine``, ``nullspace`` and ``rank``; its ``columns()`` give the columns back."""
     cols = [{i: QQ(v) for i, v in c.items()} for c in cols]
     b = {i: QQ(v) for i, v in b.items()}
     M = E.SparseMatrix.from_columns(cols, 5, QQ)
+    T = E.SparseMatrix.from_rows([M.rows.get(i, {}) for i in range(5)], len(cols), QQ)
     assert M.ncols == len(cols) and all(v for r in M.rows.values() for v in r.values())
-    assert E.SparseMatrix.from_rows([M.rows.get(i, {}) for i in range(5)], len(cols), QQ).rows == M.rows
-    assert E.solve_affine(M, [b]) == E.solve_affine(cols, [b], 5, QQ)
-    assert E.nullspace(M) == E.nullspace(M.rows, 5, len(cols), QQ)
-    assert E.rank(M) == E.rank([M.rows.get(i, {}) for i in range(5)], len(cols), QQ)
+    assert T == M
+    assert E.solve_affine(M, [b]) == E.solve_affine(T, [b])
+    assert E.nullspace(M) == E.nullspace(T) and E.rank(M) == E.rank(T) == len(E.solve_affine(M, []).pivots)
     assert [{i: v for i, v in c.items() if v} for c in M.columns()] == [{i: v for i, v in c.items() if v} for c in cols]
+
+
+@pytest.mark.parametrize("call", [lambda: E.solve_affine([{0: QQ(1)}], [{0: QQ(1)}]),
+                                  lambda: E.nullspace({0: {0: QQ(1)}}),
+                                  lambda: E.rank([{0: QQ(1)}])],
+                         ids=["solve_affine-columns", "nullspace-row-dict", "rank-row-vectors"])
+def test_elimination_takes_only_a_sparse_matrix(call):
+    """The bare-dict shapes (columns, ``{row: {col: v}}``, row vectors) are refused in one line of the package's
+    exception family, naming the function and what it accepts."""
+    with pytest.raises(E.NambuBCHError, match=r"^\w+: expects a SparseMatrix .*, got (list|dict)$"):
+        call()
 
 
 @pytest.mark.parametrize("args,fragment", [(({0: {0: QQ(1)}}, 0, 1), "row index 0 outside"),

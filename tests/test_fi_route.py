@@ -431,3 +431,48 @@ def test_doc_table_rows_are_computed():
     lines = script.table(rows).splitlines()[2:]
     assert len(lines) == 4 and all(line in doc for line in lines)
     assert any("proper part" in line for line in lines)
+
+
+# -- exact families, sympy forms on demand -------------------------------------------------------------------------
+
+def test_fi_orders_keep_exact_families_and_feed_them_to_higher_orders(monkeypatch):
+    """ho3, 12321, h^4: the higher order takes the lower family's alpha parts from the exact data (the sympy round
+    trip ``_alpha_parts`` is never called); the sympy forms are built on first access and are those of the exact
+    family: ``alpha_parts`` equals ``_alpha_parts`` of the sympy family, order by order."""
+
+    def refuse(*args):
+        raise AssertionError("a sympy round trip fed the higher orders")
+
+    monkeypatch.setattr(fi_module, "_alpha_parts", refuse)
+    R = fi_route(model("ho3"), "12321", 4)
+    o = R.orders[-1]
+    assert o.status == "solved" and R.__dict__["_corrections"] is None and o.__dict__["_corrections"] is None
+    monkeypatch.undo()
+    alg = R._ctx["algebra"]
+    for fam, forms in ((R.family, R.corrections), (o.family, o.corrections)):
+        assert fam.alpha_parts() == [fi_module._alpha_parts(alg, c) for c in forms]
+    assert o.corrections == fi_module._family(o.members)
+    assert [o.family.forms_of(p) for p in o._kernel_exact] == o.kernel and len(o.kernel) == o.fi_dim
+
+
+def test_fi_results_pickle_their_exact_data_and_compare_by_it():
+    """An FI result pickles without its sympy forms (rebuilt on access) and its copy is equal to it (``==`` on the
+    exact families, the system by its defining data), order by order; the forms rebuilt are the same."""
+    import pickle
+
+    R = fi_route(model("ho3"), "12321", 4)
+    forms = (R.corrections, [(o.corrections, o.members, o.kernel) for o in R.orders])
+    state = R.__getstate__()
+    assert state["_corrections"] is None and state["family"] is R.family
+    assert all(o.__getstate__()["_corrections"] is None for o in R.orders if o.status == "solved")
+    copy = pickle.loads(pickle.dumps(R))
+    assert copy.__dict__["_corrections"] is None and copy == R and R == copy
+    assert all(x == y for x, y in zip(copy.orders, R.orders))
+    assert (copy.corrections, [(o.corrections, o.members, o.kernel) for o in copy.orders]) == forms
+
+
+def test_fi_span_is_decided_exactly_over_an_algebraic_parameter_field():
+    """ho3, yoshida:12321 (coefficients in QQ<2^(1/3)>(m, omega), whose fractions are not kept reduced): at h^4 the
+    FI members are the family's (``reached``), decided on the difference of the exact members."""
+    R = fi_route(model("ho3"), "yoshida:12321", 4)
+    assert [s.reached for s in R.spans()] == [True, True]

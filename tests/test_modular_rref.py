@@ -119,11 +119,12 @@ def test_inconsistent_augmented_systems_through_solve_affine(monkeypatch):
         columns = [{i: r[j] for i, r in rows.items() if j in r} for j in range(ncols)]
         rhs = [{i: QQ(k + 1) for i in range(nrows) if i % 2 == 0}, {nrows: QQ(1)} if k else {}]
         nr = nrows + 1
-        new = E.solve_affine(columns, rhs, nr, QQ)
+        L = E.SparseMatrix.from_columns(columns, nr, QQ)
+        new = E.solve_affine(L, rhs)
         old = E.FAST_PATHS
         E.FAST_PATHS = False
         try:
-            ref = E.solve_affine(columns, rhs, nr, QQ)
+            ref = E.solve_affine(L, rhs)
         finally:
             E.FAST_PATHS = old
         assert new == ref

@@ -334,6 +334,26 @@ def test_constant_towers_refused_from_the_tree(text, fragment):
     assert "2^1400" in message or "cannot be bounded" in message, message
 
 
+@pytest.mark.parametrize("expr", [
+    sympy.tan(1), 1 / (sympy.pi - 3), sympy.log(sympy.pi - 3), sympy.tan(1)**2, sympy.tan(1)**-2,
+    sympy.exp(sympy.tan(1)), sympy.Abs(sympy.tan(1)) + 1, sympy.tan(1) * 2, sympy.sqrt(sympy.tan(1)),
+])
+def test_constant_bound_says_unknown_where_the_tree_gives_no_bound(expr):
+    """A value that may cancel, ``tan`` and ``log`` of what may be tiny have no upper bound, and neither has what is
+    built from them (a power of ``tan(1)`` among them: it raised a TypeError instead)."""
+    from nambu_bch.parsing import constant_bound
+
+    assert constant_bound(expr)[0] is None
+
+
+def test_a_power_of_an_unbounded_constant_is_parsed_or_refused_in_one_line():
+    """``tan(1)**2`` is an ordinary constant factor; inside ``exp`` it is refused in one line (both were a TypeError
+    from the size bound)."""
+    assert parse_expression("tan(1)**2*x1", SYMBOLS, what="--H") == sympy.tan(1)**2 * x1
+    with pytest.raises(ExpressionParseError, match=r"^--H .*the constant tan\(1\)\*\*2 in exp cannot be bounded"):
+        parse_expression("x1*exp(tan(1)**2)", SYMBOLS, what="--H")
+
+
 @pytest.mark.parametrize("text", [
     "x1*exp(700)", "x1*exp(-exp(10))", "cos(1/(pi - 3))*x1", "x1*exp(1/(1 + sqrt(2)))", "x1*exp(atan(1/2))",
     "x1*2^(1/2)*3^(1/3)", "x1*E^E^E", "x1*exp(-1/(2*pi))", "x1*cosh(3)*sin(10^300)", "exp(-x1^2/2)*cos(omega*x2)",
@@ -346,6 +366,12 @@ def test_ordinary_constants_still_accepted(text):
     sympy.exp(sympy.Rational(5, 2)), sympy.exp(sympy.exp(2)), sympy.pi**sympy.pi, sympy.sqrt(7) / 3,
     sympy.cosh(5), sympy.sinh(-4) * sympy.E, (2 + sympy.sqrt(3))**7, sympy.exp(-sympy.exp(3)),
     sympy.asin(sympy.Rational(1, 3)), sympy.log(10**50), 1 / (1 + sympy.pi)**3,
+    # one per rule of the table: Abs, sin/cos, tanh, atan, acos, log, roots of a negative base, negative and odd
+    # integer powers, a non-rational exponent, signs of products and of sums of one sign
+    sympy.Abs(sympy.pi - 4), sympy.sin(3), sympy.cos(sympy.Rational(7, 2)), sympy.tanh(-2), sympy.atan(50),
+    sympy.acos(sympy.Rational(-1, 5)), sympy.log(sympy.Rational(1, 10**6)), sympy.cbrt(-7) * sympy.I,
+    (-sympy.pi - 5)**-3, sympy.E**(sympy.pi / 3), -3 * sympy.pi * sympy.exp(2), -sympy.pi - sympy.E - 1,
+    sympy.exp(-sympy.pi), sympy.cosh(-sympy.E) * sympy.sinh(2),
 ])
 def test_constant_bound_is_an_upper_and_lower_bound(expr):
     """The tree bound brackets the true log2 |value| (checked numerically here, never in the parser)."""

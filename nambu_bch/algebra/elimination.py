@@ -26,7 +26,7 @@ field is eliminated there, right-hand sides split along ``1, theta, ..``
   functional that annihilates every field the ansatz can produce but not the
   right-hand side, so it proves that no solution exists within the ansatz.
   ``certificate=False`` skips that (second) elimination.
-* :func:`nullspace` and :func:`rank` of sparse row vectors.
+* :func:`nullspace` and :func:`rank` of a :class:`SparseMatrix` (the one matrix type all three take).
 * :func:`normal_form` reduces a solution modulo the kernel with a column
   priority: the result is the unique solution that is zero on the
   highest-priority columns the kernel can clear.  The package's
@@ -145,6 +145,13 @@ class SparseMatrix:
             for j, v in row.items():
                 cols[j][i] = v
         return cols
+
+
+def _require_matrix(name: str, matrix) -> None:
+    """Refuse, in one line, anything but a :class:`SparseMatrix` (the one matrix shape the elimination takes)."""
+    if not isinstance(matrix, SparseMatrix):
+        raise NambuBCHError(f"{name}: expects a SparseMatrix (SparseMatrix.from_rows / from_columns), "
+                            f"got {type(matrix).__name__}")
 
 
 def _sdm(rows: dict, nrows: int, ncols: int, domain) -> DomainMatrix:
@@ -511,17 +518,15 @@ def _kernel(R, pivots, ncols: int, domain) -> list:
     return kernel
 
 
-def solve_affine(columns, rhs: list, nrows: int | None = None, domain=None, *, certificate: bool = True) -> AffineSolution:
-    """Solve ``L x = b_k`` for every ``k`` exactly; ``L`` a :class:`SparseMatrix` or given by sparse columns.
+def solve_affine(matrix: SparseMatrix, rhs: list, *, certificate: bool = True) -> AffineSolution:
+    """Solve ``L x = b_k`` for every ``k`` exactly, ``L`` a :class:`SparseMatrix`.
 
     Parameters
     ----------
-    columns : SparseMatrix, or list of dict ``{row: value}``
-        ``L``, or its columns (values in ``domain``; then ``nrows`` and ``domain`` are given too).
+    matrix : SparseMatrix
+        ``L`` (values in its domain, ``QQ`` or ``QQ(params)`` ..).
     rhs : list of dict ``{row: value}``
         The right-hand sides ``b_k``.
-    nrows : int -- with columns only (a :class:`SparseMatrix` carries its shape)
-    domain : sympy domain (``QQ`` or ``QQ(params)``) -- with columns only
     certificate : bool
         Look for a left null vector when inconsistent (a second elimination, of ``L^T``);
         with ``False`` the result's ``certificate`` is ``None``.
@@ -533,24 +538,16 @@ def solve_affine(columns, rhs: list, nrows: int | None = None, domain=None, *, c
     Examples
     --------
     >>> from sympy.polys.domains import QQ
-    >>> S = solve_affine([{0: QQ(1)}, {0: QQ(1)}], [{0: QQ(2)}], 1, QQ)
+    >>> S = solve_affine(SparseMatrix.from_columns([{0: QQ(1)}, {0: QQ(1)}], 1, QQ), [{0: QQ(2)}])
     >>> S.consistent, {c: int(v) for c, v in S.particular[0].items()}, [{c: int(v) for c, v in k.items()} for k in S.kernel]
     (True, {0: 2}, [{1: 1, 0: -1}])
-    >>> {r: int(v) for r, v in solve_affine([{0: QQ(1)}], [{1: QQ(1)}], 2, QQ).certificate.items()}
+    >>> {r: int(v) for r, v in solve_affine(SparseMatrix.from_columns([{0: QQ(1)}], 2, QQ), [{1: QQ(1)}]).certificate.items()}
     {1: 1}
     """
-    if isinstance(columns, SparseMatrix):
-        matrix = columns
-        nrows, domain, ncols = matrix.nrows, matrix.domain, matrix.ncols
-        rows = {i: dict(r) for i, r in matrix.rows.items()}
-        columns = matrix.columns()
-    else:
-        ncols = len(columns)
-        rows = {}
-        for j, col in enumerate(columns):
-            for i, v in col.items():
-                if v:
-                    rows.setdefault(i, {})[j] = v
+    _require_matrix("solve_affine", matrix)
+    nrows, domain, ncols = matrix.nrows, matrix.domain, matrix.ncols
+    rows = {i: dict(r) for i, r in matrix.rows.items()}
+    columns = matrix.columns()
     split = _AlgebraicSplit.of(domain) if FAST_PATHS else None
     if split is not None:
         out = _solve_split(split, rows, columns, rhs, nrows, certificate)
@@ -679,18 +676,15 @@ def kernel_rref(kernel: list, priority: list, domain) -> list:
     return [{priority[c]: v for c, v in R.get(r, {}).items()} for r in range(len(pivots))]
 
 
-def rank(vectors, ncols: int | None = None, domain=None) -> int:
-    """Rank of a :class:`SparseMatrix`, or of sparse row vectors ``{column: value}`` (columns ``0..ncols-1``).
+def rank(matrix: SparseMatrix) -> int:
+    """Rank of a :class:`SparseMatrix` over its domain.
 
     >>> from sympy.polys.domains import QQ
-    >>> rank([{0: QQ(1), 1: QQ(2)}, {0: QQ(2), 1: QQ(4)}, {2: QQ(1)}], 3, QQ)
+    >>> rank(SparseMatrix.from_rows([{0: QQ(1), 1: QQ(2)}, {0: QQ(2), 1: QQ(4)}, {2: QQ(1)}], 3, QQ))
     2
     """
-    if isinstance(vectors, SparseMatrix):
-        rows, nrows, ncols, domain = vectors.rows, vectors.nrows, vectors.ncols, vectors.domain
-    else:
-        rows = {r: {c: v for c, v in vec.items() if v} for r, vec in enumerate(vectors)}
-        nrows = len(vectors)
+    _require_matrix("rank", matrix)
+    rows, nrows, ncols, domain = matrix.rows, matrix.nrows, matrix.ncols, matrix.domain
     if not nrows:
         return 0
     full = _full_rank_at_a_point(rows, nrows, ncols, domain) if FAST_PATHS else None
@@ -738,19 +732,18 @@ def _full_rank_at_a_point(rows: dict, nrows: int, ncols: int, domain):
     return None
 
 
-def nullspace(rows, nrows: int | None = None, ncols: int | None = None, domain=None) -> list:
-    """A basis of ``{x : M x = 0}`` for a :class:`SparseMatrix` ``M`` (or ``M = {row: {column: value}}`` with its
-    shape and domain), one vector per free column.
+def nullspace(matrix: SparseMatrix) -> list:
+    """A basis of ``{x : M x = 0}`` for a :class:`SparseMatrix` ``M``, one vector per free column.
 
     The vector of free column ``f`` is ``1`` at ``f``, zero at the other free
     columns and minus the reduced echelon entries at the pivots (Gauss-Jordan over the field).
 
     >>> from sympy.polys.domains import QQ
-    >>> [{c: int(v) for c, v in k.items()} for k in nullspace({0: {0: QQ(1), 1: QQ(1)}}, 1, 3, QQ)]
+    >>> [{c: int(v) for c, v in k.items()} for k in nullspace(SparseMatrix({0: {0: QQ(1), 1: QQ(1)}}, 1, 3, QQ))]
     [{1: 1, 0: -1}, {2: 1}]
     """
-    if isinstance(rows, SparseMatrix):
-        rows, nrows, ncols, domain = rows.rows, rows.nrows, rows.ncols, rows.domain
+    _require_matrix("nullspace", matrix)
+    rows, nrows, ncols, domain = matrix.rows, matrix.nrows, matrix.ncols, matrix.domain
     R, pivots = _rref(rows, nrows, ncols, domain)
     return _kernel(R, pivots, ncols, domain)
 

@@ -258,6 +258,105 @@ _LANES = 8  # words evaluated together by one program sweep (8 x int32: one AVX2
 
 
 @njit()
+def _class_chains(z, members, span, right, r0, r1, d, k):
+    """``chain[r, j]``: the index of ``members[r0 + r][j:]`` (the suffixes still starting with the class's smallest
+    letter), and whether any of them has ``z != 0``."""
+    size = r1 - r0
+    chain = _filled(size * d, -1).reshape((size, d))
+    any_nonzero = False
+    for r in range(size):
+        c = members[r0 + r]
+        chain[r, 0] = c
+        for j in range(1, span[c] + 1):
+            chain[r, j] = right[chain[r, j - 1]]
+        for j in range(span[c] + 1):
+            for i in range(k):
+                if z[chain[r, j], i] != 0:
+                    any_nonzero = True
+    return chain, any_nonzero
+
+
+@njit()
+def _mark_live(live, z, chain, members, span, r0, r1, k):
+    """A class left as it is (all zero, or one member): mark its members with a non-zero suffix."""
+    for r in range(r1 - r0):
+        for j in range(span[members[r0 + r]] + 1):
+            for i in range(k):
+                if z[chain[r, j], i] != 0:
+                    live[r0 + r] = 1
+
+
+@njit()
+def _group_stop(live, roots, r0, b0, b1):
+    """The last program node a group ``b0 .. b1 - 1`` needs: the largest root of a member before its last word that
+    is (or may still become) non-zero; -1 when none."""
+    stop = np.int64(-1)  # (not a literal: one compiled _run_program)
+    for q in range(r0, b1 - 1):
+        if (live[q] != 0 or q >= b0) and roots[q - r0] > stop:
+            stop = roots[q - r0]
+    return stop
+
+
+@njit()
+def _add_earlier(acc, z, X, live, roots, chain, members, K, span, lane_span, lane_lead, primes, inv, r0, b0, nb, block):
+    """``acc[lane, j] += c z`` over the members before the group (final): one row of ``X`` for all lanes.
+
+    The sum is kept in int64, reduced every ``block`` terms: ``|c| <= 2^(d-1)``, ``z < 2^28``, so
+    ``block * 2^(d+27) <= 2^62`` (no integer division in the inner loops)."""
+    k = primes.shape[0]
+    terms = 0
+    for q in range(r0, b0):
+        if live[q] != 0:
+            kv, sv, root = K[members[q]], span[members[q]], roots[q - r0]
+            hit = False
+            for lane in range(nb):
+                if kv <= lane_lead[lane]:  # Eq. (2): w starts with a^K_v
+                    c = np.int64(X[root, lane])
+                    if c != 0:
+                        hit = True
+                        for j in range(min(sv, lane_span[lane]) + 1):
+                            v = chain[q - r0, j]
+                            for i in range(k):
+                                acc[lane, j, i] += c * z[v, i]
+            if hit:
+                terms += 1
+                if terms >= block - _LANES:  # the group's own members add at most _LANES - 1
+                    for lane in range(nb):
+                        for j in range(lane_span[lane] + 1):
+                            for i in range(k):
+                                acc[lane, j, i] = _reduce(acc[lane, j, i], primes[i], inv[i])
+                    terms = 0
+
+
+@njit()
+def _finish_group(acc, z, X, live, roots, chain, members, K, span, lane_span, lane_lead, primes, inv, r0, b0, b1,
+                  ran):
+    """Each word ``w`` of the group in turn: add the group's members before it (final by now), subtract the sum from
+    ``z`` along its chain (``ran``: the program ran, else nothing is subtracted), and mark it live if non-zero."""
+    k = primes.shape[0]
+    for r in range(b0, b1):
+        lane = r - b0
+        kw, la = lane_span[lane], lane_lead[lane]
+        if ran:
+            for q in range(b0, r):
+                if live[q] != 0 and K[members[q]] <= la:
+                    c = np.int64(X[roots[q - r0], lane])
+                    if c != 0:
+                        for j in range(min(span[members[q]], kw) + 1):
+                            v = chain[q - r0, j]
+                            for i in range(k):
+                                acc[lane, j, i] += c * z[v, i]
+            for j in range(kw + 1):
+                v = chain[r - r0, j]
+                for i in range(k):
+                    z[v, i] = _reduce(z[v, i] - acc[lane, j, i], primes[i], inv[i])
+        for j in range(kw + 1):
+            for i in range(k):
+                if z[chain[r - r0, j], i] != 0:
+                    live[r] = 1
+
+
+@njit()
 def _solve(z, primes, beta, words, lengths, left, right, members, class_start, g, n, d):
     """Eq. (1) in place, all primes at once, for every degree ``<= d`` through the content classes of degree ``d``;
     then, if ``d < n``, the even degree ``n`` by Eq. (3) (:func:`_even_top`, with ``beta``).
@@ -303,88 +402,31 @@ def _solve(z, primes, beta, words, lengths, left, right, members, class_start, g
         r1 = r0
         while r1 < m and class_start[r1] == r0:
             r1 += 1
-        size = r1 - r0
-        chain = _filled(size * d, -1).reshape((size, d))  # chain[r, j]: index of members[r0 + r][j:]
-        any_nonzero = False
-        for r in range(size):
-            c = members[r0 + r]
-            chain[r, 0] = c
-            for j in range(1, span[c] + 1):
-                chain[r, j] = right[chain[r, j - 1]]
-            for j in range(span[c] + 1):
-                for i in range(k):
-                    if z[chain[r, j], i] != 0:
-                        any_nonzero = True
-        if any_nonzero and size > 1:
-            kids, roots = _class_program(members[r0:r1], core, K, words, lengths, left, right, g, d, memo)
-            X = _zeros2(g * d + kids.shape[0], _LANES, np.int32)
-            for b0 in range(r0, r1, _LANES):
-                b1 = min(b0 + _LANES, r1)
-                stop = np.int64(-1)  # (not a literal: one compiled _run_program) every member before the group's last word that is (or may still become) non-zero
-                for q in range(r0, b1 - 1):
-                    if (live[q] != 0 or q >= b0) and roots[q - r0] > stop:
-                        stop = roots[q - r0]
-                if stop >= 0:
-                    for r in range(b0, b1):
-                        for i in range(d):
-                            x[r - b0, i] = words[members[r], i]
-                    _run_program(kids, x, g, d, stop, X)
-                    work += max(0, stop + 1 - g * d) * _LANES
-                nb = b1 - b0
-                for lane in range(nb):
-                    lane_span[lane], lane_lead[lane] = span[members[b0 + lane]], lead[members[b0 + lane]]
-                if stop >= 0:
-                    # sum c z in int64, reduced every ``block`` terms: |c| <= 2^(d-1), z < 2^28, so
-                    # block * 2^(d+27) <= 2^62 (no integer division in the inner loops)
-                    acc[:nb] = 0
-                    terms = 0
-                    for q in range(r0, b0):  # members before the group (final): one row of X for all lanes
-                        if live[q] != 0:
-                            kv, sv, root = K[members[q]], span[members[q]], roots[q - r0]
-                            hit = False
-                            for lane in range(nb):
-                                if kv <= lane_lead[lane]:  # Eq. (2): w starts with a^K_v
-                                    c = np.int64(X[root, lane])
-                                    if c != 0:
-                                        hit = True
-                                        for j in range(min(sv, lane_span[lane]) + 1):
-                                            v = chain[q - r0, j]
-                                            for i in range(k):
-                                                acc[lane, j, i] += c * z[v, i]
-                            if hit:
-                                terms += 1
-                                if terms >= block - _LANES:  # the group's own members add at most _LANES - 1
-                                    for lane in range(nb):
-                                        for j in range(lane_span[lane] + 1):
-                                            for i in range(k):
-                                                acc[lane, j, i] = _reduce(acc[lane, j, i], primes[i], inv[i])
-                                    terms = 0
+        chain, any_nonzero = _class_chains(z, members, span, right, r0, r1, d, k)
+        if not any_nonzero or r1 - r0 == 1:
+            _mark_live(live, z, chain, members, span, r0, r1, k)
+            r0 = r1
+            continue
+        kids, roots = _class_program(members[r0:r1], core, K, words, lengths, left, right, g, d, memo)
+        X = _zeros2(g * d + kids.shape[0], _LANES, np.int32)
+        for b0 in range(r0, r1, _LANES):
+            b1 = min(b0 + _LANES, r1)
+            stop = _group_stop(live, roots, r0, b0, b1)
+            if stop >= 0:
                 for r in range(b0, b1):
-                    lane = r - b0
-                    kw, la = lane_span[lane], lane_lead[lane]
-                    if stop >= 0:
-                        for q in range(b0, r):  # members of the group before w (final by now)
-                            if live[q] != 0 and K[members[q]] <= la:
-                                c = np.int64(X[roots[q - r0], lane])
-                                if c != 0:
-                                    for j in range(min(span[members[q]], kw) + 1):
-                                        v = chain[q - r0, j]
-                                        for i in range(k):
-                                            acc[lane, j, i] += c * z[v, i]
-                        for j in range(kw + 1):
-                            v = chain[r - r0, j]
-                            for i in range(k):
-                                z[v, i] = _reduce(z[v, i] - acc[lane, j, i], primes[i], inv[i])
-                    for j in range(kw + 1):
-                        for i in range(k):
-                            if z[chain[r - r0, j], i] != 0:
-                                live[r] = 1
-        else:
-            for r in range(size):
-                for j in range(span[members[r0 + r]] + 1):
-                    for i in range(k):
-                        if z[chain[r, j], i] != 0:
-                            live[r0 + r] = 1
+                    for i in range(d):
+                        x[r - b0, i] = words[members[r], i]
+                _run_program(kids, x, g, d, stop, X)
+                work += max(0, stop + 1 - g * d) * _LANES
+            nb = b1 - b0
+            for lane in range(nb):
+                lane_span[lane], lane_lead[lane] = span[members[b0 + lane]], lead[members[b0 + lane]]
+            if stop >= 0:
+                acc[:nb] = 0
+                _add_earlier(acc, z, X, live, roots, chain, members, K, span, lane_span, lane_lead, primes, inv,
+                             r0, b0, nb, block)
+            _finish_group(acc, z, X, live, roots, chain, members, K, span, lane_span, lane_lead, primes, inv,
+                          r0, b0, b1, stop >= 0)
         r0 = r1
     if d < n:
         _even_top(z, primes, lengths, right, K, beta, n)

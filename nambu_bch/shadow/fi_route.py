@@ -67,6 +67,7 @@ from ..integrators.composition import composition_for
 from ..parsing import as_expression
 from ..symbols import ALPHA, STEP
 from ..systems.spec import as_system
+from ..values import system_key
 from .direct_route import needed_degree, operator_columns
 from .fi_nested import RawOps, nested_hull
 from .fundamental_identity import representations, single_representations
@@ -129,7 +130,7 @@ class FINested:
     coefficient: object
     tree: object
     hull: object  # fi_nested.NestedHull
-    ops: object = field(default=None, repr=False)  # fi_nested.RawOps, for output
+    ops: object = field(default=None, repr=False, compare=False)  # fi_nested.RawOps, for output (a cache, not data)
 
     def label(self, latex: bool = False) -> str:
         show_slot = sympy.latex if latex else str
@@ -196,6 +197,13 @@ class FIOrder:
     direct_dim : int -- dimension of the direct route's kernel at the same ansatz degree (computed on first use)
     certificate : dict or None
     span : FISpan or None -- whether the FI solutions alone held the family (set when solved)
+    family : the exact alpha-family (:class:`AlphaFamily`) of a solved order
+
+    Notes
+    -----
+    A solved order keeps its family and kernel as exact ring elements (``family``); ``corrections``, ``members``
+    and ``kernel`` are their sympy forms, built on first access (the higher orders are fed the exact data), compared
+    and pickled through the exact data.
     """
 
     order: int
@@ -209,8 +217,31 @@ class FIOrder:
     fi_dim: int = 0
     certificate: dict | None = None
     span: FISpan | None = None
+    family: AlphaFamily | None = field(default=None, repr=False)
+    _kernel_exact: tuple | None = field(default=None, repr=False)  # per kernel basis vector, its ring element per slot
     _direct: tuple = field(default=(), repr=False)
     _direct_dim: int | None = field(default=None, repr=False)
+
+    def _build(self, name):
+        """The sympy form of ``name`` from the exact data (members and family together: the family needs both)."""
+        if name == "kernel":
+            return [self.family.forms_of(polys) for polys in self._kernel_exact]
+        self.__dict__["_corrections"], self.__dict__["_members"] = self.family.forms()
+        return self.__dict__["_" + name]
+
+    def _value(self) -> tuple:
+        forms = (self.family, self._kernel_exact) if self.family is not None else (self.corrections, self.members,
+                                                                                    self.kernel)
+        return (self.order, self.status, self.degree, self.commutators, self.directions, self.fi_dim, self.certificate,
+                self.span, forms)
+
+    def __eq__(self, other):
+        if type(other) is not type(self):
+            return NotImplemented
+        return self is other or self._value() == other._value()
+
+    def __getstate__(self):
+        return _exact_state(self, ("corrections", "members", "kernel"))
 
     @property
     def direct_dim(self) -> int | None:
@@ -255,7 +286,25 @@ class FIResult:
     orders: list = field(default_factory=list)  # FIOrder, the powers above ``power``
     failed_order: int | None = None
     span: FISpan | None = None  # the lowest order's; FIOrder.span for the others
+    family: AlphaFamily | None = field(default=None, repr=False)  # the exact form of ``corrections``
     _ctx: dict = field(default_factory=dict, repr=False)
+
+    def _build(self, name):
+        return self.family.forms()[0]
+
+    def _value(self) -> tuple:
+        forms = self.family if self.family is not None else self.corrections
+        # not _ctx: the algebra, atoms and caches derived from the system and composition
+        return (system_key(self.system), self.composition, self.power, self.commutators, self.exists, self.degree,
+                self.members, forms, self.kernel, self.certificate, self.orders, self.failed_order, self.span)
+
+    def __eq__(self, other):
+        if type(other) is not type(self):
+            return NotImplemented
+        return self is other or self._value() == other._value()
+
+    def __getstate__(self):
+        return _exact_state(self, ("corrections",))
 
     @property
     def free_parameter_count(self) -> int:
@@ -330,6 +379,113 @@ class FIResult:
                             f"FI family dimension {o.fi_dim} of the direct route's {o.direct_dim}"
                             if o.status == "solved" else ""))
         return "\n".join(lines)
+
+
+def _lazy(name):
+    """A property whose sympy value is built from the exact data on first access (``None`` stored: not built yet)."""
+
+    def get(self):
+        value = self.__dict__.get("_" + name)
+        if value is None:
+            value = self.__dict__["_" + name] = self._build(name)
+        return value
+
+    def put(self, value):
+        self.__dict__["_" + name] = value
+
+    return property(get, put, doc=f"``{name}`` as sympy expressions (built from the exact data on first access)")
+
+
+def _exact_state(obj, names) -> dict:
+    """The pickle of an FI result: its exact data, without the sympy forms built from them (rebuilt on access)."""
+    state = dict(obj.__dict__)
+    if state.get("family") is not None:
+        for name in names:
+            state["_" + name] = None
+    return state
+
+
+# after @dataclass: the generated __init__ assigns through the properties (the defaults stay the fields' own)
+FIOrder.corrections = _lazy("corrections")
+FIOrder.members = _lazy("members")
+FIOrder.kernel = _lazy("kernel")
+FIResult.corrections = _lazy("corrections")
+
+
+@dataclass(frozen=True)
+class AlphaFamily:
+    """One order's alpha-family as exact data: ``(1 - alpha) m_0 + alpha m_1`` from its two canonical members.
+
+    Attributes
+    ----------
+    algebra : the algebra of the solve (its ring holds the polynomials)
+    members : ``(m_0, m_1)``; a member is one tuple per slot of pairs ``(k, dH_k)``: ``dH_k`` the coefficient
+        of ``alpha^k`` (a ring element, polynomial in the coordinates)
+
+    The sympy forms (:meth:`forms`) are those the FI route printed before it kept exact data: each member
+    expanded from its monomial terms, the family ``sympy.expand((1 - alpha) m_0 + alpha m_1)``.
+    """
+
+    algebra: object
+    members: tuple
+
+    def forms_of(self, polys) -> tuple:
+        """One sympy sum per slot of ring elements (``x^e`` times the coefficient, as :meth:`Ansatz.expressions`)."""
+        to, coords = self.algebra.domain.to_sympy, self.algebra.coordinates
+        return tuple(sympy.Add(*(to(v) * sympy.Mul(*(x**k for x, k in zip(coords, m))) for m, v in p.items()))
+                     for p in polys)
+
+    def member_forms(self) -> tuple:
+        """The two members as sympy expressions in the coordinates and ``alpha`` (expanded)."""
+        out = []
+        for member in self.members:
+            corr = []
+            for parts in member:
+                c = sympy.Integer(0)
+                for k, p in parts:
+                    c = c + ALPHA**k * self.forms_of((p,))[0]
+                corr.append(sympy.expand(c))
+            out.append(tuple(corr))
+        return tuple(out)
+
+    def forms(self) -> tuple:
+        """``(family, members)`` as sympy expressions."""
+        members = self.member_forms()
+        return _family(members), members
+
+    def alpha_parts(self) -> list:
+        """Per slot ``{k: ring element}``: the coefficient of ``alpha^k`` of the family (non-zero ones, highest ``k``
+        first), exactly -- what the higher orders' cross terms take."""
+        out = []
+        for m0, m1 in zip(*self.members):
+            parts: dict = {}
+            for sign, shift, member in ((1, 0, m0), (-1, 1, m0), (1, 1, m1)):
+                for k, p in member:
+                    term = p if sign == 1 else -p
+                    parts[k + shift] = parts[k + shift] + term if k + shift in parts else term
+            out.append({k: parts[k] for k in sorted(parts, reverse=True) if parts[k]})
+        return out
+
+
+def _same_member(m, f) -> bool:
+    """Are two members (as :class:`AlphaFamily` holds them) the same polynomials?  Decided by the difference: over
+    ``QQ<theta>(params)`` a coefficient's fraction is not reduced, so equal values may differ as pairs."""
+    for parts_m, parts_f in zip(m, f):
+        diff: dict = {}
+        for sign, parts in ((1, parts_m), (-1, parts_f)):
+            for k, p in parts:
+                term = p if sign == 1 else -p
+                diff[k] = diff[k] + term if k in diff else term
+        if any(diff.values()):
+            return False
+    return True
+
+
+def _exact_member(alg, ansatz, powers, vecs, offset=0) -> tuple:
+    """A member (one tuple per slot of ``(k, dH_k)``) from its sparse solution vectors, one per power ``k``."""
+    tail = (0,) * (len(alg.gens) - alg.n)
+    polys = [ansatz.polynomials(vec, alg.ring, tail, offset) for vec in vecs]
+    return tuple(tuple((k, p[a]) for k, p in zip(powers, polys)) for a in range(ansatz.slots))
 
 
 _RAW_OPS: dict = {}
@@ -514,14 +670,15 @@ def fi_route(system, word, order: int = 2, degree=None, terms=None) -> FIResult:
     ctx.update(nw=nw, ansatz=ansatz)
     # the canonical members (one rule: algebra/ansatz.py), the weights cleared last
     prios = ansatz.priorities([alg.convert(Hk).keys() for Hk in hams], offset=nw, rest=range(nw))
-    members = _canonical_members(alg, commutators, wcols, ansatz, sol, prios)
+    members, vecs = _canonical_members(alg, commutators, wcols, ansatz, sol, prios)
     result.members = tuple(members)
     result.kernel = kernel_rref(sol.kernel, prios[0], alg.domain)
     fi_dim = rank(SparseMatrix.from_rows([{c: v for c, v in vec.items() if c >= nw} for vec in result.kernel],
                                          nw + len(ansatz), alg.domain))
-    family, result.span = _whole_family(alg, hams, ansatz, nw, sol.particular, [0], degree if user_degree else None,
-                                        [m.corrections for m in members], fi_dim, power)
-    result.corrections = _family(family)
+    fi_members = [_exact_member(alg, ansatz, [0], [vec], nw) for vec in vecs]
+    result.family, result.span = _whole_family(alg, hams, ansatz, nw, sol.particular, [0],
+                                               degree if user_degree else None, fi_members, fi_dim, power)
+    result.corrections = None  # built from result.family on first access
     if order > power:
         _higher_orders(result, order, degree if user_degree else None)
     return result
@@ -598,9 +755,10 @@ def _weight_system(ctx, commutators, ansatz) -> tuple:
 
 
 def _canonical_members(alg, commutators, wcols, ansatz, sol, prios) -> list:
-    """One :class:`FIMember` per priority order: the canonical solution's weights and corrections."""
+    """One :class:`FIMember` per priority order: the canonical solution's weights and corrections; and the
+    canonical solution vectors."""
     nw = len(wcols)
-    members = []
+    members, vecs = [], []
     for prio in prios:
         vec, = Ansatz.canonical(sol.particular, sol.kernel, prio, alg.domain)
         weights = [[sympy.Integer(0)] * len(c.representations) for c in commutators]
@@ -609,7 +767,8 @@ def _canonical_members(alg, commutators, wcols, ansatz, sol, prios) -> list:
                 t, r = wcols[col]
                 weights[t][r] = alg.domain.to_sympy(v)
         members.append(FIMember(weights, ansatz.expressions(vec, alg.coordinates, alg.domain, offset=nw)))
-    return members
+        vecs.append(vec)
+    return members, vecs
 
 
 # -- higher orders -----------------------------------------------------------------------------------
@@ -708,12 +867,13 @@ def _whole_family(alg, hams, ansatz, nw, particulars, powers, degree, fi_members
     ansatz : Ansatz -- the FI solve's corrections, columns ``nw + k``
     particulars : list of sparse vectors -- one FI particular solution per power of alpha in ``powers``
     degree : int or None -- the ansatz degree asked for (None: the direct route's default, at least the FI one)
-    fi_members : the FI route's own two members (corrections), to tell whether they were already the family's
+    fi_members : the FI route's own two members (exact, as :class:`AlphaFamily` holds them), to tell whether
+        they were already the family's
     fi_dim, order : for the :class:`FISpan`
 
     Returns
     -------
-    (members, span) -- two tuples of corrections (polynomial in alpha), the span record
+    (family, span) -- the :class:`AlphaFamily` and the span record
     """
     domain = alg.domain
     rings = [alg.convert(Hk) for Hk in hams]
@@ -733,15 +893,10 @@ def _whole_family(alg, hams, ansatz, nw, particulars, powers, degree, fi_members
     if big is not ansatz:
         vecs = [{big.index[ansatz.columns[c]]: v for c, v in vec.items()} for vec in vecs]
     kernel = _operator(alg, hams, rings, degree)[2]
-    members = []
-    for prio in big.priorities([p.keys() for p in rings]):
-        corr = [sympy.Integer(0)] * big.slots
-        for k, vec in zip(powers, vecs):
-            part = normal_form(vec, kernel, prio, domain)
-            corr = [c + ALPHA**k * d for c, d in zip(corr, big.expressions(part, alg.coordinates, domain))]
-        members.append(tuple(sympy.expand(c) for c in corr))
-    reached = all(is_zero(a - b) for m, f in zip(members, fi_members) for a, b in zip(m, f))
-    return tuple(members), FISpan(order, degree, fi_dim, len(kernel), reached)
+    members = tuple(_exact_member(alg, big, powers, [normal_form(vec, kernel, prio, domain) for vec in vecs])
+                    for prio in big.priorities([p.keys() for p in rings]))
+    reached = all(_same_member(m, f) for m, f in zip(members, fi_members))
+    return AlphaFamily(alg, members), FISpan(order, degree, fi_dim, len(kernel), reached)
 
 
 _OPERATOR: dict = {}
@@ -773,20 +928,34 @@ def _higher_orders(result, order, degree) -> None:
     alg, atoms = ctx["algebra"], ctx["atoms"]
     if not result.exists:
         return
-    corrections = {(a, result.power): _alpha_parts(alg, c) for a, c in enumerate(result.corrections)}
+    corrections = {(a, result.power): parts for a, parts in enumerate(result.family.alpha_parts())}
     ops = _raw_ops(alg, atoms)
     memo = ops.hulls  # hulls of subtrees, shared by all words of the splitting
     series = formal_bch(comp, order + 1)
     for j in range(result.power + 1, order + 1):
         o = _solve_order(system, ctx, ops, memo, series, j, corrections, degree)
+        if o.status == "obstructed":
+            # the certificate is the first left null vector in row order, and the cross terms' rows are numbered in
+            # the order of the lower orders' terms; the route has always taken that order from their sympy forms
+            # (an exact ring element built from an expression): the terminal, obstructed order is solved again so
+            o = _solve_order(system, ctx, ops, memo, series, j, _sympy_ordered(alg, result), degree)
         result.orders.append(o)
         if o.status == "obstructed":
             result.exists = False
             result.failed_order = j
             return
-        for a, c in enumerate(o.corrections):
-            corrections[(a, j)] = _alpha_parts(alg, c)
+        parts = o.family.alpha_parts() if o.status == "solved" else [{} for _ in o.corrections]
+        for a, p in enumerate(parts):
+            corrections[(a, j)] = p
     ctx["ops"] = ops
+
+
+def _sympy_ordered(alg, result) -> dict:
+    """The lower orders' alpha parts of ``result`` (as the cross terms take them) from their sympy forms."""
+    out = {(a, result.power): _alpha_parts(alg, c) for a, c in enumerate(result.corrections)}
+    for o in result.orders:
+        out.update({(a, o.order): _alpha_parts(alg, c) for a, c in enumerate(o.corrections)})
+    return out
 
 
 _EVALUATORS = weakref.WeakKeyDictionary()
@@ -1030,21 +1199,18 @@ def _solve_order(system, ctx, ops, memo, series, j, corrections, degree) -> FIOr
         return out
     # the canonical members (one rule: algebra/ansatz.py), the FI directions' weights cleared last
     prios = ansatz.priorities([alg.convert(Hk).keys() for Hk in hams], offset=nw, rest=range(nw))
-    members = []
-    for prio in prios:
-        corr = [sympy.Integer(0)] * slots
-        for k, part in zip(powers, Ansatz.canonical(sol.particular, sol.kernel, prio, domain)):
-            corr = [c + ALPHA**k * d for c, d in zip(corr, ansatz.expressions(part, alg.coordinates, domain, offset=nw))]
-        members.append(tuple(sympy.expand(c) for c in corr))
+    members = [_exact_member(alg, ansatz, powers, Ansatz.canonical(sol.particular, sol.kernel, prio, domain), nw)
+               for prio in prios]
     projected = [{col: v for col, v in vec.items() if col >= nw} for vec in sol.kernel]
     projected = [p for p in projected if p]
     basis = kernel_rref(projected, prios[0][: len(ansatz)], domain) if projected else []
-    out.kernel = [ansatz.expressions(vec, alg.coordinates, domain, offset=nw) for vec in basis]
+    tail = (0,) * (len(alg.gens) - alg.n)
+    out._kernel_exact = tuple(tuple(ansatz.polynomials(vec, alg.ring, tail, nw)) for vec in basis)
     out.fi_dim = len(basis)
     out._direct = (alg, hams, ansatz)
-    out.members, out.span = _whole_family(alg, hams, ansatz, nw, sol.particular, powers, user_degree, members,
-                                          out.fi_dim, j)
+    out.family, out.span = _whole_family(alg, hams, ansatz, nw, sol.particular, powers, user_degree, members,
+                                         out.fi_dim, j)
     if out.span.degree == degree:  # the kernel at the FI degree was just computed
         out._direct_dim = out.span.gauge_dim
-    out.corrections = _family(out.members)
+    out.corrections = out.members = out.kernel = None  # built from the exact data on first access
     return out

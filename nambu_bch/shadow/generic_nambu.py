@@ -41,7 +41,7 @@ from sympy.polys.domains import QQ
 from sympy.polys.rings import ring
 
 from ..algebra.backend import PolynomialBackend
-from ..algebra.elimination import solve_affine
+from ..algebra.elimination import SparseMatrix, solve_affine
 from ..bch.evaluation import BracketEvaluator
 from ..bch.formal import formal_bch
 from ..errors import InvalidOrderError
@@ -162,7 +162,7 @@ def generic_nambu_h2(word: str = "12321", max_order: int = 6) -> GenericNambuRes
         X = J.field(m, Gt) if slot == "H" else J.field(Ht, m)
         vecs.append({rows.setdefault((i, mono), len(rows)): c for i, comp in enumerate(X) for mono, c in comp.items()})
     rhs = {rows.setdefault((i, mono), len(rows)): c for i, comp in enumerate(Z2) for mono, c in comp.items()}
-    res = solve_affine(vecs, [rhs], len(rows), QQ)
+    res = solve_affine(SparseMatrix.from_columns(vecs, len(rows), QQ), [rhs])
     corrections = certificate = None
     if res.consistent:
         sol = res.particular[0]
