@@ -937,7 +937,9 @@ def _higher_orders(result, order, degree) -> None:
         if o.status == "obstructed":
             # the certificate is the first left null vector in row order, and the cross terms' rows are numbered in
             # the order of the lower orders' terms; the route has always taken that order from their sympy forms
-            # (an exact ring element built from an expression): the terminal, obstructed order is solved again so
+            # (an exact ring element built from an expression): the terminal, obstructed order is solved again with
+            # that order, so that its certificate stays the one the route has always printed (only an obstructed
+            # order pays for the second solve)
             o = _solve_order(system, ctx, ops, memo, series, j, _sympy_ordered(alg, result), degree)
         result.orders.append(o)
         if o.status == "obstructed":
