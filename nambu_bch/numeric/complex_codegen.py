@@ -48,7 +48,7 @@ from ..errors import InvalidRunError, NumericalRangeError
 from ..integrators.composition import composition_for
 from ..integrators.flows import TIME, exact_flow
 from .codegen import _Hoister, _indent, _sampling_loop, check_kernel_expression, constants_source, print_python
-from .complex_iterate import ENTIRE, check_entire, coefficient_value
+from .complex_flows import ENTIRE, check_entire, coefficient_value
 from .kernels import Kernel, cache_dir
 
 #: Bump when the generated source changes meaning (the template an index records also carries this file's digest).

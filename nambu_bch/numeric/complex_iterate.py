@@ -46,45 +46,17 @@ import numpy as np
 import sympy
 
 from ..checks import check_flag
-from ..errors import InvalidRunError, NumericalRangeError, ResourceLimitError
+from ..errors import NumericalRangeError, ResourceLimitError
 from ..integrators.composition import composition_for
 from ..integrators.flows import TIME, exact_flow
 from ..integrators.step import parameter_values
 from .guards import MAX_SAMPLE_BYTES, check_backend, check_count, check_inputs, check_work, initial_state, run_label
+from .complex_flows import ENTIRE, check_entire, coefficient_value
 from .kernels import resolve_backend
 from .samples import sample_steps
 
-#: The functions an entire sub-flow may contain (analytic on all of ``C^N x C``: no branch cut, no pole).
-ENTIRE = (sympy.exp, sympy.sin, sympy.cos, sympy.sinh, sympy.cosh)
-
-
 #: The entire functions by name for one trajectory's scalar step.
 _CMATH = {f.__name__: getattr(cmath, f.__name__) for f in ENTIRE}
-
-
-def _entire_obstacle(expr, variables):
-    """``None`` if ``expr`` is an entire function of ``variables``, else the sub-expression that is not (a power
-    other than a natural one, or a function other than :data:`ENTIRE`, of something depending on them)."""
-    for node in sympy.preorder_traversal(expr):
-        if not (node.free_symbols & variables):
-            continue
-        if isinstance(node, sympy.Pow) and not (node.exp.is_Integer and node.exp >= 0):
-            return node
-        if isinstance(node, sympy.Function) and not isinstance(node, ENTIRE):
-            return node
-    return None
-
-
-def check_entire(system, comp, k, exprs) -> None:
-    """Refuse, in one line, a sub-flow ``exprs`` of piece ``k`` that is not an entire function of the state and the
-    time: its continuation to a complex time would depend on the path around a branch cut or a pole."""
-    variables = {*system.coordinates, TIME}
-    bad = next((b for b in (_entire_obstacle(e, variables) for e in exprs) if b is not None), None)
-    if bad is not None:
-        raise InvalidRunError(
-            f"composition {comp.name!r} has complex coefficients, and the flow of piece {k} of {system.name} contains "
-            f"{bad}, which has a branch cut or a pole in the complex plane: a complex time step is defined only for "
-            "sub-flows built from polynomials, exp, sin and cos")
 
 
 def complex_subflows(system, word, params=None) -> list:
@@ -102,15 +74,6 @@ def complex_subflows(system, word, params=None) -> list:
         # cmath's functions by name (sympy's "cmath" printer recurses on Float constants)
         flows[k] = (sympy.lambdify(args, exprs, modules=[_CMATH]), sympy.lambdify(args, exprs, modules="numpy"))
     return [(*flows[k], coefficient_value(comp, c)) for k, c in comp.factors()]
-
-
-def coefficient_value(comp, c) -> complex:
-    """The exact coefficient ``c`` of ``comp`` as complex128 (17 significant digits, then rounded), or one
-    :class:`~nambu_bch.errors.NumericalRangeError` line when it is beyond the range of complex128."""
-    value = complex(sympy.N(c, 17))
-    if not (np.isfinite(value.real) and np.isfinite(value.imag)):
-        raise NumericalRangeError(f"the coefficient {str(c)[:40]} of {comp.name[:60]!r} is beyond the complex128 range")
-    return value
 
 
 #: ``backend="auto"`` interprets a run while its compiled loop is not in this process and the run is small: at most
