@@ -11,7 +11,7 @@ both workers finish within seconds of each other (measured: docs/suite_time.md).
 It is also the one place where the suite is split into two tiers (docs/suite_time.md, "Two tiers"): the tests named
 in :data:`DEEP` carry the marker ``deep``, which ``pyproject.toml`` deselects by default (``-m "not deep"``); the
 *fast tier* (the README's test command) runs the rest, and ``pytest -m deep`` runs the *deep tier*.  The hypothesis
-tests run in both: in the fast tier at an eighth of their example counts, in the deep tier at the full counts.
+tests run in both: in the fast tier at a quarter of their example counts, in the deep tier at the full counts.
 """
 
 from __future__ import annotations
@@ -40,7 +40,7 @@ LONG = (
     ("test_docs.py", "test_api_reference_builds_without_warnings"),         # a Sphinx build in a subprocess
     ("test_bch_modular.py", "test_sparse_engine_equals_dense_engine"),      # 9 s at [12-12], cold: numba compile
     ("test_pickle.py", "test_results_come_back_from_spawned_workers"),      # a spawned worker imports and computes
-    ("test_cli.py", "test_every_subcommand_runs_as_a_subprocess"),          # 14 s: nine subprocesses, two at a time
+    ("test_cli.py", "test_every_subcommand_runs_as_a_subprocess"),          # 1-2 s each: a subprocess per subcommand
     ("test_packaging.py", "test_"),                                         # wheel and sdist built, installed, run
     ("test_fuzz_cli.py", "test_"),
     ("test_direct_route_fast.py", "test_rigid_body_symbolic_yoshida_family_over_base_field"),
@@ -71,7 +71,7 @@ LONG = (
 
 
 #: The fast tier runs ``ceil(n / HYPOTHESIS_FAST_DIVISOR)`` of a hypothesis test's ``n`` examples; the deep tier all ``n``.
-HYPOTHESIS_FAST_DIVISOR = 8
+HYPOTHESIS_FAST_DIVISOR = 4
 
 
 def _diagonal(values: int):
@@ -88,7 +88,8 @@ def _diagonal(values: int):
 #: cases of the table are deep.  A test belongs here when it repeats a concern the fast tier already checks, at greater
 #: depth or cost (docs/suite_time.md, "Two tiers"): another notebook, a build (Sphinx, wheel), another pdflatex run,
 #: another cache-damage probe in subprocesses, an order of h^6 or more, another row of a large table, another process
-#: start.  Nothing else is moved: the fast tier keeps a case of every table, every module and every subcommand.
+#: start, another compile of a kind of compiled loop the fast tier compiles once (about 0.3 s or more cold each).
+#: Nothing else is moved: the fast tier keeps a case of every table, every module and every subcommand.
 DEEP = (
     # one notebook in the fast tier; a kernel process each, 5-12 s
     ("test_notebooks.py", "test_notebook_executes", ("01_hamiltonian_warmup",)),
@@ -189,7 +190,7 @@ DEEP = (
     # the generic T|V answer against the concrete systems: d = 1 and 2 in the fast tier, the d = 3 quartic (4-6 s)
     ("test_generic_separable.py", "test_substituted_equals_the_concrete_shadow_hamiltonian_d3", ()),
     # the command line as a subprocess (cli_run): the fast tier runs the same assertions on main(argv) in process; the
-    # process start is test_cli's one subprocess per subcommand (1.4-2.2 s each)
+    # process start is test_cli's subprocess of `python -m nambu_bch` (1.4-2.2 s each)
     ("test_runge_kutta_cli.py", "test_shadow_integrator_gauss4_json_subprocess", ("in-process",)),
     ("test_runge_kutta_cli.py", "test_shadow_tableau_file_subprocess", ("in-process",)),
     ("test_runge_kutta_cli.py", "test_check_integrator_midpoint_subprocess", ("in-process",)),
@@ -220,14 +221,12 @@ DEEP = (
     ("test_bseries.py", "test_shadow_pair_field_equals_modified_field", ("ho3-midpoint", "lotka-volterra-midpoint")),
     ("test_bch_concrete.py", "test_fast_and_plain_representations_agree",
      ("ho3-12321", "lotka-volterra-123", "ho-forest-ruth")),
-    # compiled code once per kind in the fast tier, with the smallest system: the single-step loops of ho3/32123 (which
-    # test_hardening_numeric's probes compile anyway), the oscillator's batch loops (shared through the kernel cache
-    # with test_batch_kernel_counts_non_finite_samples), the Lotka-Volterra batch loop
+    # compiled code once per kind in the fast tier: ho3/32123's single-step and batch loops (which
+    # test_hardening_numeric's probes and test_numeric_parallel's threads compile anyway), the Lotka-Volterra batch loop
     # (test_exponential_flows_agree_across_backends), the Runge-Kutta loop, the compiled scan and the sparse BCH engine
-    # once each; every other system's generated loop (0.3-3.4 s of compile each, cold) is deep.  The generated source of
-    # every system is still run on the interpreter by the fast tier (iterate's numpy backend and backend="auto")
+    # once each; the other systems' generated loops of this table (0.3-0.9 s of compile each, cold) are deep.  Their
+    # generated source is still run on the interpreter by the fast tier (iterate's numpy backend and backend="auto")
     ("test_numeric.py", "test_numba_and_numpy_agree_bitwise", ("False-ho3-32123", "True-ho3-32123")),
-    ("test_numeric.py", "test_batch_numba_numpy_and_single_agree_bitwise", ("False-ho-TVT", "True-ho-TVT")),
     # the kernel cache's damage probes recompile ho3/32123 in an empty cache each: the fast tier keeps garbage in place
     # of the source and an index naming a path outside the cache; the empty files and the unparsable index are deep
     ("test_hardening_numeric.py", "test_corrupt_cache_entries_are_regenerated", ("garbage source", "wrong index")),
@@ -260,7 +259,8 @@ def cli_run(request, monkeypatch):
     Two cases of every test that asks for it: ``main(argv)`` in this process (stdout and stderr captured, the working
     directory changed for the call), and ``python -m nambu_bch ARGV`` in a subprocess (the package from this checkout).
     The same assertions run on both.  The subprocess case is deep (:data:`DEEP`): a process start adds only the
-    interpreter start and the imports, which ``test_cli.py``'s one subprocess per subcommand checks in the fast tier.
+    interpreter start and the imports, which ``test_cli.py``'s subprocess of ``python -m nambu_bch`` checks in the fast
+    tier (and one subprocess per subcommand in the deep tier).
     """
     def in_process(*args, cwd):
         from nambu_bch.cli import main

@@ -320,15 +320,14 @@ def test_numba_and_numpy_agree_bitwise(name, word, kahan):
 
 
 @numba_only
-@pytest.mark.parametrize("name,word", [("ho", "TVT"), ("ho3", "32123")])
 @pytest.mark.parametrize("kahan", [False, True])
-def test_batch_numba_numpy_and_single_agree_bitwise(kahan, name, word):
+def test_batch_numba_numpy_and_single_agree_bitwise(kahan):
     rng = np.random.default_rng(1)
-    X = rng.normal(size=(len(X0[name]), 301))           # not a multiple of the chunk sizes
-    a = iterate(name, word, 0.1, 50, X, every=10, kahan=kahan, backend="numba")
-    b = iterate(name, word, 0.1, 50, X, every=10, kahan=kahan, backend="numpy", chunk=64)
+    X = rng.normal(size=(3, 301))                       # not a multiple of the chunk sizes
+    a = iterate("ho3", "32123", 0.1, 50, X, every=10, kahan=kahan, backend="numba")
+    b = iterate("ho3", "32123", 0.1, 50, X, every=10, kahan=kahan, backend="numpy", chunk=64)
     assert np.array_equal(a, b)
-    single = iterate(name, word, 0.1, 50, X[:, 123], every=10, kahan=kahan)
+    single = iterate("ho3", "32123", 0.1, 50, X[:, 123], every=10, kahan=kahan)
     assert np.array_equal(a[:, :, 123], single)
 
 
