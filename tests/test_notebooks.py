@@ -13,9 +13,6 @@ from pathlib import Path
 
 import pytest
 
-nbformat = pytest.importorskip("nbformat")
-nbclient = pytest.importorskip("nbclient")
-
 REPO = Path(__file__).resolve().parents[1]
 NOTEBOOKS = sorted((REPO / "notebooks").glob("*.ipynb"))
 CELL_TIMEOUT = 180
@@ -35,6 +32,10 @@ def _ensure_kernel():
 
 @pytest.mark.parametrize("path", NOTEBOOKS, ids=[p.stem for p in NOTEBOOKS])
 def test_notebook_executes(path, monkeypatch):
+    # imported here, not at collection: jupyter's client costs every pytest process ~0.35 s to import, and the fast
+    # tier runs one notebook in one of the two workers
+    nbformat = pytest.importorskip("nbformat")
+    nbclient = pytest.importorskip("nbclient")
     _ensure_kernel()
     monkeypatch.setenv("PYTHONPATH", str(REPO) + os.pathsep + os.environ.get("PYTHONPATH", ""))
     monkeypatch.setenv("MPLBACKEND", "Agg")
@@ -71,6 +72,7 @@ def _output_texts(book) -> list:
 
 def test_warning_scan_sees_tqdm_s_message():
     """The scan of the test above finds tqdm's warning where a kernel prints it (stderr stream)."""
+    nbformat = pytest.importorskip("nbformat")
     book = nbformat.v4.new_notebook(cells=[nbformat.v4.new_code_cell("x")])
     book.cells[0].outputs = [nbformat.v4.new_output("stream", name="stderr",
                                                     text="TqdmWarning: IProgress not found. Please update jupyter and ipywidgets.")]
