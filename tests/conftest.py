@@ -245,6 +245,11 @@ DEEP = (
     ("test_integrators.py", "test_time_reversal_symbolic", lambda pid: pid != "lotka-volterra-13231"),
     ("test_bch_concrete.py", "test_bch_route_equals_backward_error_analysis_to_h6",
      lambda pid: pid != "rigid-body-23132"),
+    # a second compiled complex loop and its batch (two numba compiles, ~4 s cold): the fast tier keeps ho3's loop
+    # against the reference bits
+    ("test_complex_compiled.py", "test_compiled_rigid_body_and_batches", ()),
+    # the FI span over QQ<2^(1/3)>(m, omega) (2.7 s cold): the fast tier keeps the exact families over QQ(params)
+    ("test_fi_route.py", "test_fi_span_is_decided_exactly_over_an_algebraic_parameter_field", ()),
 )
 
 #: The two ways :func:`cli_run` runs the command line; the fast tier keeps ``in-process`` (DEEP).
