@@ -27,11 +27,10 @@ Horikoshi, Eq. (BCH2) (nested commutators written as trees).
 
 from __future__ import annotations
 
+import sys
 from functools import lru_cache
 
-import numpy as np
-import sympy
-
+# numpy and sympy are imported where they are used: the trees of a series served from the table need neither
 from ..checks import check_int, check_sequence, is_int, show
 from ..errors import InvalidRunError, ResourceLimitError, UnknownPieceError
 
@@ -39,15 +38,14 @@ from ..errors import InvalidRunError, ResourceLimitError, UnknownPieceError
 def is_bracket(tree) -> bool:
     """``True`` for a bracket node ``(left, right)``, ``False`` for a leaf.
 
+    >>> import sympy
     >>> is_bracket((1, (2, 3))), is_bracket(1), is_bracket((sympy.Symbol("A"), sympy.Symbol("C")))
     (True, False, False)
     """
-    return (
-        type(tree) is tuple
-        and len(tree) == 2
-        and not isinstance(tree[0], sympy.Basic)
-        and not isinstance(tree[1], sympy.Basic)
-    )
+    if type(tree) is not tuple or len(tree) != 2:
+        return False
+    sympy = sys.modules.get("sympy")  # a Liouville term's entries exist only once sympy is imported
+    return sympy is None or not (isinstance(tree[0], sympy.Basic) or isinstance(tree[1], sympy.Basic))
 
 
 def tree_degree(tree) -> int:
@@ -211,6 +209,8 @@ def lyndon_expansion(word: tuple, n_letters: int) -> tuple:
     A word ``a_1 .. a_d`` has index ``sum a_i g^(d-i)`` (base-``g`` digits), so that
     lexicographic order of equal-length words is numeric order of indices.
     """
+    import numpy as np
+
     g = n_letters
     if len(word) == 1:
         return np.array([word[0]], dtype=np.int64), np.array([1], dtype=np.int64)
@@ -328,6 +328,8 @@ def tree_to_latex(tree, names=None) -> str:
                                     f"{show(sorted(names, key=str))}")
         return names[tree]
     if isinstance(tree, tuple):
+        import sympy
+
         return "X_{" + ",".join(sympy.latex(e) for e in tree) + "}"
     return f"X_{{{tree}}}"
 
@@ -346,10 +348,13 @@ def terms_to_latex(terms, names=None) -> str:
     --------
     Eq. (BCH1) in the paper's form:
 
+    >>> import sympy
     >>> terms_to_latex([(1, 1), (1, 2), (sympy.Rational(-1, 24), (1, (1, 2))), (sympy.Rational(1, 12), (2, (2, 1)))],
     ...                {1: "X_T", 2: "X_V"})
     'X_T + X_V - \\frac{1}{24} [X_T,[X_T,X_V]] + \\frac{1}{12} [X_V,[X_V,X_T]]'
     """
+    import sympy
+
     parts = []
     for item in _terms(terms, (2, 3)):
         c, tree, factor = item if len(item) == 3 else (*item, sympy.Integer(1))

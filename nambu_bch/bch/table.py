@@ -46,6 +46,7 @@ import threading
 import warnings
 import zlib
 from array import array
+from collections.abc import Mapping
 from fractions import Fraction
 
 #: SHA-256 of the table's header (which holds the SHA-256 of each degree's bytes); written by tools/build_bch_table.py.
@@ -119,15 +120,16 @@ def _header():
     return header
 
 
-def _decode(data: bytes, width: int) -> list:
-    """Python ints from ``width``-byte little-endian two's-complement integers."""
+def _decode(data: bytes, width: int):
+    """The ``width``-byte little-endian two's-complement integers of ``data``: an :class:`array.array` when a
+    machine type has that width (8 bytes a number, Python ints only when a term is asked for), else a list."""
     code = _TYPECODES.get(width)
     if code is not None:  # in bulk, without numpy (not imported on this path)
         values = array(code)
         values.frombytes(data)
         if sys.byteorder == "big":
             values.byteswap()
-        return values.tolist()
+        return values
     from_bytes = int.from_bytes
     return [from_bytes(data[i : i + width], "little", signed=True) for i in range(0, len(data), width)]
 
@@ -168,18 +170,24 @@ def _load(header, series: str, n: int) -> bool:
     return True
 
 
-def _trees(generators: tuple, n: int) -> list:
+def _trees(generators: tuple, factors: list, n: int) -> list:
     """The standard bracketings of the Lyndon words of degrees ``1..n`` as one flat list (degree by degree,
-    lexicographic within a degree), leaves named by ``generators``, from the decoded standard factors."""
+    lexicographic within a degree), leaves named by ``generators``, from the standard factors of each degree.
+
+    Kept per generators and extended degree by degree; the caller holds :data:`_LOCK`."""
     state = _TREES.get(generators)
     if state is None:
         state = _TREES[generators] = [[generators[0], generators[1]], 1]
     trees = state[0]
-    for d in range(state[1] + 1, n + 1):
-        factors = _FACTORS[d - 1]
-        m = len(factors) // 2
-        trees.extend([(trees[left], trees[right]) for left, right in zip(factors[:m], factors[m:])])
-        state[1] = d
+    if state[1] < n:
+        from .formal import _no_full_collection
+
+        with _no_full_collection():  # acyclic tuples: nothing for the collector to find
+            for d in range(state[1] + 1, n + 1):
+                pairs = factors[d - 1]
+                m = len(pairs) // 2
+                trees.extend([(trees[left], trees[right]) for left, right in zip(pairs[:m], pairs[m:])])
+                state[1] = d
     return trees
 
 
@@ -207,7 +215,8 @@ def serve(letters, values, q: int, generators: tuple, n: int, denominators):
     ``letters`` (``0`` for the smaller generator) and ``values`` (integers, coefficients
     ``values / q``) describe the factors, ``denominators[d] = D_d``; the numerators are
     ``D_d`` times the coefficients, the same Python ints the engine returns, non-zero ones only,
-    Lyndon words of each degree in lexicographic order.
+    Lyndon words of each degree in lexicographic order.  The mapping (:class:`Served`) builds a degree's
+    pairs when it is asked for; the stored numerators stay machine integers until then.
     """
     if len(generators) != 2 or n < 1:
         return None
@@ -221,22 +230,57 @@ def serve(letters, values, q: int, generators: tuple, n: int, denominators):
     with _LOCK:  # the decoded degrees are appended in order: one request at a time extends them
         if not _load(header, series, n):
             return None
-        trees = _trees(tuple(generators), n)
-    out = {}
+        factors = _FACTORS[:n]
+        stored = {d: _NUMERATORS[series, d] for d in range(1, n + 1)}
+    degrees = header["degrees"]
+    parts = {}
     start = 0
     for d in range(1, n + 1):
-        entry = header["degrees"][d - 1]
-        stored = _NUMERATORS[series, d]
-        if stored:
+        if stored[d]:
             # D_d / T_d is an integer: T_d is the least common denominator of the degree, and D_d times every
             # coefficient is an integer (the engines' denominators, nambu_bch.bch.formal)
-            factor, rest = divmod(denominators[d], int(entry[series][3]))
+            factor, rest = divmod(denominators[d], int(degrees[d - 1][series][3]))
             if rest:
                 raise ArithmeticError(f"internal error: the BCH table's degree-{d} denominator does not divide "
                                       f"{denominators[d]}")
-            if flip and d % 2 == 0:
-                factor = -factor
-            window = range(start, start + entry["count"])
-            out[d] = (denominators[d], tuple((v * factor, trees[k]) for v, k in zip(stored, window) if v))
-        start += entry["count"]
-    return out
+            parts[d] = (denominators[d], -factor if flip and d % 2 == 0 else factor, stored[d], start)
+        start += degrees[d - 1]["count"]
+    return Served(tuple(generators), factors, parts)
+
+
+class Served(Mapping):
+    """``{degree: (D_d, ((numerator, tree), ...))}`` read from the table, each degree built when it is asked for.
+
+    Holds per degree ``D_d``, the factor ``D_d / T_d`` (negated in the even degrees of the reversed product
+    ``log(e^B e^A)``), the stored numerators ``n_w`` and the index of the degree's first word among the trees; a
+    degree's pairs ``(n_w D_d / T_d, P_w)`` are built on each access (nothing is kept but the trees,
+    shared by every request).  Pickles as the plain dict it stands for.
+    """
+
+    __slots__ = ("_generators", "_factors", "_parts")
+
+    def __init__(self, generators: tuple, factors: list, parts: dict):
+        self._generators, self._factors, self._parts = generators, factors, parts
+
+    def __getitem__(self, degree):
+        den, factor, stored, start = self._parts[degree]
+        with _LOCK:
+            trees = _trees(self._generators, self._factors, len(self._factors))
+        return den, tuple([(v * factor, trees[k]) for v, k in zip(stored, range(start, start + len(stored))) if v])
+
+    def __iter__(self):
+        return iter(self._parts)
+
+    def __len__(self):
+        return len(self._parts)
+
+    def __contains__(self, degree):
+        return degree in self._parts
+
+    def count(self, degree) -> int:
+        """The number of non-zero terms of ``degree`` (0 when it has none), without building them."""
+        part = self._parts.get(degree)
+        return 0 if part is None else len(part[2]) - part[2].count(0)
+
+    def __reduce__(self):
+        return dict, (list(self.items()),)
