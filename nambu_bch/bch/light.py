@@ -42,6 +42,7 @@ ALIASES = {"tvt": "121", "pv": "121", "position-verlet": "121", "vtv": "212", "v
 #: whitelist parser) reads them; at most 30 digits each (anything longer goes the full parser's way)
 _NUMBER = re.compile(r"-?(?:0|[1-9][0-9]{0,29})(?:/[1-9][0-9]{0,29})?")
 _PIECE = re.compile(r"[0-9]{1,3}")
+_ONE, _HALF = Fraction(1), Fraction(1, 2)
 #: the characters the full parser accepts in a composition's text (letters and digits besides)
 _PUNCTUATION = " :,/.+-*()^_"
 
@@ -122,11 +123,10 @@ def _digits(word: str):
     """Pieces and coefficients of a digit word: a palindrome of odd length halves every step but the middle one."""
     pieces = tuple(int(ch) for ch in word)
     if len(word) % 2 == 1 and len(word) > 1 and word == word[::-1]:
-        half = Fraction(1, 2)
-        coefficients = [half] * len(word)
-        coefficients[len(word) // 2] = Fraction(1)
+        coefficients = [_HALF] * len(word)
+        coefficients[len(word) // 2] = _ONE
         return pieces, tuple(coefficients)
-    return pieces, (Fraction(1),) * len(word)
+    return pieces, (_ONE,) * len(word)
 
 
 def _pairs(spec, n_pieces, text):
@@ -150,7 +150,7 @@ def _checked(spec, n_pieces, pieces, coefficients, name):
         return None
     totals: dict = {}
     for k, c in zip(pieces, coefficients):
-        totals[k] = totals.get(k, 0) + c
+        totals[k] = totals[k] + c if k in totals else c
     if any(t != 1 for t in totals.values()):
         return None
     return Word(spec, n_pieces, pieces, coefficients, name)

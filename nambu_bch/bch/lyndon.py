@@ -42,10 +42,14 @@ def is_bracket(tree) -> bool:
     >>> is_bracket((1, (2, 3))), is_bracket(1), is_bracket((sympy.Symbol("A"), sympy.Symbol("C")))
     (True, False, False)
     """
-    if type(tree) is not tuple or len(tree) != 2:
-        return False
-    sympy = sys.modules.get("sympy")  # a Liouville term's entries exist only once sympy is imported
-    return sympy is None or not (isinstance(tree[0], sympy.Basic) or isinstance(tree[1], sympy.Basic))
+    basic = _sympy_basic()
+    return type(tree) is tuple and len(tree) == 2 and not isinstance(tree[0], basic) and not isinstance(tree[1], basic)
+
+
+def _sympy_basic():
+    """sympy's ``Basic`` if sympy is imported, else ``()``: a Liouville term's entries exist only once it is."""
+    sympy = sys.modules.get("sympy")
+    return () if sympy is None else sympy.Basic
 
 
 def tree_degree(tree) -> int:
@@ -65,8 +69,13 @@ def tree_leaves(tree) -> tuple:
     >>> tree_leaves(((1, 2), (1, 3)))
     (1, 2, 1, 3)
     """
-    if is_bracket(tree):
-        return tree_leaves(tree[0]) + tree_leaves(tree[1])
+    return _leaves(tree, _sympy_basic())
+
+
+def _leaves(tree, basic) -> tuple:
+    """:func:`tree_leaves`, a tuple with an entry of type ``basic`` (sympy's) being a leaf (:func:`is_bracket`)."""
+    if type(tree) is tuple and len(tree) == 2 and not isinstance(tree[0], basic) and not isinstance(tree[1], basic):
+        return _leaves(tree[0], basic) + _leaves(tree[1], basic)
     return (tree,)
 
 

@@ -37,7 +37,6 @@ Algebras* (1993), Thm. 5.1 (Lyndon basis, standard factorisation).
 
 from __future__ import annotations
 
-import hashlib
 import json
 import os
 import stat
@@ -60,6 +59,14 @@ SERIES = {
     "121": ((0, 1, 0), (Fraction(1, 2), Fraction(1), Fraction(1, 2))),
     "212": ((1, 0, 1), (Fraction(1, 2), Fraction(1), Fraction(1, 2))),
 }
+
+try:  # CPython's own SHA-256 (the same digest): hashlib's OpenSSL one maps libcrypto, 3.7 MB of a 20 MB process
+    from _sha2 import sha256 as _sha256  # Python >= 3.12
+except ImportError:
+    try:
+        from _sha256 import sha256 as _sha256  # Python <= 3.11
+    except ImportError:
+        from hashlib import sha256 as _sha256
 
 #: array typecodes of the signed integer widths that convert in bulk
 _TYPECODES = {array(code).itemsize: code for code in "bhiq"}
@@ -111,10 +118,10 @@ def _header():
     except OSError as exc:
         _unusable(f"cannot read it: {exc.strerror or exc}")
         return None
-    if hashlib.sha256(raw).hexdigest() != TABLE_SHA256:
+    if _sha256(raw).hexdigest() != TABLE_SHA256:
         _unusable("its SHA-256 does not match the package's")
         return None
-    header = json.loads(raw)
+    header = json.loads(raw.decode("ascii"))  # the tool writes ASCII JSON (json.dumps' default)
     header["base"] = len(MAGIC) + 4 + size
     _HEADER[:] = [header]
     return header
@@ -155,7 +162,7 @@ def _load(header, series: str, n: int) -> bool:
     for d in range(first, n + 1):
         entry = degrees[d - 1]
         low = (degrees[d - 2]["end"] if d > 1 else 0) - start
-        if hashlib.sha256(view[low : entry["end"] - start]).hexdigest() != entry["sha256"]:
+        if _sha256(view[low : entry["end"] - start]).hexdigest() != entry["sha256"]:
             _unusable(f"the bytes of degree {d} do not match their SHA-256")
             return False
 
