@@ -108,3 +108,15 @@ def test_a_fresh_process_serves_the_table_without_sympy_or_numpy(tmp_path):
     assert run.stdout.split(" ", 2)[:2] == [str(len(expected))] * 2
     assert f"{expected.scaled_terms(3)} {formal_bch('121', 5).to_text()[:40]} []\n" in run.stdout
     assert "Warning" not in run.stderr
+
+
+def test_both_sha256_give_the_table_digest():
+    """The built-in SHA-256 (a fresh process) and hashlib's (once imported) verify the same header."""
+    import hashlib
+
+    with open(table.TABLE_PATH, "rb") as fh:
+        fh.seek(len(table.MAGIC))
+        raw = fh.read(int.from_bytes(fh.read(4), "little"))
+    assert hashlib.sha256(raw).hexdigest() == table.TABLE_SHA256 == table._sha256(raw).hexdigest()
+    if table._builtin_sha256 is not None:
+        assert table._builtin_sha256(raw).hexdigest() == table.TABLE_SHA256

@@ -21,7 +21,13 @@ Integrity.  The header (JSON: per degree the number of words, where its blocks l
 and the SHA-256 of the degree's bytes) is trusted only when its own SHA-256 equals
 :data:`TABLE_SHA256`, written into this module by the tool; a degree's bytes are decoded only when
 their SHA-256 equals the header's.  A missing, damaged or replaced file is not used: the engine
-computes the series, and one warning line says why.
+computes the series, and one warning line says why.  The digests are hashlib's (OpenSSL) in a process that has
+imported hashlib and CPython's built-in SHA-256 otherwise: the same digest, without mapping libcrypto (3.7 MB)
+into a fresh process that reads the table and nothing else.
+
+Memory.  Only the degrees asked are read; the numerators stay machine integers (:mod:`array`) until a degree's
+terms are asked for, and :class:`Served` builds them on each access (the trees, shared by every request, are the
+only Python objects kept).
 
 File format: ``b"NBCHTAB1"``, the header's length (4 bytes, little-endian), the header, then degree
 by degree the standard factors (int32: left indices, then right indices, into the flat list of the
@@ -60,13 +66,24 @@ SERIES = {
     "212": ((1, 0, 1), (Fraction(1, 2), Fraction(1), Fraction(1, 2))),
 }
 
-try:  # CPython's own SHA-256 (the same digest): hashlib's OpenSSL one maps libcrypto, 3.7 MB of a 20 MB process
-    from _sha2 import sha256 as _sha256  # Python >= 3.12
+try:  # CPython's own SHA-256 (the same digest) for a process that has not imported hashlib (module docstring)
+    from _sha2 import sha256 as _builtin_sha256  # Python >= 3.12
 except ImportError:
     try:
-        from _sha256 import sha256 as _sha256  # Python <= 3.11
+        from _sha256 import sha256 as _builtin_sha256  # Python <= 3.11
     except ImportError:
-        from hashlib import sha256 as _sha256
+        _builtin_sha256 = None
+
+
+def _sha256(data):
+    """SHA-256 of ``data``: hashlib's (OpenSSL, several times faster) when hashlib is imported already, else
+    CPython's own -- importing hashlib maps libcrypto, 3.7 MB of a fresh process that reads the table."""
+    hashlib = sys.modules.get("hashlib")
+    if hashlib is None and _builtin_sha256 is not None:
+        return _builtin_sha256(data)
+    if hashlib is None:
+        import hashlib
+    return hashlib.sha256(data)
 
 #: array typecodes of the signed integer widths that convert in bulk
 _TYPECODES = {array(code).itemsize: code for code in "bhiq"}
