@@ -2,8 +2,9 @@
 
 A result class defines ``to_latex()`` and ``to_text()``; the mixin turns them into sympy's printer hooks,
 ``str(result)`` and Jupyter's ``_repr_latex_``.  It lives apart from :mod:`nambu_bch.printing` (which imports
-sympy to lay out series) so that a result served without sympy, the BCH table's series
-(:mod:`nambu_bch.bch.light`), defines its class without importing it; :mod:`nambu_bch.printing` re-exports it.
+sympy to lay out series) so that a result that can be served without sympy,
+:class:`~nambu_bch.bch.formal.FormalBCH` read from the BCH table, defines its class without importing it;
+:mod:`nambu_bch.printing` re-exports it.
 """
 
 from __future__ import annotations

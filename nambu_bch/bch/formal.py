@@ -58,7 +58,6 @@ from math import comb, factorial, gcd, lcm
 # (a word read by .light, its numerators by .table) imports neither (about a second and 70 MB in a fresh process)
 from ..checks import check_int
 from ..errors import InvalidCompositionError, InvalidOrderError
-from ..compiled import numba_available
 from ..printable import Printable
 from ..values import ValueEquality
 from . import table as _table
@@ -710,6 +709,8 @@ def _formal(comp, max_degree, use_table: bool) -> FormalBCH:
         served = _from_table(comp, scalars.values, [scalars.q] * len(scalars.values), max_degree)
         if served is not None:
             return served
+    from ..compiled import numba_available  # the engines' concern: a served series does not look for numba
+
     sparse = scalars.K is None and numba_available()
     n = check_degree(max_degree, g, dense=not sparse)
     # low degrees: the dense engine answers in milliseconds without loading numba (~0.4 s in a fresh process)
