@@ -85,6 +85,8 @@ def _sha256(data):
         import hashlib
     return hashlib.sha256(data)
 
+#: Bytes read after the header with it (degrees 1-13 of the shipped table, 14 kB)
+_FIRST_BLOCKS = 16384
 #: array typecodes of the signed integer widths that convert in bulk
 _TYPECODES = {array(code).itemsize: code for code in "bhiq"}
 _HEADER: list = []  # [header dict] once read and verified; [None] when the table is unusable in this process
@@ -131,15 +133,18 @@ def _header():
         with _open_table() as fh:
             start = fh.read(len(MAGIC) + 4)
             size = int.from_bytes(start[len(MAGIC):], "little")
-            raw = fh.read(size) if start[: len(MAGIC)] == MAGIC and size < 2**20 else b""
+            # the first blocks come with the header (one open for a request to a low degree, see _load)
+            raw = fh.read(size + _FIRST_BLOCKS) if start[: len(MAGIC)] == MAGIC and size < 2**20 else b""
     except OSError as exc:
         _unusable(f"cannot read it: {exc.strerror or exc}")
         return None
+    raw, first_blocks = raw[:size], raw[size:]
     if _sha256(raw).hexdigest() != TABLE_SHA256:
         _unusable("its SHA-256 does not match the package's")
         return None
     header = json.loads(raw.decode("ascii"))  # the tool writes ASCII JSON (json.dumps' default)
     header["base"] = len(MAGIC) + 4 + size
+    header["first_blocks"] = first_blocks  # unverified bytes: each degree's SHA-256 is checked when it is decoded
     _HEADER[:] = [header]
     return header
 
@@ -168,13 +173,17 @@ def _load(header, series: str, n: int) -> bool:
     if first is None:
         return True
     start = degrees[first - 2]["end"] if first > 1 else 0
-    try:
-        with _open_table() as fh:
-            fh.seek(header["base"] + start)
-            data = fh.read(degrees[n - 1]["end"] - start)
-    except OSError as exc:
-        _unusable(f"cannot read it: {exc.strerror or exc}")
-        return False
+    stop = degrees[n - 1]["end"]
+    if stop <= len(header["first_blocks"]):  # read with the header
+        data = memoryview(header["first_blocks"])[start:stop]
+    else:
+        try:
+            with _open_table() as fh:
+                fh.seek(header["base"] + start)
+                data = fh.read(stop - start)
+        except OSError as exc:
+            _unusable(f"cannot read it: {exc.strerror or exc}")
+            return False
     view = memoryview(data)
     for d in range(first, n + 1):
         entry = degrees[d - 1]
