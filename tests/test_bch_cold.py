@@ -120,3 +120,12 @@ def test_both_sha256_give_the_table_digest():
     assert hashlib.sha256(raw).hexdigest() == table.TABLE_SHA256 == table._sha256(raw).hexdigest()
     if table._builtin_sha256 is not None:
         assert table._builtin_sha256(raw).hexdigest() == table.TABLE_SHA256
+
+
+def test_tree_leaves_with_and_without_sympy_agree():
+    """The leaves of a served series' trees, by both of tree_leaves' walks (sympy imported or not)."""
+    from nambu_bch.bch import lyndon
+
+    trees = [t for d in range(1, 9) for _, t in formal_bch("12", 8).scaled_terms(d)[1]]
+    assert [lyndon._pair_leaves(t) for t in trees] == [lyndon._leaves(t, lyndon._sympy_basic()) for t in trees]
+    assert lyndon._pair_leaves(((1, 2), 2)) == (1, 2, 2) == lyndon.tree_leaves(((1, 2), 2))
