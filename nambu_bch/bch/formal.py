@@ -9,7 +9,11 @@ degree ``d``.  With the step, ``Phi_h = exp(h X_eff)`` and
 
 Table.  The two-generator products ``12``, ``21``, ``121`` and ``212`` (``log(e^A e^B)``, its reverse,
 the symmetric series) are read from a verified table shipped with the package,
-:mod:`nambu_bch.bch.table`, up to its top degree; the result is the engines' to the last numerator.
+:mod:`nambu_bch.bch.table`, up to its top degree; the result is the engines' to the last numerator.  A plain
+word (``"12"``, ``"TVT"``, ``"1:1/2,2:1,1:1/2"``) is read by :mod:`nambu_bch.bch.light` with ``Fraction``
+coefficients, so that such a request imports neither sympy nor numpy: the result's
+:attr:`FormalBCH.composition`, :meth:`FormalBCH.terms` and LaTeX build their sympy objects when first asked,
+and each degree's ``(numerator, tree)`` pairs are built from the stored numerators when asked for.
 
 Engines (exact, no floats).  Rational compositions run the sparse engine of
 :mod:`nambu_bch.bch.modular`: coefficients of ``log Phi`` on Lyndon words only
