@@ -23,8 +23,9 @@ Two measurements per row, the sides interleaved:
   column ``+terms`` is the CPU time of asking for all of them right after (``scaled_terms`` of every
   degree), so ``ours warm`` + ``+terms`` is the call with every term in hand.  The column ``engine`` is
   the same call with the table bypassed (``formal._formal_engine``: what the engine alone costs).  One
-  untimed call on each side first; then ``--repeat`` calls each, alternating, the median CPU seconds
-  reported.
+  untimed call on each side first; then ``--repeat`` calls each (at least :data:`SMALL_REPEAT` when our
+  untimed call took under 10 ms: one sub-millisecond call is mostly noise on a loaded machine), alternating,
+  the median CPU seconds reported.
 * cold, whole processes: the ``bch`` process (``table_output=1``, its table written to a file) and
   ``python -c`` importing ``nambu_bch`` and calling ``formal_bch`` (interpreter start and imports
   included; the table's series import neither sympy nor numpy; numba's machine code from its on-disk cache
@@ -98,6 +99,9 @@ formal_bch(sys.argv[1], int(sys.argv[2]))
 t4 = clock()
 print(t1 - t0, t2 - t1, t3 - t2, t4 - t3)
 """
+
+#: warm calls per side for a row whose untimed call took under 10 ms
+SMALL_REPEAT = 21
 
 PRIME = "from nambu_bch.bch import formal_bch; formal_bch('123', 10); formal_bch('12', 16)"  # sparse engine
 
@@ -272,8 +276,8 @@ def main(argv=None):
     jobs += [("121", int(d)) for d in args.sym_degrees.split(",") if d]
     jobs += [("12321", int(d)) for d in args.three_degrees.split(",") if d]
     print(f"# C: {exe} (CFLAGS '{CFLAGS}' with --build), OMP_NUM_THREADS=1; ours: {sys.executable}")
-    print("# warm = the call alone, in-process, median CPU s of --repeat; cold = whole process, CPU s (wall s), "
-          "peak RSS MB; ratio = ours / C")
+    print(f"# warm = the call alone, in-process, median CPU s of --repeat calls (at least {SMALL_REPEAT} when a call "
+          "takes under 10 ms); cold = whole process, CPU s (wall s), peak RSS MB; ratio = ours / C")
     print(f"{'series':>6} {'N':>3} {'terms':>6} | {'C warm':>8} {'ours warm':>9} {'by':>6} {'ratio':>6} {'+terms':>8} "
           f"{'engine':>8} {'ratio':>6} | "
           f"{'C cold':>15} {'ours cold':>15} {'ratio':>6} | {'C MB':>6} {'ours MB':>7} {'ratio':>6} | same  load")
@@ -282,12 +286,14 @@ def main(argv=None):
         spec, letters, expression, _ = SERIES[series]
         peer.call(series, n)  # untimed: pages touched, code loaded
         clear_caches()
+        t = time.process_time()
         formal_bch(spec, n)
+        repeat = args.repeat if time.process_time() - t > 0.01 else max(args.repeat, SMALL_REPEAT)
         source = by(spec, n)
         if source == "table":
             engine(spec, n)
         c_warm, ours_warm, engine_warm, terms_warm = [], [], [], []
-        for _ in range(args.repeat):
+        for _ in range(repeat):
             t = time.process_time()
             peer.call(series, n)
             c_warm.append(time.process_time() - t)
