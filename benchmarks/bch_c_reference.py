@@ -29,8 +29,9 @@ Two measurements per row, the sides interleaved:
 * cold, whole processes: the ``bch`` process (``table_output=1``, its table written to a file) and
   ``python -c`` importing ``nambu_bch`` and calling ``formal_bch`` (interpreter start and imports
   included; the table's series import neither sympy nor numpy; numba's machine code from its on-disk cache
-  where the engine runs; the series written to a file as ``word numerator denominator`` lines).  CPU (user + sys), wall seconds and peak RSS of each child from
-  ``/usr/bin/time`` (the peak RSS of a child forked from this large process would be inflated otherwise).
+  where the engine runs; the series written to a file as ``word numerator denominator`` lines).  CPU
+  (user + sys), wall seconds and peak RSS of each child from ``/usr/bin/time`` (the peak RSS of a child
+  forked from this large process would be inflated otherwise).
   The numba cache is primed once, untimed, at the start (the first use after an install compiles the
   engine; that is a one-time cost and not what this row measures).
 

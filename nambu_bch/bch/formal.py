@@ -59,7 +59,7 @@ from functools import lru_cache
 from math import comb, factorial, gcd, lcm
 
 # numpy and sympy are imported where the engines and the sympy views need them: a series served from the table
-# (a word read by .light, its numerators by .table) imports neither (about a second and 70 MB in a fresh process)
+# (a word read by .light, its numerators by .table) imports neither (most of a fresh process's time and memory)
 from ..checks import check_int
 from ..errors import InvalidCompositionError, InvalidOrderError
 from ..printable import Printable
@@ -219,7 +219,8 @@ def _positive_degree(max_degree) -> int:
     sympy, np = sys.modules.get("sympy"), sys.modules.get("numpy")
     if sympy is not None and isinstance(max_degree, sympy.Integer):
         max_degree = int(max_degree)
-    if isinstance(max_degree, bool) or not (isinstance(max_degree, int) or (np is not None and isinstance(max_degree, np.integer))):
+    integer = isinstance(max_degree, int) or (np is not None and isinstance(max_degree, np.integer))
+    if isinstance(max_degree, bool) or not integer:
         raise InvalidOrderError(f"BCH degree must be a positive integer, got {max_degree!r}")
     max_degree = int(max_degree)
     if max_degree < 1:

@@ -3,8 +3,8 @@
 :func:`formal_bch` serves the two-generator series (``12``, ``21``, ``121``, ``212``) from the shipped table
 (:mod:`nambu_bch.bch.table`), which needs only the pieces and rational coefficients of the word.  Reading the
 word with :func:`~nambu_bch.integrators.composition.composition` imports sympy (the coefficients of a
-:class:`~nambu_bch.integrators.composition.Composition` are sympy numbers), about a second and 70 MB in a fresh
-process, more than the whole series to degree 18.  :func:`parse_word` reads the plain forms of that grammar with
+:class:`~nambu_bch.integrators.composition.Composition` are sympy numbers), which costs a fresh process more time
+and memory than the whole series to degree 18.  :func:`parse_word` reads the plain forms of that grammar with
 the same rules and the same result (pieces, coefficients, name, symmetry), and answers ``None`` for anything else
 -- named methods, symbolic or decimal coefficients, and every input the full parser refuses -- so that the caller
 goes the full parser's way, which gives the one-line errors.  The :class:`Word` builds its ``Composition`` only
@@ -72,7 +72,8 @@ class Word:
         return self.pieces == self.pieces[::-1] and self.coefficients == self.coefficients[::-1]
 
     def remainder_power(self, order: int) -> int:
-        """:meth:`Composition.remainder_power`: ``order + 2`` for a symmetric word after an even order, else ``order + 1``."""
+        """:meth:`Composition.remainder_power`: ``order + 2`` for a symmetric word after an even order, else
+        ``order + 1``."""
         return order + 2 if self.symmetric and order % 2 == 0 else order + 1
 
     def composition(self):

@@ -81,7 +81,7 @@ def _leaves(tree, basic) -> tuple:
 
 
 def _pair_leaves(tree) -> tuple:
-    """:func:`tree_leaves` without sympy: every pair is a bracket (a quarter faster than :func:`_leaves`, the cost
+    """:func:`tree_leaves` without sympy: every pair is a bracket (faster than :func:`_leaves`, the cost
     of writing a series served without sympy)."""
     return _pair_leaves(tree[0]) + _pair_leaves(tree[1]) if type(tree) is tuple and len(tree) == 2 else (tree,)
 

@@ -22,7 +22,7 @@ and the SHA-256 of the degree's bytes) is trusted only when its own SHA-256 equa
 :data:`TABLE_SHA256`, written into this module by the tool; a degree's bytes are decoded only when
 their SHA-256 equals the header's.  A missing, damaged or replaced file is not used: the engine
 computes the series, and one warning line says why.  The digests are hashlib's (OpenSSL) in a process that has
-imported hashlib and CPython's built-in SHA-256 otherwise: the same digest, without mapping libcrypto (3.7 MB)
+imported hashlib and CPython's built-in SHA-256 otherwise: the same digest, without mapping libcrypto (megabytes)
 into a fresh process that reads the table and nothing else.
 
 Memory.  Only the degrees asked are read; the numerators stay machine integers (:mod:`array`) until a degree's
@@ -77,13 +77,14 @@ except ImportError:
 
 def _sha256(data):
     """SHA-256 of ``data``: hashlib's (OpenSSL, several times faster) when hashlib is imported already, else
-    CPython's own -- importing hashlib maps libcrypto, 3.7 MB of a fresh process that reads the table."""
+    CPython's own -- importing hashlib maps libcrypto, megabytes of a fresh process that reads the table."""
     hashlib = sys.modules.get("hashlib")
     if hashlib is None and _builtin_sha256 is not None:
         return _builtin_sha256(data)
     if hashlib is None:
         import hashlib
     return hashlib.sha256(data)
+
 
 #: Bytes read after the header with it (degrees 1-13 of the shipped table, 14 kB)
 _FIRST_BLOCKS = 16384
