@@ -17,15 +17,21 @@ Two measurements per row, the sides interleaved:
   with numba started and every in-memory cache of the package cleared before each call
   (``nambu_bch.clear_caches``: Lyndon tables rebuilt, as the C routine rebuilds its own).  Where the
   shipped table serves the series (``12`` and ``121`` to its top degree, column ``by`` = ``table``) that
-  call reads the table file again each time (from the page cache), checks the SHA-256 of what it reads and
-  builds the result's Python objects; the column ``engine`` is the same call with the table bypassed
-  (``formal._formal_engine``: what the engine alone costs).  One untimed call on each side first; then
-  ``--repeat`` calls each, alternating, the median CPU seconds reported.
+  call reads the word (no sympy), reads the table's header and blocks again each time (from the page
+  cache), checks the SHA-256 of what it reads and decodes the standard factors and the numerators into
+  machine integers; the terms' Python objects (ints and bracket trees) are built when asked for, and the
+  column ``+terms`` is the CPU time of asking for all of them right after (``scaled_terms`` of every
+  degree), so ``ours warm`` + ``+terms`` is the call with every term in hand.  The column ``engine`` is
+  the same call with the table bypassed (``formal._formal_engine``: what the engine alone costs).  One
+  untimed call on each side first; then ``--repeat`` calls each (at least :data:`SMALL_REPEAT` when our
+  untimed call took under 10 ms: one sub-millisecond call is mostly noise on a loaded machine), alternating,
+  the median CPU seconds reported.
 * cold, whole processes: the ``bch`` process (``table_output=1``, its table written to a file) and
   ``python -c`` importing ``nambu_bch`` and calling ``formal_bch`` (interpreter start and imports
-  included, numba's machine code from its on-disk cache, the series written to a file as
-  ``word numerator denominator`` lines).  CPU (user + sys), wall seconds and peak RSS of each child from
-  ``/usr/bin/time`` (the peak RSS of a child forked from this large process would be inflated otherwise).
+  included; the table's series import neither sympy nor numpy; numba's machine code from its on-disk cache
+  where the engine runs; the series written to a file as ``word numerator denominator`` lines).  CPU
+  (user + sys), wall seconds and peak RSS of each child from ``/usr/bin/time`` (the peak RSS of a child
+  forked from this large process would be inflated otherwise).
   The numba cache is primed once, untimed, at the start (the first use after an install compiles the
   engine; that is a one-time cost and not what this row measures).
 
@@ -94,6 +100,9 @@ formal_bch(sys.argv[1], int(sys.argv[2]))
 t4 = clock()
 print(t1 - t0, t2 - t1, t3 - t2, t4 - t3)
 """
+
+#: warm calls per side for a row whose untimed call took under 10 ms
+SMALL_REPEAT = 21
 
 PRIME = "from nambu_bch.bch import formal_bch; formal_bch('123', 10); formal_bch('12', 16)"  # sparse engine
 
@@ -268,9 +277,9 @@ def main(argv=None):
     jobs += [("121", int(d)) for d in args.sym_degrees.split(",") if d]
     jobs += [("12321", int(d)) for d in args.three_degrees.split(",") if d]
     print(f"# C: {exe} (CFLAGS '{CFLAGS}' with --build), OMP_NUM_THREADS=1; ours: {sys.executable}")
-    print("# warm = the call alone, in-process, median CPU s of --repeat; cold = whole process, CPU s (wall s), "
-          "peak RSS MB; ratio = ours / C")
-    print(f"{'series':>6} {'N':>3} {'terms':>6} | {'C warm':>8} {'ours warm':>9} {'by':>6} {'ratio':>6} "
+    print(f"# warm = the call alone, in-process, median CPU s of --repeat calls (at least {SMALL_REPEAT} when a call "
+          "takes under 10 ms); cold = whole process, CPU s (wall s), peak RSS MB; ratio = ours / C")
+    print(f"{'series':>6} {'N':>3} {'terms':>6} | {'C warm':>8} {'ours warm':>9} {'by':>6} {'ratio':>6} {'+terms':>8} "
           f"{'engine':>8} {'ratio':>6} | "
           f"{'C cold':>15} {'ours cold':>15} {'ratio':>6} | {'C MB':>6} {'ours MB':>7} {'ratio':>6} | same  load")
     rows = []
@@ -278,12 +287,14 @@ def main(argv=None):
         spec, letters, expression, _ = SERIES[series]
         peer.call(series, n)  # untimed: pages touched, code loaded
         clear_caches()
+        t = time.process_time()
         formal_bch(spec, n)
+        repeat = args.repeat if time.process_time() - t > 0.01 else max(args.repeat, SMALL_REPEAT)
         source = by(spec, n)
         if source == "table":
             engine(spec, n)
-        c_warm, ours_warm, engine_warm = [], [], []
-        for _ in range(args.repeat):
+        c_warm, ours_warm, engine_warm, terms_warm = [], [], [], []
+        for _ in range(repeat):
             t = time.process_time()
             peer.call(series, n)
             c_warm.append(time.process_time() - t)
@@ -291,6 +302,10 @@ def main(argv=None):
             t = time.process_time()
             served = formal_bch(spec, n)
             ours_warm.append(time.process_time() - t)
+            t = time.process_time()
+            for d in range(1, n + 1):
+                served.scaled_terms(d)
+            terms_warm.append(time.process_time() - t)
             if source == "table":
                 clear_caches()
                 t = time.process_time()
@@ -308,13 +323,15 @@ def main(argv=None):
         same = c_terms(c_table, letters) == ours
         cw, ow = statistics.median(c_warm), statistics.median(ours_warm)
         ew = statistics.median(engine_warm) if engine_warm else ow
+        tw = statistics.median(terms_warm)
         load = os.getloadavg()
-        row = dict(series=series, degree=n, terms=len(ours), c_warm=cw, ours_warm=ow, by=source, engine_warm=ew,
+        row = dict(series=series, degree=n, terms=len(ours), c_warm=cw, ours_warm=ow, by=source, terms_warm=tw,
+                   engine_warm=ew,
                    c_cold=c_cold[:2],
                    ours_cold=ours_cold[:2], c_rss_mb=c_cold[2] / 1024, ours_rss_mb=ours_cold[2] / 1024,
                    identical=same, load=load)
         rows.append(row)
-        print(f"{series:>6} {n:>3} {len(ours):>6} | {cw:>8.4f} {ow:>9.4f} {source:>6} {ow / cw:>5.2f}x "
+        print(f"{series:>6} {n:>3} {len(ours):>6} | {cw:>8.4f} {ow:>9.4f} {source:>6} {ow / cw:>5.2f}x {tw:>8.4f} "
               f"{ew:>8.4f} {ew / cw:>5.2f}x | "
               f"{c_cold[0]:>6.3f} ({c_cold[1]:>5.2f}) {ours_cold[0]:>6.3f} ({ours_cold[1]:>5.2f}) "
               f"{ours_cold[0] / max(c_cold[0], 0.005):>5.1f}x | {c_cold[2] / 1024:>6.1f} {ours_cold[2] / 1024:>7.1f} "

@@ -33,6 +33,7 @@ import re
 
 import sympy
 
+from .printable import Printable  # the mixin imports nothing: results served without sympy use it
 from .symbols import STEP
 
 __all__ = [
@@ -44,26 +45,6 @@ __all__ = [
 
 #: Estimated width of one display line, in characters of printed math (``article``, 10 pt, no overfull boxes).
 WIDTH = 58
-
-
-class Printable:
-    """Mixin: ``to_latex()`` (an ``aligned`` block) and ``to_text()`` give the printer hooks.
-
-    ``sympy.latex(obj)`` -> ``obj.to_latex()``; ``sympy.sstr(obj)``, ``str(obj)`` and
-    ``print(obj)`` -> ``obj.to_text()``; ``obj._repr_latex_()`` -> ``$$`` + block + ``$$``.
-    """
-
-    def _latex(self, printer=None):
-        return self.to_latex()
-
-    def _sympystr(self, printer=None):
-        return self.to_text()
-
-    def __str__(self):
-        return self.to_text()
-
-    def _repr_latex_(self):
-        return "$$" + self.to_latex() + "$$"
 
 
 # --------------------------------------------------------------------------------------------

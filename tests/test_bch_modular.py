@@ -6,6 +6,7 @@ import numpy as np
 import pytest
 import sympy
 from hypothesis import given, settings
+from sympy.polys.constructor import construct_domain
 
 from nambu_bch.bch import formal_bch, lyndon_words, standard_bracketing, witt_dimension
 from nambu_bch.bch import formal as formal_module
@@ -329,7 +330,7 @@ def test_rational_scalars_skip_the_domain_search_with_the_same_result():
     """Rational coefficients take the short path; q and the integer values equal construct_domain's route."""
     coefficients = (R(1, 2), sympy.Integer(-3), R(2, 3), R(0))
     scalars = formal_module._Scalars(coefficients)
-    K, _ = formal_module.construct_domain(list(coefficients), extension=True)
+    K, _ = construct_domain(list(coefficients), extension=True)
     assert K.is_QQ and scalars.K is None
     assert (scalars.q, scalars.values) == (6, [3, -18, 4, 0])
     assert formal_module._Scalars((sympy.Integer(2) ** R(1, 3), R(1))).K is not None  # algebraic: the field

@@ -12,7 +12,8 @@ _LAZY = {
                 "tree_degree", "tree_to_associative", "tree_to_latex", "witt_dimension"),
 }
 _WHERE = {name: module for module, names in _LAZY.items() for name in names}
-_SUBMODULES = ("backward", "concrete", "evaluation", "expansion", "formal", "lyndon", "modular", "report", "table")
+_SUBMODULES = ("backward", "concrete", "evaluation", "expansion", "formal", "light", "lyndon", "modular", "report",
+               "table")
 
 
 def __getattr__(name):

@@ -9,7 +9,11 @@ degree ``d``.  With the step, ``Phi_h = exp(h X_eff)`` and
 
 Table.  The two-generator products ``12``, ``21``, ``121`` and ``212`` (``log(e^A e^B)``, its reverse,
 the symmetric series) are read from a verified table shipped with the package,
-:mod:`nambu_bch.bch.table`, up to its top degree; the result is the engines' to the last numerator.
+:mod:`nambu_bch.bch.table`, up to its top degree; the result is the engines' to the last numerator.  A plain
+word (``"12"``, ``"TVT"``, ``"1:1/2,2:1,1:1/2"``) is read by :mod:`nambu_bch.bch.light` with ``Fraction``
+coefficients, so that such a request imports neither sympy nor numpy: the result's
+:attr:`FormalBCH.composition`, :meth:`FormalBCH.terms` and LaTeX build their sympy objects when first asked,
+and each degree's ``(numerator, tree)`` pairs are built from the stored numerators when asked for.
 
 Engines (exact, no floats).  Rational compositions run the sparse engine of
 :mod:`nambu_bch.bch.modular`: coefficients of ``log Phi`` on Lyndon words only
@@ -50,22 +54,18 @@ import gc
 import sys
 from contextlib import contextmanager
 from dataclasses import dataclass, field
+from fractions import Fraction
 from functools import lru_cache
 from math import comb, factorial, gcd, lcm
 
-import numpy as np
-import sympy
-from sympy.polys.constructor import construct_domain
-from sympy.polys.domains import QQ
-
+# numpy and sympy are imported where the engines and the sympy views need them: a series served from the table
+# (a word read by .light, its numerators by .table) imports neither (most of a fresh process's time and memory)
 from ..checks import check_int
 from ..errors import InvalidCompositionError, InvalidOrderError
-from ..integrators.composition import Composition
-from ..integrators.composition import composition as make_composition
-from ..compiled import numba_available
-from ..printing import Printable, bracket_sum
+from ..printable import Printable
 from ..values import ValueEquality
 from . import table as _table
+from .light import Word, parse_word
 from .lyndon import (
     divisors,
     lyndon_expansion,
@@ -215,9 +215,12 @@ def check_degree(max_degree, n_generators: int, dense: bool = False) -> int:
 
 def _positive_degree(max_degree) -> int:
     """``max_degree`` as an int ``>= 1`` (an int, numpy or sympy integer), else :class:`InvalidOrderError`."""
-    if isinstance(max_degree, sympy.Integer):
+    # a numpy or sympy integer exists only once its module is imported: looked up, never imported here
+    sympy, np = sys.modules.get("sympy"), sys.modules.get("numpy")
+    if sympy is not None and isinstance(max_degree, sympy.Integer):
         max_degree = int(max_degree)
-    if isinstance(max_degree, bool) or not isinstance(max_degree, (int, np.integer)):
+    integer = isinstance(max_degree, int) or (np is not None and isinstance(max_degree, np.integer))
+    if isinstance(max_degree, bool) or not integer:
         raise InvalidOrderError(f"BCH degree must be a positive integer, got {max_degree!r}")
     max_degree = int(max_degree)
     if max_degree < 1:
@@ -229,6 +232,10 @@ class _Scalars:
     """Coefficient arithmetic: python ints (rational compositions) or a sympy algebraic field."""
 
     def __init__(self, coefficients):
+        import sympy
+        from sympy.polys.constructor import construct_domain
+        from sympy.polys.domains import QQ
+
         if all(getattr(c, "is_Rational", False) for c in coefficients):
             K = QQ  # the usual case, without construct_domain's algebraic-field search (about 1 ms a call)
         else:
@@ -248,6 +255,8 @@ class _Scalars:
 
 
 def _element_to_sympy(K):
+    import sympy
+
     if K is None:
         return lambda e: sympy.Rational(int(e.numerator), int(e.denominator))
     return K.to_sympy
@@ -269,6 +278,8 @@ def _log_of_product(letters, scalars: _Scalars, g: int, n: int):
     every intermediate magnitude) stays below ``2^60``: then no int64 operation can overflow and
     the result is exact.  Otherwise (and for algebraic coefficients) Python ints / field elements.
     """
+    import numpy as np
+
     big = lcm(*range(1, n + 1))
     dens = [factorial(d) * big * scalars.q**d for d in range(n + 1)]
     if scalars.K is None:
@@ -283,6 +294,8 @@ def _log_of_product(letters, scalars: _Scalars, g: int, n: int):
 
 def _log_arrays(letters, values, dtype, zero, one, g, n, big, bounding):
     """The log's arrays and, when ``bounding`` (non-negative floats), the largest magnitude met."""
+    import numpy as np
+
     largest = [0.0]
 
     def zeros(size):
@@ -354,6 +367,8 @@ def _permute_letters(vector, d: int, g: int, rank):
     """The same element with letter ``a`` renamed ``rank[a]`` (a permutation of base-``g`` digits)."""
     if d == 0:
         return vector
+    import numpy as np
+
     out = np.empty_like(vector)
     out[_digit_permutation(d, g, tuple(rank))] = vector
     return out
@@ -361,6 +376,8 @@ def _permute_letters(vector, d: int, g: int, rank):
 
 @lru_cache(maxsize=256)
 def _digit_permutation(d: int, g: int, rank: tuple):
+    import numpy as np
+
     index = np.arange(g**d, dtype=np.int64)
     new_index = np.zeros_like(index)
     perm = np.asarray(rank, dtype=np.int64)
@@ -374,6 +391,8 @@ def _digit_permutation(d: int, g: int, rank: tuple):
 
 def _graded_product_part(R, Q, d, k, g, zeros):
     """Part ``d`` of ``R * Q`` (both scaled by degree factorials), ``R`` of min degree ``k - 1``."""
+    import numpy as np
+
     out = zeros(g**d)
     for a in range(k - 1, d):
         b = d - a
@@ -407,6 +426,8 @@ def _lyndon_inverse(g: int, d: int):
     lexicographic order, and ``L[w'] = sum_w c_w M[w', w]`` on Lyndon words, so ``c = M^{-1} L``.
     Built once per (generators, degree); ``None`` when too large or when int64 would overflow.
     """
+    import numpy as np
+
     table = _lyndon_table(g, d)
     n = len(table)
     if n > _INVERSE_LIMIT:
@@ -430,6 +451,8 @@ def _lyndon_inverse(g: int, d: int):
 
 def _lyndon_coordinates(vector, d: int, g: int):
     """Coordinates ``[(position in the Lyndon table, numerator), ...]`` of a homogeneous Lie element."""
+    import numpy as np
+
     if not vector.any():
         return []
     inverse = _lyndon_inverse(g, d)
@@ -464,19 +487,33 @@ class FormalBCH(Printable, ValueEquality):
         The distinct piece numbers, in increasing order: the ordered alphabet of
         the Lyndon basis (piece ``k`` is the generator ``X_k``).
     max_degree : int
+
+    A series served from the table holds the word as read without sympy (:class:`~nambu_bch.bch.light.Word`)
+    and its numerators as the table stores them: :attr:`composition`, :meth:`terms` and :meth:`to_latex` build
+    the sympy objects when first asked; :meth:`scaled_terms`, :meth:`to_text`, :attr:`degrees` and ``len``
+    need none.
     """
 
-    composition: Composition
+    _composition: object  # Composition, or the light Word it is built from when asked
     generators: tuple
     max_degree: int
-    _scaled: dict  # degree -> (denominator, ((numerator: int or field element, tree), ...))
+    _scaled: dict  # degree -> (denominator, ((numerator: int or field element, tree), ...)); table.Served: lazy
     _domain: object = None  # None: QQ; else the algebraic field of the coefficients
     _sympy: dict = field(default_factory=dict)  # degree -> ((sympy coefficient, tree), ...), filled lazily
     _cache: dict = field(default_factory=dict)
 
+    @property
+    def composition(self):
+        """The :class:`~nambu_bch.integrators.composition.Composition` (built from the word on first use)."""
+        comp = self._composition
+        if isinstance(comp, Word):
+            comp = comp.composition()
+            object.__setattr__(self, "_composition", comp)
+        return comp
+
     def _value(self) -> tuple:
         """The exact data (``==``, ``hash``): per degree the common denominator and ``(numerator, tree)`` pairs."""
-        return self.composition, self.generators, self.max_degree, self._scaled, str(self.domain)
+        return self.composition, self.generators, self.max_degree, dict(self._scaled), str(self.domain)
 
     def scaled_terms(self, degree: int):
         """``(D, [(n, tree), ...])`` with coefficients ``n / D``: ``n`` a Python int (rational series) or an
@@ -487,11 +524,16 @@ class FormalBCH(Printable, ValueEquality):
     @property
     def domain(self):
         """The coefficient field: ``QQ``, or ``QQ(2^(1/3))`` etc. for algebraic compositions."""
+        from sympy.polys.domains import QQ
+
         return self._domain if self._domain is not None else QQ
 
     @property
     def _elements(self) -> dict:
         if "elements" not in self._cache:
+            import sympy
+            from sympy.polys.domains import QQ
+
             K = self.domain
             out = {}
             for d, (den, items) in self._scaled.items():
@@ -530,14 +572,17 @@ class FormalBCH(Printable, ValueEquality):
     @property
     def degrees(self) -> tuple:
         """Degrees ``1..max_degree`` whose part is non-zero (odd only for a symmetric composition)."""
-        return tuple(d for d in range(1, self.max_degree + 1) if self._scaled.get(d))
+        return tuple(d for d in range(1, self.max_degree + 1) if d in self._scaled)
 
     def all_terms(self) -> list:
         """``[(coefficient, tree), ...]`` over all degrees, lowest first."""
         return [t for d in range(1, self.max_degree + 1) for t in self._terms.get(d, ())]
 
     def __len__(self):
-        return sum(len(v[1]) for v in self._scaled.values())
+        scaled = self._scaled
+        if isinstance(scaled, _table.Served):  # counted without building the terms
+            return sum(scaled.count(d) for d in scaled)
+        return sum(len(v[1]) for v in scaled.values())
 
     def to_latex(self, names=None, step="h") -> str:
         r"""The series term by term in an ``aligned`` block, e.g. ``X_{\rm eff} &= X_{1} + X_{2} - \frac{h^{2}}{24}[...] ...``.
@@ -552,9 +597,13 @@ class FormalBCH(Printable, ValueEquality):
             With a step symbol the series is printed as ``X_eff`` (degree ``d`` carries
             ``step^(d-1)``, Eq. BCH2); with ``None`` as ``log Phi`` of the bare generators.
         """
+        import sympy
+
+        from ..printing import bracket_sum
+
         items = [(c, tree, d - 1 if step else 0) for d in range(1, self.max_degree + 1) for c, tree in self._terms.get(d, ())]
         lhs = r"X_{\rm eff}" if step else r"\log \Phi"
-        remainder = self.composition.remainder_power(self.max_degree - 1) if step else None
+        remainder = self._composition.remainder_power(self.max_degree - 1) if step else None
         return bracket_sum(lhs, items, names, remainder, sympy.Symbol(step or "h"))
 
     def to_text(self) -> str:
@@ -569,14 +618,19 @@ class FormalBCH(Printable, ValueEquality):
 
         parts = []
         for d in range(1, self.max_degree + 1):
-            for c, tree in self._terms.get(d, ()):
+            if self._domain is None:  # rationals: a Fraction prints as the sympy Rational does, without sympy
+                den, items = self._scaled.get(d, (1, ()))
+                terms = [(Fraction(n, den), tree) for n, tree in items]
+            else:
+                terms = self._terms.get(d, ())
+            for c, tree in terms:
                 factor = "" if d == 1 else ("h*" if d == 2 else f"h**{d - 1}*")
                 parts.append(("" if c == 1 else f"({c})*") + factor + bracket(tree))
-        tail = f" + O(h^{self.composition.remainder_power(self.max_degree - 1)})"
+        tail = f" + O(h^{self._composition.remainder_power(self.max_degree - 1)})"
         return "X_eff = " + (" + ".join(parts) or "0") + tail
 
     def __repr__(self):
-        return f"FormalBCH({self.composition.name!r}, max_degree={self.max_degree}, terms={len(self)})"
+        return f"FormalBCH({self._composition.name!r}, max_degree={self.max_degree}, terms={len(self)})"
 
 
 def formal_bch(comp, max_degree: int, n_pieces: int | None = None) -> FormalBCH:
@@ -607,33 +661,61 @@ def formal_bch(comp, max_degree: int, n_pieces: int | None = None) -> FormalBCH:
     >>> formal_bch("12", 2).terms(2)     # Lie-Trotter: X_1 + X_2 + [X_1, X_2]/2
     [(1/2, (1, 2))]
     """
-    comp = make_composition(comp, n_pieces)
-    if not isinstance(comp, Composition) or not comp.pieces:
-        raise InvalidCompositionError(f"formal_bch needs a composition with at least one factor, got {comp!r}")
+    # a plain word with rational coefficients is read without sympy: the table's series need nothing more
+    word = parse_word(comp, n_pieces) if isinstance(comp, str) else None
+    if word is not None:
+        served = _from_table(word, [c.numerator for c in word.coefficients],
+                             [c.denominator for c in word.coefficients], max_degree)
+        if served is not None:
+            return served
+        comp = word.composition()
+    else:
+        from ..integrators.composition import Composition
+        from ..integrators.composition import composition as make_composition
+
+        comp = make_composition(comp, n_pieces)
+        if not isinstance(comp, Composition) or not comp.pieces:
+            raise InvalidCompositionError(f"formal_bch needs a composition with at least one factor, got {comp!r}")
     return _formal(comp, max_degree, True)
 
 
-def _formal_engine(comp: Composition, max_degree: int) -> FormalBCH:
+def _formal_engine(comp, max_degree: int) -> FormalBCH:
     """:func:`formal_bch` computed by the engines, never read from the table (the table's tool and tests)."""
     return _formal(comp, max_degree, False)
 
 
-def _formal(comp: Composition, max_degree, use_table: bool) -> FormalBCH:
+def _from_table(comp, numerators, denominators, max_degree):
+    """The series from the shipped table (:mod:`nambu_bch.bch.table`), or ``None`` where it is not served.
+
+    ``comp`` is a Composition or a :class:`~nambu_bch.bch.light.Word`; its coefficients are the rationals
+    ``numerators[i] / denominators[i]``.  The table holds the two-generator products of two or three
+    factors; a degree it holds is served whatever the engines' size limits (without numba the dense engine
+    stops at degree 19)."""
+    generators = tuple(sorted(set(comp.pieces)))
+    if len(generators) != 2 or len(comp.pieces) > 3:
+        return None
+    n = _positive_degree(max_degree)
+    if n > _table.max_degree():
+        return None
+    q = lcm(*denominators)
+    values = [a * (q // b) for a, b in zip(numerators, denominators)]
+    big = lcm(*range(1, n + 1))
+    dens = [factorial(d) * big * q**d for d in range(n + 1)]
+    letters = [generators.index(k) for k in comp.pieces]
+    served = _table.serve(letters, values, q, generators, n, dens)
+    return None if served is None else FormalBCH(comp, generators, n, served, None)
+
+
+def _formal(comp, max_degree, use_table: bool) -> FormalBCH:
     generators = tuple(sorted(set(comp.pieces)))
     g = len(generators)
     scalars = _Scalars(tuple(comp.coefficients))
-    if use_table and scalars.K is None and g == 2 and len(comp.pieces) <= 3:
-        # the two-generator series of the shipped table (nambu_bch.bch.table): a degree it holds is served
-        # whatever the engines' size limits (without numba the dense engine stops at degree 19)
-        n = _positive_degree(max_degree)
-        if n <= _table.max_degree():
-            big = lcm(*range(1, n + 1))
-            dens = [factorial(d) * big * scalars.q**d for d in range(n + 1)]
-            letters = [generators.index(k) for k in comp.pieces]
-            with _no_full_collection():  # acyclic tuples and ints, as in the sparse engine below
-                served = _table.serve(letters, scalars.values, scalars.q, generators, n, dens)
-            if served is not None:
-                return FormalBCH(comp, generators, n, served, None)
+    if use_table and scalars.K is None:
+        served = _from_table(comp, scalars.values, [scalars.q] * len(scalars.values), max_degree)
+        if served is not None:
+            return served
+    from ..compiled import numba_available  # the engines' concern: a served series does not look for numba
+
     sparse = scalars.K is None and numba_available()
     n = check_degree(max_degree, g, dense=not sparse)
     # low degrees: the dense engine answers in milliseconds without loading numba (~0.4 s in a fresh process)
@@ -705,6 +787,8 @@ def _formal_dense(comp, generators: tuple, n: int) -> FormalBCH:
 def _duval_trees(g: int, n: int, generators: tuple) -> tuple:
     """Standard bracketings of all Lyndon words of length ``<= n``, in the Duval order of
     :func:`~nambu_bch.bch.modular.lyndon_table` (children are shorter: built by length)."""
+    import numpy as np
+
     from .modular import lyndon_table
 
     words, lengths, left, right = lyndon_table(g, n)

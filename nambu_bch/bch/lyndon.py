@@ -27,11 +27,10 @@ Horikoshi, Eq. (BCH2) (nested commutators written as trees).
 
 from __future__ import annotations
 
+import sys
 from functools import lru_cache
 
-import numpy as np
-import sympy
-
+# numpy and sympy are imported where they are used: the trees of a series served from the table need neither
 from ..checks import check_int, check_sequence, is_int, show
 from ..errors import InvalidRunError, ResourceLimitError, UnknownPieceError
 
@@ -39,15 +38,18 @@ from ..errors import InvalidRunError, ResourceLimitError, UnknownPieceError
 def is_bracket(tree) -> bool:
     """``True`` for a bracket node ``(left, right)``, ``False`` for a leaf.
 
+    >>> import sympy
     >>> is_bracket((1, (2, 3))), is_bracket(1), is_bracket((sympy.Symbol("A"), sympy.Symbol("C")))
     (True, False, False)
     """
-    return (
-        type(tree) is tuple
-        and len(tree) == 2
-        and not isinstance(tree[0], sympy.Basic)
-        and not isinstance(tree[1], sympy.Basic)
-    )
+    basic = _sympy_basic()
+    return type(tree) is tuple and len(tree) == 2 and not isinstance(tree[0], basic) and not isinstance(tree[1], basic)
+
+
+def _sympy_basic():
+    """sympy's ``Basic`` if sympy is imported, else ``()``: a Liouville term's entries exist only once it is."""
+    sympy = sys.modules.get("sympy")
+    return () if sympy is None else sympy.Basic
 
 
 def tree_degree(tree) -> int:
@@ -67,9 +69,21 @@ def tree_leaves(tree) -> tuple:
     >>> tree_leaves(((1, 2), (1, 3)))
     (1, 2, 1, 3)
     """
-    if is_bracket(tree):
-        return tree_leaves(tree[0]) + tree_leaves(tree[1])
+    basic = _sympy_basic()
+    return _leaves(tree, basic) if basic else _pair_leaves(tree)
+
+
+def _leaves(tree, basic) -> tuple:
+    """:func:`tree_leaves`, a tuple with an entry of type ``basic`` (sympy's) being a leaf (:func:`is_bracket`)."""
+    if type(tree) is tuple and len(tree) == 2 and not isinstance(tree[0], basic) and not isinstance(tree[1], basic):
+        return _leaves(tree[0], basic) + _leaves(tree[1], basic)
     return (tree,)
+
+
+def _pair_leaves(tree) -> tuple:
+    """:func:`tree_leaves` without sympy: every pair is a bracket (faster than :func:`_leaves`, the cost
+    of writing a series served without sympy)."""
+    return _pair_leaves(tree[0]) + _pair_leaves(tree[1]) if type(tree) is tuple and len(tree) == 2 else (tree,)
 
 
 #: Largest number of bits of ``n_letters ** degree`` that :func:`witt_dimension` computes (the degree is a BCH
@@ -211,6 +225,8 @@ def lyndon_expansion(word: tuple, n_letters: int) -> tuple:
     A word ``a_1 .. a_d`` has index ``sum a_i g^(d-i)`` (base-``g`` digits), so that
     lexicographic order of equal-length words is numeric order of indices.
     """
+    import numpy as np
+
     g = n_letters
     if len(word) == 1:
         return np.array([word[0]], dtype=np.int64), np.array([1], dtype=np.int64)
@@ -328,6 +344,8 @@ def tree_to_latex(tree, names=None) -> str:
                                     f"{show(sorted(names, key=str))}")
         return names[tree]
     if isinstance(tree, tuple):
+        import sympy
+
         return "X_{" + ",".join(sympy.latex(e) for e in tree) + "}"
     return f"X_{{{tree}}}"
 
@@ -346,10 +364,13 @@ def terms_to_latex(terms, names=None) -> str:
     --------
     Eq. (BCH1) in the paper's form:
 
+    >>> import sympy
     >>> terms_to_latex([(1, 1), (1, 2), (sympy.Rational(-1, 24), (1, (1, 2))), (sympy.Rational(1, 12), (2, (2, 1)))],
     ...                {1: "X_T", 2: "X_V"})
     'X_T + X_V - \\frac{1}{24} [X_T,[X_T,X_V]] + \\frac{1}{12} [X_V,[X_V,X_T]]'
     """
+    import sympy
+
     parts = []
     for item in _terms(terms, (2, 3)):
         c, tree, factor = item if len(item) == 3 else (*item, sympy.Integer(1))

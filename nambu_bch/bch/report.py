@@ -12,6 +12,7 @@ Horikoshi, Eqs. (BCH1), (BCH2), (BCH4).
 from __future__ import annotations
 
 from dataclasses import dataclass
+from fractions import Fraction
 
 from .backward import effective_field
 from .expansion import expand_terms
@@ -71,8 +72,14 @@ class BCHReport:
         comp, series = self.composition, self.series
         lines = [f"{comp.name}: Phi_h = " + " ".join(f"exp({'' if c == 1 else f'({c})*'}h*X{k})" for k, c in comp.factors())]
         lines.append(f"X_eff through h^{self.order} (formal BCH in the Lyndon basis):")
+        rational = series._domain is None  # a Fraction prints as the sympy Rational does: no sympy term is built
         for d in range(1, series.max_degree + 1):
-            for c, t in series.terms(d):
+            if rational:
+                den, items = series.scaled_terms(d)
+                terms = [(Fraction(n, den), t) for n, t in items]
+            else:
+                terms = series.terms(d)
+            for c, t in terms:
                 lines.append(f"  h^{d - 1}  {c}  {bracket_text(t)}")
         if self.field is not None:
             for j, Z in enumerate(self.field.coefficients):

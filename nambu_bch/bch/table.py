@@ -21,7 +21,13 @@ Integrity.  The header (JSON: per degree the number of words, where its blocks l
 and the SHA-256 of the degree's bytes) is trusted only when its own SHA-256 equals
 :data:`TABLE_SHA256`, written into this module by the tool; a degree's bytes are decoded only when
 their SHA-256 equals the header's.  A missing, damaged or replaced file is not used: the engine
-computes the series, and one warning line says why.
+computes the series, and one warning line says why.  The digests are hashlib's (OpenSSL) in a process that has
+imported hashlib and CPython's built-in SHA-256 otherwise: the same digest, without mapping libcrypto (megabytes)
+into a fresh process that reads the table and nothing else.
+
+Memory.  Only the degrees asked are read; the numerators stay machine integers (:mod:`array`) until a degree's
+terms are asked for, and :class:`Served` builds them on each access (the trees, shared by every request, are the
+only Python objects kept).
 
 File format: ``b"NBCHTAB1"``, the header's length (4 bytes, little-endian), the header, then degree
 by degree the standard factors (int32: left indices, then right indices, into the flat list of the
@@ -37,7 +43,6 @@ Algebras* (1993), Thm. 5.1 (Lyndon basis, standard factorisation).
 
 from __future__ import annotations
 
-import hashlib
 import json
 import os
 import stat
@@ -46,6 +51,7 @@ import threading
 import warnings
 import zlib
 from array import array
+from collections.abc import Mapping
 from fractions import Fraction
 
 #: SHA-256 of the table's header (which holds the SHA-256 of each degree's bytes); written by tools/build_bch_table.py.
@@ -60,6 +66,28 @@ SERIES = {
     "212": ((1, 0, 1), (Fraction(1, 2), Fraction(1), Fraction(1, 2))),
 }
 
+try:  # CPython's own SHA-256 (the same digest) for a process that has not imported hashlib (module docstring)
+    from _sha2 import sha256 as _builtin_sha256  # Python >= 3.12
+except ImportError:
+    try:
+        from _sha256 import sha256 as _builtin_sha256  # Python <= 3.11
+    except ImportError:
+        _builtin_sha256 = None
+
+
+def _sha256(data):
+    """SHA-256 of ``data``: hashlib's (OpenSSL, several times faster) when hashlib is imported already, else
+    CPython's own -- importing hashlib maps libcrypto, megabytes of a fresh process that reads the table."""
+    hashlib = sys.modules.get("hashlib")
+    if hashlib is None and _builtin_sha256 is not None:
+        return _builtin_sha256(data)
+    if hashlib is None:
+        import hashlib
+    return hashlib.sha256(data)
+
+
+#: Bytes read after the header with it (degrees 1-13 of the shipped table, 14 kB)
+_FIRST_BLOCKS = 16384
 #: array typecodes of the signed integer widths that convert in bulk
 _TYPECODES = {array(code).itemsize: code for code in "bhiq"}
 _HEADER: list = []  # [header dict] once read and verified; [None] when the table is unusable in this process
@@ -106,28 +134,32 @@ def _header():
         with _open_table() as fh:
             start = fh.read(len(MAGIC) + 4)
             size = int.from_bytes(start[len(MAGIC):], "little")
-            raw = fh.read(size) if start[: len(MAGIC)] == MAGIC and size < 2**20 else b""
+            # the first blocks come with the header (one open for a request to a low degree, see _load)
+            raw = fh.read(size + _FIRST_BLOCKS) if start[: len(MAGIC)] == MAGIC and size < 2**20 else b""
     except OSError as exc:
         _unusable(f"cannot read it: {exc.strerror or exc}")
         return None
-    if hashlib.sha256(raw).hexdigest() != TABLE_SHA256:
+    raw, first_blocks = raw[:size], raw[size:]
+    if _sha256(raw).hexdigest() != TABLE_SHA256:
         _unusable("its SHA-256 does not match the package's")
         return None
-    header = json.loads(raw)
+    header = json.loads(raw.decode("ascii"))  # the tool writes ASCII JSON (json.dumps' default)
     header["base"] = len(MAGIC) + 4 + size
+    header["first_blocks"] = first_blocks  # unverified bytes: each degree's SHA-256 is checked when it is decoded
     _HEADER[:] = [header]
     return header
 
 
-def _decode(data: bytes, width: int) -> list:
-    """Python ints from ``width``-byte little-endian two's-complement integers."""
+def _decode(data: bytes, width: int):
+    """The ``width``-byte little-endian two's-complement integers of ``data``: an :class:`array.array` when a
+    machine type has that width (8 bytes a number, Python ints only when a term is asked for), else a list."""
     code = _TYPECODES.get(width)
     if code is not None:  # in bulk, without numpy (not imported on this path)
         values = array(code)
         values.frombytes(data)
         if sys.byteorder == "big":
             values.byteswap()
-        return values.tolist()
+        return values
     from_bytes = int.from_bytes
     return [from_bytes(data[i : i + width], "little", signed=True) for i in range(0, len(data), width)]
 
@@ -142,18 +174,22 @@ def _load(header, series: str, n: int) -> bool:
     if first is None:
         return True
     start = degrees[first - 2]["end"] if first > 1 else 0
-    try:
-        with _open_table() as fh:
-            fh.seek(header["base"] + start)
-            data = fh.read(degrees[n - 1]["end"] - start)
-    except OSError as exc:
-        _unusable(f"cannot read it: {exc.strerror or exc}")
-        return False
+    stop = degrees[n - 1]["end"]
+    if stop <= len(header["first_blocks"]):  # read with the header
+        data = memoryview(header["first_blocks"])[start:stop]
+    else:
+        try:
+            with _open_table() as fh:
+                fh.seek(header["base"] + start)
+                data = fh.read(stop - start)
+        except OSError as exc:
+            _unusable(f"cannot read it: {exc.strerror or exc}")
+            return False
     view = memoryview(data)
     for d in range(first, n + 1):
         entry = degrees[d - 1]
         low = (degrees[d - 2]["end"] if d > 1 else 0) - start
-        if hashlib.sha256(view[low : entry["end"] - start]).hexdigest() != entry["sha256"]:
+        if _sha256(view[low : entry["end"] - start]).hexdigest() != entry["sha256"]:
             _unusable(f"the bytes of degree {d} do not match their SHA-256")
             return False
 
@@ -168,18 +204,24 @@ def _load(header, series: str, n: int) -> bool:
     return True
 
 
-def _trees(generators: tuple, n: int) -> list:
+def _trees(generators: tuple, factors: list, n: int) -> list:
     """The standard bracketings of the Lyndon words of degrees ``1..n`` as one flat list (degree by degree,
-    lexicographic within a degree), leaves named by ``generators``, from the decoded standard factors."""
+    lexicographic within a degree), leaves named by ``generators``, from the standard factors of each degree.
+
+    Kept per generators and extended degree by degree; the caller holds :data:`_LOCK`."""
     state = _TREES.get(generators)
     if state is None:
         state = _TREES[generators] = [[generators[0], generators[1]], 1]
     trees = state[0]
-    for d in range(state[1] + 1, n + 1):
-        factors = _FACTORS[d - 1]
-        m = len(factors) // 2
-        trees.extend([(trees[left], trees[right]) for left, right in zip(factors[:m], factors[m:])])
-        state[1] = d
+    if state[1] < n:
+        from .formal import _no_full_collection
+
+        with _no_full_collection():  # acyclic tuples: nothing for the collector to find
+            for d in range(state[1] + 1, n + 1):
+                pairs = factors[d - 1]
+                m = len(pairs) // 2
+                trees.extend([(trees[left], trees[right]) for left, right in zip(pairs[:m], pairs[m:])])
+                state[1] = d
     return trees
 
 
@@ -207,7 +249,8 @@ def serve(letters, values, q: int, generators: tuple, n: int, denominators):
     ``letters`` (``0`` for the smaller generator) and ``values`` (integers, coefficients
     ``values / q``) describe the factors, ``denominators[d] = D_d``; the numerators are
     ``D_d`` times the coefficients, the same Python ints the engine returns, non-zero ones only,
-    Lyndon words of each degree in lexicographic order.
+    Lyndon words of each degree in lexicographic order.  The mapping (:class:`Served`) builds a degree's
+    pairs when it is asked for; the stored numerators stay machine integers until then.
     """
     if len(generators) != 2 or n < 1:
         return None
@@ -221,22 +264,57 @@ def serve(letters, values, q: int, generators: tuple, n: int, denominators):
     with _LOCK:  # the decoded degrees are appended in order: one request at a time extends them
         if not _load(header, series, n):
             return None
-        trees = _trees(tuple(generators), n)
-    out = {}
+        factors = _FACTORS[:n]
+        stored = {d: _NUMERATORS[series, d] for d in range(1, n + 1)}
+    degrees = header["degrees"]
+    parts = {}
     start = 0
     for d in range(1, n + 1):
-        entry = header["degrees"][d - 1]
-        stored = _NUMERATORS[series, d]
-        if stored:
+        if stored[d]:
             # D_d / T_d is an integer: T_d is the least common denominator of the degree, and D_d times every
             # coefficient is an integer (the engines' denominators, nambu_bch.bch.formal)
-            factor, rest = divmod(denominators[d], int(entry[series][3]))
+            factor, rest = divmod(denominators[d], int(degrees[d - 1][series][3]))
             if rest:
                 raise ArithmeticError(f"internal error: the BCH table's degree-{d} denominator does not divide "
                                       f"{denominators[d]}")
-            if flip and d % 2 == 0:
-                factor = -factor
-            window = range(start, start + entry["count"])
-            out[d] = (denominators[d], tuple((v * factor, trees[k]) for v, k in zip(stored, window) if v))
-        start += entry["count"]
-    return out
+            parts[d] = (denominators[d], -factor if flip and d % 2 == 0 else factor, stored[d], start)
+        start += degrees[d - 1]["count"]
+    return Served(tuple(generators), factors, parts)
+
+
+class Served(Mapping):
+    """``{degree: (D_d, ((numerator, tree), ...))}`` read from the table, each degree built when it is asked for.
+
+    Holds per degree ``D_d``, the factor ``D_d / T_d`` (negated in the even degrees of the reversed product
+    ``log(e^B e^A)``), the stored numerators ``n_w`` and the index of the degree's first word among the trees; a
+    degree's pairs ``(n_w D_d / T_d, P_w)`` are built on each access (nothing is kept but the trees,
+    shared by every request).  Pickles as the plain dict it stands for.
+    """
+
+    __slots__ = ("_generators", "_factors", "_parts")
+
+    def __init__(self, generators: tuple, factors: list, parts: dict):
+        self._generators, self._factors, self._parts = generators, factors, parts
+
+    def __getitem__(self, degree):
+        den, factor, stored, start = self._parts[degree]
+        with _LOCK:
+            trees = _trees(self._generators, self._factors, len(self._factors))
+        return den, tuple([(v * factor, trees[k]) for v, k in zip(stored, range(start, start + len(stored))) if v])
+
+    def __iter__(self):
+        return iter(self._parts)
+
+    def __len__(self):
+        return len(self._parts)
+
+    def __contains__(self, degree):
+        return degree in self._parts
+
+    def count(self, degree) -> int:
+        """The number of non-zero terms of ``degree`` (0 when it has none), without building them."""
+        part = self._parts.get(degree)
+        return 0 if part is None else len(part[2]) - part[2].count(0)
+
+    def __reduce__(self):
+        return dict, (list(self.items()),)
