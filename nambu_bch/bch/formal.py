@@ -50,9 +50,7 @@ Algebras*, Thm. 5.1 (Lyndon basis); Casas & Murua, J. Math. Phys. 50 (2009)
 
 from __future__ import annotations
 
-import gc
 import sys
-from contextlib import contextmanager
 from dataclasses import dataclass, field
 from fractions import Fraction
 from functools import lru_cache
@@ -65,6 +63,7 @@ from ..errors import InvalidCompositionError, InvalidOrderError
 from ..printable import Printable
 from ..values import ValueEquality
 from . import table as _table
+from .collector import no_full_collection
 from .light import Word, parse_word
 from .lyndon import (
     divisors,
@@ -728,7 +727,7 @@ def _formal(comp, max_degree, use_table: bool) -> FormalBCH:
         big = lcm(*range(1, n + 1))
         dens = [factorial(d) * big * scalars.q**d for d in range(n + 1)]
         letters = [generators.index(k) for k in comp.pieces]
-        with _no_full_collection():
+        with no_full_collection():
             numerators = lyndon_numerators(letters, scalars.values, scalars.q, g, n, dens)
             if numerators is not None:
                 trees = _duval_trees(g, n, generators)
@@ -745,22 +744,6 @@ def _sparse_engine_loaded() -> bool:
     """The compiled engine has run in this process (numba's start-up is paid)."""
     modular = sys.modules.get("nambu_bch.bch.modular")
     return modular is not None and modular.runs > 0
-
-
-@contextmanager
-def _no_full_collection():
-    """Pause the cyclic garbage collector while the sparse engine builds its (acyclic) tuples and ints.
-
-    Tens of thousands of new objects otherwise trigger a full collection that walks every object
-    of the interpreter (sympy's caches: about 70 ms, more than the whole computation at degree
-    16); nothing allocated here forms a cycle, so nothing is left for the collector to find."""
-    was_enabled = gc.isenabled()
-    gc.disable()
-    try:
-        yield
-    finally:
-        if was_enabled:
-            gc.enable()
 
 
 def _formal_dense(comp, generators: tuple, n: int) -> FormalBCH:

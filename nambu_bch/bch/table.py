@@ -54,6 +54,8 @@ from array import array
 from collections.abc import Mapping
 from fractions import Fraction
 
+from .collector import no_full_collection
+
 #: SHA-256 of the table's header (which holds the SHA-256 of each degree's bytes); written by tools/build_bch_table.py.
 TABLE_SHA256 = "eb0531b5d621fd793d0d06a1dc0d4ccb4b40bb7053b1c4d7684ba7499faa3737"
 #: The table file shipped with the package.
@@ -214,9 +216,7 @@ def _trees(generators: tuple, factors: list, n: int) -> list:
         state = _TREES[generators] = [[generators[0], generators[1]], 1]
     trees = state[0]
     if state[1] < n:
-        from .formal import _no_full_collection
-
-        with _no_full_collection():  # acyclic tuples: nothing for the collector to find
+        with no_full_collection():  # acyclic tuples: nothing for the collector to find
             for d in range(state[1] + 1, n + 1):
                 pairs = factors[d - 1]
                 m = len(pairs) // 2
