@@ -479,6 +479,11 @@ def _lyndon_coordinates(vector, d: int, g: int):
 class FormalBCH(Printable, ValueEquality):
     """``log(exp(c_1 X_{k_1}) ... exp(c_s X_{k_s}))`` through ``max_degree`` in the Lyndon basis.
 
+    A series served from the table holds the word as read without sympy (:class:`~nambu_bch.bch.light.Word`)
+    and its numerators as the table stores them: :attr:`composition`, :meth:`terms` and :meth:`to_latex` build
+    the sympy objects when first asked; :meth:`scaled_terms`, :meth:`to_text`, :attr:`degrees` and ``len``
+    need none.
+
     Attributes
     ----------
     composition : Composition
@@ -486,11 +491,6 @@ class FormalBCH(Printable, ValueEquality):
         The distinct piece numbers, in increasing order: the ordered alphabet of
         the Lyndon basis (piece ``k`` is the generator ``X_k``).
     max_degree : int
-
-    A series served from the table holds the word as read without sympy (:class:`~nambu_bch.bch.light.Word`)
-    and its numerators as the table stores them: :attr:`composition`, :meth:`terms` and :meth:`to_latex` build
-    the sympy objects when first asked; :meth:`scaled_terms`, :meth:`to_text`, :attr:`degrees` and ``len``
-    need none.
     """
 
     _composition: object  # Composition, or the light Word it is built from when asked

@@ -416,14 +416,16 @@ FIResult.corrections = _lazy("corrections")
 class AlphaFamily:
     """One order's alpha-family as exact data: ``(1 - alpha) m_0 + alpha m_1`` from its two canonical members.
 
-    Attributes
-    ----------
-    algebra : the algebra of the solve (its ring holds the polynomials)
-    members : ``(m_0, m_1)``; a member is one tuple per slot of pairs ``(k, dH_k)``: ``dH_k`` the coefficient
-        of ``alpha^k`` (a ring element, polynomial in the coordinates)
-
     The sympy forms (:meth:`forms`) are those the FI route printed before it kept exact data: each member
     expanded from its monomial terms, the family ``sympy.expand((1 - alpha) m_0 + alpha m_1)``.
+
+    Attributes
+    ----------
+    algebra
+        The algebra of the solve (its ring holds the polynomials).
+    members
+        ``(m_0, m_1)``; a member is one tuple per slot of pairs ``(k, dH_k)``: ``dH_k`` the coefficient of
+        ``alpha^k`` (a ring element, polynomial in the coordinates).
     """
 
     algebra: object
