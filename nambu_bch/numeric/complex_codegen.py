@@ -153,7 +153,7 @@ import math
 _exp, _expm1, _log, _sqrt = math.exp, math.expm1, math.log, math.sqrt
 _sin, _cos, _tan, _sinh, _cosh, _tanh = math.sin, math.cos, math.tan, math.sinh, math.cosh, math.tanh
 _atan, _asin, _acos = math.atan, math.asin, math.acos
-_pi, _e = math.pi, math.e
+_pi, _e, _cpi, _ce = math.pi, math.e, math.pi, math.e  # pi and E under both prefixes (constants, loop)
 {loop_functions}
 _cisfinite = cmath.isfinite
 '''
