@@ -11,8 +11,9 @@ exponent vectors.  Everything here is an exact reduced row echelon form
 ``{index: value}`` with values in the domain.
 
 The echelon form is unique, so its routes are interchangeable and give identical
-results: the matrix is split into the blocks of its sparsity graph; over ``QQ`` a block
-is eliminated densely by python-flint's ``fmpq_mat`` (a dependency;
+results: the matrix is split into the blocks of its sparsity graph; over ``QQ`` a sparse block (at most
+:data:`SPARSE_ROW_ENTRIES` entries a row) is first eliminated sparsely (:func:`_rref_sparse`, in column order, within
+a budget of entry updates), otherwise, or past that budget, densely by python-flint's ``fmpq_mat`` (a dependency;
 ``NAMBU_BCH_DISABLE_FLINT=1`` switches it off), without it multi-modularly in numpy with an exact check of the
 result (:mod:`nambu_bch.algebra.modular_rref`, blocks of at least :data:`MODULAR_MIN` rows and columns); over ``QQ<theta>`` or
 ``QQ<theta>(parameters)`` (triple-jump coefficients) a matrix with entries in the base
@@ -38,7 +39,8 @@ field is eliminated there, right-hand sides split along ``1, theta, ..``
 
 References
 ----------
-sympy ``DomainMatrix`` (``sympy/polys/matrices``); FLINT ``fmpq_mat_rref``; Cabay (1971) and von zur Gathen &
+sympy ``DomainMatrix`` (``sympy/polys/matrices``); FLINT ``fmpq_mat_rref``; Markowitz (1957) and Duff, Erisman &
+Reid, *Direct Methods for Sparse Matrices*, ch. 7 (the sparse pass); Cabay (1971) and von zur Gathen &
 Gerhard, *Modern Computer Algebra*, ch. 5 (the modular route); Horikoshi, Sect. 4.2
 (the identification ``X_eff = X_{H_S,G_S}``, Eq. L2, is linear order by order).
 """
@@ -567,7 +569,8 @@ def _rref_block(rows: dict, nrows: int, ncols: int, domain, lift: bool = True):
 
     ``R`` is ``{row: {column: value}}`` (the ``rank`` non-zero rows, pivot entries one),
     ``pivots`` the pivot columns.  The reduced echelon form is unique, so every route gives
-    the same ``R`` (:func:`_rref` calls it on each block): dense ``fmpq_mat`` (python-flint) over ``QQ``, else
+    the same ``R`` (:func:`_rref` calls it on each block): over ``QQ`` the sparse pass (:func:`_rref_sparse`) when
+    the rows are sparse and it stays within its budget (:data:`SPARSE_RATIO`), then dense ``fmpq_mat`` (python-flint), else
     :func:`~nambu_bch.algebra.modular_rref.rref_qq` for blocks of at least :data:`MODULAR_MIN` rows and columns; over an algebraic
     extension, the base field when every entry lies in it (:class:`_AlgebraicSplit`);
     otherwise sympy's sparse Gauss-Jordan (``DomainMatrix.rref``).  ``lift=False``: the
