@@ -454,7 +454,12 @@ def _rref(rows: dict, nrows: int, ncols: int, domain, lift: bool = True, link: i
         return _rref_block(live, nrows, ncols, domain, lift)
     out = []
     for members in groups.values():
-        cols = sorted({j for i in members for j in live[i]})
+        cols = {j for i in members for j in live[i]}
+        sparse = _sparse_first({i: live[i] for i in members}, len(members), len(cols), domain)
+        if sparse is not None:  # the sparse pass keeps the matrix's own column indices: nothing to renumber
+            out += sparse[0].values()
+            continue
+        cols = sorted(cols)
         index = {c: k for k, c in enumerate(cols)}
         block = {k: {index[j]: v for j, v in live[i].items()} for k, i in enumerate(members)}
         R, _ = _rref_block(block, len(members), len(cols), domain, lift)
@@ -474,6 +479,20 @@ def _rref(rows: dict, nrows: int, ncols: int, domain, lift: bool = True, link: i
 #: ``SPARSE_RATIO = None`` switches the sparse pass off, ``0`` runs it to the end on every ``QQ`` block.
 SPARSE_RATIO = 1500
 SPARSE_ROW_ENTRIES = 6
+
+
+def _sparse_first(rows: dict, nrows: int, ncols: int, domain):
+    """:func:`_rref_sparse` of a ``QQ`` block (no zero entries) when its rows are sparse enough and it finishes within
+    its budget (:data:`SPARSE_RATIO`, :data:`SPARSE_ROW_ENTRIES`); ``None`` otherwise (the block goes to the dense route)."""
+    if not (FAST_PATHS and domain.is_QQ and SPARSE_RATIO is not None and nrows * ncols <= FLINT_DENSE_LIMIT):
+        return None
+    entries = sum(map(len, rows.values()))
+    if SPARSE_RATIO == 0:
+        return _rref_sparse(rows, ncols, domain, None)
+    if entries > SPARSE_ROW_ENTRIES * len(rows):
+        return None
+    r = len(rows)
+    return _rref_sparse(rows, ncols, domain, r * ncols * min(r, ncols) // SPARSE_RATIO + 4 * entries)
 
 
 def _rref_sparse(rows: dict, ncols: int, domain, budget: int | None):
@@ -580,14 +599,10 @@ def _rref_block(rows: dict, nrows: int, ncols: int, domain, lift: bool = True):
     rows = {i: r for i, r in rows.items() if r}
     if not rows:
         return {}, ()
+    sparse = _sparse_first(rows, nrows, ncols, domain)
+    if sparse is not None:
+        return sparse
     if FAST_PATHS and domain.is_QQ and nrows * ncols <= FLINT_DENSE_LIMIT:
-        entries = sum(map(len, rows.values()))
-        if SPARSE_RATIO == 0 or (SPARSE_RATIO is not None and entries <= SPARSE_ROW_ENTRIES * len(rows)):
-            r, c = len(rows), ncols
-            budget = r * c * min(r, c) // SPARSE_RATIO + 4 * entries if SPARSE_RATIO else None
-            out = _rref_sparse(rows, ncols, domain, budget)
-            if out is not None:
-                return out
         if flint_available():
             return _rref_flint_qq(rows, nrows, ncols)
         if min(len(rows), ncols) >= MODULAR_MIN:
