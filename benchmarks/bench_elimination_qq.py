@@ -11,8 +11,8 @@ For each case (system, word, order) one ``shadow_hamiltonians(...).shadows`` cal
   numerator or denominator of an entry and of the reduced echelon form, in bits);
 * the process CPU seconds of eliminating all of them again, interleaved, by: flint's dense ``fmpq_mat.rref`` read
   as before (every entry of the reduced form made an object), flint's dense ``fmpq_mat.rref`` read at the pivots'
-  rows and free columns only (``SPARSE_RATIO = None``), the sparse pass run to the end on every block (``SPARSE_RATIO = 0``), and the
-  package's choice (sparse pass for sparse rows within its budget, else dense); best of three, with the load.
+  rows and free columns only (``SPARSE_RATIO = None``), the sparse pass run to the end on every block
+  (``SPARSE_RATIO = 0``), and the package's choice (sparse pass for sparse rows within its budget, else dense); best of three, with the load.
 
 Every route must give the same reduced echelon forms; the script checks that too.
 """
@@ -124,6 +124,7 @@ if __name__ == "__main__":
     if not E.flint_available():
         sys.exit("python-flint is off (NAMBU_BCH_DISABLE_FLINT): this script compares against its dense route")
     cases = CASES[:2] if "--quick" in sys.argv else CASES
-    print(f"QQ blocks of the direct route, eliminated again by each route (CPU s, best of 3; load {os.getloadavg()[0]:.1f})")
+    print("QQ blocks of the direct route, eliminated again by each route "
+          f"(CPU s, best of 3; load {os.getloadavg()[0]:.1f})")
     ok = all([report(*case) for case in cases])
     sys.exit(0 if ok else 1)

@@ -1,6 +1,7 @@
 """Backward error analysis (nambu_bch/bch/backward.py): what the modified field's recursion computes.
 
-``Z_j^i = [h^(j+1)] Phi^* x_i - sum_{k >= 2} [h^(j+1)] (hY)^k x_i / k!`` with ``[h^m] U_k = sum_l Z_l [h^(m-1-l)] U_{k-1}``
+``Z_j^i = [h^(j+1)] Phi^* x_i - sum_{k >= 2} [h^(j+1)] (hY)^k x_i / k!`` with
+``[h^m] U_k = sum_l Z_l [h^(m-1-l)] U_{k-1}``
 (Hairer, Lubich, Wanner, *Geometric Numerical Integration*, Sect. IX.1).  A symmetric composition has ``Z_l = 0``
 for every odd ``l`` (ibid., Theorem IX.3.2), so the recursion applies only the non-zero ``Z_l``.
 """

@@ -482,8 +482,8 @@ SPARSE_ROW_ENTRIES = 6
 
 
 def _sparse_first(rows: dict, nrows: int, ncols: int, domain):
-    """:func:`_rref_sparse` of a ``QQ`` block (no zero entries) when its rows are sparse enough and it finishes within
-    its budget (:data:`SPARSE_RATIO`, :data:`SPARSE_ROW_ENTRIES`); ``None`` otherwise (the block goes to the dense route)."""
+    """:func:`_rref_sparse` of a ``QQ`` block (no zero entries) when its rows are sparse enough and it finishes
+    within its budget (:data:`SPARSE_RATIO`, :data:`SPARSE_ROW_ENTRIES`); ``None`` otherwise (then the dense route)."""
     if not (FAST_PATHS and domain.is_QQ and SPARSE_RATIO is not None and nrows * ncols <= FLINT_DENSE_LIMIT):
         return None
     entries = sum(map(len, rows.values()))
@@ -496,7 +496,7 @@ def _sparse_first(rows: dict, nrows: int, ncols: int, domain):
 
 
 def _rref_sparse(rows: dict, ncols: int, domain, budget: int | None):
-    """The reduced row echelon form by sparse Gauss-Jordan in column order: ``(R, pivots)``, or ``None`` past ``budget``.
+    """The reduced row echelon form by sparse Gauss-Jordan in column order: ``(R, pivots)``; ``None`` past ``budget``.
 
     The columns are taken in increasing order; the pivot of column ``j`` is the shortest row (then the
     lowest index) among the rows not yet used whose entry at ``j`` is non-zero, and ``j`` is eliminated from the
@@ -589,7 +589,8 @@ def _rref_block(rows: dict, nrows: int, ncols: int, domain, lift: bool = True):
     ``R`` is ``{row: {column: value}}`` (the ``rank`` non-zero rows, pivot entries one),
     ``pivots`` the pivot columns.  The reduced echelon form is unique, so every route gives
     the same ``R`` (:func:`_rref` calls it on each block): over ``QQ`` the sparse pass (:func:`_rref_sparse`) when
-    the rows are sparse and it stays within its budget (:data:`SPARSE_RATIO`), then dense ``fmpq_mat`` (python-flint), else
+    the rows are sparse and it stays within its budget (:data:`SPARSE_RATIO`), then dense ``fmpq_mat``
+    (python-flint), else
     :func:`~nambu_bch.algebra.modular_rref.rref_qq` for blocks of at least :data:`MODULAR_MIN` rows and columns; over an algebraic
     extension, the base field when every entry lies in it (:class:`_AlgebraicSplit`);
     otherwise sympy's sparse Gauss-Jordan (``DomainMatrix.rref``).  ``lift=False``: the
