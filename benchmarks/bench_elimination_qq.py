@@ -12,7 +12,8 @@ For each case (system, word, order) one ``shadow_hamiltonians(...).shadows`` cal
 * the process CPU seconds of eliminating all of them again, interleaved, by: flint's dense ``fmpq_mat.rref`` read
   as before (every entry of the reduced form made an object), flint's dense ``fmpq_mat.rref`` read at the pivots'
   rows and free columns only (``SPARSE_RATIO = None``), the sparse pass run to the end on every block
-  (``SPARSE_RATIO = 0``), and the package's choice (sparse pass for sparse rows within its budget, else dense); best of three, with the load.
+  (``SPARSE_RATIO = 0``), and the package's choice (sparse pass for sparse rows within its budget, else dense);
+  best of three, with the load.
 
 Every route must give the same reduced echelon forms; the script checks that too.
 """
