@@ -5,6 +5,8 @@ pivots, the same particular solution (free columns zero), the same kernel basis 
 same certificate as sympy's sparse Gauss-Jordan ``DomainMatrix.rref`` over the full domain
 (``FAST_PATHS = False``).  The routes under test:
 
+* over ``QQ``, the sparse Gauss-Jordan in column order that runs first (``_rref_sparse``, within its budget of
+  entry updates, else the block goes on to the dense routes);
 * dense ``fmpq_mat.rref`` of python-flint over ``QQ`` (and, with ``NAMBU_BCH_DISABLE_FLINT=1``,
   the pure-sympy path the package keeps when python-flint is absent);
 * without python-flint, the multi-modular elimination over ``QQ`` (``algebra/modular_rref.py``; route
@@ -53,10 +55,14 @@ def flint_switch(request, monkeypatch):
 @pytest.fixture
 def route_switch(route, monkeypatch):
     """The route of a ``(domain_name, route)`` parameter (see ``ROUTES``)."""
-    return _switch(route, monkeypatch)
+    return _switch(route, monkeypatch, dense=True)
 
 
-def _switch(route, monkeypatch):
+def _switch(route, monkeypatch, dense=False):
+    """Select a route; ``dense=True`` (the random systems) also switches off the sparse pass over ``QQ``, so that
+    ``flint`` is flint's dense ``fmpq_mat.rref`` alone (the sparse pass has its own tests below)."""
+    if route in ("sympy-only", "modular") or dense:
+        monkeypatch.setattr(E, "SPARSE_RATIO", None)
     if route in ("sympy-only", "modular"):
         monkeypatch.setenv("NAMBU_BCH_DISABLE_FLINT", "1")
         monkeypatch.setattr(E, "MODULAR_MIN", 1 if route == "modular" else 10**9)
@@ -286,3 +292,76 @@ def test_elimination_takes_only_a_sparse_matrix(call):
 def test_sparse_matrix_refuses_entries_outside_its_shape(args, fragment):
     with pytest.raises(E.NambuBCHError, match=fragment.replace("(", r"\(").replace(")", r"\)")):
         E.SparseMatrix(*args, QQ)
+
+
+# -- the sparse pass over QQ -------------------------------------------------------------------------------------
+
+@st.composite
+def qq_blocks(draw):
+    """A random sparse matrix over QQ (rows ``{column: value}``), sometimes with rows that are combinations of others
+    (rank deficiency, fill-in when they are eliminated)."""
+    nrows, ncols = draw(st.integers(1, 9)), draw(st.integers(1, 9))
+    entry = st.builds(lambda p, q: QQ(p, q), st.integers(-7, 7), st.integers(1, 5))
+    rows = {i: draw(st.dictionaries(st.integers(0, ncols - 1), entry, max_size=3)) for i in range(nrows)}
+    if draw(st.booleans()) and nrows > 2:
+        c1, c2 = draw(entry), draw(entry)
+        mix = {j: c1 * rows[0].get(j, QQ(0)) + c2 * rows[1].get(j, QQ(0)) for j in range(ncols)}
+        rows[nrows - 1] = mix
+    rows = {i: {j: v for j, v in r.items() if v} for i, r in rows.items()}
+    return {i: r for i, r in rows.items() if r}, nrows, ncols
+
+
+@settings(max_examples=40, deadline=None, derandomize=True)
+@given(qq_blocks())
+def test_sparse_pass_is_the_reduced_echelon_form(block):
+    """The sparse Gauss-Jordan in column order gives the unique reduced echelon form: the same rows (entries in
+    column order), values and pivots as sympy's ``DomainMatrix.rref``; with no budget left it gives up (``None``)."""
+    rows, nrows, ncols = block
+    if not rows:
+        return
+    R, pivots = E._rref_sparse(rows, ncols, QQ, None)
+    ref, ref_pivots = E._sdm(rows, nrows, ncols, QQ).rref()
+    assert pivots == tuple(ref_pivots)
+    assert R == {k: dict(sorted(r.items())) for k, r in ref.rep.to_sdm().items()}
+    assert all(list(r) == sorted(r) for r in R.values())
+    if len(rows) > 1 and pivots:
+        assert E._rref_sparse(rows, ncols, QQ, -1) is None
+
+
+def _banded(n, m):
+    """An n x m matrix over QQ with three entries per row (a band), the sparsity of the direct route's blocks."""
+    return {i: {j % m: QQ(1 + (i * j) % 5, 1 + j % 3) for j in (i, i + 1, i + 7)} for i in range(n)}
+
+
+def test_sparse_matrices_over_qq_are_eliminated_sparsely(monkeypatch):
+    """A sparse 150 x 100 block (three entries a row) is reduced by the sparse pass within its budget, without the dense
+    routes; with the sparse pass switched off (``SPARSE_RATIO = None``) flint's dense route gives the same form."""
+    rows = _banded(150, 100)
+    dense = []
+    original = E._rref_flint_qq
+    monkeypatch.setattr(E, "_rref_flint_qq", lambda *a: dense.append(a) or original(*a))
+    R, pivots = E._rref_block(rows, 150, 100, QQ)
+    assert not dense
+    monkeypatch.setattr(E, "SPARSE_RATIO", None)
+    if E.flint_available():
+        assert E._rref_block(rows, 150, 100, QQ) == (R, pivots) and dense
+    ref, ref_pivots = E._sdm(rows, 150, 100, QQ).rref()
+    assert pivots == tuple(ref_pivots) and R == {k: dict(sorted(r.items())) for k, r in ref.rep.to_sdm().items()}
+
+
+def test_dense_matrices_over_qq_leave_the_sparse_pass(monkeypatch):
+    """A nearly full 40 x 40 block never enters the sparse pass (more than SPARSE_ROW_ENTRIES entries a row); a 60 x 60
+    block with five scattered entries a row enters it, fills in, gives up within its budget; the dense route (flint,
+    or without it the multi-modular one) eliminates both, with the same result as sympy's."""
+    full = {i: {j: QQ((i + 1) * (j + 2) % 11 + (i == j), 1 + (i + j) % 4) for j in range(40)} for i in range(40)}
+    scattered = {i: {(i * 7 + 13 * k * k + k) % 60: QQ(1 + (i + k) % 6, 1 + k) for k in range(5)} for i in range(60)}
+    spent = []
+    original = E._rref_sparse
+    monkeypatch.setattr(E, "_rref_sparse", lambda *a: spent.append(original(*a)) or spent[-1])
+    for rows, n, entered in ((full, 40, False), (scattered, 60, True)):
+        rows = {i: {j: v for j, v in r.items() if v} for i, r in rows.items()}  # sympy's SDM holds no zeros
+        spent.clear()
+        R, pivots = E._rref_block(rows, n, n, QQ)
+        assert spent == ([None] if entered else [])
+        ref, ref_pivots = E._sdm(rows, n, n, QQ).rref()
+        assert pivots == tuple(ref_pivots) and R == {k: dict(sorted(r.items())) for k, r in ref.rep.to_sdm().items()}

@@ -209,8 +209,8 @@ def test_bounded_work_refuses_an_elimination_above_the_cost_budget(ex17, ex17_12
     # ... as the default run (shadow_hamiltonians, max_unknowns 2000, budget SOLVE_COST) did: obstructed
     assert ex17_12321.details.orders[-1].status == "obstructed" and ex17_12321.details.orders[-1].degree == 14
     eliminated = []
-    original = elimination._rref_block
-    monkeypatch.setattr(elimination, "_rref_block", lambda *a, **k: eliminated.append(a) or original(*a, **k))
+    original = elimination._rref
+    monkeypatch.setattr(elimination, "_rref", lambda *a, **k: eliminated.append(a) or original(*a, **k))
     monkeypatch.setattr(dr, "SOLVE_COST", cost - 1)
     R = direct_route(ex17, "12321", 2, max_unknowns=2000)
     assert R.orders[-1].status == "refused" and R.orders[-1].degree == 14 and not eliminated

@@ -180,6 +180,7 @@ class PolynomialBackend:
         self._monomials: dict = {}  # Laurent monomial -> its canonical QQ(parameters) coefficient
         self.flint = None  # flint's fmpz_mpoly context of the bracket ring, when brackets run there (_use_flint)
         self.flint_q = None  # flint's fmpq_mpoly context of the value ring, when apply runs there (_use_flint)
+        self._exponents: dict = {}  # flint's exponent tuple (fmpz) -> the same as Python ints, for _apply_flint
 
     # -- construction -------------------------------------------------------------
     @classmethod
@@ -453,7 +454,16 @@ class PolynomialBackend:
                     total = c * d if total is None else total + c * d
         if total is None or total.is_zero():
             return self.zero
-        poly = self.ring.dtype(zip(exponents(total), total.coeffs()))
+        # flint's exponents are fmpz, which must not reach sympy's ring; a series of backward error analysis meets
+        # the same few thousand monomials again and again, and a dictionary lookup costs a fifth of converting them
+        known = self._exponents
+        monoms = []
+        for m in total.monoms():
+            e = known.get(m)
+            if e is None:
+                e = known[m] = tuple(map(int, m))
+            monoms.append(e)
+        poly = self.ring.dtype(zip(monoms, total.coeffs()))
         degrees = total.degrees()  # no term holds both p and p_inv unless both occur: then no reduction to do
         return self.reduce(poly) if any(degrees[i] > 0 and degrees[j] > 0 for i, j in self._pairs) else poly
 

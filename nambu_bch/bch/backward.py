@@ -211,6 +211,9 @@ def modified_field_of_map(backend, pulled, order) -> tuple:
     # U[i][k][m] = [h^m] (hY)^k x_i
     U = [[[x] + [zero] * top] + [[zero] * (top + 1) for _ in range(top)] for x in coords]
     inverse_factorial = [backend.rational(1 / sympy.factorial(k)) for k in range(top + 1)]
+    # the l with Z_l != 0, increasing: a zero field adds nothing to a sum, and a symmetric composition has no odd
+    # Z_l, so half of the O(order^3) applications below would apply a zero field
+    live = []
     for j in range(order + 1):
         m = j + 1
         comps = []
@@ -219,12 +222,16 @@ def modified_field_of_map(backend, pulled, order) -> tuple:
             rest = zero
             for k in range(2, m + 1):
                 value = zero
-                for l in range(0, m - k + 1):
+                for l in live:
+                    if l > m - k:
+                        break
                     value = value + backend.apply(Z[l], Ui[k - 1][m - 1 - l])
                 Ui[k][m] = value
                 rest = rest + value * inverse_factorial[k]
             comps.append(pulled[i][m] - rest)
         Z.append(backend.field(comps))
+        if not backend.is_zero(Z[j]):
+            live.append(j)
         for i in range(n):
             U[i][1][m] = comps[i]
     return tuple(backend.vector_field(backend.values(Zj)) for Zj in Z)
