@@ -75,14 +75,13 @@ SERIES = {
 OURS_COLD = r"""
 import sys
 from nambu_bch.bch import formal_bch
-from nambu_bch.bch.lyndon import tree_leaves
 spec, n, out = sys.argv[1], int(sys.argv[2]), sys.argv[3]
 B = formal_bch(spec, n)
+digits = bytes.maketrans(bytes(range(10)), b"0123456789")  # the pieces here are 1, 2, 3: one digit each
 with open(out, "w") as fh:
     for d in range(1, n + 1):
-        den, items = B.scaled_terms(d)
-        for num, tree in items:
-            fh.write("%s %d %d\n" % ("".join(map(str, tree_leaves(tree))), num, den))
+        den, items = B.iter_scaled_words(d)
+        fh.writelines("%s %d %d\n" % (bytes(word).translate(digits).decode(), num, den) for num, word in items)
 """
 
 COLD_PARTS = r"""

@@ -129,3 +129,15 @@ def test_tree_leaves_with_and_without_sympy_agree():
     trees = [t for d in range(1, 9) for _, t in formal_bch("12", 8).scaled_terms(d)[1]]
     assert [lyndon._pair_leaves(t) for t in trees] == [lyndon._leaves(t, lyndon._sympy_basic()) for t in trees]
     assert lyndon._pair_leaves(((1, 2), 2)) == (1, 2, 2) == lyndon.tree_leaves(((1, 2), 2))
+
+
+def test_the_light_word_is_an_immutable_value():
+    """A :class:`light.Word` compares, hashes and pickles by its fields and refuses assignment."""
+    word = light.parse_word("TVT")
+    assert word == light.parse_word("TVT") and hash(word) == hash(light.parse_word("TVT"))
+    assert word != light.parse_word("121") and pickle.loads(pickle.dumps(word)) == word
+    assert repr(word).startswith("Word(spec='TVT', n_pieces=None, pieces=(1, 2, 1)")
+    with pytest.raises(AttributeError):
+        word.pieces = (1,)
+    with pytest.raises(AttributeError):
+        formal_bch("12", 2).max_degree = 3

@@ -158,3 +158,19 @@ def test_a_fresh_process_serves_without_numba_or_the_effective_field_modules(tmp
     assert run.returncode == 0, run.stderr
     assert run.stdout.split(None, 1) == ["76760", "[]\n"]  # the C program's count for degree 20 (bch_c_reference)
     assert "Warning" not in run.stderr
+
+
+@pytest.mark.parametrize("spec", ["12", "21", "121", "212", "13", "1:1/2,3:1,1:1/2"])
+def test_words_are_the_leaves_of_the_trees(spec):
+    """``scaled_words`` (built from the table's standard factors, no tree walked) equals the leaves of
+    ``scaled_terms``, and the engine's ``scaled_words``, degree by degree."""
+    from nambu_bch.bch.lyndon import tree_leaves
+
+    served = formal_bch(spec, 9)
+    den, items = served.iter_scaled_words(9)
+    assert table._TREES == {} and den == served.scaled_terms(9)[0]  # words without a single tree built
+    engine = _engine(spec, 9)
+    for d in range(1, 10):
+        den, items = served.scaled_terms(d)
+        assert served.scaled_words(d) == (den, [(n, tree_leaves(t)) for n, t in items]) == engine.scaled_words(d)
+    assert list(served.iter_scaled_words(0)[1]) == []

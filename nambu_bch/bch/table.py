@@ -47,7 +47,7 @@ import json
 import os
 import stat
 import sys
-import threading
+import _thread
 import warnings
 import zlib
 from array import array
@@ -94,15 +94,17 @@ _FIRST_BLOCKS = 16384
 _TYPECODES = {array(code).itemsize: code for code in "bhiq"}
 _HEADER: list = []  # [header dict] once read and verified; [None] when the table is unusable in this process
 _TREES: dict = {}  # generators -> [flat list of the trees, degrees done]
+_WORDS: dict = {}  # generators -> [flat list of the Lyndon words as bytes of piece numbers, degrees done]
 _FACTORS: list = []  # per degree decoded so far: the standard factors (left indices + right indices)
 _NUMERATORS: dict = {}  # (series, degree) -> the stored numerators n_w as Python ints
-_LOCK = threading.Lock()
+_LOCK = _thread.allocate_lock()  # _thread: the threading module is not imported for one lock
 
 
 def clear_cache() -> None:
     """Forget the table's header, trees and decoded numerators (the next request reads the file again)."""
     _HEADER.clear()
     _TREES.clear()
+    _WORDS.clear()
     _FACTORS.clear()
     _NUMERATORS.clear()
 
@@ -225,6 +227,26 @@ def _trees(generators: tuple, factors: list, n: int) -> list:
     return trees
 
 
+def _words(generators: tuple, factors: list, n: int) -> list:
+    """The Lyndon words of degrees ``1..n`` as one flat list in the order of :func:`_trees`, each word the
+    ``bytes`` of its piece numbers (all below 256), from the standard factors: ``w = u v`` is one concatenation
+    of two shorter words, so no tree is walked.
+
+    Kept per generators and extended degree by degree; the caller holds :data:`_LOCK`."""
+    state = _WORDS.get(generators)
+    if state is None:
+        state = _WORDS[generators] = [[bytes(generators[:1]), bytes(generators[1:])], 1]
+    words = state[0]
+    if state[1] < n:
+        with no_full_collection():  # bytes objects only: nothing for the collector to find
+            for d in range(state[1] + 1, n + 1):
+                pairs = factors[d - 1]
+                m = len(pairs) // 2
+                words.extend([words[left] + words[right] for left, right in zip(pairs[:m], pairs[m:])])
+                state[1] = d
+    return words
+
+
 def _request(letters, values, q: int):
     """``(series, reversed)`` when the product is a stored series or the reverse of ``log(e^A e^B)``, else ``None``."""
     letters = tuple(letters)
@@ -301,6 +323,21 @@ class Served(Mapping):
         with _LOCK:
             trees = _trees(self._generators, self._factors, len(self._factors))
         return den, tuple([(v * factor, trees[k]) for v, k in zip(stored, range(start, start + len(stored))) if v])
+
+    def words(self, degree):
+        """``(D_d, iterator of (numerator, word))`` of ``degree``: the pairs of ``self[degree]`` with each tree
+        replaced by its Lyndon word (a tuple of piece numbers, the tree's leaves), built one by one from the
+        standard factors without the trees."""
+        den, factor, stored, start = self._parts[degree]
+        generators = self._generators
+        if max(generators) > 255:  # a word is kept as bytes of piece numbers: beyond a byte, walk the trees
+            from .lyndon import tree_leaves
+
+            den, items = self[degree]
+            return den, ((v, tree_leaves(t)) for v, t in items)
+        with _LOCK:
+            words = _words(generators, self._factors, len(self._factors))
+        return den, ((v * factor, tuple(words[k])) for v, k in zip(stored, range(start, start + len(stored))) if v)
 
     def __iter__(self):
         return iter(self._parts)
