@@ -63,8 +63,12 @@ class Word:
     __slots__ = ("spec", "n_pieces", "pieces", "coefficients", "name")
 
     def __init__(self, spec, n_pieces, pieces, coefficients, name):
-        for key, value in zip(self.__slots__, (spec, n_pieces, pieces, coefficients, name)):
-            object.__setattr__(self, key, value)
+        put = object.__setattr__
+        put(self, "spec", spec)
+        put(self, "n_pieces", n_pieces)
+        put(self, "pieces", pieces)
+        put(self, "coefficients", coefficients)
+        put(self, "name", name)
 
     def __setattr__(self, name, value):
         raise AttributeError(f"cannot assign to field {name!r}: a Word is immutable")
