@@ -92,13 +92,14 @@ def test_errors_are_the_full_parsers():
 
 def test_a_fresh_process_serves_the_table_without_sympy_or_numpy(tmp_path):
     """``formal_bch('12', 18)`` in a fresh interpreter, every degree's terms and the text of the other three
-    series: neither sympy nor numpy (nor numba) is imported."""
+    series: neither sympy nor numpy (nor numba) is imported, nor dataclasses (inspect) and json, which cost such a
+    process more than reading the series."""
     code = (
         "import sys; from nambu_bch.bch import formal_bch; B = formal_bch('12', 18)\n"
         "n = sum(len(B.scaled_terms(d)[1]) for d in range(1, 19))\n"
         "texts = [formal_bch(s, 5).to_text() for s in ('21', '121', '212', 'TVT')]\n"
-        "print(n, len(B), B.scaled_terms(3), texts[1][:40], sorted(m for m in ('sympy', 'numpy', 'numba') "
-        "if m in sys.modules))"
+        "print(n, len(B), B.scaled_terms(3), texts[1][:40], sorted(m for m in ('sympy', 'numpy', 'numba', "
+        "'dataclasses', 'inspect', 'json') if m in sys.modules))"
     )
     env = {**os.environ, "PYTHONPATH": str(ROOT), "NAMBU_BCH_CACHE": str(tmp_path / "cache")}
     run = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=tmp_path, env=env,
