@@ -31,7 +31,10 @@ Two measurements per row, the sides interleaved:
   included; the table's series import neither sympy nor numpy; numba's machine code from its on-disk cache
   where the engine runs; the series written to a file as ``word numerator denominator`` lines).  CPU
   (user + sys), wall seconds and peak RSS of each child from ``/usr/bin/time`` (the peak RSS of a child
-  forked from this large process would be inflated otherwise).
+  forked from this large process would be inflated otherwise).  Our children run with the package's bytecode
+  cached, as an installed package has it (``PYTHONDONTWRITEBYTECODE`` is dropped from their environment and the
+  untimed priming run writes it); the series is written from ``iter_scaled_words`` (the words built from the
+  table's standard factors, as the C program writes its table from its own).
   The numba cache is primed once, untimed, at the start (the first use after an install compiles the
   engine; that is a one-time cost and not what this row measures).
 
@@ -269,6 +272,10 @@ def main(argv=None):
     peer = Peer(checkout)
     c_env = dict(os.environ, OMP_NUM_THREADS="1", LD_LIBRARY_PATH=str(checkout))
     py_env = dict(os.environ, PYTHONPATH=str(ROOT) + os.pathsep + os.environ.get("PYTHONPATH", ""))
+    # our side as installed: `pip install .` compiles the package's bytecode, and the C side is compiled ahead too;
+    # with PYTHONDONTWRITEBYTECODE in the environment every cold child would compile our modules from source first
+    # (the untimed priming run below writes the bytecode instead)
+    no_bytecode = py_env.pop("PYTHONDONTWRITEBYTECODE", None) is not None
     subprocess.run([sys.executable, "-c", PRIME], check=True, env=py_env, cwd=ROOT)  # numba's disk cache filled
     formal_bch("123", 10)  # numba started in this process (the sparse engine has run)
 
@@ -276,6 +283,8 @@ def main(argv=None):
     jobs += [("121", int(d)) for d in args.sym_degrees.split(",") if d]
     jobs += [("12321", int(d)) for d in args.three_degrees.split(",") if d]
     print(f"# C: {exe} (CFLAGS '{CFLAGS}' with --build), OMP_NUM_THREADS=1; ours: {sys.executable}")
+    print(f"# ours cold: the package's bytecode cached, as `pip install .` leaves it"
+          + (" (PYTHONDONTWRITEBYTECODE removed from the children's environment)" if no_bytecode else ""))
     print(f"# warm = the call alone, in-process, median CPU s of --repeat calls (at least {SMALL_REPEAT} when a call "
           "takes under 10 ms); cold = whole process, CPU s (wall s), peak RSS MB; ratio = ours / C")
     print(f"{'series':>6} {'N':>3} {'terms':>6} | {'C warm':>8} {'ours warm':>9} {'by':>6} {'ratio':>6} {'+terms':>8} "
