@@ -25,7 +25,9 @@ Two measurements per row, the sides interleaved:
   the same call with the table bypassed (``formal._formal_engine``: what the engine alone costs).  One
   untimed call on each side first; then ``--repeat`` calls each (at least :data:`SMALL_REPEAT` when our
   untimed call took under 10 ms: one sub-millisecond call is mostly noise on a loaded machine), alternating,
-  the median CPU seconds reported.
+  the median CPU seconds reported; the previous round's result is freed before our timed call, and the
+  engine's calls and the check that the table's series is the engine's run after those rounds, not between
+  the two sides' calls.
 * cold, whole processes: the ``bch`` process (``table_output=1``, its table written to a file) and
   ``python -c`` importing ``nambu_bch`` and calling ``formal_bch`` (interpreter start and imports
   included; the table's series import neither sympy nor numpy; numba's machine code from its on-disk cache
@@ -302,14 +304,14 @@ def main(argv=None):
         if source == "table":
             engine(spec, n)
         c_warm, ours_warm, engine_warm, terms_warm = [], [], [], []
-        served = computed = None
-        for _ in range(repeat):
+        served = None
+        for _ in range(repeat):  # C and ours interleaved, nothing else between them
             t = time.process_time()
             peer.call(series, n)
             c_warm.append(time.process_time() - t)
-            # the previous round's results freed here, untimed: assigning the new result would free them inside the
-            # timed call (the C call frees only its own series, and so does ours); at degree 10 that doubled ours
-            served = computed = None
+            # the previous round's result freed here, untimed: assigning the new one would free it inside the
+            # timed call (the C call frees only its own series, and so does ours)
+            served = None
             clear_caches()
             t = time.process_time()
             served = formal_bch(spec, n)
@@ -318,12 +320,16 @@ def main(argv=None):
             for d in range(1, n + 1):
                 served.scaled_terms(d)
             terms_warm.append(time.process_time() - t)
-            if source == "table":
+        if source == "table":  # the engine alone, in rounds of its own (its memory traffic not between the sides)
+            computed = None
+            for _ in range(repeat):
+                computed = None
                 clear_caches()
                 t = time.process_time()
                 computed = engine(spec, n)
                 engine_warm.append(time.process_time() - t)
-                assert served == computed, (spec, n)  # the table's series is the engine's, numerator by numerator
+            assert served == computed, (spec, n)  # the table's series is the engine's, numerator by numerator
+            served = computed = None
         clear_caches()
         c_table, our_table = args.work / f"c_{series}_{n}.txt", args.work / f"ours_{series}_{n}.txt"
         c_args = [str(exe), f"N={n}", "table_output=1"] + ([f"expression={expression}"] if expression else [])
