@@ -97,14 +97,19 @@ except ImportError:
 
 
 def _sha256(data):
-    """SHA-256 of ``data``: hashlib's (OpenSSL, several times faster) when hashlib is imported already, else
+    """SHA-256 of ``data`` (:func:`_sha256_function`)."""
+    return _sha256_function()(data)
+
+
+def _sha256_function():
+    """The SHA-256 constructor: hashlib's (OpenSSL, several times faster) when hashlib is imported already, else
     CPython's own -- importing hashlib maps libcrypto, megabytes of a fresh process that reads the table."""
     hashlib = sys.modules.get("hashlib")
     if hashlib is None and _builtin_sha256 is not None:
-        return _builtin_sha256(data)
+        return _builtin_sha256
     if hashlib is None:
         import hashlib
-    return hashlib.sha256(data)
+    return hashlib.sha256
 
 
 #: Bytes read after the header with it (degrees 1-13 of the shipped table, 14 kB)
@@ -135,19 +140,37 @@ def _unusable(reason: str) -> None:
     _HEADER[:] = [None]
 
 
-def _open_table():
-    """The table file opened for reading: a regular file, never a link, FIFO or device (refused before it is opened,
-    so opening cannot block), and the very file checked (same device and inode after opening)."""
+def _read_table(offset: int, size: int, more=None) -> list:
+    """``[the table's bytes offset .. offset + size]``, and with ``more`` (a function of those bytes giving a second
+    ``(offset, size)`` or ``None``) the second span too, read from one opening of the file.
+
+    The file is opened only if it is a regular file, never a link, FIFO or device (refused before it is opened, so
+    opening cannot block), and read only if it is the very file checked (same device and inode after opening).
+    Positional reads on the descriptor: no buffered file object is built for two reads."""
     before = os.lstat(TABLE_PATH)
     if not stat.S_ISREG(before.st_mode):
         raise OSError(f"{TABLE_PATH} is not a regular file")
     flags = os.O_RDONLY | getattr(os, "O_NOFOLLOW", 0) | getattr(os, "O_NONBLOCK", 0) | getattr(os, "O_CLOEXEC", 0)
-    fh = os.fdopen(os.open(TABLE_PATH, flags), "rb")
-    st = os.fstat(fh.fileno())
-    if (st.st_dev, st.st_ino) != (before.st_dev, before.st_ino) or not stat.S_ISREG(st.st_mode):
-        fh.close()
-        raise OSError(f"{TABLE_PATH} was replaced while it was opened")
-    return fh
+    fd = os.open(TABLE_PATH, flags)
+    try:
+        st = os.fstat(fd)
+        if (st.st_dev, st.st_ino) != (before.st_dev, before.st_ino) or not stat.S_ISREG(st.st_mode):
+            raise OSError(f"{TABLE_PATH} was replaced while it was opened")
+        out = [_pread(fd, size, offset)]
+        span = more(out[0]) if more is not None else None
+        if span is not None:
+            out.append(_pread(fd, span[1], span[0]))
+        return out
+    finally:
+        os.close(fd)
+
+
+def _pread(fd: int, size: int, offset: int) -> bytes:
+    """Up to ``size`` bytes at ``offset`` (fewer only at the end of the file)."""
+    if hasattr(os, "pread"):
+        return os.pread(fd, size, offset)
+    os.lseek(fd, offset, os.SEEK_SET)  # no pread (Windows): the descriptor is this call's own
+    return os.read(fd, size)
 
 
 def _header():
@@ -157,15 +180,19 @@ def _header():
     "base" (where the blocks start in the file), "first_blocks"}``."""
     if _HEADER:
         return _HEADER[0]
+    lead = len(MAGIC) + 4
+
+    def rest(start):  # the header and, with it, the first blocks (one opening for a request to a low degree)
+        size = int.from_bytes(start[len(MAGIC) : lead], "little")
+        return (lead, size + _FIRST_BLOCKS) if start[: len(MAGIC)] == MAGIC and size < 2**20 else None
+
     try:
-        with _open_table() as fh:
-            start = fh.read(len(MAGIC) + 4)
-            size = int.from_bytes(start[len(MAGIC):], "little")
-            # the first blocks come with the header (one open for a request to a low degree, see _load)
-            raw = fh.read(size + _FIRST_BLOCKS) if start[: len(MAGIC)] == MAGIC and size < 2**20 else b""
+        parts = _read_table(0, lead, rest)
     except OSError as exc:
         _unusable(f"cannot read it: {exc.strerror or exc}")
         return None
+    size = int.from_bytes(parts[0][len(MAGIC) : lead], "little")
+    raw = parts[1] if len(parts) > 1 else b""
     raw, first_blocks = raw[:size], raw[size:]
     if _sha256(raw).hexdigest() != TABLE_SHA256:
         _unusable("its SHA-256 does not match the package's")
@@ -224,9 +251,7 @@ def _load(header, series: str, n: int) -> bool:
     else:
         shift = start  # the bytes read start there (the records' offsets count from the first block)
         try:
-            with _open_table() as fh:
-                fh.seek(header["base"] + start)
-                data = fh.read(stop - start)
+            data = _read_table(header["base"] + start, stop - start)[0]
         except OSError as exc:
             _unusable(f"cannot read it: {exc.strerror or exc}")
             return False
@@ -234,13 +259,14 @@ def _load(header, series: str, n: int) -> bool:
             _unusable("it is shorter than its header says")
             return False
     view = memoryview(data)
+    sha256 = _sha256_function()
     at = header["series"][series]
     swap = sys.byteorder == "big"  # the table is little-endian
     low = start
     for d in range(first, n + 1):
         record = degrees[d - 1]
         end = record[1]
-        if _sha256(view[low - shift : end - shift]).digest() != record[-1]:
+        if sha256(view[low - shift : end - shift]).digest() != record[-1]:
             _unusable(f"the bytes of degree {d} do not match their SHA-256")
             return False
         low = end
