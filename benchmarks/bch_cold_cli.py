@@ -143,8 +143,8 @@ def main(argv=None) -> int:
                   f"CPU {cpu / max(medians['baseline'][0], 1e-9):.2f}x baseline | {os.getloadavg()[0]:.2f}", flush=True)
     print(f"# phases of one fresh process (CPU s; median of {args.repeat}): start = the interpreter before the first "
           "statement, import = from nambu_bch.bch import formal_bch (modules it adds; RSS MB after it), call = "
-          "formal_bch('12', 18), write = every term as 'word numerator denominator' (words from iter_scaled_words where "
-          "the checkout has it, else tree_leaves)")
+          "formal_bch('12', 18), write = every term as 'word numerator denominator' (words from iter_scaled_words "
+          "where the checkout has it, else tree_leaves)")
     for name in sides:
         runs = []
         for _ in range(args.repeat):
