@@ -25,13 +25,18 @@ Two measurements per row, the sides interleaved:
   the same call with the table bypassed (``formal._formal_engine``: what the engine alone costs).  One
   untimed call on each side first; then ``--repeat`` calls each (at least :data:`SMALL_REPEAT` when our
   untimed call took under 10 ms: one sub-millisecond call is mostly noise on a loaded machine), alternating,
-  the median CPU seconds reported.
+  the median CPU seconds reported; the previous round's result is freed before our timed call, and the
+  engine's calls and the check that the table's series is the engine's run after those rounds, not between
+  the two sides' calls.
 * cold, whole processes: the ``bch`` process (``table_output=1``, its table written to a file) and
   ``python -c`` importing ``nambu_bch`` and calling ``formal_bch`` (interpreter start and imports
   included; the table's series import neither sympy nor numpy; numba's machine code from its on-disk cache
   where the engine runs; the series written to a file as ``word numerator denominator`` lines).  CPU
   (user + sys), wall seconds and peak RSS of each child from ``/usr/bin/time`` (the peak RSS of a child
-  forked from this large process would be inflated otherwise).
+  forked from this large process would be inflated otherwise).  Our children run with the package's bytecode
+  cached, as an installed package has it (``PYTHONDONTWRITEBYTECODE`` is dropped from their environment and the
+  untimed priming run writes it); the series is written from ``iter_scaled_words`` (the words built from the
+  table's standard factors, as the C program writes its table from its own).
   The numba cache is primed once, untimed, at the start (the first use after an install compiles the
   engine; that is a one-time cost and not what this row measures).
 
@@ -75,14 +80,13 @@ SERIES = {
 OURS_COLD = r"""
 import sys
 from nambu_bch.bch import formal_bch
-from nambu_bch.bch.lyndon import tree_leaves
 spec, n, out = sys.argv[1], int(sys.argv[2]), sys.argv[3]
 B = formal_bch(spec, n)
+digits = bytes.maketrans(bytes(range(10)), b"0123456789")  # the pieces here are 1, 2, 3: one digit each
 with open(out, "w") as fh:
     for d in range(1, n + 1):
-        den, items = B.scaled_terms(d)
-        for num, tree in items:
-            fh.write("%s %d %d\n" % ("".join(map(str, tree_leaves(tree))), num, den))
+        den, items = B.iter_scaled_words(d)
+        fh.writelines("%s %d %d\n" % (bytes(word).translate(digits).decode(), num, den) for num, word in items)
 """
 
 COLD_PARTS = r"""
@@ -270,6 +274,10 @@ def main(argv=None):
     peer = Peer(checkout)
     c_env = dict(os.environ, OMP_NUM_THREADS="1", LD_LIBRARY_PATH=str(checkout))
     py_env = dict(os.environ, PYTHONPATH=str(ROOT) + os.pathsep + os.environ.get("PYTHONPATH", ""))
+    # our side as installed: `pip install .` compiles the package's bytecode, and the C side is compiled ahead too;
+    # with PYTHONDONTWRITEBYTECODE in the environment every cold child would compile our modules from source first
+    # (the untimed priming run below writes the bytecode instead)
+    no_bytecode = py_env.pop("PYTHONDONTWRITEBYTECODE", None) is not None
     subprocess.run([sys.executable, "-c", PRIME], check=True, env=py_env, cwd=ROOT)  # numba's disk cache filled
     formal_bch("123", 10)  # numba started in this process (the sparse engine has run)
 
@@ -277,6 +285,8 @@ def main(argv=None):
     jobs += [("121", int(d)) for d in args.sym_degrees.split(",") if d]
     jobs += [("12321", int(d)) for d in args.three_degrees.split(",") if d]
     print(f"# C: {exe} (CFLAGS '{CFLAGS}' with --build), OMP_NUM_THREADS=1; ours: {sys.executable}")
+    print(f"# ours cold: the package's bytecode cached, as `pip install .` leaves it"
+          + (" (PYTHONDONTWRITEBYTECODE removed from the children's environment)" if no_bytecode else ""))
     print(f"# warm = the call alone, in-process, median CPU s of --repeat calls (at least {SMALL_REPEAT} when a call "
           "takes under 10 ms); cold = whole process, CPU s (wall s), peak RSS MB; ratio = ours / C")
     print(f"{'series':>6} {'N':>3} {'terms':>6} | {'C warm':>8} {'ours warm':>9} {'by':>6} {'ratio':>6} {'+terms':>8} "
@@ -294,10 +304,14 @@ def main(argv=None):
         if source == "table":
             engine(spec, n)
         c_warm, ours_warm, engine_warm, terms_warm = [], [], [], []
-        for _ in range(repeat):
+        served = None
+        for _ in range(repeat):  # C and ours interleaved, nothing else between them
             t = time.process_time()
             peer.call(series, n)
             c_warm.append(time.process_time() - t)
+            # the previous round's result freed here, untimed: assigning the new one would free it inside the
+            # timed call (the C call frees only its own series, and so does ours)
+            served = None
             clear_caches()
             t = time.process_time()
             served = formal_bch(spec, n)
@@ -306,12 +320,16 @@ def main(argv=None):
             for d in range(1, n + 1):
                 served.scaled_terms(d)
             terms_warm.append(time.process_time() - t)
-            if source == "table":
+        if source == "table":  # the engine alone, in rounds of its own (its memory traffic not between the sides)
+            computed = None
+            for _ in range(repeat):
+                computed = None
                 clear_caches()
                 t = time.process_time()
                 computed = engine(spec, n)
                 engine_warm.append(time.process_time() - t)
-                assert served == computed, (spec, n)  # the table's series is the engine's, numerator by numerator
+            assert served == computed, (spec, n)  # the table's series is the engine's, numerator by numerator
+            served = computed = None
         clear_caches()
         c_table, our_table = args.work / f"c_{series}_{n}.txt", args.work / f"ours_{series}_{n}.txt"
         c_args = [str(exe), f"N={n}", "table_output=1"] + ([f"expression={expression}"] if expression else [])

@@ -9,7 +9,6 @@ per-system caches), so results compare the systems they hold by their defining d
 
 from __future__ import annotations
 
-import dataclasses
 import math
 
 
@@ -73,6 +72,8 @@ def freeze(value):
 
     if isinstance(value, VectorField):  # compares by its exact components; has no hash of its own
         return ("VectorField", value.algebra, tuple(freeze(c) for c in value.components))
+    import dataclasses  # here: a result served without sympy (the BCH table) does not import it
+
     if dataclasses.is_dataclass(value) and not isinstance(value, type):
         return (type(value).__qualname__,
                 tuple(freeze(getattr(value, f.name)) for f in dataclasses.fields(value) if f.compare))

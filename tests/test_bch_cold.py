@@ -92,13 +92,14 @@ def test_errors_are_the_full_parsers():
 
 def test_a_fresh_process_serves_the_table_without_sympy_or_numpy(tmp_path):
     """``formal_bch('12', 18)`` in a fresh interpreter, every degree's terms and the text of the other three
-    series: neither sympy nor numpy (nor numba) is imported."""
+    series: neither sympy nor numpy (nor numba) is imported, nor dataclasses (inspect) and json, which cost such a
+    process more than reading the series."""
     code = (
         "import sys; from nambu_bch.bch import formal_bch; B = formal_bch('12', 18)\n"
         "n = sum(len(B.scaled_terms(d)[1]) for d in range(1, 19))\n"
         "texts = [formal_bch(s, 5).to_text() for s in ('21', '121', '212', 'TVT')]\n"
-        "print(n, len(B), B.scaled_terms(3), texts[1][:40], sorted(m for m in ('sympy', 'numpy', 'numba') "
-        "if m in sys.modules))"
+        "print(n, len(B), B.scaled_terms(3), texts[1][:40], sorted(m for m in ('sympy', 'numpy', 'numba', "
+        "'dataclasses', 'inspect', 'json') if m in sys.modules))"
     )
     env = {**os.environ, "PYTHONPATH": str(ROOT), "NAMBU_BCH_CACHE": str(tmp_path / "cache")}
     run = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=tmp_path, env=env,
@@ -129,3 +130,99 @@ def test_tree_leaves_with_and_without_sympy_agree():
     trees = [t for d in range(1, 9) for _, t in formal_bch("12", 8).scaled_terms(d)[1]]
     assert [lyndon._pair_leaves(t) for t in trees] == [lyndon._leaves(t, lyndon._sympy_basic()) for t in trees]
     assert lyndon._pair_leaves(((1, 2), 2)) == (1, 2, 2) == lyndon.tree_leaves(((1, 2), 2))
+
+
+def test_the_light_word_is_an_immutable_value():
+    """A :class:`light.Word` compares, hashes and pickles by its fields and refuses assignment."""
+    word = light.parse_word("TVT")
+    assert word == light.parse_word("TVT") and hash(word) == hash(light.parse_word("TVT"))
+    assert word != light.parse_word("121") and pickle.loads(pickle.dumps(word)) == word
+    assert repr(word).startswith("Word(spec='TVT', n_pieces=None, pieces=(1, 2, 1)")
+    with pytest.raises(AttributeError):
+        word.pieces = (1,)
+    with pytest.raises(AttributeError):
+        formal_bch("12", 2).max_degree = 3
+
+
+# --- nambu-bch bch: a series the table serves is printed without sympy or numpy ---------------------------------
+
+LIGHT_REQUESTS = [
+    ["--model", "ho", "--integrator", "TVT", "--format", "text", "--order", "5"],
+    ["--model", "ho", "--format", "json"],
+    ["--model", "pendulum", "--integrator", "1:1/2,2:1,1:1/2", "--format", "text", "--order", "8"],
+    ["--model", "kepler", "--integrator", "12", "--format", "json", "--order", "4"],
+    ["--model", "ho3-composite", "--integrator", "VTV", "--format", "text"],
+    ["--model", "fpu-beta", "--integrator", "21", "--format", "json", "--order", "3"],
+]
+
+
+def _cli(argv, light, monkeypatch, capsys):
+    from nambu_bch.cli import bch as bch_command
+    from nambu_bch.cli import main
+
+    if not light:
+        monkeypatch.setattr(bch_command, "_light", lambda args: None)
+    assert main(["bch", *argv]) == 0
+    monkeypatch.undo()
+    return capsys.readouterr()
+
+
+def test_the_cli_models_of_two_pieces_are_the_built_ones():
+    """Each entry of ``LIGHT_MODELS``: the system line and JSON head of the built model, which has two pieces; every
+    built-in model of two pieces has an entry."""
+    from nambu_bch import model, model_names, render
+    from nambu_bch.cli._output import system_line
+    from nambu_bch.cli.bch import LIGHT_MODELS
+
+    two = [name for name in model_names() if len(model(name).splitting) == 2]
+    assert sorted(LIGHT_MODELS) == sorted(two)
+    for name, (line, head) in LIGHT_MODELS.items():
+        system = model(name)
+        assert line == system_line(system) and head == render.system_dict(system), name
+        assert list(head) == list(render.system_dict(system)), name  # the JSON's key order
+
+
+@pytest.mark.parametrize("argv", LIGHT_REQUESTS, ids=lambda a: " ".join(a))
+def test_the_cli_light_path_prints_what_the_full_path_prints(argv, monkeypatch, capsys):
+    light = _cli(argv, True, monkeypatch, capsys)
+    full = _cli(argv, False, monkeypatch, capsys)
+    assert light.out == full.out and light.err == full.err == ""
+
+
+def test_the_cli_light_path_writes_output_files_as_the_full_path(tmp_path, monkeypatch, capsys):
+    argv = ["--model", "ho", "--integrator", "TVT", "--format", "json", "--order", "3"]
+    light = _cli([*argv, "--output", str(tmp_path / "light.json")], True, monkeypatch, capsys)
+    full = _cli([*argv, "--output", str(tmp_path / "full.json")], False, monkeypatch, capsys)
+    assert (tmp_path / "light.json").read_bytes() == (tmp_path / "full.json").read_bytes()
+    assert light.err.replace("light.json", "full.json") == full.err and "wrote" in full.err
+    assert light.out == full.out == ""
+
+
+@pytest.mark.parametrize("argv", [
+    ["--model", "ho", "--integrator", "TVT", "--format", "latex"],  # LaTeX: the full path
+    ["--model", "ho", "--param", "m=2", "--format", "text"],  # a value substituted into the system
+    ["--model", "ho", "--integrator", "1:1/3,2:1,1:2/3", "--format", "text"],  # not a series of the table
+    ["--model", "ho", "--integrator", "TVT", "--field", "--format", "text"],  # X_eff on the system
+    ["--format", "text"],  # ho3: three pieces
+])
+def test_the_cli_light_path_leaves_other_requests_to_the_full_path(argv):
+    from nambu_bch.cli import build_parser
+    from nambu_bch.cli._options import normalise
+    from nambu_bch.cli.bch import _light
+
+    assert _light(normalise(build_parser().parse_args(["bch", *argv]))) is None
+
+
+def test_the_cli_prints_a_served_series_without_sympy_or_numpy(tmp_path):
+    """``nambu-bch bch --model ho --integrator TVT`` as text and JSON in a fresh interpreter: neither sympy nor numpy
+    (nor numba) is imported."""
+    code = ("import sys; from nambu_bch.cli import main\n"
+            "for fmt in ('text', 'json'):\n"
+            "    assert main(['bch', '--model', 'ho', '--integrator', 'TVT', '--order', '6', '--format', fmt]) == 0\n"
+            "print(sorted(m for m in ('sympy', 'numpy', 'numba') if m in sys.modules), file=sys.stderr)")
+    env = {**os.environ, "PYTHONPATH": str(ROOT), "NAMBU_BCH_CACHE": str(tmp_path / "cache")}
+    run = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=tmp_path, env=env,
+                         timeout=120)
+    assert run.returncode == 0, run.stderr
+    assert run.stderr == "[]\n" and run.stdout.startswith("system ho: canonical bracket on x1, x2")
+    assert '"integrator": "TVT"' in run.stdout and "h^6  " in run.stdout

@@ -75,7 +75,7 @@ def _damaged(tmp_path, monkeypatch, edit):
 def _offsets():
     """``(start of the blocks, start of the degree-3 block of log(e^A e^B))`` in the shipped file."""
     header = table._header()
-    return header["base"], header["base"] + header["degrees"][2]["12"][0]
+    return header["base"], header["base"] + table._numerators_block(header, 3, "12")[0]
 
 
 def _flip(index):
@@ -123,11 +123,15 @@ def test_the_tool_rebuilds_the_low_degrees_exactly(tmp_path):
     with open(path, "rb") as fh:
         fh.read(len(table.MAGIC))
         size = int.from_bytes(fh.read(4), "little")
-    import json
+    raw = path.read_bytes()[len(table.MAGIC) + 4 : len(table.MAGIC) + 4 + size]
+    _, letters, n_series, top, t_bytes = table.PREAMBLE.unpack_from(raw)
+    import struct
 
-    low = json.loads(path.read_bytes()[len(table.MAGIC) + 4 : len(table.MAGIC) + 4 + size])
-    assert low["degrees"] == shipped["degrees"][:9]  # block places, widths, denominators, SHA-256 of each degree
-    end = shipped["degrees"][8]["end"]
+    record = struct.Struct(table.record_format(n_series, t_bytes))
+    low = list(record.iter_unpack(raw[len(raw) - top * record.size :]))
+    assert (letters, top) == (2, 9)
+    assert low == shipped["degrees"][:9]  # block places, widths, denominators, SHA-256 of each degree
+    end = shipped["degrees"][8][1]
     with open(table.TABLE_PATH, "rb") as fh:
         fh.seek(shipped["base"])
         assert path.read_bytes()[len(table.MAGIC) + 4 + size :] == fh.read(end)
@@ -158,3 +162,19 @@ def test_a_fresh_process_serves_without_numba_or_the_effective_field_modules(tmp
     assert run.returncode == 0, run.stderr
     assert run.stdout.split(None, 1) == ["76760", "[]\n"]  # the C program's count for degree 20 (bch_c_reference)
     assert "Warning" not in run.stderr
+
+
+@pytest.mark.parametrize("spec", ["12", "21", "121", "212", "13", "1:1/2,3:1,1:1/2"])
+def test_words_are_the_leaves_of_the_trees(spec):
+    """``scaled_words`` (built from the table's standard factors, no tree walked) equals the leaves of
+    ``scaled_terms``, and the engine's ``scaled_words``, degree by degree."""
+    from nambu_bch.bch.lyndon import tree_leaves
+
+    served = formal_bch(spec, 9)
+    den, items = served.iter_scaled_words(9)
+    assert table._TREES == {} and den == served.scaled_terms(9)[0]  # words without a single tree built
+    engine = _engine(spec, 9)
+    for d in range(1, 10):
+        den, items = served.scaled_terms(d)
+        assert served.scaled_words(d) == (den, [(n, tree_leaves(t)) for n, t in items]) == engine.scaled_words(d)
+    assert list(served.iter_scaled_words(0)[1]) == []

@@ -163,7 +163,7 @@ NOT_CACHES = {("nambu_bch.shadow.liouville_terms", "_ATOM_IDS")}
 # caches emptied by a module's clear_cache() listed in CACHES
 VIA_CLEAR_CACHE = {
     ("nambu_bch.bch.concrete", "_EVALUATORS"), ("nambu_bch.bch.formal", "_PATTERN_CACHE"),
-    ("nambu_bch.bch.table", "_TREES"), ("nambu_bch.bch.table", "_NUMERATORS"),
+    ("nambu_bch.bch.table", "_TREES"), ("nambu_bch.bch.table", "_WORDS"), ("nambu_bch.bch.table", "_NUMERATORS"),
     ("nambu_bch.numeric.precision", "_MPMATH"), ("nambu_bch.shadow.fi_route", "_RAW_OPS"),
     ("nambu_bch.shadow.fi_route", "_FORMS"), ("nambu_bch.shadow.fi_route", "_MONOMIAL_COLUMNS"),
     ("nambu_bch.shadow.fi_route", "_EVALUATORS"), ("nambu_bch.shadow.fi_route", "_OPERATOR"),

@@ -14,8 +14,8 @@ from __future__ import annotations
 
 import argparse
 import hashlib
-import json
 import re
+import struct
 import sys
 import zlib
 from math import gcd
@@ -73,12 +73,15 @@ def build(n: int, path: Path) -> tuple:
             index[w] = k
             k += 1
     columns = {name: series_numerators(name, n, words) for name in table.SERIES}
-    blocks, header = [], {"format": 2, "letters": 2, "max_degree": n, "series": list(table.SERIES), "degrees": []}
+    # T_d in a fixed number of bytes (16 to degree 20 and beyond): a table built to a lower degree has the same
+    # records for the degrees both hold
+    t_bytes = max(16, *((columns[name][d][0].bit_length() + 7) // 8 for name in table.SERIES for d in columns[name]))
+    record = struct.Struct(table.record_format(len(table.SERIES), t_bytes))
+    blocks, records = [], []
     offset = 0
     costs = {}
     for d in range(1, n + 1):  # degree by degree: a request to degree n reads one contiguous piece
         start = offset
-        entry = {"count": len(words[d])}
 
         def add(data: bytes) -> list:
             nonlocal offset
@@ -88,18 +91,18 @@ def build(n: int, path: Path) -> tuple:
             return [offset - len(data), len(data)]
 
         factors = [standard_factorization(w) for w in words[d]] if d > 1 else []
-        entry["lyndon"] = add(b"".join(index[u].to_bytes(4, "little") for u, _ in factors)
-                              + b"".join(index[v].to_bytes(4, "little") for _, v in factors))
+        fields = [len(words[d]), 0] + add(b"".join(index[u].to_bytes(4, "little") for u, _ in factors)
+                                          + b"".join(index[v].to_bytes(4, "little") for _, v in factors))
         for name in table.SERIES:
             T, column = columns[name][d]
             w = _width(column)
             data = b"".join(v.to_bytes(w, "little", signed=True) for v in column) if w else b""
-            entry[name] = add(data) + [w, str(T)]
-        entry["end"] = offset
-        entry["sha256"] = hashlib.sha256(b"".join(blocks)[start:]).hexdigest()
-        header["degrees"].append(entry)
+            fields += add(data) + [w, T.to_bytes(t_bytes, "little")]
+        fields[1] = offset  # the end of the degree's bytes
+        records.append(record.pack(*fields, hashlib.sha256(b"".join(blocks)[start:]).digest()))
         costs[d] = offset - start
-    raw = json.dumps(header, sort_keys=True, separators=(",", ":")).encode()
+    names = b"".join(name.encode("ascii").ljust(table.NAME_BYTES, b"\0") for name in table.SERIES)
+    raw = table.PREAMBLE.pack(table.FORMAT_VERSION, 2, len(table.SERIES), n, t_bytes) + names + b"".join(records)
     path.parent.mkdir(parents=True, exist_ok=True)
     path.write_bytes(table.MAGIC + len(raw).to_bytes(4, "little") + raw + b"".join(blocks))
     return hashlib.sha256(raw).hexdigest(), costs, len(raw)

@@ -51,7 +51,6 @@ Algebras*, Thm. 5.1 (Lyndon basis); Casas & Murua, J. Math. Phys. 50 (2009)
 from __future__ import annotations
 
 import sys
-from dataclasses import dataclass, field
 from fractions import Fraction
 from functools import lru_cache
 from math import comb, factorial, gcd, lcm
@@ -475,7 +474,6 @@ def _lyndon_coordinates(vector, d: int, g: int):
     return coords
 
 
-@dataclass(frozen=True, eq=False)
 class FormalBCH(Printable, ValueEquality):
     """``log(exp(c_1 X_{k_1}) ... exp(c_s X_{k_s}))`` through ``max_degree`` in the Lyndon basis.
 
@@ -493,13 +491,24 @@ class FormalBCH(Printable, ValueEquality):
     max_degree : int
     """
 
-    _composition: object  # Composition, or the light Word it is built from when asked
-    generators: tuple
-    max_degree: int
-    _scaled: dict  # degree -> (denominator, ((numerator: int or field element, tree), ...)); table.Served: lazy
-    _domain: object = None  # None: QQ; else the algebraic field of the coefficients
-    _sympy: dict = field(default_factory=dict)  # degree -> ((sympy coefficient, tree), ...), filled lazily
-    _cache: dict = field(default_factory=dict)
+    # A plain class with the fields of a frozen dataclass: importing dataclasses (inspect, ast, dis, ...) costs a
+    # fresh process that serves a series from the table more than reading the series.
+    def __init__(self, _composition, generators, max_degree, _scaled, _domain=None, _sympy=None, _cache=None):
+        put = object.__setattr__
+        put(self, "_composition", _composition)  # Composition, or the light Word it is built from when asked
+        put(self, "generators", generators)
+        put(self, "max_degree", max_degree)
+        # degree -> (denominator, ((numerator: int or field element, tree), ...)); table.Served: built when asked
+        put(self, "_scaled", _scaled)
+        put(self, "_domain", _domain)  # None: QQ; else the algebraic field of the coefficients
+        put(self, "_sympy", {} if _sympy is None else _sympy)  # degree -> ((sympy coefficient, tree), ...), lazily
+        put(self, "_cache", {} if _cache is None else _cache)
+
+    def __setattr__(self, name, value):
+        raise AttributeError(f"cannot assign to field {name!r}: a FormalBCH is immutable")
+
+    def __delattr__(self, name):
+        raise AttributeError(f"cannot delete field {name!r}: a FormalBCH is immutable")
 
     @property
     def composition(self):
@@ -519,6 +528,29 @@ class FormalBCH(Printable, ValueEquality):
         element of the algebraic field :attr:`domain`, ``D`` a positive int common to the degree."""
         den, items = self._scaled.get(degree, (1, ()))
         return den, list(items)
+
+    def scaled_words(self, degree: int):
+        """``(D, [(n, word), ...])``: :meth:`scaled_terms` with each bracket tree replaced by its Lyndon word (the
+        tree's leaves, a tuple of piece numbers; ``P_w`` is the standard bracketing of ``w``).
+
+        >>> formal_bch("12", 3).scaled_words(3)
+        (36, [(3, (1, 1, 2)), (3, (1, 2, 2))])
+        """
+        den, items = self.iter_scaled_words(degree)
+        return den, list(items)
+
+    def iter_scaled_words(self, degree: int):
+        """``(D, iterator of (n, word))``: :meth:`scaled_words` one pair at a time (a long series written out
+        without holding a degree's pairs at once).
+
+        A series served from the table builds each word from the table's standard factors, one concatenation
+        of two shorter words, without building or walking a tree.
+        """
+        scaled = self._scaled
+        if isinstance(scaled, _table.Served):
+            return scaled.words(degree) if degree in scaled else (1, iter(()))
+        den, items = scaled.get(degree, (1, ()))
+        return den, ((n, tree_leaves(t)) for n, t in items)
 
     @property
     def domain(self):

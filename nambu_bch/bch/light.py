@@ -29,7 +29,6 @@ Integration*, Sect. II.4 (compositions).
 from __future__ import annotations
 
 import re
-from dataclasses import dataclass
 from fractions import Fraction
 
 # The grammar's limits and aliases, as nambu_bch.integrators.composition has them (tests/test_bch_cold.py
@@ -47,7 +46,6 @@ _ONE, _HALF = Fraction(1), Fraction(1, 2)
 _PUNCTUATION = " :,/.+-*()^_"
 
 
-@dataclass(frozen=True)
 class Word:
     """A composition with rational coefficients, read without sympy.
 
@@ -60,11 +58,38 @@ class Word:
     name : str -- the name the full parser gives it
     """
 
-    spec: str
-    n_pieces: object
-    pieces: tuple
-    coefficients: tuple
-    name: str
+    # a plain immutable class: importing dataclasses (inspect, ast, dis, ...) would cost a fresh process more than
+    # reading the series from the table
+    __slots__ = ("spec", "n_pieces", "pieces", "coefficients", "name")
+
+    def __init__(self, spec, n_pieces, pieces, coefficients, name):
+        put = object.__setattr__
+        put(self, "spec", spec)
+        put(self, "n_pieces", n_pieces)
+        put(self, "pieces", pieces)
+        put(self, "coefficients", coefficients)
+        put(self, "name", name)
+
+    def __setattr__(self, name, value):
+        raise AttributeError(f"cannot assign to field {name!r}: a Word is immutable")
+
+    def __delattr__(self, name):
+        raise AttributeError(f"cannot delete field {name!r}: a Word is immutable")
+
+    def _fields(self) -> tuple:
+        return tuple(getattr(self, key) for key in self.__slots__)
+
+    def __eq__(self, other):
+        return self._fields() == other._fields() if type(other) is type(self) else NotImplemented
+
+    def __hash__(self):
+        return hash(self._fields())
+
+    def __repr__(self):
+        return "Word(" + ", ".join(f"{key}={getattr(self, key)!r}" for key in self.__slots__) + ")"
+
+    def __reduce__(self):
+        return Word, self._fields()
 
     @property
     def symmetric(self) -> bool:

@@ -14,9 +14,61 @@ from __future__ import annotations
 from dataclasses import dataclass
 from fractions import Fraction
 
-from .backward import effective_field
-from .expansion import expand_terms
+# the effective field and the Liouville expansion (sympy) are imported by bch_report when asked for: the command
+# line prints a series served from the BCH table through the functions below without sympy (nambu_bch.cli.bch)
 from .formal import formal_bch
+
+
+def word_line(name: str, factors) -> str:
+    """``TVT: Phi_h = exp((1/2)*h*X1) exp(h*X2) exp((1/2)*h*X1)``: the word as a product of exponentials.
+
+    ``factors`` are the ``(piece, coefficient)`` pairs in operator order (a sympy or ``Fraction`` coefficient)."""
+    return f"{name}: Phi_h = " + " ".join(f"exp({'' if c == 1 else f'({c})*'}h*X{k})" for k, c in factors)
+
+
+def _int_bracket_text(tree) -> str:
+    """:func:`nambu_bch.render.bracket_text` of a tree whose leaves are piece numbers (no sympy needed)."""
+    return f"[{_int_bracket_text(tree[0])},{_int_bracket_text(tree[1])}]" if type(tree) is tuple else f"X{tree}"
+
+
+def _int_bracket_tree(tree):
+    """:func:`nambu_bch.render.bracket_tree` of a tree whose leaves are piece numbers (no sympy needed)."""
+    if type(tree) is tuple:
+        return {"bracket": [_int_bracket_tree(tree[0]), _int_bracket_tree(tree[1])]}
+    return tree
+
+
+def series_lines(series) -> list:
+    """``  h^k  coefficient  bracket`` per term of a :class:`~nambu_bch.bch.formal.FormalBCH`, lowest degree first.
+
+    A rational series prints each coefficient as a ``Fraction`` (as the sympy ``Rational`` prints) and its
+    brackets of piece numbers directly: no sympy object is built."""
+    lines = []
+    if series._domain is None:
+        for d in range(1, series.max_degree + 1):
+            den, items = series.scaled_terms(d)
+            lines += [f"  h^{d - 1}  {Fraction(n, den)}  {_int_bracket_text(t)}" for n, t in items]
+        return lines
+    from ..render import bracket_text
+
+    for d in range(1, series.max_degree + 1):
+        lines += [f"  h^{d - 1}  {c}  {bracket_text(t)}" for c, t in series.terms(d)]
+    return lines
+
+
+def series_terms(series) -> list:
+    """The ``terms`` of :meth:`BCHReport.to_dict`: per term its degree, power of ``h``, coefficient, bracket, tree."""
+    if series._domain is None:  # the same strings as render's, without sympy
+        out = []
+        for d in range(1, series.max_degree + 1):
+            den, items = series.scaled_terms(d)
+            out += [{"degree": d, "power_of_h": d - 1, "coefficient": str(Fraction(n, den)),
+                     "bracket": _int_bracket_text(t), "tree": _int_bracket_tree(t)} for n, t in items]
+        return out
+    from .. import render
+
+    return [{"degree": d, "power_of_h": d - 1, "coefficient": render.expression(c), "bracket": render.bracket_text(t),
+             "tree": render.bracket_tree(t)} for d in range(1, series.max_degree + 1) for c, t in series.terms(d)]
 
 
 @dataclass(frozen=True)
@@ -47,11 +99,7 @@ class BCHReport:
         from .lyndon import tree_to_latex
 
         series, comp = self.series, self.composition
-        terms = [
-            {"degree": d, "power_of_h": d - 1, "coefficient": render.expression(c), "bracket": render.bracket_text(t),
-             "tree": render.bracket_tree(t)}
-            for d in range(1, series.max_degree + 1) for c, t in series.terms(d)
-        ]
+        terms = series_terms(series)
         out = render.result_head(self.system, comp.name, order=self.order, max_degree=series.max_degree,
                                  coefficients=[render.expression(c) for c in comp.coefficients],
                                  pieces=list(comp.pieces), terms=terms)
@@ -67,25 +115,15 @@ class BCHReport:
 
     def to_text(self) -> str:
         """The word as a product of exponentials, then ``h^k  coefficient  bracket`` per term."""
-        from ..render import bracket_text
-
         comp, series = self.composition, self.series
-        lines = [f"{comp.name}: Phi_h = " + " ".join(f"exp({'' if c == 1 else f'({c})*'}h*X{k})" for k, c in comp.factors())]
-        lines.append(f"X_eff through h^{self.order} (formal BCH in the Lyndon basis):")
-        rational = series._domain is None  # a Fraction prints as the sympy Rational does: no sympy term is built
-        for d in range(1, series.max_degree + 1):
-            if rational:
-                den, items = series.scaled_terms(d)
-                terms = [(Fraction(n, den), t) for n, t in items]
-            else:
-                terms = series.terms(d)
-            for c, t in terms:
-                lines.append(f"  h^{d - 1}  {c}  {bracket_text(t)}")
+        lines = [word_line(comp.name, comp.factors()), series_heading(self.order), *series_lines(series)]
         if self.field is not None:
             for j, Z in enumerate(self.field.coefficients):
                 comps = ", ".join(str(c) for c in Z.to_sympy())
                 lines.append(f"Z_{j} = ({comps})")
         if self.expanded is not None:
+            from ..render import bracket_text
+
             lines.append("Liouville terms (zero brackets pruned):")
             for d, items in self.expanded.items():
                 for c, t in items:
@@ -106,6 +144,11 @@ class BCHReport:
         return blocks
 
 
+def series_heading(order: int) -> str:
+    """The line above the terms: ``X_eff through h^2 (formal BCH in the Lyndon basis):``."""
+    return f"X_eff through h^{order} (formal BCH in the Lyndon basis):"
+
+
 def bch_report(system, comp, order: int = 2, field: bool = False, terms: bool = False) -> BCHReport:
     """The formal BCH series of ``comp`` through ``h^order``, with ``X_eff`` on ``system`` and its Liouville terms.
 
@@ -121,6 +164,9 @@ def bch_report(system, comp, order: int = 2, field: bool = False, terms: bool = 
     -------
     BCHReport
     """
+    from .backward import effective_field
+    from .expansion import expand_terms
+
     series = formal_bch(comp, order + 1)
     X = effective_field(system.splitting, comp, order) if field else None
     expanded = {d: expand_terms(series.terms(d), system.splitting) for d in series.degrees} if terms else None

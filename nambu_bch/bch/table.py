@@ -17,8 +17,8 @@ fixed-width little-endian integers.  A request to degree ``n`` rescales ``n_w`` 
 of the coefficients) and builds the Python objects of the degrees asked only: the result is equal,
 numerator by numerator, to the engine's.
 
-Integrity.  The header (JSON: per degree the number of words, where its blocks lie, the denominators
-and the SHA-256 of the degree's bytes) is trusted only when its own SHA-256 equals
+Integrity.  The header (binary, :func:`record_format`: per degree the number of words, where its blocks lie,
+the denominators and the SHA-256 of the degree's bytes) is trusted only when its own SHA-256 equals
 :data:`TABLE_SHA256`, written into this module by the tool; a degree's bytes are decoded only when
 their SHA-256 equals the header's.  A missing, damaged or replaced file is not used: the engine
 computes the series, and one warning line says why.  The digests are hashlib's (OpenSSL) in a process that has
@@ -29,8 +29,10 @@ Memory.  Only the degrees asked are read; the numerators stay machine integers (
 terms are asked for, and :class:`Served` builds them on each access (the trees, shared by every request, are the
 only Python objects kept).
 
-File format: ``b"NBCHTAB1"``, the header's length (4 bytes, little-endian), the header, then degree
-by degree the standard factors (int32: left indices, then right indices, into the flat list of the
+File format: ``b"NBCHTAB2"``, the header's length (4 bytes, little-endian), the header (:data:`PREAMBLE`, the
+series' names in :data:`NAME_BYTES` each, one :func:`record_format` record per degree: fixed-size fields read
+by :mod:`struct` in one call, where a JSON header cost more than the blocks of a request to degree 10), then
+degree by degree the standard factors (int32: left indices, then right indices, into the flat list of the
 Lyndon words of all degrees) and the three series' numerators, each block zlib-compressed.
 
 References
@@ -43,11 +45,11 @@ Algebras* (1993), Thm. 5.1 (Lyndon basis, standard factorisation).
 
 from __future__ import annotations
 
-import json
 import os
 import stat
+import struct
 import sys
-import threading
+import _thread
 import warnings
 import zlib
 from array import array
@@ -57,16 +59,33 @@ from fractions import Fraction
 from .collector import no_full_collection
 
 #: SHA-256 of the table's header (which holds the SHA-256 of each degree's bytes); written by tools/build_bch_table.py.
-TABLE_SHA256 = "eb0531b5d621fd793d0d06a1dc0d4ccb4b40bb7053b1c4d7684ba7499faa3737"
+TABLE_SHA256 = "a91b9da3201655559af7e275287661924dd283cf78ebf1349536fe54ffc382d9"
 #: The table file shipped with the package.
 TABLE_PATH = os.path.join(os.path.dirname(__file__), "data", "bch_series.bin")
-MAGIC = b"NBCHTAB1"
+MAGIC = b"NBCHTAB2"
+#: The header's fixed part: format version, letters, number of series, top degree, bytes of a denominator ``T_d``.
+PREAMBLE = struct.Struct("<5H")
+FORMAT_VERSION = 2
+#: Bytes of a series' name in the header (ASCII, NUL-padded).
+NAME_BYTES = 4
+
+
+def record_format(n_series: int, t_bytes: int) -> str:
+    """The :mod:`struct` format of the header's record of one degree: the number of Lyndon words, the end of the
+    degree's bytes, the standard factors' block (offset, size), per series its numerators' block (offset, size,
+    bytes per numerator) and ``T_d`` (unsigned little-endian), and the SHA-256 of the degree's bytes (offsets
+    count from the first block)."""
+    return "<4I" + f"2IB{t_bytes}s" * n_series + "32s"
+
 #: The series of the table: name -> ``(letters of the factors, their coefficients)``, letter 0 the smaller piece.
 SERIES = {
     "12": ((0, 1), (Fraction(1), Fraction(1))),
     "121": ((0, 1, 0), (Fraction(1, 2), Fraction(1), Fraction(1, 2))),
     "212": ((1, 0, 1), (Fraction(1, 2), Fraction(1), Fraction(1, 2))),
 }
+#: :data:`SERIES` with the coefficients as ``(numerator, denominator)`` pairs (compared without Fractions)
+_SERIES_PAIRS = {name: (letters, tuple((c.numerator, c.denominator) for c in coefficients))
+                 for name, (letters, coefficients) in SERIES.items()}
 
 try:  # CPython's own SHA-256 (the same digest) for a process that has not imported hashlib (module docstring)
     from _sha2 import sha256 as _builtin_sha256  # Python >= 3.12
@@ -78,31 +97,39 @@ except ImportError:
 
 
 def _sha256(data):
-    """SHA-256 of ``data``: hashlib's (OpenSSL, several times faster) when hashlib is imported already, else
+    """SHA-256 of ``data`` (:func:`_sha256_function`)."""
+    return _sha256_function()(data)
+
+
+def _sha256_function():
+    """The SHA-256 constructor: hashlib's (OpenSSL, several times faster) when hashlib is imported already, else
     CPython's own -- importing hashlib maps libcrypto, megabytes of a fresh process that reads the table."""
     hashlib = sys.modules.get("hashlib")
     if hashlib is None and _builtin_sha256 is not None:
-        return _builtin_sha256(data)
+        return _builtin_sha256
     if hashlib is None:
         import hashlib
-    return hashlib.sha256(data)
+    return hashlib.sha256
 
 
 #: Bytes read after the header with it (degrees 1-13 of the shipped table, 14 kB)
 _FIRST_BLOCKS = 16384
 #: array typecodes of the signed integer widths that convert in bulk
 _TYPECODES = {array(code).itemsize: code for code in "bhiq"}
+_INT32 = _TYPECODES[4]  # the standard factors' indices
 _HEADER: list = []  # [header dict] once read and verified; [None] when the table is unusable in this process
 _TREES: dict = {}  # generators -> [flat list of the trees, degrees done]
+_WORDS: dict = {}  # generators -> [flat list of the Lyndon words as bytes of piece numbers, degrees done]
 _FACTORS: list = []  # per degree decoded so far: the standard factors (left indices + right indices)
 _NUMERATORS: dict = {}  # (series, degree) -> the stored numerators n_w as Python ints
-_LOCK = threading.Lock()
+_LOCK = _thread.allocate_lock()  # _thread: the threading module is not imported for one lock
 
 
 def clear_cache() -> None:
     """Forget the table's header, trees and decoded numerators (the next request reads the file again)."""
     _HEADER.clear()
     _TREES.clear()
+    _WORDS.clear()
     _FACTORS.clear()
     _NUMERATORS.clear()
 
@@ -113,43 +140,85 @@ def _unusable(reason: str) -> None:
     _HEADER[:] = [None]
 
 
-def _open_table():
-    """The table file opened for reading: a regular file, never a link, FIFO or device (refused before it is opened,
-    so opening cannot block), and the very file checked (same device and inode after opening)."""
+def _read_table(offset: int, size: int, more=None) -> list:
+    """``[the table's bytes offset .. offset + size]``, and with ``more`` (a function of those bytes giving a second
+    ``(offset, size)`` or ``None``) the second span too, read from one opening of the file.
+
+    The file is opened only if it is a regular file, never a link, FIFO or device (refused before it is opened, so
+    opening cannot block), and read only if it is the very file checked (same device and inode after opening).
+    Positional reads on the descriptor: no buffered file object is built for two reads."""
     before = os.lstat(TABLE_PATH)
     if not stat.S_ISREG(before.st_mode):
         raise OSError(f"{TABLE_PATH} is not a regular file")
     flags = os.O_RDONLY | getattr(os, "O_NOFOLLOW", 0) | getattr(os, "O_NONBLOCK", 0) | getattr(os, "O_CLOEXEC", 0)
-    fh = os.fdopen(os.open(TABLE_PATH, flags), "rb")
-    st = os.fstat(fh.fileno())
-    if (st.st_dev, st.st_ino) != (before.st_dev, before.st_ino) or not stat.S_ISREG(st.st_mode):
-        fh.close()
-        raise OSError(f"{TABLE_PATH} was replaced while it was opened")
-    return fh
+    fd = os.open(TABLE_PATH, flags)
+    try:
+        st = os.fstat(fd)
+        if (st.st_dev, st.st_ino) != (before.st_dev, before.st_ino) or not stat.S_ISREG(st.st_mode):
+            raise OSError(f"{TABLE_PATH} was replaced while it was opened")
+        out = [_pread(fd, size, offset)]
+        span = more(out[0]) if more is not None else None
+        if span is not None:
+            out.append(_pread(fd, span[1], span[0]))
+        return out
+    finally:
+        os.close(fd)
+
+
+def _pread(fd: int, size: int, offset: int) -> bytes:
+    """Up to ``size`` bytes at ``offset`` (fewer only at the end of the file)."""
+    if hasattr(os, "pread"):
+        return os.pread(fd, size, offset)
+    os.lseek(fd, offset, os.SEEK_SET)  # no pread (Windows): the descriptor is this call's own
+    return os.read(fd, size)
 
 
 def _header():
-    """The verified header, or ``None`` (then a warning has been given once in this process)."""
+    """The verified header, or ``None`` (then a warning has been given once in this process).
+
+    ``{"max_degree", "series" (name -> position), "degrees" (one :func:`record_struct` tuple per degree),
+    "base" (where the blocks start in the file), "first_blocks"}``."""
     if _HEADER:
         return _HEADER[0]
+    lead = len(MAGIC) + 4
+
+    def rest(start):  # the header and, with it, the first blocks (one opening for a request to a low degree)
+        size = int.from_bytes(start[len(MAGIC) : lead], "little")
+        return (lead, size + _FIRST_BLOCKS) if start[: len(MAGIC)] == MAGIC and size < 2**20 else None
+
     try:
-        with _open_table() as fh:
-            start = fh.read(len(MAGIC) + 4)
-            size = int.from_bytes(start[len(MAGIC):], "little")
-            # the first blocks come with the header (one open for a request to a low degree, see _load)
-            raw = fh.read(size + _FIRST_BLOCKS) if start[: len(MAGIC)] == MAGIC and size < 2**20 else b""
+        parts = _read_table(0, lead, rest)
     except OSError as exc:
         _unusable(f"cannot read it: {exc.strerror or exc}")
         return None
+    size = int.from_bytes(parts[0][len(MAGIC) : lead], "little")
+    raw = parts[1] if len(parts) > 1 else b""
     raw, first_blocks = raw[:size], raw[size:]
     if _sha256(raw).hexdigest() != TABLE_SHA256:
         _unusable("its SHA-256 does not match the package's")
         return None
-    header = json.loads(raw.decode("ascii"))  # the tool writes ASCII JSON (json.dumps' default)
-    header["base"] = len(MAGIC) + 4 + size
-    header["first_blocks"] = first_blocks  # unverified bytes: each degree's SHA-256 is checked when it is decoded
+    # the header is the tool's, byte for byte (its SHA-256 is pinned above): its layout needs no further checks
+    version, _, n_series, top, t_bytes = PREAMBLE.unpack_from(raw)
+    names = raw[PREAMBLE.size : PREAMBLE.size + NAME_BYTES * n_series]
+    record = record_format(n_series, t_bytes)  # struct keeps the compiled formats it has seen
+    at = PREAMBLE.size + len(names)
+    header = {
+        "max_degree": top,
+        # each name -> where its numerators' block lies in a record
+        "series": {names[i : i + NAME_BYTES].rstrip(b"\0").decode("ascii"): 4 + 4 * (i // NAME_BYTES)
+                   for i in range(0, len(names), NAME_BYTES)},
+        "degrees": list(struct.iter_unpack(record, raw[at : at + struct.calcsize(record) * top])),
+        "base": len(MAGIC) + 4 + size,
+        "first_blocks": first_blocks,  # unverified bytes: each degree's SHA-256 is checked when it is decoded
+    }
     _HEADER[:] = [header]
     return header
+
+
+def _numerators_block(header, d: int, series: str) -> tuple:
+    """``(offset, size, bytes per numerator, T_d)`` of the numerators of ``series`` in degree ``d``."""
+    record, at = header["degrees"][d - 1], header["series"][series]
+    return record[at], record[at + 1], record[at + 2], int.from_bytes(record[at + 3], "little")
 
 
 def _decode(data: bytes, width: int):
@@ -175,34 +244,43 @@ def _load(header, series: str, n: int) -> bool:
     first = next((d for d in range(1, n + 1) if d > len(_FACTORS) or (series, d) not in _NUMERATORS), None)
     if first is None:
         return True
-    start = degrees[first - 2]["end"] if first > 1 else 0
-    stop = degrees[n - 1]["end"]
+    start = degrees[first - 2][1] if first > 1 else 0
+    stop = degrees[n - 1][1]
     if stop <= len(header["first_blocks"]):  # read with the header
-        data = memoryview(header["first_blocks"])[start:stop]
+        data, shift = header["first_blocks"], 0
     else:
+        shift = start  # the bytes read start there (the records' offsets count from the first block)
         try:
-            with _open_table() as fh:
-                fh.seek(header["base"] + start)
-                data = fh.read(stop - start)
+            data = _read_table(header["base"] + start, stop - start)[0]
         except OSError as exc:
             _unusable(f"cannot read it: {exc.strerror or exc}")
             return False
+        if len(data) != stop - start:
+            _unusable("it is shorter than its header says")
+            return False
     view = memoryview(data)
+    sha256 = _sha256_function()
+    at = header["series"][series]
+    swap = sys.byteorder == "big"  # the table is little-endian
+    low = start
     for d in range(first, n + 1):
-        entry = degrees[d - 1]
-        low = (degrees[d - 2]["end"] if d > 1 else 0) - start
-        if _sha256(view[low : entry["end"] - start]).hexdigest() != entry["sha256"]:
+        record = degrees[d - 1]
+        end = record[1]
+        if sha256(view[low - shift : end - shift]).digest() != record[-1]:
             _unusable(f"the bytes of degree {d} do not match their SHA-256")
             return False
-
-        def block(offset, size):
-            return zlib.decompress(view[offset - start : offset - start + size]) if size else b""
-
+        low = end
         if d > len(_FACTORS):
-            _FACTORS.append(_decode(block(*entry["lyndon"]), 4))
+            offset, size = record[2] - shift, record[3]
+            factors = array(_INT32)
+            if size:
+                factors.frombytes(zlib.decompress(view[offset : offset + size]))
+                if swap:
+                    factors.byteswap()
+            _FACTORS.append(factors)
         if (series, d) not in _NUMERATORS:
-            offset, size, width, _ = entry[series]
-            _NUMERATORS[series, d] = _decode(block(offset, size), width) if width else []
+            offset, size, width = record[at] - shift, record[at + 1], record[at + 2]
+            _NUMERATORS[series, d] = _decode(zlib.decompress(view[offset : offset + size]), width) if width else []
     return True
 
 
@@ -225,14 +303,34 @@ def _trees(generators: tuple, factors: list, n: int) -> list:
     return trees
 
 
+def _words(generators: tuple, factors: list, n: int) -> list:
+    """The Lyndon words of degrees ``1..n`` as one flat list in the order of :func:`_trees`, each word the
+    ``bytes`` of its piece numbers (all below 256), from the standard factors: ``w = u v`` is one concatenation
+    of two shorter words, so no tree is walked.
+
+    Kept per generators and extended degree by degree; the caller holds :data:`_LOCK`."""
+    state = _WORDS.get(generators)
+    if state is None:
+        state = _WORDS[generators] = [[bytes(generators[:1]), bytes(generators[1:])], 1]
+    words = state[0]
+    if state[1] < n:
+        with no_full_collection():  # bytes objects only: nothing for the collector to find
+            for d in range(state[1] + 1, n + 1):
+                pairs = factors[d - 1]
+                m = len(pairs) // 2
+                words.extend([words[left] + words[right] for left, right in zip(pairs[:m], pairs[m:])])
+                state[1] = d
+    return words
+
+
 def _request(letters, values, q: int):
     """``(series, reversed)`` when the product is a stored series or the reverse of ``log(e^A e^B)``, else ``None``."""
     letters = tuple(letters)
-    coefficients = tuple(Fraction(v, q) for v in values)
-    for name, stored in SERIES.items():
-        if (letters, coefficients) == stored:
+    for name, (stored, pairs) in _SERIES_PAIRS.items():
+        if letters == stored and all(v * b == a * q for v, (a, b) in zip(values, pairs)):
             return name, False
-    if (letters[::-1], coefficients[::-1]) == SERIES["12"]:
+    stored, pairs = _SERIES_PAIRS["12"]
+    if letters[::-1] == stored and all(v * b == a * q for v, (a, b) in zip(values[::-1], pairs)):
         return "12", True
     return None
 
@@ -273,12 +371,12 @@ def serve(letters, values, q: int, generators: tuple, n: int, denominators):
         if stored[d]:
             # D_d / T_d is an integer: T_d is the least common denominator of the degree, and D_d times every
             # coefficient is an integer (the engines' denominators, nambu_bch.bch.formal)
-            factor, rest = divmod(denominators[d], int(degrees[d - 1][series][3]))
+            factor, rest = divmod(denominators[d], _numerators_block(header, d, series)[3])
             if rest:
                 raise ArithmeticError(f"internal error: the BCH table's degree-{d} denominator does not divide "
                                       f"{denominators[d]}")
             parts[d] = (denominators[d], -factor if flip and d % 2 == 0 else factor, stored[d], start)
-        start += degrees[d - 1]["count"]
+        start += degrees[d - 1][0]
     return Served(tuple(generators), factors, parts)
 
 
@@ -301,6 +399,21 @@ class Served(Mapping):
         with _LOCK:
             trees = _trees(self._generators, self._factors, len(self._factors))
         return den, tuple([(v * factor, trees[k]) for v, k in zip(stored, range(start, start + len(stored))) if v])
+
+    def words(self, degree):
+        """``(D_d, iterator of (numerator, word))`` of ``degree``: the pairs of ``self[degree]`` with each tree
+        replaced by its Lyndon word (a tuple of piece numbers, the tree's leaves), built one by one from the
+        standard factors without the trees."""
+        den, factor, stored, start = self._parts[degree]
+        generators = self._generators
+        if max(generators) > 255:  # a word is kept as bytes of piece numbers: beyond a byte, walk the trees
+            from .lyndon import tree_leaves
+
+            den, items = self[degree]
+            return den, ((v, tree_leaves(t)) for v, t in items)
+        with _LOCK:
+            words = _words(generators, self._factors, len(self._factors))
+        return den, ((v * factor, tuple(words[k])) for v, k in zip(stored, range(start, start + len(stored))) if v)
 
     def __iter__(self):
         return iter(self._parts)
