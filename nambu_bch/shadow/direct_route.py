@@ -606,8 +606,13 @@ class _Solver:
             )
             return OrderSolution(j, "obstructed", degree=D, certificate=cert, obstruction_value=sympy.factor(value),
                                  kernel_dim=len(sol.kernel), rhs=rhs)
-        member1 = (Ansatz.solve_canonical(col_vectors, rhs_list, len(rows), domain, prio1, certificate=False).particular
-                   if self.slots > 1 else member0)
+        if self.slots == 1:
+            member1 = member0
+        elif domain.is_QQ or self._flint_context() is not None:
+            # the other member as the normal form of this one modulo the kernel: no second elimination
+            member1 = Ansatz.member(sol, prio1, domain)
+        else:  # over QQ<theta>(params) the reduction would run on sympy's field: a second elimination instead
+            member1 = Ansatz.solve_canonical(col_vectors, rhs_list, len(rows), domain, prio1, certificate=False).particular
         members = [member0, member1]
         # family = (1 - alpha) member0 + alpha member1, each member a polynomial in alpha
         fam = [alg.zero for _ in range(self.slots)]
@@ -811,11 +816,13 @@ def direct_route(system, word, order: int = 2, degree=None, max_unknowns=None, p
     orders = []
     from ..progress import stages
 
-    for j in stages(range(1, order + 1), f"shadow {getattr(comp, 'name', comp)} on {system.name}: orders", enabled=progress):
-        sol = solver.solve_order(j, corrections)
-        orders.append(sol)
-        if sol.status in ("obstructed", "refused"):
-            break
+    with frac_rref.shared_conversions():  # each coefficient crosses to flint once for all orders' eliminations
+        for j in stages(range(1, order + 1), f"shadow {getattr(comp, 'name', comp)} on {system.name}: orders",
+                        enabled=progress):
+            sol = solver.solve_order(j, corrections)
+            orders.append(sol)
+            if sol.status in ("obstructed", "refused"):
+                break
     if orders and orders[-1].status == "refused" and effective is None:  # order 0 solves nothing: H_S = H, G_S = G
         from .generic import poisson_structure
 
