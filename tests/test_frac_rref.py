@@ -145,3 +145,40 @@ def test_direct_route_eliminates_each_order_once(monkeypatch):
     solved = [o for o in R.orders if o.status == "solved"]
     assert len(solved) == 2 and len(calls) == len(solved)
     assert all(m[0] != m[1] for o in solved for m in [o.members])  # two distinct members all the same
+
+
+X1, X2, H = sympy.symbols("x1 x2 h")
+
+
+@st.composite
+def sums(draw):
+    """Parts ``(p_k, (h^j_k,))`` over ``QQ``, ``QQ(a, b)`` with monomial and non-monomial denominators, on a ring
+    with ``h`` among its generators (so that a part's ``h^j`` may meet another part's monomials) or without."""
+    from nambu_bch.algebra import PolynomialAlgebra
+
+    params = draw(st.sampled_from([(), (a, b)]))
+    alg = PolynomialAlgebra([X1, X2], list(params))
+    if draw(st.booleans()):
+        alg = alg.with_constants(H)
+    gens = [X1, X2] + ([H] if len(alg.gens) > 2 else [])
+    den = [sympy.Integer(1), 2 * a, a**2 * b, a - 2 * b][: 4 if params else 1]
+    parts = []
+    for j in draw(st.lists(st.integers(0, 3), min_size=1, max_size=3, unique=True)):
+        expr = sympy.Integer(0)
+        for _ in range(draw(st.integers(0, 4))):
+            c = sympy.Rational(draw(st.integers(-5, 5)), draw(st.integers(1, 4)))
+            mono = sympy.Mul(*[g ** draw(st.integers(0, 2)) for g in gens])
+            coeff = c * (a ** draw(st.integers(0, 2)) + draw(st.integers(0, 1)) * b if params else 1)
+            expr += coeff * mono / draw(st.sampled_from(den))
+        parts.append((alg.convert(expr), (H**j,) if j else ()))
+    return alg, parts
+
+
+@settings(max_examples=40, deadline=None, derandomize=True)
+@given(sums())
+def test_expanded_sum_is_sympy_expand_of_the_sum(case):
+    """``expanded_sum`` of several parts is the very expression ``sympy.expand`` of their sum (same srepr), whether
+    the keyed construction applies or the terms go through ``canonical_add``."""
+    alg, parts = case
+    plain = sympy.expand(sympy.Add(*[alg.to_sympy(p) * sympy.Mul(*f) for p, f in parts]))
+    assert sympy.srepr(alg.expanded_sum(parts)) == sympy.srepr(plain)

@@ -66,7 +66,6 @@ import sympy
 
 from ..algebra import VectorField, liouville_field
 from ..algebra.ansatz import Ansatz, Rows
-from ..algebra.canonical import canonical_add
 from ..algebra import elimination, frac_rref
 from ..algebra.elimination import SparseMatrix, elimination_cost, rank, signed_sums
 from ..algebra.flint_ring import polynomial_ring
@@ -204,7 +203,7 @@ class DirectResult:
     def shadow(self, upto=None) -> tuple:
         """``(H_S, G_S, ...)`` as sympy expressions in ``h`` and ``alpha`` through ``h^upto``."""
         upto = self.order if upto is None else upto
-        out, memo = [], {}  # canonical_add's sort keys, shared by the shadows
+        out, memo = [], {}  # the sort keys of the terms, shared by the shadows
         for a, Ha in enumerate(self.hamiltonians):
             # term by term: the same expression as sympy.expand of the sum (PolynomialAlgebra.expanded_terms),
             # without expand's walk over the rational-function coefficients, and sorted by a key (the distinct
@@ -212,7 +211,7 @@ class DirectResult:
             parts = [(Ha, ())] + [(self.corrections[(a, j)], (H_STEP**j,)) for j in range(1, upto + 1)
                                   if self.corrections.get((a, j))]
             if all(self.algebra.is_polynomial(p) for p, _ in parts):
-                out.append(canonical_add([t for p, f in parts for t in self.algebra.expanded_terms(p, f, memo)], memo))
+                out.append(self.algebra.expanded_sum(parts, memo))
             else:  # non-polynomial pieces (the BCH series of _non_polynomial): sympy expands the sum, but not
                 # the powers of sums (a denominator (q1**2 + q2**2)**4 stays one factor instead of nine terms)
                 out.append(sympy.expand(sympy.Add(*[sympy.Mul(self.algebra.to_sympy(p), *f) for p, f in parts]),
