@@ -114,7 +114,18 @@ def fmpq_mat(nrows: int, ncols: int):
     return module().fmpq_mat(nrows, ncols)
 
 
-def exponents(p) -> list:
+def exponents(p, memo: dict | None = None) -> list:
     """The exponent tuples of a flint polynomial's terms as Python ints (flint returns ``fmpz`` exponents, which
-    must not leak into sympy's rings), in the order of ``p.coeffs()``."""
-    return [tuple(map(int, m)) for m in p.monoms()]
+    must not leak into sympy's rings), in the order of ``p.coeffs()``.
+
+    ``memo``: a dict from flint's exponent tuples to the converted ones, shared by the caller's conversions (the
+    polynomials of one solve have few distinct exponents; a lookup is cheaper than converting each ``fmpz``)."""
+    if memo is None:
+        return [tuple(map(int, m)) for m in p.monoms()]
+    out = []
+    for m in p.monoms():
+        e = memo.get(m)
+        if e is None:
+            e = memo[m] = tuple(map(int, m))
+        out.append(e)
+    return out

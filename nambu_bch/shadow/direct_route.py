@@ -70,6 +70,7 @@ from ..algebra import elimination, frac_rref
 from ..algebra.elimination import SparseMatrix, elimination_cost, rank, signed_sums
 from ..algebra.flint_ring import polynomial_ring
 from ..bch.backward import check_order
+from ..bch.collector import no_full_collection
 from ..checks import check_flag, show
 from ..bch.concrete import effective_field_by_cost
 from ..errors import InvalidOrderError, NambuBCHError, ResourceLimitError
@@ -202,7 +203,10 @@ class DirectResult:
 
     def shadow(self, upto=None) -> tuple:
         """``(H_S, G_S, ...)`` as sympy expressions in ``h`` and ``alpha`` through ``h^upto``."""
-        upto = self.order if upto is None else upto
+        with no_full_collection():  # thousands of new terms and keys, no cycles among them
+            return self._shadow(self.order if upto is None else upto)
+
+    def _shadow(self, upto) -> tuple:
         out, memo = [], {}  # the sort keys of the terms, shared by the shadows
         for a, Ha in enumerate(self.hamiltonians):
             # term by term: the same expression as sympy.expand of the sum (PolynomialAlgebra.expanded_terms),
@@ -810,12 +814,14 @@ def direct_route(system, word, order: int = 2, degree=None, max_unknowns=None, p
         return _non_polynomial(system, comp, order)
     if max_unknowns is not None and (isinstance(max_unknowns, bool) or not isinstance(max_unknowns, int) or max_unknowns < 1):
         raise InvalidOrderError(f"max_unknowns must be a positive integer or None, got {max_unknowns!r}")
-    solver = _Solver(system, comp, order, degree, max_unknowns, effective)
     corrections: dict = {}
     orders = []
     from ..progress import stages
 
-    with frac_rref.shared_conversions():  # each coefficient crosses to flint once for all orders' eliminations
+    # each coefficient crosses to flint once for all orders' eliminations; the solve builds tens of thousands of
+    # acyclic ring elements, each of which would count towards a full collection walking sympy's caches
+    with frac_rref.shared_conversions(), no_full_collection():
+        solver = _Solver(system, comp, order, degree, max_unknowns, effective)
         for j in stages(range(1, order + 1), f"shadow {getattr(comp, 'name', comp)} on {system.name}: orders",
                         enabled=progress):
             sol = solver.solve_order(j, corrections)
