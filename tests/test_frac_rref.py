@@ -22,7 +22,7 @@ from sympy.polys.domains import QQ
 
 from nambu_bch import model
 from nambu_bch.algebra import ansatz as ansatz_module
-from nambu_bch.algebra import frac_rref
+from nambu_bch.algebra import _flint, frac_rref
 from nambu_bch.algebra.ansatz import Ansatz
 from nambu_bch.errors import NambuBCHError
 from nambu_bch.shadow.direct_route import direct_route
@@ -126,23 +126,25 @@ def test_shared_conversions_convert_each_element_once():
         made = frac_rref.to_field(pair, K)
         assert identical(made, u * u)
         assert frac_rref.from_field(made, CTX) is pair
-        seen = frac_rref._SHARED.get()[1]  # flint's exponent tuples, converted once each
+        seen = _flint._EXPONENTS.get()  # flint's exponent tuples, converted once each
         assert seen and all(type(e) is int for t in seen.values() for e in t)
         assert identical(frac_rref.to_field(pair, K), made)
-    assert frac_rref._SHARED.get() is None
+    assert frac_rref._SHARED.get() is None and _flint._EXPONENTS.get() is None
     assert frac_rref.from_field(u, CTX) is not p
 
 
 def test_exponents_with_a_memo_are_python_ints():
-    """``_flint.exponents`` with a memo: the same tuples of Python ints as without, each distinct tuple converted once."""
-    from nambu_bch.algebra import _flint
-
+    """``_flint.exponents`` with a memo: the same tuples of Python ints as without, each distinct tuple converted once;
+    inside ``shared_exponents`` the scope's memo is used."""
     n, _ = frac_rref.from_field(K.from_sympy(a**3 * b - 2 * a * b**2 + 5), CTX)
     memo: dict = {}
     assert _flint.exponents(n, memo) == _flint.exponents(n) == [(3, 1), (1, 2), (0, 0)]
     first = _flint.exponents(n, memo)
     assert all(x is y for x, y in zip(first, _flint.exponents(n, memo))) and len(memo) == 3
     assert all(type(e) is int for t in first for e in t)
+    with _flint.shared_exponents():
+        inner = _flint.exponents(n)
+        assert _flint.exponents(n)[0] is inner[0] and len(_flint._EXPONENTS.get()) == 3
 
 
 def test_direct_route_eliminates_each_order_once(monkeypatch):

@@ -97,9 +97,8 @@ def normalize(n, d):
     return n, d
 
 
-#: the conversion memos of the outermost :func:`shared_conversions` scope (``None`` outside one): ``(pairs,
-#: exponents)``, ``pairs`` ``id(element) -> (element, context, pair)`` (the element is held, so its id stays its own
-#: while it is there), ``exponents`` flint's exponent tuples as Python's (:func:`~nambu_bch.algebra._flint.exponents`)
+#: the conversion memo of the outermost :func:`shared_conversions` scope (``None`` outside one):
+#: ``id(element) -> (element, context, pair)``; the element is held, so its id stays its own while it is there
 _SHARED: contextvars.ContextVar = contextvars.ContextVar("frac_rref_shared", default=None)
 
 
@@ -111,15 +110,16 @@ def shared_conversions():
     One exact solve passes the same coefficients through several eliminations (the two canonical members of an
     order, the operator columns shared by the orders, the solutions fed back as cross terms): inside the scope
     each is converted once, and the exponent tuples flint returns are converted to Python's once per distinct
-    tuple.  The pair of an element is a function of its value (the normal form of the module docstring), so the
+    tuple (:func:`~nambu_bch.algebra._flint.shared_exponents`, which the scope opens).  The pair of an element is a function of its value (the normal form of the module docstring), so the
     memo changes no result; nested scopes share the outermost memo.
     """
     if _SHARED.get() is not None:
         yield
         return
-    token = _SHARED.set(({}, {}))
+    token = _SHARED.set({})
     try:
-        yield
+        with _flint.shared_exponents():
+            yield
     finally:
         _SHARED.reset(token)
 
@@ -128,12 +128,12 @@ def from_field(v, ctx):
     """A field element (sympy ``FracElement`` of ``QQ(params)``) as a normalised pair ``(n, d)`` of ``fmpz_mpoly``."""
     shared = _SHARED.get()
     if shared is not None:
-        pairs = shared[0]
-        hit = pairs.get(id(v))
+        hit = shared.get(id(v))
         if hit is not None and hit[0] is v and hit[1] is ctx:
             return hit[2]
-        pair = pairs[id(v)] = (v, ctx, _from_field(v, ctx))
-        return pair[2]
+        pair = _from_field(v, ctx)
+        shared[id(v)] = (v, ctx, pair)
+        return pair
     return _from_field(v, ctx)
 
 
@@ -157,19 +157,18 @@ def to_field(pair, domain):
     native = _flint.qq_is_fmpq(coeff)  # flint ground types: fmpz coefficients convert directly
 
     zero = (0,) * len(field.ring.gens)
-    shared = _SHARED.get()
-    seen = shared[1] if shared is not None else None
 
     def poly(p):
         if p.is_constant():  # most entries of an elimination: no exponents to convert
             c = p.leading_coefficient() if not p.is_zero() else None
             return make([(zero, coeff(c if native else int(c)))] if c is not None else [])
         cs = p.coeffs() if native else [int(c) for c in p.coeffs()]
-        return make(zip(exponents(p, seen), map(coeff, cs)))
+        return make(zip(exponents(p), map(coeff, cs)))
 
     out = field.raw_new(poly(n), poly(d))
+    shared = _SHARED.get()
     if shared is not None:
-        shared[0][id(out)] = (out, n.context(), pair)
+        shared[id(out)] = (out, n.context(), pair)
     return out
 
 
