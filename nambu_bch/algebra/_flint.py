@@ -22,6 +22,8 @@ FLINT documentation, ``fmpq``, ``fmpq_mat``, ``fmpz_mpoly``, ``fmpq_mpoly``; pyt
 
 from __future__ import annotations
 
+import contextlib
+import contextvars
 import importlib
 import os
 
@@ -31,6 +33,8 @@ _MODULE: list = []
 _FMPZ_CONTEXTS: dict = {}  # number of variables -> fmpz_mpoly_ctx (lex)
 _FMPQ_CONTEXTS: dict = {}  # number of variables -> fmpq_mpoly_ctx (lex)
 _QQ_IS_FMPQ: dict = {}  # a sympy ground type -> is it flint's fmpq
+#: the exponent memo of the outermost :func:`shared_exponents` scope (``None`` outside one): flint's tuples -> Python's
+_EXPONENTS: contextvars.ContextVar = contextvars.ContextVar("flint_exponents", default=None)
 
 
 def _import():
@@ -114,7 +118,35 @@ def fmpq_mat(nrows: int, ncols: int):
     return module().fmpq_mat(nrows, ncols)
 
 
-def exponents(p) -> list:
+@contextlib.contextmanager
+def shared_exponents():
+    """A scope in which :func:`exponents` converts each distinct exponent tuple once (nested scopes share the
+    outermost memo): the polynomials of one exact solve have few distinct exponents, and a lookup is cheaper than
+    converting each ``fmpz``."""
+    if _EXPONENTS.get() is not None:
+        yield
+        return
+    token = _EXPONENTS.set({})
+    try:
+        yield
+    finally:
+        _EXPONENTS.reset(token)
+
+
+def exponents(p, memo: dict | None = None) -> list:
     """The exponent tuples of a flint polynomial's terms as Python ints (flint returns ``fmpz`` exponents, which
-    must not leak into sympy's rings), in the order of ``p.coeffs()``."""
-    return [tuple(map(int, m)) for m in p.monoms()]
+    must not leak into sympy's rings), in the order of ``p.coeffs()``.
+
+    ``memo``: a dict from flint's exponent tuples to the converted ones (default: the one of the enclosing
+    :func:`shared_exponents` scope, if any)."""
+    if memo is None:
+        memo = _EXPONENTS.get()
+    if memo is None:
+        return [tuple(map(int, m)) for m in p.monoms()]
+    out = []
+    for m in p.monoms():
+        e = memo.get(m)
+        if e is None:
+            e = memo[m] = tuple(map(int, m))
+        out.append(e)
+    return out

@@ -82,6 +82,7 @@ import sympy
 
 from ..checks import is_int
 from ..errors import NambuBCHError, ResourceLimitError
+from . import elimination, frac_rref
 from .elimination import SparseMatrix, normal_form, solve_affine
 
 #: The monomial orders of :class:`Ansatz`.
@@ -243,6 +244,36 @@ class Ansatz:
     def canonical(vectors, kernel, priority, domain) -> list:
         """The normal forms of solutions ``vectors`` modulo ``span(kernel)`` for ``priority`` (the canonical member)."""
         return [normal_form(v, kernel, priority, domain) for v in vectors]
+
+    @staticmethod
+    def member(solution, priority, domain) -> list:
+        """The canonical member for ``priority`` from a consistent solution of the same system: the particular
+        solutions ``solve_canonical(.., priority).particular`` would give, without a second elimination.
+
+        A canonical member is the normal form of any solution modulo the kernel (module docstring), so the
+        particular solutions of one :meth:`solve_canonical` call and its kernel give the member of every other
+        priority by reduction against the kernel's echelon form (a few dozen vectors instead of the whole
+        system; over ``QQ(params)`` on python-flint's fraction pairs, :func:`~nambu_bch.algebra.frac_rref.normal_forms`).
+        The entries of each vector are in :meth:`solve_canonical`'s order (descending position in ``priority``).
+
+        Parameters
+        ----------
+        solution : AffineSolution -- consistent, its column indices the caller's (a :meth:`solve_canonical` result)
+        priority : list -- every column once, most important to clear first
+        domain : the coefficient field
+
+        Returns
+        -------
+        list of dict -- one vector per right-hand side
+        """
+        if not solution.consistent:
+            raise NambuBCHError("an inconsistent system has no canonical member")
+        ctx = frac_rref.context(domain) if elimination.FAST_PATHS and elimination.flint_available() else None
+        if ctx is not None:
+            return frac_rref.normal_forms(solution.particular, solution.kernel, priority, domain, ctx)
+        position = {c: i for i, c in enumerate(priority)}
+        return [dict(sorted(v.items(), key=lambda cv: -position[cv[0]]))
+                for v in Ansatz.canonical(solution.particular, solution.kernel, priority, domain)]
 
     @staticmethod
     def solve_canonical(columns, rhs, nrows: int, domain, priority, certificate: bool = True):

@@ -25,6 +25,9 @@ Knuth, *The Art of Computer Programming*, vol. 2, Sect. 4.5.1 (rational arithmet
 
 from __future__ import annotations
 
+import contextlib
+import contextvars
+
 from . import _flint
 from ._flint import exponents
 from .fields import CoefficientField
@@ -94,8 +97,47 @@ def normalize(n, d):
     return n, d
 
 
+#: the conversion memo of the outermost :func:`shared_conversions` scope (``None`` outside one):
+#: ``id(element) -> (element, context, pair)``; the element is held, so its id stays its own while it is there
+_SHARED: contextvars.ContextVar = contextvars.ContextVar("frac_rref_shared", default=None)
+
+
+@contextlib.contextmanager
+def shared_conversions():
+    """A scope in which every field element crosses to flint once: :func:`from_field` and :func:`to_field` record
+    the pairs of the elements they meet or make (by identity, the elements held until the scope ends).
+
+    One exact solve passes the same coefficients through several eliminations (the two canonical members of an
+    order, the operator columns shared by the orders, the solutions fed back as cross terms): inside the scope
+    each is converted once, and the exponent tuples flint returns are converted to Python's once per distinct
+    tuple (:func:`~nambu_bch.algebra._flint.shared_exponents`, which the scope opens).  The pair of an element is a function of its value (the normal form of the module docstring), so the
+    memo changes no result; nested scopes share the outermost memo.
+    """
+    if _SHARED.get() is not None:
+        yield
+        return
+    token = _SHARED.set({})
+    try:
+        with _flint.shared_exponents():
+            yield
+    finally:
+        _SHARED.reset(token)
+
+
 def from_field(v, ctx):
     """A field element (sympy ``FracElement`` of ``QQ(params)``) as a normalised pair ``(n, d)`` of ``fmpz_mpoly``."""
+    shared = _SHARED.get()
+    if shared is not None:
+        hit = shared.get(id(v))
+        if hit is not None and hit[0] is v and hit[1] is ctx:
+            return hit[2]
+        pair = _from_field(v, ctx)
+        shared[id(v)] = (v, ctx, pair)
+        return pair
+    return _from_field(v, ctx)
+
+
+def _from_field(v, ctx):
     numer, denom = v.numer, v.denom
     if numer.is_ground and denom.is_ground:  # a rational number (most entries of the shadow solves)
         q = numer.LC / denom.LC  # sympy's QQ: reduced, positive denominator -- the normal form of a constant
@@ -123,7 +165,11 @@ def to_field(pair, domain):
         cs = p.coeffs() if native else [int(c) for c in p.coeffs()]
         return make(zip(exponents(p), map(coeff, cs)))
 
-    return field.raw_new(poly(n), poly(d))
+    out = field.raw_new(poly(n), poly(d))
+    shared = _SHARED.get()
+    if shared is not None:
+        shared[id(out)] = (out, n.context(), pair)
+    return out
 
 
 def mul(a, b):
@@ -231,3 +277,36 @@ def rref(rows: dict, ncols: int, ctx):
         pivot_rows.append((col, p))
     R = {k: work[p] for k, (col, p) in enumerate(pivot_rows)}
     return R, tuple(col for col, _ in pivot_rows)
+
+
+def normal_forms(vectors, kernel, priority, domain, ctx) -> list:
+    """The normal forms of ``vectors`` modulo ``span(kernel)`` for the column order ``priority``, on flint pairs.
+
+    The same vectors as :func:`~nambu_bch.algebra.elimination.normal_form` of each (the unique ``v + k``,
+    ``k`` in the span, vanishing on the greedily first priority columns the kernel can clear): the kernel is
+    brought to reduced echelon form once, with the columns in ``priority`` order (:func:`rref`), and each
+    vector loses its entries on the pivot columns, ``x <- x - x_p R_p``.  The values are elements of ``domain``
+    (``QQ(params)``, ``ctx`` its flint context) and come back in sympy's normal form; the entries of a result
+    are ordered by descending position in ``priority``, as the elimination in reverse priority of
+    :meth:`~nambu_bch.algebra.ansatz.Ansatz.solve_canonical` orders its particular solutions.
+    """
+    position = {c: i for i, c in enumerate(priority)}
+    rows = {r: {position[c]: from_field(v, ctx) for c, v in vec.items() if v} for r, vec in enumerate(kernel)}
+    R, pivots = rref(rows, len(priority), ctx) if rows else ({}, ())
+    out = []
+    for vec in vectors:
+        x = {position[c]: from_field(v, ctx) for c, v in vec.items() if v}
+        for r, p in enumerate(pivots):
+            f = x.get(p)
+            if f is None:
+                continue
+            for c, w in R[r].items():
+                t = mul(f, w)
+                old = x.get(c)
+                s = (-t[0], t[1]) if old is None else sub(old, t)
+                if s[0].is_zero():
+                    x.pop(c, None)
+                else:
+                    x[c] = s
+        out.append({priority[c]: to_field(x[c], domain) for c in sorted(x, reverse=True)})
+    return out

@@ -29,7 +29,7 @@ from ..checks import check_sequence
 from ..errors import InvalidSystemError
 from ..parsing import as_expression, as_symbols
 from .backend import ExpressionBackend, PolynomialBackend
-from .canonical import canonical_add, product_key, sort_key
+from .canonical import _NoKey, canonical_add, product_key, sort_key
 from .fields import CoefficientField
 from .ring import declare
 from .zero import is_zero
@@ -107,6 +107,38 @@ def _rational_term(coeff, exps: dict, memo: dict, factors: dict):
 
 def _first(pair):
     return pair[0]
+
+
+def _power_pairs(exps: dict, memo: dict, factors: dict) -> list:
+    """``[(sort key, s^k)]`` of ``{symbol: exponent}`` (zero exponents left out) in the order of ``Basic.compare``;
+    ``factors`` memoises ``(s, k) -> (key, power)``."""
+    pairs = []
+    for s, k in exps.items():
+        if k:
+            power = factors.get((s, k))
+            if power is None:
+                value = s if k == 1 else sympy.Pow(s, k)
+                power = factors[(s, k)] = (sort_key(value, memo), value)
+            pairs.append(power)
+    pairs.sort(key=_first)
+    return pairs
+
+
+def _keyed_term(q, pairs: list, memo: dict, numbers: dict) -> tuple:
+    """``(sort key, q * prod(powers))`` for a rational ``q`` of ``QQ`` and the sorted :func:`_power_pairs` of the
+    powers: :func:`_rational_term`'s product with its key returned instead of recorded (no hash of the new
+    product), the number and its key memoised in ``numbers`` by numerator and denominator."""
+    ident = (q.numerator, q.denominator)
+    hit = numbers.get(ident)
+    if hit is None:
+        coeff = QQ.to_sympy(q)
+        hit = numbers[ident] = (sort_key(coeff, memo), coeff)
+    if hit[1] is not sympy.S.One or not pairs:
+        pairs = [hit, *pairs]
+    if len(pairs) == 1:
+        return pairs[0]
+    term = sympy.Mul._from_args([f for _, f in pairs], True)  # the ring's generators and parameters commute
+    return product_key(term, [k for k, _ in pairs]), term
 
 
 # -- pickling -----------------------------------------------------------------------------
@@ -495,9 +527,123 @@ class PolynomialAlgebra:
                     terms.append(sympy.Mul(part, *[s**k for s, k in zip(params, e) if k], *mono, inv))
         return terms
 
+    def expanded_sum(self, parts, memo=None) -> sympy.Expr:
+        """``sympy.expand(sum_k to_sympy(value_k) * prod(factors_k))`` for ``parts = [(value_k, factors_k)]``, identical.
+
+        The terms are :meth:`expanded_terms`'; when every value is a ring element over ``QQ`` or ``QQ(params)``,
+        every factor a power of a symbol other than the parameters, and the monomials of the parts times their
+        factors pairwise distinct, no two terms share their non-numeric part (distinct powers of the generators
+        and the factors' symbols, then of the parameters; a coefficient with a sum in its denominator gives
+        products with a power of that sum, distinct by their powers of the parameters), so ``Add`` would keep
+        every term as it is, in the order of ``Basic.compare``: the sum is built from the terms' sort keys
+        (:func:`~nambu_bch.algebra.canonical.sort_key`'s order), computed with the terms of monomial denominators,
+        the numbers summed in front (``sympy.core.add.Add.flatten``).  Otherwise
+        :func:`~nambu_bch.algebra.canonical.canonical_add` of the terms.
+
+        Parameters
+        ----------
+        parts : sequence of ``(value, factors)`` -- a ring element or sympy expression, and a sequence of sympy
+            expressions multiplying each of its terms
+        memo : dict, optional -- :func:`~nambu_bch.algebra.canonical.sort_key`'s memo, shared between sums
+
+        Returns
+        -------
+        sympy.Expr
+
+        Examples
+        --------
+        >>> x, m, h = sympy.symbols("x m h")
+        >>> A = PolynomialAlgebra([x], [m])
+        >>> p, q = A.convert(x**2 / (2 * m) + 3), A.convert(-x / m**2 + m * x)
+        >>> A.expanded_sum([(p, ()), (q, (h,))]) == sympy.expand(A.to_sympy(p) + A.to_sympy(q) * h)
+        True
+        """
+        parts = list(parts)
+        memo = {} if memo is None else memo
+        keyed = self._keyed_terms(parts, memo)
+        if keyed is None:
+            return canonical_add([t for p, f in parts for t in self.expanded_terms(p, f, memo)], memo)
+        number = sympy.S.Zero
+        rest = []
+        for key, term in keyed:
+            if term.is_Number:
+                number += term
+            else:
+                rest.append((key, term))
+        rest.sort(key=_first)  # distinct terms have distinct keys: the terms themselves are never compared
+        ordered = [term for _, term in rest]
+        if number:
+            ordered.insert(0, number)
+        if len(ordered) <= 1:
+            return ordered[0] if ordered else sympy.S.Zero
+        return sympy.Add._from_args(ordered, True)
+
+    def _keyed_terms(self, parts, memo):
+        """``[(sort key, term)]`` of :meth:`expanded_sum`'s parts when its conditions hold, else ``None``."""
+        ring = self.ring
+        if not all(isinstance(p, PolyElement) and p.ring == ring for p, _ in parts):
+            return None
+        domain = ring.domain
+        fraction = getattr(domain, "is_FractionField", False)
+        if not (domain.domain.is_QQ if fraction else domain.is_QQ):
+            return None
+        gens = ring.symbols
+        params = domain.field.ring.symbols if fraction else ()
+        powers = [_symbol_powers(f) for _, f in parts]
+        if any(w is None for w in powers):
+            return None
+        if any(s in params for w in powers for s in w) or set(params) & set(gens):
+            return None
+        place = {s: i for i, s in enumerate(gens)}
+        outside = sorted({s for w in powers for s in w if s not in place}, key=str)
+        seen: set = set()  # the exponents of the generators and outside symbols of every (part, monomial)
+        for (p, _), w in zip(parts, powers):
+            shift = [0] * len(gens)
+            for s, k in w.items():
+                if s in place:
+                    shift[place[s]] += k
+            extra = tuple(w.get(s, 0) for s in outside)
+            for m in p.keys():
+                seen.add((tuple(e + k for e, k in zip(m, shift)), extra))
+        if len(seen) != sum(len(p) for p, _ in parts):
+            return None
+        built: dict = {}  # (symbol, exponent) -> (sort key, power)
+        numbers: dict = {}  # (numerator, denominator) -> (sort key, sympy number)
+        by_shift: dict = {}  # exponents of the parameters -> their sorted power pairs
+        out = []
+        for (p, f), w in zip(parts, powers):
+            for m, c in p.items():
+                if fraction and len(c.denom) != 1:  # a sum in the denominator, kept whole: expanded_terms' terms
+                    for t in self.expanded_terms(ring({m: c}), f, memo):
+                        # the terms canonical_add keeps as they are (products with a power of the sum)
+                        if not (t.is_Mul and t.is_commutative):
+                            return None
+                        try:
+                            out.append((sort_key(t, memo), t))
+                        except _NoKey:
+                            return None
+                    continue
+                base = dict(w)
+                for s, e in zip(gens, m):
+                    if e:
+                        base[s] = base.get(s, 0) + e
+                mono = _power_pairs(base, memo, built)
+                if not fraction:
+                    out.append(_keyed_term(c, mono, memo, numbers))
+                    continue
+                [(dexp, d)] = c.denom.items()
+                for e, a in c.numer.items():
+                    shift = tuple(k - j for k, j in zip(e, dexp))
+                    own = by_shift.get(shift)
+                    if own is None:
+                        own = by_shift[shift] = _power_pairs(dict(zip(params, shift)), memo, built)
+                    # the parameters are not among the other symbols: the two sorted runs merge into one
+                    out.append(_keyed_term(a / d, sorted(mono + own, key=_first) if own else mono, memo, numbers))
+        return out
+
     def to_sympy_expanded(self, value, factors=()) -> sympy.Expr:
-        """``sympy.expand(to_sympy(value) * prod(factors))``, identical, from :meth:`expanded_terms` (no ``expand``)."""
-        return canonical_add(self.expanded_terms(value, factors))
+        """``sympy.expand(to_sympy(value) * prod(factors))``, identical, from :meth:`expanded_sum` (no ``expand``)."""
+        return self.expanded_sum([(value, factors)])
 
     @cached_property
     def coefficient_field(self) -> CoefficientField:

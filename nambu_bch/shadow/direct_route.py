@@ -66,11 +66,11 @@ import sympy
 
 from ..algebra import VectorField, liouville_field
 from ..algebra.ansatz import Ansatz, Rows
-from ..algebra.canonical import canonical_add
 from ..algebra import elimination, frac_rref
 from ..algebra.elimination import SparseMatrix, elimination_cost, rank, signed_sums
 from ..algebra.flint_ring import polynomial_ring
 from ..bch.backward import check_order
+from ..bch.collector import no_full_collection
 from ..checks import check_flag, show
 from ..bch.concrete import effective_field_by_cost
 from ..errors import InvalidOrderError, NambuBCHError, ResourceLimitError
@@ -203,8 +203,11 @@ class DirectResult:
 
     def shadow(self, upto=None) -> tuple:
         """``(H_S, G_S, ...)`` as sympy expressions in ``h`` and ``alpha`` through ``h^upto``."""
-        upto = self.order if upto is None else upto
-        out, memo = [], {}  # canonical_add's sort keys, shared by the shadows
+        with no_full_collection():  # thousands of new terms and keys, no cycles among them
+            return self._shadow(self.order if upto is None else upto)
+
+    def _shadow(self, upto) -> tuple:
+        out, memo = [], {}  # the sort keys of the terms, shared by the shadows
         for a, Ha in enumerate(self.hamiltonians):
             # term by term: the same expression as sympy.expand of the sum (PolynomialAlgebra.expanded_terms),
             # without expand's walk over the rational-function coefficients, and sorted by a key (the distinct
@@ -212,7 +215,7 @@ class DirectResult:
             parts = [(Ha, ())] + [(self.corrections[(a, j)], (H_STEP**j,)) for j in range(1, upto + 1)
                                   if self.corrections.get((a, j))]
             if all(self.algebra.is_polynomial(p) for p, _ in parts):
-                out.append(canonical_add([t for p, f in parts for t in self.algebra.expanded_terms(p, f, memo)], memo))
+                out.append(self.algebra.expanded_sum(parts, memo))
             else:  # non-polynomial pieces (the BCH series of _non_polynomial): sympy expands the sum, but not
                 # the powers of sums (a denominator (q1**2 + q2**2)**4 stays one factor instead of nine terms)
                 out.append(sympy.expand(sympy.Add(*[sympy.Mul(self.algebra.to_sympy(p), *f) for p, f in parts]),
@@ -606,8 +609,13 @@ class _Solver:
             )
             return OrderSolution(j, "obstructed", degree=D, certificate=cert, obstruction_value=sympy.factor(value),
                                  kernel_dim=len(sol.kernel), rhs=rhs)
-        member1 = (Ansatz.solve_canonical(col_vectors, rhs_list, len(rows), domain, prio1, certificate=False).particular
-                   if self.slots > 1 else member0)
+        if self.slots == 1:
+            member1 = member0
+        elif domain.is_QQ or self._flint_context() is not None:
+            # the other member as the normal form of this one modulo the kernel: no second elimination
+            member1 = Ansatz.member(sol, prio1, domain)
+        else:  # over QQ<theta>(params) the reduction would run on sympy's field: a second elimination instead
+            member1 = Ansatz.solve_canonical(col_vectors, rhs_list, len(rows), domain, prio1, certificate=False).particular
         members = [member0, member1]
         # family = (1 - alpha) member0 + alpha member1, each member a polynomial in alpha
         fam = [alg.zero for _ in range(self.slots)]
@@ -806,16 +814,20 @@ def direct_route(system, word, order: int = 2, degree=None, max_unknowns=None, p
         return _non_polynomial(system, comp, order)
     if max_unknowns is not None and (isinstance(max_unknowns, bool) or not isinstance(max_unknowns, int) or max_unknowns < 1):
         raise InvalidOrderError(f"max_unknowns must be a positive integer or None, got {max_unknowns!r}")
-    solver = _Solver(system, comp, order, degree, max_unknowns, effective)
     corrections: dict = {}
     orders = []
     from ..progress import stages
 
-    for j in stages(range(1, order + 1), f"shadow {getattr(comp, 'name', comp)} on {system.name}: orders", enabled=progress):
-        sol = solver.solve_order(j, corrections)
-        orders.append(sol)
-        if sol.status in ("obstructed", "refused"):
-            break
+    # each coefficient crosses to flint once for all orders' eliminations; the solve builds tens of thousands of
+    # acyclic ring elements, each of which would count towards a full collection walking sympy's caches
+    with frac_rref.shared_conversions(), no_full_collection():
+        solver = _Solver(system, comp, order, degree, max_unknowns, effective)
+        for j in stages(range(1, order + 1), f"shadow {getattr(comp, 'name', comp)} on {system.name}: orders",
+                        enabled=progress):
+            sol = solver.solve_order(j, corrections)
+            orders.append(sol)
+            if sol.status in ("obstructed", "refused"):
+                break
     if orders and orders[-1].status == "refused" and effective is None:  # order 0 solves nothing: H_S = H, G_S = G
         from .generic import poisson_structure
 

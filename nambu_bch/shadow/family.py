@@ -20,7 +20,7 @@ from dataclasses import dataclass, field
 import sympy
 
 from ..algebra.ansatz import Ansatz
-from ..algebra.canonical import canonical_add, coordinate_coefficients
+from ..algebra.canonical import coordinate_coefficients
 from ..parsing import as_expression
 from ..printing import (Printable, aligned, by_monomials, h_coefficients, laid_out, latex_text, series_text,
                         series_tokens)
@@ -143,8 +143,8 @@ def _exact_layout(result, slot: int, hamiltonian, coordinates, with_base: bool):
     parts = {k: result.corrections[(slot, k)] for k in range(1, result.order + 1) if result.corrections.get((slot, k))}
     if not all(alg.is_polynomial(p) for p in (Ha, *parts.values())):
         return None
-    memo: dict = {}  # canonical_add's sort keys, shared by the orders
-    base = canonical_add(alg.expanded_terms(Ha, (), memo), memo)
+    memo: dict = {}  # the sort keys of the terms, shared by the orders
+    base = alg.expanded_sum([(Ha, ())], memo)
     if base != sympy.expand(hamiltonian):
         return None
     pieces = {0: Ha, **parts} if with_base else parts
@@ -152,7 +152,7 @@ def _exact_layout(result, slot: int, hamiltonian, coordinates, with_base: bool):
         rows = {k: coordinate_coefficients(p, alg.n) for k, p in pieces.items()}
         if all(r is not None for r in rows.values()):
             return [(k, by_monomials(rows[k], coordinates)) for k in sorted(rows) if rows[k]]
-    by_power = {k: canonical_add(alg.expanded_terms(p, (), memo), memo) for k, p in parts.items()}
+    by_power = {k: alg.expanded_sum([(p, ())], memo) for k, p in parts.items()}
     if with_base:
         by_power[0] = base
     return laid_out(by_power, coordinates)
@@ -183,7 +183,7 @@ def _exact_series(result, slot: int, hamiltonian):
     elif not domain.is_QQ:
         return None
     memo: dict = {}
-    out = {k: canonical_add(alg.expanded_terms(p, (), memo), memo) for k, p in sorted(pieces.items())}
+    out = {k: alg.expanded_sum([(p, ())], memo) for k, p in sorted(pieces.items())}
     if out[0] != sympy.expand(hamiltonian):
         return None
     return out
