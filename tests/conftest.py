@@ -67,6 +67,8 @@ LONG = (
     ("test_shadow.py", "test_n4_full_split_is_obstructed"),
     ("test_numeric.py", "test_series_pair_is_accurate"),
     ("test_runge_kutta_numeric.py", "test_compiled_equals_interpreted_bit_for_bit"),  # cold: numba compiles the RK loops
+    ("test_text_door.py", "test_text_reaches_eval_only_in_the_parser"),     # the package's ASTs (shared_results) ...
+    ("test_flint_seam.py", "test_only_the_seam_imports_flint"),             # ... reused here
 )
 
 
