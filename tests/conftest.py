@@ -250,6 +250,9 @@ DEEP = (
     # a second compiled complex loop and its batch (two numba compiles, ~4 s cold): the fast tier keeps ho3's loop
     # against the reference bits
     ("test_complex_compiled.py", "test_compiled_rigid_body_and_batches", ()),
+    # the h^2 hull against Eqs. (1AX)-(2BY) for the rigid body over QQ(I1, I2, I3) (2.7 s cold): the fast tier keeps the
+    # ho3 (CL5-CL8) and Lotka-Volterra rows, and test_fi_route's rigid-body obstruction at h^2 keeps its hulls
+    ("test_fi_route.py", "test_h2_hull_equals_affine_hull_of_eqs_1AX_to_2BY", ("ho3", "lotka-volterra")),
     # the FI span over QQ<2^(1/3)>(m, omega) (2.7 s cold): the fast tier keeps the exact families over QQ(params)
     ("test_fi_route.py", "test_fi_span_is_decided_exactly_over_an_algebraic_parameter_field", ()),
 )
