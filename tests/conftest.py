@@ -191,14 +191,8 @@ DEEP = (
     ("test_numeric_parallel.py", "test_threads_give_the_one_thread_bits", ("False-ho3-32123", "True-ho3-32123")),
     # the generic T|V answer against the concrete systems: d = 1 and 2 in the fast tier, the d = 3 quartic (4-6 s)
     ("test_generic_separable.py", "test_substituted_equals_the_concrete_shadow_hamiltonian_d3", ()),
-    # the command line as a subprocess (cli_run): the fast tier runs the same assertions on main(argv) in process; the
-    # process start is test_cli's subprocess of `python -m nambu_bch` (1.4-2.2 s each)
-    ("test_runge_kutta_cli.py", "test_shadow_integrator_gauss4_json_subprocess", ("in-process",)),
-    ("test_runge_kutta_cli.py", "test_shadow_tableau_file_subprocess", ("in-process",)),
-    ("test_runge_kutta_cli.py", "test_check_integrator_midpoint_subprocess", ("in-process",)),
-    ("test_runge_kutta_cli.py", "test_compare_across_families_subprocess", ("in-process",)),
-    ("test_numerical_shadow.py", "test_cli_check_adds_the_numerical_shadow_in_a_subprocess", ("in-process",)),
-    ("test_generic_separable.py", "test_cli_prints_the_generic_answer_as_json", ("in-process",)),
+    # the command line as a subprocess (cli_run's "subprocess" case, 1.4-2.2 s each) is deep by the fixture's own
+    # parameter mark (CLI_RUNNERS), for every test that asks for cli_run
     # the new method families: one case of each concern stays fast (ABA864's generalised order, the two routes on ho,
     # the compare rows and their CLI); the costlier repeats (2-5 s each, measured under load) are deep
     ("test_families_on_systems.py", "test_aba_methods_have_their_published_generalized_order", ("aba864-orders0",)),
@@ -257,8 +251,9 @@ DEEP = (
     ("test_fi_route.py", "test_fi_span_is_decided_exactly_over_an_algebraic_parameter_field", ()),
 )
 
-#: The two ways :func:`cli_run` runs the command line; the fast tier keeps ``in-process`` (DEEP).
-CLI_RUNNERS = ("in-process", "subprocess")
+#: The two ways :func:`cli_run` runs the command line; the fast tier keeps ``in-process``: the ``subprocess`` case
+#: carries the mark ``deep`` itself, so a new test asking for ``cli_run`` needs no entry in :data:`DEEP`.
+CLI_RUNNERS = ("in-process", pytest.param("subprocess", marks=pytest.mark.deep))
 REPO = Path(__file__).resolve().parents[1]
 
 
@@ -268,7 +263,7 @@ def cli_run(request, monkeypatch):
 
     Two cases of every test that asks for it: ``main(argv)`` in this process (stdout and stderr captured, the working
     directory changed for the call), and ``python -m nambu_bch ARGV`` in a subprocess (the package from this checkout).
-    The same assertions run on both.  The subprocess case is deep (:data:`DEEP`): a process start adds only the
+    The same assertions run on both.  The subprocess case is deep (its parameter's mark): a process start adds only the
     interpreter start and the imports, which ``test_cli.py``'s subprocess of ``python -m nambu_bch`` checks in the fast
     tier (and one subprocess per subcommand in the deep tier).
     """
