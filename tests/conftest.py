@@ -289,7 +289,9 @@ def cli_run(request, monkeypatch):
 #: Plugin distributions whose modules pytest marks for assertion rewriting (every module of a distribution with a
 #: ``pytest11`` entry point).  None of them has an ``assert`` the suite relies on (the package has none at all), but
 #: every pytest process re-parsed and rewrote ~150 of their modules as they were imported, ~0.7 s of CPU per process,
-#: since ``PYTHONDONTWRITEBYTECODE`` keeps pytest from caching the result (docs/suite_time.md).
+#: since ``PYTHONDONTWRITEBYTECODE`` keeps pytest from caching the result (docs/suite_time.md).  A module imported
+#: before :func:`pytest_configure` (by a plugin's own imports) is rewritten regardless: hence the package's light
+#: ``pytest11`` module, ``nambu_bch._pytest_plugin``.
 NOT_REWRITTEN = ("nambu_bch", "hypothesis", "_hypothesis_pytestplugin", "_hypothesis_globals", "_hypothesis_ftz_detector",
                  "xdist", "platformdirs")
 
