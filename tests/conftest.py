@@ -69,6 +69,12 @@ LONG = (
     ("test_runge_kutta_numeric.py", "test_compiled_equals_interpreted_bit_for_bit"),  # cold: numba compiles the RK loops
     ("test_text_door.py", "test_text_reaches_eval_only_in_the_parser"),     # the package's ASTs (shared_results) ...
     ("test_flint_seam.py", "test_only_the_seam_imports_flint"),             # ... reused here
+    ("test_flint_seam.py", "test_the_arithmetic_layer_has_no_import_cycle"),  # ... and here
+    ("test_import_cycles.py", "test_package_has_no_import_cycle"),          # ... and here
+    ("test_existence.py", "test_issue_example_has_a_smooth_pair_not_polynomial"),  # the issue's example at h^2 ...
+    ("test_existence.py", "test_bounded_work_refuses_an_elimination_above_the_cost_budget"),  # ... reused here
+    ("test_existence.py", "test_issue_example_smooth_corrections_are_conserved"),  # ... and here
+    ("test_existence.py", "test_section_integral_solves_the_homological_equation"),  # ... and here
 )
 
 
