@@ -1,8 +1,10 @@
 """pytest helpers and plugin: assertions for one's own test suite, and fixtures for the built-in models.
 
 The plugin is registered through the ``pytest11`` entry point ``nambu_bch``
-(pyproject.toml), so installing the package makes the fixtures available in
-any pytest run; ``pytest -p nambu_bch.testing`` loads it explicitly.
+(pyproject.toml: the light module :mod:`nambu_bch._pytest_plugin`, which defines
+the fixtures and imports sympy only when one is used), so installing the package
+makes the fixtures available in any pytest run; ``pytest -p nambu_bch.testing``
+loads them explicitly (this module re-exports them).
 
 Fixtures: ``ho``, ``ho3``, ``rigid_body``, ``lotka_volterra``,
 ``ho3_composite`` (the built-in :func:`~nambu_bch.model` systems),
@@ -29,14 +31,14 @@ Example (``examples/test_paper_results.py`` has more)::
 
 from __future__ import annotations
 
-import pytest
 import sympy
 
+# the plugin's fixtures, defined in the entry point's light module; here for ``pytest -p nambu_bch.testing``
+from ._pytest_plugin import ho, ho3, ho3_composite, lotka_volterra, paper_words, rigid_body, symbols  # noqa: F401
 from .algebra.zero import witness
 from .errors import NambuBCHError
 from .parsing import as_expression, as_symbols
 from .symbols import STEP
-from .systems import model
 from .systems.spec import as_system
 
 __all__ = [
@@ -328,50 +330,3 @@ def assert_invariant(system, word, I, h=STEP):
         f"residual I(Phi_h(x)) - I(x) = {_short(residual)}{where}{first}"
     )
 
-
-# --------------------------------------------------------------------------------------------
-# fixtures (the plugin)
-# --------------------------------------------------------------------------------------------
-@pytest.fixture
-def ho():
-    """The harmonic oscillator, Eq. (HO1); pieces 1 = T, 2 = V."""
-    return model("ho")
-
-
-@pytest.fixture
-def ho3():
-    """The paper's N = 3 oscillator (q, p, q^2), Eqs. (Ex1), (H), (G); pieces Eqs. (hX1)-(hX3)."""
-    return model("ho3")
-
-
-@pytest.fixture
-def rigid_body():
-    """The free rigid body, H = sum x_i^2/(2 I_i), G = |x|^2/2, full split."""
-    return model("rigid-body")
-
-
-@pytest.fixture
-def lotka_volterra():
-    """Cyclic Lotka-Volterra, H = x1 + x2 + x3, G = x1 x2 x3, only H split."""
-    return model("lotka-volterra")
-
-
-@pytest.fixture
-def ho3_composite():
-    """The (q^2, p^2, qp) oscillator of the conclusions, only H split."""
-    return model("ho3-composite")
-
-
-@pytest.fixture
-def paper_words():
-    """The six symmetric second-order words of the paper's Sect. 5.1 / Table (table)."""
-    from .integrators import PAPER_WORDS
-
-    return PAPER_WORDS
-
-
-@pytest.fixture
-def symbols():
-    """Name -> Symbol for the built-in models' symbols, the step ``h`` and ``alpha``."""
-    names = "x1 x2 x3 m omega I1 I2 I3 h alpha"
-    return {s.name: s for s in sympy.symbols(names)}

@@ -67,6 +67,14 @@ LONG = (
     ("test_shadow.py", "test_n4_full_split_is_obstructed"),
     ("test_numeric.py", "test_series_pair_is_accurate"),
     ("test_runge_kutta_numeric.py", "test_compiled_equals_interpreted_bit_for_bit"),  # cold: numba compiles the RK loops
+    ("test_text_door.py", "test_text_reaches_eval_only_in_the_parser"),     # the package's ASTs (shared_results) ...
+    ("test_flint_seam.py", "test_only_the_seam_imports_flint"),             # ... reused here
+    ("test_flint_seam.py", "test_the_arithmetic_layer_has_no_import_cycle"),  # ... and here
+    ("test_import_cycles.py", "test_package_has_no_import_cycle"),          # ... and here
+    ("test_existence.py", "test_issue_example_has_a_smooth_pair_not_polynomial"),  # the issue's example at h^2 ...
+    ("test_existence.py", "test_bounded_work_refuses_an_elimination_above_the_cost_budget"),  # ... reused here
+    ("test_existence.py", "test_issue_example_smooth_corrections_are_conserved"),  # ... and here
+    ("test_existence.py", "test_section_integral_solves_the_homological_equation"),  # ... and here
 )
 
 
@@ -189,14 +197,8 @@ DEEP = (
     ("test_numeric_parallel.py", "test_threads_give_the_one_thread_bits", ("False-ho3-32123", "True-ho3-32123")),
     # the generic T|V answer against the concrete systems: d = 1 and 2 in the fast tier, the d = 3 quartic (4-6 s)
     ("test_generic_separable.py", "test_substituted_equals_the_concrete_shadow_hamiltonian_d3", ()),
-    # the command line as a subprocess (cli_run): the fast tier runs the same assertions on main(argv) in process; the
-    # process start is test_cli's subprocess of `python -m nambu_bch` (1.4-2.2 s each)
-    ("test_runge_kutta_cli.py", "test_shadow_integrator_gauss4_json_subprocess", ("in-process",)),
-    ("test_runge_kutta_cli.py", "test_shadow_tableau_file_subprocess", ("in-process",)),
-    ("test_runge_kutta_cli.py", "test_check_integrator_midpoint_subprocess", ("in-process",)),
-    ("test_runge_kutta_cli.py", "test_compare_across_families_subprocess", ("in-process",)),
-    ("test_numerical_shadow.py", "test_cli_check_adds_the_numerical_shadow_in_a_subprocess", ("in-process",)),
-    ("test_generic_separable.py", "test_cli_prints_the_generic_answer_as_json", ("in-process",)),
+    # the command line as a subprocess (cli_run's "subprocess" case, 1.4-2.2 s each) is deep by the fixture's own
+    # parameter mark (CLI_RUNNERS), for every test that asks for cli_run
     # the new method families: one case of each concern stays fast (ABA864's generalised order, the two routes on ho,
     # the compare rows and their CLI); the costlier repeats (2-5 s each, measured under load) are deep
     ("test_families_on_systems.py", "test_aba_methods_have_their_published_generalized_order", ("aba864-orders0",)),
@@ -248,12 +250,16 @@ DEEP = (
     # a second compiled complex loop and its batch (two numba compiles, ~4 s cold): the fast tier keeps ho3's loop
     # against the reference bits
     ("test_complex_compiled.py", "test_compiled_rigid_body_and_batches", ()),
+    # the h^2 hull against Eqs. (1AX)-(2BY) for the rigid body over QQ(I1, I2, I3) (2.7 s cold): the fast tier keeps the
+    # ho3 (CL5-CL8) and Lotka-Volterra rows, and test_fi_route's rigid-body obstruction at h^2 keeps its hulls
+    ("test_fi_route.py", "test_h2_hull_equals_affine_hull_of_eqs_1AX_to_2BY", ("ho3", "lotka-volterra")),
     # the FI span over QQ<2^(1/3)>(m, omega) (2.7 s cold): the fast tier keeps the exact families over QQ(params)
     ("test_fi_route.py", "test_fi_span_is_decided_exactly_over_an_algebraic_parameter_field", ()),
 )
 
-#: The two ways :func:`cli_run` runs the command line; the fast tier keeps ``in-process`` (DEEP).
-CLI_RUNNERS = ("in-process", "subprocess")
+#: The two ways :func:`cli_run` runs the command line; the fast tier keeps ``in-process``: the ``subprocess`` case
+#: carries the mark ``deep`` itself, so a new test asking for ``cli_run`` needs no entry in :data:`DEEP`.
+CLI_RUNNERS = ("in-process", pytest.param("subprocess", marks=pytest.mark.deep))
 REPO = Path(__file__).resolve().parents[1]
 
 
@@ -263,7 +269,7 @@ def cli_run(request, monkeypatch):
 
     Two cases of every test that asks for it: ``main(argv)`` in this process (stdout and stderr captured, the working
     directory changed for the call), and ``python -m nambu_bch ARGV`` in a subprocess (the package from this checkout).
-    The same assertions run on both.  The subprocess case is deep (:data:`DEEP`): a process start adds only the
+    The same assertions run on both.  The subprocess case is deep (its parameter's mark): a process start adds only the
     interpreter start and the imports, which ``test_cli.py``'s subprocess of ``python -m nambu_bch`` checks in the fast
     tier (and one subprocess per subcommand in the deep tier).
     """
@@ -289,7 +295,9 @@ def cli_run(request, monkeypatch):
 #: Plugin distributions whose modules pytest marks for assertion rewriting (every module of a distribution with a
 #: ``pytest11`` entry point).  None of them has an ``assert`` the suite relies on (the package has none at all), but
 #: every pytest process re-parsed and rewrote ~150 of their modules as they were imported, ~0.7 s of CPU per process,
-#: since ``PYTHONDONTWRITEBYTECODE`` keeps pytest from caching the result (docs/suite_time.md).
+#: since ``PYTHONDONTWRITEBYTECODE`` keeps pytest from caching the result (docs/suite_time.md).  A module imported
+#: before :func:`pytest_configure` (by a plugin's own imports) is rewritten regardless: hence the package's light
+#: ``pytest11`` module, ``nambu_bch._pytest_plugin``.
 NOT_REWRITTEN = ("nambu_bch", "hypothesis", "_hypothesis_pytestplugin", "_hypothesis_globals", "_hypothesis_ftz_detector",
                  "xdist", "platformdirs")
 

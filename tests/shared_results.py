@@ -12,7 +12,9 @@ Import from a test with ``sys.path`` holding this directory (tests/conftest.py p
 
 from __future__ import annotations
 
+import ast
 from functools import lru_cache
+from pathlib import Path
 
 import nambu_bch as nb
 from nambu_bch.bch.backward import effective_field
@@ -69,3 +71,14 @@ def brackets(name: str, word: str, order: int):
     from nambu_bch.shadow.fi_route import fi_brackets
 
     return tuple(fi_brackets(nb.model(name), word, order))
+
+
+@lru_cache(maxsize=None)
+def package_trees(package: str):
+    """``{path: AST}`` of every module under the directory ``package`` (sorted by path), parsed once: the source
+    scans of test_flint_seam.py, test_text_door.py and test_import_cycles.py read the same ~140 modules (about 1 s of
+    parsing each); the mapping is read-only and the trees are only walked."""
+    from types import MappingProxyType
+
+    paths = sorted(Path(package).rglob("*.py"))
+    return MappingProxyType({p: ast.parse(p.read_text(encoding="utf-8"), filename=str(p)) for p in paths})

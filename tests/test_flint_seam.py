@@ -13,6 +13,7 @@ import pathlib
 from fractions import Fraction
 
 import pytest
+import shared_results as shared
 from sympy.polys.domains import QQ
 
 import nambu_bch
@@ -52,8 +53,7 @@ def test_detector_sees_every_spelling():
 @pytest.fixture(scope="module")
 def package_trees() -> dict:
     """``{path: AST}`` of every module of the package, parsed once for the tests that walk them."""
-    return {path: ast.parse(path.read_text(encoding="utf-8"), filename=str(path))
-            for path in sorted(PACKAGE.rglob("*.py"))}
+    return shared.package_trees(str(PACKAGE))
 
 
 def test_only_the_seam_imports_flint(package_trees):

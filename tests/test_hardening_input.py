@@ -43,6 +43,10 @@ from nambu_bch.systems.system import USER_NAME
 
 REPO = Path(__file__).resolve().parents[1]
 ENV = {**os.environ, "PYTHONPATH": str(REPO)}
+# The first statement of the SIGINT tests' children: Ctrl-C as a terminal delivers it.  A child inherits an ignored
+# SIGINT from a background job or a CI runner that ignores it, and Python then installs no handler: the signal would
+# be lost, the child would run its whole computation and the test would fail for a reason outside the package.
+TERMINAL_SIGINT = "import signal; signal.signal(signal.SIGINT, signal.default_int_handler)\n"
 THREE_PIECES = ("ho3", "rigid-body", "lotka-volterra")  # (ho3-composite has two pieces)
 
 
@@ -443,7 +447,7 @@ def test_keyboard_interrupt_in_main_is_one_line(monkeypatch, capsys):
 
 def test_interrupt_during_import_is_one_line():
     """SIGINT delivered while the command line imports sympy (deterministic: an import hook sends it)."""
-    code = textwrap.dedent("""
+    code = TERMINAL_SIGINT + textwrap.dedent("""
         import os, signal, sys
         sys.argv[0] = "nambu-bch"                      # as the console script
         class Hook:
@@ -462,7 +466,7 @@ def test_interrupt_during_import_is_one_line():
 
 
 def test_library_import_keeps_pythons_sigint_handler():
-    code = "import signal, nambu_bch; print(signal.getsignal(signal.SIGINT) is signal.default_int_handler)"
+    code = TERMINAL_SIGINT + "import nambu_bch; print(signal.getsignal(signal.SIGINT) is signal.default_int_handler)"
     done = subprocess.run([sys.executable, "-c", code], env=ENV, capture_output=True, text=True, timeout=600)
     assert done.stdout.strip() == "True", done.stderr
 
@@ -470,7 +474,7 @@ def test_library_import_keeps_pythons_sigint_handler():
 def test_sigint_while_computing_is_one_line():
     """SIGINT delivered while ``nambu-bch shadow --model rigid-body --order 8`` computes (the child says on stdout
     when the computation starts, so the signal is sent then instead of after a fixed sleep)."""
-    code = textwrap.dedent("""
+    code = TERMINAL_SIGINT + textwrap.dedent("""
         import sys
         import nambu_bch.shadow as shadow
         sys.argv[0] = "nambu-bch"                      # as the console script

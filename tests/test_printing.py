@@ -202,7 +202,9 @@ def test_help_and_errors_import_neither_sympy_nor_numpy(tmp_path):
     for argv in (["--help"], ["shadow", "--help"], ["models", "--help"], ["shadow", "--order", "x"]):
         done = _python(PROBE.format(argv=argv), tmp_path)
         assert done.stderr.strip().splitlines()[-1] == "[]", (argv, done.stderr)
-    done = _python("import sys, nambu_bch\nprint('sympy' in sys.modules)\nfrom nambu_bch import model\n"
+    # nambu_bch._pytest_plugin: the pytest11 entry point, which pytest imports at the start of every test run
+    done = _python("import sys, nambu_bch, nambu_bch._pytest_plugin\nprint('sympy' in sys.modules)\n"
+                   "from nambu_bch import model\n"
                    "print('sympy' in sys.modules, model('ho').N)", tmp_path)
     assert done.stdout.split() == ["False", "True", "2"]  # the package imports lazily, and still works
 

@@ -44,3 +44,12 @@ def test_diagonal_keeps_one_case_per_row():
     rows = ["iterate-h", "check-x0", "ModifiedSolution.numeric()(t, x0)-t", "shadow_along-word"]
     for row in rows:
         assert sum(keep(f"{row}-{k}") for k in range(19)) == 1, row
+
+
+def test_cli_run_subprocess_case_is_deep():
+    """``cli_run``'s subprocess case is deep for every test that asks for the fixture, listed in DEEP or not."""
+    from conftest import CLI_RUNNERS
+
+    cases = {getattr(p, "values", (p,))[0]: getattr(p, "marks", ()) for p in CLI_RUNNERS}
+    assert set(cases) == {"in-process", "subprocess"}
+    assert [m.name for m in cases["subprocess"]] == ["deep"] and not cases["in-process"]

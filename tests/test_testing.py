@@ -23,6 +23,19 @@ def test_fixtures_come_from_the_plugin(ho, ho3, rigid_body, lotka_volterra, ho3_
     assert symbols["alpha"] == alpha
 
 
+def test_the_entry_point_is_the_light_plugin_module():
+    """pyproject's pytest11 entry point names the fixtures' own module (pytest imports it in every test run of any
+    project where the package is installed: test_printing checks it imports no sympy); nambu_bch.testing re-exports
+    the same fixtures for ``-p nambu_bch.testing``."""
+    import tomllib
+
+    from nambu_bch import _pytest_plugin, testing
+
+    entry = tomllib.loads((REPO / "pyproject.toml").read_text())["project"]["entry-points"]["pytest11"]
+    assert entry == {"nambu_bch": "nambu_bch._pytest_plugin"}
+    assert all(getattr(testing, name) is getattr(_pytest_plugin, name) for name in _pytest_plugin.__all__)
+
+
 def test_liouville_components_match_the_library(ho3, rigid_body):
     """X_{H,G} by the Jacobian determinant agrees with System.vector_field (Eq. gLiouville)."""
     for S in (ho3, rigid_body):

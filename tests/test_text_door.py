@@ -18,6 +18,7 @@ import sys
 from pathlib import Path
 
 import pytest
+import shared_results as shared
 import sympy
 
 import nambu_bch as nb
@@ -193,11 +194,10 @@ def test_text_reaches_eval_only_in_the_parser():
     ``GENERATED_SOURCE`` with its reason.
     """
     offences, sites = [], {}
-    for path in sorted(PACKAGE.rglob("*.py")):
+    for path, tree in shared.package_trees(str(PACKAGE)).items():
         rel = path.relative_to(PACKAGE).as_posix()
         if rel == "parsing.py":
             continue
-        tree = ast.parse(path.read_text(encoding="utf-8"), filename=str(path))
         for node in ast.walk(tree):
             if not isinstance(node, ast.Call):
                 continue
