@@ -344,3 +344,14 @@ def test_stats_report_the_phases():
     assert stats["solved_degree"] == 7 and stats["primes"] >= 1
     assert list(stats["seconds"]) == ["lyndon_tables", "factor_tables", "word_coefficients", "solve", "crt"]
     assert all(t >= 0 for t in stats["seconds"].values())
+
+
+def test_the_solve_compiles_each_helper_for_one_signature():
+    """numba types an argument that is a literal on a loop's first pass as ``Literal[int](0)`` and compiles the
+    callee again for ``int64``: the class loop's start must not be a literal (five helpers compiled twice cost
+    ~3 s of a cold start).  Checked where the engine was compiled in this process (a cold cache)."""
+    formal_bch("123", 5)
+    for helper in (modular._class_chains, modular._mark_live, modular._group_stop, modular._add_earlier,
+                   modular._finish_group):
+        assert len(helper.signatures) <= 1, (helper, helper.signatures)
+
