@@ -33,6 +33,7 @@ def main(argv=None):
     import numba
 
     from nambu_bch.numeric import codegen, kernel
+    from nambu_bch.compiled import dispatcher
     from nambu_bch.numeric.codegen import SCAN_FUNCTION
     from nambu_bch.numeric.scan import scan_into
 
@@ -44,7 +45,7 @@ def main(argv=None):
             codegen.JAM_STEPS = jam
             module = types.ModuleType(f"nambu_bch_jam{jam}")
             exec(compile(codegen.python_source(k.program), module.__name__, "exec"), module.__dict__)  # noqa: S102
-            module.__dict__[SCAN_FUNCTION] = scan_into
+            module.__dict__[SCAN_FUNCTION] = dispatcher(scan_into)  # compiled code calls the numba dispatcher
             loops[jam] = numba.njit(nogil=True, error_model="numpy")(module.run_batch)
     finally:
         codegen.JAM_STEPS = saved

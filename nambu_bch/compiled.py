@@ -89,6 +89,7 @@ class LazyDispatcher:
         if self._dispatcher is None:
             import numba
 
+            _register_typeof()
             made = numba.njit(**self.options)(self.py_func)
             enable_private_cache(made)
             self._dispatcher = made
@@ -105,6 +106,19 @@ class LazyDispatcher:
     def __repr__(self):
         state = "made" if self._dispatcher is not None else "not made yet"
         return f"<compiled function {self.__module__}.{self.__qualname__} ({state})>"
+
+
+_TYPEOF_REGISTERED = False
+
+
+def _register_typeof() -> None:
+    """Let numba type a wrapper held as a global of other compiled code as its dispatcher (made then)."""
+    global _TYPEOF_REGISTERED
+    if not _TYPEOF_REGISTERED:
+        from numba.core.typing.typeof import typeof_impl
+
+        typeof_impl.register(LazyDispatcher)(lambda value, context: typeof_impl(value.dispatcher, context))
+        _TYPEOF_REGISTERED = True
 
 
 def _make_module_dispatchers(namespace: dict) -> None:

@@ -391,3 +391,8 @@ def test_a_compiled_function_held_before_first_use_forwards_to_its_dispatcher(tm
     made = dispatcher(held)
     assert made is held.dispatcher and dispatcher(made) is made and "made" in repr(held)
     assert held.signatures == made.signatures and len(made.signatures) == 1
+    import numba  # compiled code holding the wrapper as a global types it as its dispatcher
+
+    namespace = {"_held": held}
+    exec("def caller(x):\n    return _held(x) + 1\n", namespace)  # noqa: S102 - a fixed test source
+    assert numba.njit(namespace["caller"])(4) == 9
