@@ -4,7 +4,8 @@ The batch kernel advances a 256-state chunk ``JAM_STEPS`` steps per state before
 (:func:`nambu_bch.numeric.codegen._chunk_step`); each state goes through the same operations whatever the value,
 so the script first checks that the three loops give the same bits, then times them in turn (``--repeats``
 rounds, CPU time, best and median per state-step, the load average printed): a chunk that stays in cache
-(compute only) and the 10^6-state batch of bench_iterate.py.
+(compute only) and the 10^6-state batch of bench_iterate.py.  It prints the CPU each loop's compilation took
+first (the loops compiled one after the other in this process, the shared guards' scan before them).
 
 Usage (from the repository root):
     python benchmarks/bench_iterate_jam.py [--system ho3 --word 32123 --repeats 9]
@@ -50,6 +51,16 @@ def main(argv=None):
     finally:
         codegen.JAM_STEPS = saved
     none = np.zeros(0, dtype=np.int64)
+    from nambu_bch.numeric.scan import RESULT_SIZE, scan_range
+
+    scan_range(np.ones((k.N, 8)), 0, 8, np.zeros(RESULT_SIZE, dtype=np.int64))  # the shared scan: compiled first
+    compile_cpu = {}
+    for jam, fn in loops.items():  # the first call compiles (this process's numba cache is in memory only)
+        c0 = time.process_time()
+        fn(np.ones((k.N, 8)), K, 2, 2, np.empty((2, k.N, 8)), 256, 1, 0, 0, 8, none)
+        compile_cpu[jam] = time.process_time() - c0
+    print(f"# compile CPU of the batch loop (load {os.getloadavg()[0]:.2f}): "
+          + ", ".join(f"{jam} step(s) per pass {c:.2f} s" for jam, c in compile_cpu.items()))
     print(f"# {args.system} {args.word}: batch loop with 1, 2, 4 steps per pass over a 256-state chunk "
           f"(package default {saved}); {args.repeats} rounds, CPU time, interleaved")
     for B, steps, what in ((4096, 2000, "4096 states x 2000 steps (in cache)"), (10**6, 50, "10^6 states x 50 steps")):
