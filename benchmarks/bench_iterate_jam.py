@@ -4,7 +4,8 @@ The batch kernel advances a 256-state chunk ``JAM_STEPS`` steps per state before
 (:func:`nambu_bch.numeric.codegen._chunk_step`); each state goes through the same operations whatever the value,
 so the script first checks that the three loops give the same bits, then times them in turn (``--repeats``
 rounds, CPU time, best and median per state-step, the load average printed): a chunk that stays in cache
-(compute only) and the 10^6-state batch of bench_iterate.py.
+(compute only) and the 10^6-state batch of bench_iterate.py.  It prints the CPU each loop's compilation took
+first (the loops compiled one after the other in this process, the shared guards' scan before them).
 
 Usage (from the repository root):
     python benchmarks/bench_iterate_jam.py [--system ho3 --word 32123 --repeats 9]
@@ -33,6 +34,7 @@ def main(argv=None):
     import numba
 
     from nambu_bch.numeric import codegen, kernel
+    from nambu_bch.compiled import dispatcher
     from nambu_bch.numeric.codegen import SCAN_FUNCTION
     from nambu_bch.numeric.scan import scan_into
 
@@ -44,11 +46,21 @@ def main(argv=None):
             codegen.JAM_STEPS = jam
             module = types.ModuleType(f"nambu_bch_jam{jam}")
             exec(compile(codegen.python_source(k.program), module.__name__, "exec"), module.__dict__)  # noqa: S102
-            module.__dict__[SCAN_FUNCTION] = scan_into
+            module.__dict__[SCAN_FUNCTION] = dispatcher(scan_into)  # compiled code calls the numba dispatcher
             loops[jam] = numba.njit(nogil=True, error_model="numpy")(module.run_batch)
     finally:
         codegen.JAM_STEPS = saved
     none = np.zeros(0, dtype=np.int64)
+    from nambu_bch.numeric.scan import RESULT_SIZE, scan_range
+
+    scan_range(np.ones((k.N, 8)), 0, 8, np.zeros(RESULT_SIZE, dtype=np.int64))  # the shared scan: compiled first
+    compile_cpu = {}
+    for jam, fn in loops.items():  # the first call compiles (this process's numba cache is in memory only)
+        c0 = time.process_time()
+        fn(np.ones((k.N, 8)), K, 2, 2, np.empty((2, k.N, 8)), 256, 1, 0, 0, 8, none)
+        compile_cpu[jam] = time.process_time() - c0
+    print(f"# compile CPU of the batch loop (load {os.getloadavg()[0]:.2f}): "
+          + ", ".join(f"{jam} step(s) per pass {c:.2f} s" for jam, c in compile_cpu.items()))
     print(f"# {args.system} {args.word}: batch loop with 1, 2, 4 steps per pass over a 256-state chunk "
           f"(package default {saved}); {args.repeats} rounds, CPU time, interleaved")
     for B, steps, what in ((4096, 2000, "4096 states x 2000 steps (in cache)"), (10**6, 50, "10^6 states x 50 steps")):

@@ -12,6 +12,7 @@ from __future__ import annotations
 import importlib.util
 import os
 import sys
+import threading
 
 
 def numba_available() -> bool:
@@ -36,20 +37,100 @@ _NUMBA_DIRS: dict = {}
 
 
 def njit(**options):
-    """``numba.njit(**options)`` whose machine code is kept only in the package's private cache, verified on reading.
+    """``numba.njit(**options)`` whose machine code is kept only in the package's private cache, verified on reading,
+    made on first use (:class:`LazyDispatcher`).
 
     Use it instead of ``numba.njit(cache=True)``: numba's own cache goes to ``$NUMBA_CACHE_DIR``, the
     source tree's ``__pycache__`` or ``~/.cache/numba`` -- directories the package does not check -- and
-    unpickles whatever it finds there.  See :func:`enable_private_cache`.
+    unpickles whatever it finds there.  See :func:`enable_private_cache`.  Decorating imports nothing:
+    a module of compiled functions can be imported (and its numpy twins run) without numba's ~0.3 s import.
     """
     def decorate(fn):
-        import numba
-
-        dispatcher = numba.njit(**options)(fn)
-        enable_private_cache(dispatcher)
-        return dispatcher
+        return LazyDispatcher(fn, options)
 
     return decorate
+
+
+_LAZY_LOCK = threading.Lock()
+
+
+class LazyDispatcher:
+    """A compiled function of :func:`njit` whose numba dispatcher is made when it is first called or inspected.
+
+    The first use imports numba, makes the dispatchers of every :class:`LazyDispatcher` of the same
+    module (``numba.njit(**options)`` and :func:`enable_private_cache`) and puts them in the module's
+    namespace in place of the wrappers: numba types a call from one compiled function to another
+    through the callee's global, which must be a dispatcher by then.  A wrapper held elsewhere (imported
+    by name before the first use) forwards calls and attributes to its dispatcher; :func:`dispatcher`
+    gives the dispatcher itself (what a generated module calling it from compiled code must bind).
+    Making the dispatcher compiles nothing: numba compiles on the first call with new argument types.
+    """
+
+    def __init__(self, fn, options):
+        self.py_func = fn
+        self.options = dict(options)
+        self._dispatcher = None
+        self.__doc__, self.__name__, self.__qualname__ = fn.__doc__, fn.__name__, fn.__qualname__
+        self.__module__ = fn.__module__
+        self.__wrapped__ = fn
+
+    @property
+    def dispatcher(self):
+        """The numba dispatcher (made, with those of the rest of the module, on first use)."""
+        made = self._dispatcher
+        if made is None:
+            with _LAZY_LOCK:  # a threaded first call (the guards' scan) makes each dispatcher once
+                if self._dispatcher is None:
+                    _make_module_dispatchers(self.py_func.__globals__)
+                made = self._make()  # (made above unless this wrapper is not one of its module's globals)
+        return made
+
+    def _make(self):
+        if self._dispatcher is None:
+            import numba
+
+            _register_typeof()
+            made = numba.njit(**self.options)(self.py_func)
+            enable_private_cache(made)
+            self._dispatcher = made
+        return self._dispatcher
+
+    def __call__(self, *args, **kwargs):
+        return self.dispatcher(*args, **kwargs)
+
+    def __getattr__(self, name):  # signatures, overloads, inspect_types, ...: the dispatcher's
+        if name.startswith("__") or name in ("py_func", "options", "_dispatcher"):  # copy/pickle probes, __init__
+            raise AttributeError(name)
+        return getattr(self.dispatcher, name)
+
+    def __repr__(self):
+        state = "made" if self._dispatcher is not None else "not made yet"
+        return f"<compiled function {self.__module__}.{self.__qualname__} ({state})>"
+
+
+_TYPEOF_REGISTERED = False
+
+
+def _register_typeof() -> None:
+    """Let numba type a wrapper held as a global of other compiled code as its dispatcher (made then)."""
+    global _TYPEOF_REGISTERED
+    if not _TYPEOF_REGISTERED:
+        from numba.core.typing.typeof import typeof_impl
+
+        typeof_impl.register(LazyDispatcher)(lambda value, context: typeof_impl(value.dispatcher, context))
+        _TYPEOF_REGISTERED = True
+
+
+def _make_module_dispatchers(namespace: dict) -> None:
+    """Replace every :class:`LazyDispatcher` of ``namespace`` (a module's globals) by its numba dispatcher."""
+    for name, value in list(namespace.items()):
+        if isinstance(value, LazyDispatcher) and value.py_func.__globals__ is namespace:
+            namespace[name] = value._make()
+
+
+def dispatcher(function):
+    """The numba dispatcher of ``function`` (a :class:`LazyDispatcher` made now), or ``function`` itself."""
+    return function.dispatcher if isinstance(function, LazyDispatcher) else function
 
 
 def numba_cache_directory(py_file):

@@ -344,3 +344,55 @@ def test_stats_report_the_phases():
     assert stats["solved_degree"] == 7 and stats["primes"] >= 1
     assert list(stats["seconds"]) == ["lyndon_tables", "factor_tables", "word_coefficients", "solve", "crt"]
     assert all(t >= 0 for t in stats["seconds"].values())
+
+
+def test_the_solve_compiles_each_helper_for_one_signature():
+    """numba types an argument that is a literal on a loop's first pass as ``Literal[int](0)`` and compiles the
+    callee again for ``int64``: the class loop's start must not be a literal (five helpers compiled twice cost
+    ~3 s of a cold start).  Checked where the engine was compiled in this process (a cold cache)."""
+    formal_bch("123", 5)
+    for helper in (modular._class_chains, modular._mark_live, modular._group_stop, modular._add_earlier,
+                   modular._finish_group):
+        assert len(helper.signatures) <= 1, (helper, helper.signatures)
+
+
+# -- numba is imported on first use ------------------------------------------------------------------------
+
+def test_importing_the_compiled_modules_does_not_import_numba(tmp_path):
+    """Decorating with ``compiled.njit`` imports nothing: a fresh process imports the two modules of compiled
+    functions without numba; the first use of one brings it in and makes every dispatcher of that module."""
+    import os
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    code = ("import sys\nimport nambu_bch.bch.modular as m, nambu_bch.numeric.scan\n"
+            "print('numba' in sys.modules)\n"
+            "print(m._solve.signatures, 'numba' in sys.modules, type(m._duval_count).__name__)\n")
+    env = {**os.environ, "PYTHONPATH": str(Path(__file__).resolve().parents[1]), "NAMBU_BCH_CACHE": str(tmp_path)}
+    done = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True, timeout=300)
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.split("\n")[:2] == ["False", "[] True CPUDispatcher"]
+
+
+def _twice(x):
+    return 2 * x
+
+
+def test_a_compiled_function_held_before_first_use_forwards_to_its_dispatcher(tmp_path, monkeypatch):
+    """A wrapper held outside its module's namespace (as when imported by name) calls and inspects its own
+    dispatcher, made once, and :func:`compiled.dispatcher` unwraps it."""
+    from nambu_bch.compiled import LazyDispatcher, dispatcher
+
+    monkeypatch.setenv("NAMBU_BCH_CACHE", str(tmp_path))
+    held = LazyDispatcher(_twice, {})
+    assert "not made yet" in repr(held) and held.__name__ == "_twice"
+    assert held(21) == 42
+    made = dispatcher(held)
+    assert made is held.dispatcher and dispatcher(made) is made and "made" in repr(held)
+    assert held.signatures == made.signatures and len(made.signatures) == 1
+    import numba  # compiled code holding the wrapper as a global types it as its dispatcher
+
+    namespace = {"_held": held}
+    exec("def caller(x):\n    return _held(x) + 1\n", namespace)  # noqa: S102 - a fixed test source
+    assert numba.njit(namespace["caller"])(4) == 9

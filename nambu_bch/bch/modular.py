@@ -397,7 +397,7 @@ def _solve(z, primes, beta, words, lengths, left, right, members, class_start, g
     lane_lead = np.zeros(_LANES, dtype=np.int64)
     block = 1 << max(0, 35 - d)
     work = 0
-    r0 = 0
+    r0 = np.int64(0)  # not a literal 0: the helpers taking r0 would be compiled twice (Literal[int](0), int64)
     while r0 < m:
         r1 = r0
         while r1 < m and class_start[r1] == r0:

@@ -69,7 +69,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..compiled import cache_variant, enable_private_cache, fused_multiply_add
+from ..compiled import cache_variant, dispatcher, enable_private_cache, fused_multiply_add
 from ..compiled import numba_available  # noqa: F401  (re-exported: nambu_bch.numeric.numba_available)
 from ..errors import InvalidRunError, NumericalRangeError
 from ..atomic import write_atomic
@@ -352,7 +352,7 @@ class Kernel:
             if name.startswith("run_batch"):  # the guards' scan they extend as they load the states
                 from .scan import scan_into
 
-                self.module.__dict__[SCAN_FUNCTION] = scan_into
+                self.module.__dict__[SCAN_FUNCTION] = dispatcher(scan_into)  # numba types a dispatcher global
             source = name
             if fma and name == "run":  # one trajectory: the fused multiply-adds written out (codegen.fused_product)
                 source = "run_fma"
