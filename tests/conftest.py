@@ -178,6 +178,14 @@ DEEP = (
     ("test_bch_formal.py", "test_against_free_associative_log",
      ("12-6", "1:1/3,2:1,3:1,1:2/3-6", "2:1/3,1:1/2,2:2/3,1:1/2-6")),
     ("test_bch_modular.py", "test_bernoulli_coefficients_of_ad_powers", ("13",)),
+    # the engine's helper signatures after a cold compile (another compile of the engine the fast tier compiles once),
+    # numba's import on first use and the served series' CLI in fresh processes (other process starts), and the
+    # stored lines of the CLI's light models against every built model (builds all twelve; the fast tier keeps the
+    # light path's byte-for-byte comparison with the full path)
+    ("test_bch_modular.py", "test_the_solve_compiles_each_helper_for_one_signature", ()),
+    ("test_bch_modular.py", "test_importing_the_compiled_modules_does_not_import_numba", ()),
+    ("test_bch_cold.py", "test_the_cli_prints_a_served_series_without_sympy_or_numpy", ()),
+    ("test_bch_cold.py", "test_the_cli_models_of_two_pieces_are_the_built_ones", ()),
     ("test_modular_rref.py", "test_n4_single_split_h4_same_with_modular_and_flint", ()),
     # sweeps against a reference at many points: the Lotka-Volterra exponential flows in both ranges (the fast tier
     # keeps test_exponential_flows_use_expm1 and _agree_across_backends), the expm1 pair against mpmath
