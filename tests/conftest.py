@@ -263,6 +263,13 @@ DEEP = (
     ("test_fi_route.py", "test_h2_hull_equals_affine_hull_of_eqs_1AX_to_2BY", ("ho3", "lotka-volterra")),
     # the FI span over QQ<2^(1/3)>(m, omega) (2.7 s cold): the fast tier keeps the exact families over QQ(params)
     ("test_fi_route.py", "test_fi_span_is_decided_exactly_over_an_algebraic_parameter_field", ()),
+    # the paper's Figs. 3-4 are 32123's (10^4 steps, three solutions each): the fast tier keeps that word; 12321's
+    # solutions stay in the fast tier through test_shadow_solution_at_t_equal_h_is_the_map's ho3-12321 row
+    ("test_exact_solutions.py", "test_shadow_solution_tracks_the_integrator_figs_3_4", ("32123",)),
+    # undefined functions H_i(x_i), G_j(x_j), BCH route against backward error analysis at h^2: the symmetric word in
+    # the fast tier; the non-symmetric 123 (0.75 s of backward error analysis) deep: both routes of a non-symmetric
+    # word stay in the fast tier on a model (test_bch_concrete's lotka-volterra-123 row, to h^4)
+    ("test_bch_fast.py", "test_generic_separable_system_both_routes", ("12321",)),
 )
 
 #: The two ways :func:`cli_run` runs the command line; the fast tier keeps ``in-process``: the ``subprocess`` case

@@ -115,7 +115,7 @@ def test_exact_series_and_remainder(capsys):
     # independently: the Taylor series of the closed form F(omega h)^alpha H_c
     exact = read(data, data["H_S"])
     taylor = sympy.series(exact, h, 0, 5).removeO()
-    assert sympy.simplify(sympy.expand(taylor) - read(data, data["H_S_series"])) == 0
+    assert sympy.expand(taylor - read(data, data["H_S_series"])) == 0      # expanded Laurent polynomials: exact
 
 
 def test_bch_terms_json_brackets_are_sympy_readable(capsys):
