@@ -542,21 +542,7 @@ def _rref_sparse(rows: dict, ncols: int, domain, budget: int | None):
             if t == i:
                 continue
             row = rows[t]
-            c = row.pop(j)
-            for k, v in pivot_row.items():
-                if k == j:
-                    continue
-                x = row.get(k)
-                if x is None:
-                    row[k] = -c * v
-                    holders[k].add(t)
-                else:
-                    x = x - c * v
-                    if x:
-                        row[k] = x
-                    else:
-                        del row[k]
-                        holders[k].discard(t)
+            _subtract_multiple(row, row.pop(j), pivot_row, j, holders, t)
         order.append((j, i))
     row_of = dict(order)
     for j, i in reversed(order):  # later pivot rows are reduced already: substituting them adds no pivot entries
@@ -567,20 +553,30 @@ def _rref_sparse(rows: dict, ncols: int, domain, budget: int | None):
             spent += len(below)
             if budget is not None and spent > budget:
                 return None
-            for m, v in below.items():
-                if m == k:
-                    continue
-                x = row.get(m)
-                if x is None:
-                    row[m] = -c * v
-                else:
-                    x = x - c * v
-                    if x:
-                        row[m] = x
-                    else:
-                        del row[m]
+            _subtract_multiple(row, c, below, k)
     out = {n: dict(sorted(rows[i].items())) for n, (_, i) in enumerate(order)}
     return out, tuple(j for j, _ in order)
+
+
+def _subtract_multiple(row: dict, c, pivot_row: dict, skip, holders=None, index=None) -> None:
+    """``row <- row - c * pivot_row`` in place on every column but ``skip`` (whose entry the caller removed), zeros
+    dropped; with ``holders`` (column -> the rows with a non-zero entry there) row ``index`` is kept in it."""
+    for k, v in pivot_row.items():
+        if k == skip:
+            continue
+        x = row.get(k)
+        if x is None:
+            row[k] = -c * v
+            if holders is not None:
+                holders[k].add(index)
+        else:
+            x = x - c * v
+            if x:
+                row[k] = x
+            else:
+                del row[k]
+                if holders is not None:
+                    holders[k].discard(index)
 
 
 def _rref_block(rows: dict, nrows: int, ncols: int, domain, lift: bool = True):

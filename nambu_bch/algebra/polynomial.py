@@ -85,15 +85,7 @@ def _rational_term(coeff, exps: dict, memo: dict, factors: dict):
     product's class, its number of arguments, the arguments' keys) is recorded in ``memo`` (the sort-key memo of
     :func:`~nambu_bch.algebra.canonical.canonical_add`), and ``factors`` keeps ``(s, k) -> (key, power)``.
     """
-    pairs = []
-    for s, k in exps.items():
-        if k:
-            hit = factors.get((s, k))
-            if hit is None:
-                power = s if k == 1 else sympy.Pow(s, k)
-                hit = factors[(s, k)] = (sort_key(power, memo), power)
-            pairs.append(hit)
-    pairs.sort(key=_first)
+    pairs = _power_pairs(exps, memo, factors)
     if coeff is not sympy.S.One:
         pairs.insert(0, (sort_key(coeff, memo), coeff))
     if not pairs:
