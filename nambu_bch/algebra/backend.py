@@ -456,14 +456,7 @@ class PolynomialBackend:
             return self.zero
         # flint's exponents are fmpz, which must not reach sympy's ring; a series of backward error analysis meets
         # the same few thousand monomials again and again, and a dictionary lookup costs a fifth of converting them
-        known = self._exponents
-        monoms = []
-        for m in total.monoms():
-            e = known.get(m)
-            if e is None:
-                e = known[m] = tuple(map(int, m))
-            monoms.append(e)
-        poly = self.ring.dtype(zip(monoms, total.coeffs()))
+        poly = self.ring.dtype(zip(exponents(total, self._exponents), total.coeffs()))
         degrees = total.degrees()  # no term holds both p and p_inv unless both occur: then no reduction to do
         return self.reduce(poly) if any(degrees[i] > 0 and degrees[j] > 0 for i, j in self._pairs) else poly
 
