@@ -38,7 +38,7 @@ CACHES = (
     ("nambu_bch.bch.formal", "_duval_trees"),
     ("nambu_bch.bch.formal", "_fits_dense"),
     ("nambu_bch.bch.modular", "lyndon_table"),
-    ("nambu_bch.bch.table", "clear_cache"),             # _HEADER, _TREES, _NUMERATORS
+    ("nambu_bch.bch.table", "clear_decoded"),           # _TREES, _WORDS, _FACTORS, _NUMERATORS (not the verified image)
     ("nambu_bch.bch.modular", "_surjection_sum"),
     ("nambu_bch.bch.modular", "_class_order"),
     ("nambu_bch.bch.modular", "_tanh_half_coefficients"),
