@@ -143,6 +143,40 @@ def test_the_verified_image_outlives_clear_caches_and_the_file(tmp_path, monkeyp
         assert formal_bch("12", 5) == _engine("12", 5)
 
 
+@pytest.mark.parametrize("kind", ["empty", "small", "zeros", "noise"])
+def test_a_block_is_raw_exactly_when_its_size_is_its_decoded_size(kind):
+    """pack_block stores a block of at most RAW_BYTES bytes, or one zlib does not shorten, as is; a compressed block
+    is shorter than its data, so unpack_block needs no flag."""
+    import random
+
+    data = {"empty": b"", "small": b"\0" * table.RAW_BYTES, "zeros": b"\0" * 4 * table.RAW_BYTES,
+            "noise": random.Random(26).randbytes(4 * table.RAW_BYTES)}[kind]
+    block = table.pack_block(data)
+    assert table.unpack_block(block, len(data)) == data
+    assert (block == data) == (kind != "zeros") and (len(block) == len(data)) == (block == data)
+
+
+def test_a_request_to_degree_10_decompresses_only_its_large_blocks(monkeypatch):
+    """The shipped table stores the small blocks raw: after clear_caches a request to degree 10 calls zlib only for
+    the blocks whose decoded size exceeds RAW_BYTES (two: the standard factors of degrees 9 and 10)."""
+    import zlib
+
+    import nambu_bch
+
+    before = formal_bch("12", 10)
+    nambu_bch.clear_caches()
+    calls = []
+    decompress = zlib.decompress
+    monkeypatch.setattr(zlib, "decompress", lambda data: calls.append(len(data)) or decompress(data))
+    served = formal_bch("12", 10)
+    degrees = table._header()["degrees"]
+    at = table._header()["series"]["12"]
+    large = sum((8 * r[0] > table.RAW_BYTES) + (r[at + 2] * r[0] > table.RAW_BYTES) for r in degrees[1:10])
+    assert len(calls) == large == 2
+    monkeypatch.undo()
+    assert served == before  # decoded again, from the same bytes
+
+
 def test_the_tool_rebuilds_the_low_degrees_exactly(tmp_path):
     """tools/build_bch_table.py at degree 9 (formal_bch's engines at that degree: the dense one) writes the same
     blocks as the shipped table (built at its top degree by the sparse engine)."""

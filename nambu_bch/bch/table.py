@@ -36,11 +36,13 @@ Memory.  Only the degrees asked are read; the numerators stay machine integers (
 terms are asked for, and :class:`Served` builds them on each access (the trees, shared by every request, are the
 only Python objects kept).
 
-File format: ``b"NBCHTAB2"``, the header's length (4 bytes, little-endian), the header (:data:`PREAMBLE`, the
+File format: ``b"NBCHTAB3"``, the header's length (4 bytes, little-endian), the header (:data:`PREAMBLE`, the
 series' names in :data:`NAME_BYTES` each, one :func:`record_format` record per degree: fixed-size fields read
 by :mod:`struct` in one call, where a JSON header cost more than the blocks of a request to degree 10), then
 degree by degree the standard factors (int32: left indices, then right indices, into the flat list of the
-Lyndon words of all degrees) and the three series' numerators, each block zlib-compressed.
+Lyndon words of all degrees) and the three series' numerators, each block zlib-compressed unless it is small
+(:func:`pack_block`: a block is raw exactly when its size is its decoded size, known from the number of words and
+the bytes per numerator).
 
 References
 ----------
@@ -66,15 +68,34 @@ from fractions import Fraction
 from .collector import no_full_collection
 
 #: SHA-256 of the table's header (which holds the SHA-256 of each degree's bytes); written by tools/build_bch_table.py.
-TABLE_SHA256 = "a91b9da3201655559af7e275287661924dd283cf78ebf1349536fe54ffc382d9"
+TABLE_SHA256 = "429fe19eb6043f38848af4c8fab53b606d35ba48db3d219ec09a73754cbaabac"
 #: The table file shipped with the package.
 TABLE_PATH = os.path.join(os.path.dirname(__file__), "data", "bch_series.bin")
-MAGIC = b"NBCHTAB2"
+MAGIC = b"NBCHTAB3"
 #: The header's fixed part: format version, letters, number of series, top degree, bytes of a denominator ``T_d``.
 PREAMBLE = struct.Struct("<5H")
-FORMAT_VERSION = 2
+FORMAT_VERSION = 3
 #: Bytes of a series' name in the header (ASCII, NUL-padded).
 NAME_BYTES = 4
+#: A block of at most this many bytes is stored as is: zlib shortens so few by tens of bytes, while each compressed
+#: block costs a decompression call of its own (nineteen in a request to degree 10 when every block was compressed,
+#: two now; the file is 294 bytes longer).
+RAW_BYTES = 256
+
+
+def pack_block(data: bytes) -> bytes:
+    """A block as the table stores it: ``data`` as is when it has at most :data:`RAW_BYTES` bytes or zlib does not
+    shorten it, else zlib-compressed -- so a stored block is raw exactly when its size is ``len(data)`` (a
+    compressed block is always shorter), which :func:`unpack_block` reads back without a flag."""
+    if len(data) <= RAW_BYTES:
+        return data
+    compressed = zlib.compress(data, 9)
+    return compressed if len(compressed) < len(data) else data
+
+
+def unpack_block(block, size: int):
+    """The ``size`` bytes of a block stored by :func:`pack_block` (``block`` itself when it is stored raw)."""
+    return block if len(block) == size else zlib.decompress(block)
 
 
 def record_format(n_series: int, t_bytes: int) -> str:
@@ -204,8 +225,9 @@ def _header():
 
     ``{"max_degree", "series" (name -> position), "degrees" (one :func:`record_format` tuple per degree),
     "base" (where the blocks start in the file), "first_blocks", "denominators" (name -> ``T_d`` of each degree as
-    ints), "starts" (the index of each degree's first word among the Lyndon words of all degrees), "blocks" (the
-    bytes of degrees ``1, 2, ...`` already checked against their SHA-256)}``."""
+    ints), "starts" (the index of each degree's first word among the Lyndon words of all degrees), "blocks" (per
+    degree ``1, 2, ...`` whose bytes are checked against their SHA-256, its standard factors' block and
+    ``{series: (numerators' block, bytes per numerator)}``, as stored: :func:`unpack_block`)}``."""
     if _HEADER:
         return _HEADER[0]
     lead = len(MAGIC) + 4
@@ -297,15 +319,19 @@ def _verify(header, n: int) -> bool:
             return False
     view = memoryview(data)
     sha256 = _sha256_function()
+    series = header["series"]
     low = start
     for d in range(first, n + 1):
         record = degrees[d - 1]
         end = record[1]
-        block = view[low - shift : end - shift]
-        if sha256(block).digest() != record[-1]:
+        if sha256(view[low - shift : end - shift]).digest() != record[-1]:
             _unusable(f"the bytes of degree {d} do not match their SHA-256")
             return False
-        blocks.append(block)  # a view of the bytes read: what was checked is what is decoded, now and later
+        # views of the bytes read, cut once here: what was checked is what is decoded, now and after clear_decoded
+        offset = record[2] - shift
+        blocks.append((view[offset : offset + record[3]],
+                       {name: (view[record[at] - shift : record[at] - shift + record[at + 1]], record[at + 2])
+                        for name, at in series.items()}))
         low = end
     return True
 
@@ -319,27 +345,21 @@ def _load(header, series: str, n: int) -> bool:
     ``n`` present means every lower one is."""
     if len(_FACTORS) >= n and (series, n) in _NUMERATORS:
         return True
-    if len(header["blocks"]) < n and not _verify(header, n):
+    image = header["blocks"]
+    if len(image) < n and not _verify(header, n):
         return False
-    blocks, degrees = header["blocks"], header["degrees"]
-    at = header["series"][series]
-    swap = sys.byteorder == "big"  # the table is little-endian
-    decompress = zlib.decompress
-    low = 0  # the records' offsets count from the first block of degree 1; a block starts where the last ended
+    degrees = header["degrees"]
+    for d in range(len(_FACTORS), n):
+        factors = array(_INT32)
+        if d:  # degree 1 has no standard factors; degree d + 1 two int32 indices a word
+            factors.frombytes(unpack_block(image[d][0], 8 * degrees[d][0]))
+            if sys.byteorder == "big":  # the table is little-endian
+                factors.byteswap()
+        _FACTORS.append(factors)
     for d in range(1, n + 1):
-        record, block = degrees[d - 1], blocks[d - 1]
-        if d > len(_FACTORS):
-            factors = array(_INT32)
-            if record[3]:
-                offset = record[2] - low
-                factors.frombytes(decompress(block[offset : offset + record[3]]))
-                if swap:
-                    factors.byteswap()
-            _FACTORS.append(factors)
         if (series, d) not in _NUMERATORS:
-            offset, size, width = record[at] - low, record[at + 1], record[at + 2]
-            _NUMERATORS[series, d] = _decode(decompress(block[offset : offset + size]), width) if width else []
-        low = record[1]
+            block, width = image[d - 1][1][series]
+            _NUMERATORS[series, d] = _decode(unpack_block(block, width * degrees[d - 1][0]), width) if width else []
     return True
 
 
