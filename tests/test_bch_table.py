@@ -143,6 +143,19 @@ def test_the_verified_image_outlives_clear_caches_and_the_file(tmp_path, monkeyp
         assert formal_bch("12", 5) == _engine("12", 5)
 
 
+def test_the_image_grows_across_reads():
+    """Degrees 1-5 from the bytes read with the header, then 6-15 read from the file in a second piece: the same
+    series as one request to degree 15 (offsets of a piece that does not start at degree 1)."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        whole = [formal_bch("12", 15).scaled_words(d) for d in (6, 13, 14, 15)]
+        table.clear_cache()
+        formal_bch("212", 5)
+        assert len(table._header()["blocks"]) == 5
+        assert [formal_bch("12", 15).scaled_words(d) for d in (6, 13, 14, 15)] == whole
+    assert len(table._header()["blocks"]) == 15
+
+
 @pytest.mark.parametrize("kind", ["empty", "small", "zeros", "noise"])
 def test_a_block_is_raw_exactly_when_its_size_is_its_decoded_size(kind):
     """pack_block stores a block of at most RAW_BYTES bytes, or one zlib does not shorten, as is; a compressed block
