@@ -9,7 +9,11 @@ sub-flows (:mod:`nambu_bch.integrators`), FI hulls and formal columns
 :data:`CACHES` lists each one; ``tests/test_public_api.py`` checks that no
 ``functools.lru_cache`` or module-level cache dictionary is missing from it.
 Disk caches (generated kernels, the ``models`` listing) live under
-``$NAMBU_BCH_CACHE`` and are verified on reading; they are not touched here.
+``$NAMBU_BCH_CACHE`` and are verified on reading; they are not touched here.  Nor is
+the BCH table's verified image (:mod:`nambu_bch.bch.table`: the shipped file's header and
+the degrees' bytes, each checked against its SHA-256 once per process): it is the
+package's data as read, like an imported module; what was decoded from it is emptied
+(``table.clear_decoded``), and ``table.clear_cache()`` forgets the image too.
 
 >>> from nambu_bch import clear_caches, model
 >>> S = model("ho3"); clear_caches(); model("ho3") is S, model("ho3").hamiltonians == S.hamiltonians
@@ -38,7 +42,7 @@ CACHES = (
     ("nambu_bch.bch.formal", "_duval_trees"),
     ("nambu_bch.bch.formal", "_fits_dense"),
     ("nambu_bch.bch.modular", "lyndon_table"),
-    ("nambu_bch.bch.table", "clear_cache"),             # _HEADER, _TREES, _NUMERATORS
+    ("nambu_bch.bch.table", "clear_decoded"),           # _TREES, _WORDS, _FACTORS, _NUMERATORS (not the verified image)
     ("nambu_bch.bch.modular", "_surjection_sum"),
     ("nambu_bch.bch.modular", "_class_order"),
     ("nambu_bch.bch.modular", "_tanh_half_coefficients"),

@@ -111,6 +111,85 @@ def test_a_damaged_or_replaced_table_is_not_trusted(tmp_path, monkeypatch, what)
     assert table._HEADER == [None]
 
 
+def test_the_verified_image_outlives_clear_caches_and_the_file(tmp_path, monkeypatch):
+    """The degrees checked once are kept as the bytes that were checked: after ``clear_caches`` they are decoded
+    again from memory (the file, damaged since, is not read for them), while a degree not read yet comes from the
+    file and is checked first (a damaged one: one warning, not served).  ``table.clear_cache`` forgets the
+    image."""
+    import nambu_bch
+
+    _damaged(tmp_path, monkeypatch, lambda data: None)
+    table.clear_cache()
+    assert formal_bch("12", 5) == _engine("12", 5)
+    header = table._header()
+    base, block = _offsets()
+    degree_14 = base + table._numerators_block(header, 14, "12")[0]
+    assert degree_14 - base > len(header["first_blocks"])  # beyond the bytes read with the header
+    data = bytearray(Path(table.TABLE_PATH).read_bytes())
+    for index in (block, degree_14):  # degree 3 (verified, in memory) and degree 14 (not read yet)
+        data[index] ^= 1
+    Path(table.TABLE_PATH).write_bytes(bytes(data))
+    nambu_bch.clear_caches()
+    assert table._NUMERATORS == {} and table._FACTORS == []
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        assert formal_bch("21", 5) == _engine("21", 5)  # from the image: the damaged degree 3 is not read
+        assert not caught
+        assert table.serve([0, 1], [1, 1], 1, (1, 2), 14, [1] * 15) is None  # degree 14 read and refused
+    messages = [str(w.message) for w in caught if issubclass(w.category, RuntimeWarning)]
+    assert len(messages) == 1 and "degree 14 do not match" in messages[0], messages
+    table.clear_cache()  # the image forgotten: the file is read again, and its damaged degree 3 is refused
+    with pytest.warns(RuntimeWarning, match="degree 3 do not match"):
+        assert formal_bch("12", 5) == _engine("12", 5)
+
+
+def test_the_image_grows_across_reads():
+    """Degrees 1-5 from the bytes read with the header, then 6-15 read from the file in a second piece: the same
+    series as one request to degree 15 (offsets of a piece that does not start at degree 1)."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        whole = [formal_bch("12", 15).scaled_words(d) for d in (6, 13, 14, 15)]
+        table.clear_cache()
+        formal_bch("212", 5)
+        assert len(table._header()["blocks"]) == 5
+        assert [formal_bch("12", 15).scaled_words(d) for d in (6, 13, 14, 15)] == whole
+    assert len(table._header()["blocks"]) == 15
+
+
+@pytest.mark.parametrize("kind", ["empty", "small", "zeros", "noise"])
+def test_a_block_is_raw_exactly_when_its_size_is_its_decoded_size(kind):
+    """pack_block stores a block of at most RAW_BYTES bytes, or one zlib does not shorten, as is; a compressed block
+    is shorter than its data, so unpack_block needs no flag."""
+    import random
+
+    data = {"empty": b"", "small": b"\0" * table.RAW_BYTES, "zeros": b"\0" * 4 * table.RAW_BYTES,
+            "noise": random.Random(26).randbytes(4 * table.RAW_BYTES)}[kind]
+    block = table.pack_block(data)
+    assert table.unpack_block(block, len(data)) == data
+    assert (block == data) == (kind != "zeros") and (len(block) == len(data)) == (block == data)
+
+
+def test_a_request_to_degree_10_decompresses_only_its_large_blocks(monkeypatch):
+    """The shipped table stores the small blocks raw: after clear_caches a request to degree 10 calls zlib only for
+    the blocks whose decoded size exceeds RAW_BYTES (two: the standard factors of degrees 9 and 10)."""
+    import zlib
+
+    import nambu_bch
+
+    before = formal_bch("12", 10)
+    nambu_bch.clear_caches()
+    calls = []
+    decompress = zlib.decompress
+    monkeypatch.setattr(zlib, "decompress", lambda data: calls.append(len(data)) or decompress(data))
+    served = formal_bch("12", 10)
+    degrees = table._header()["degrees"]
+    at = table._header()["series"]["12"]
+    large = sum((8 * r[0] > table.RAW_BYTES) + (r[at + 2] * r[0] > table.RAW_BYTES) for r in degrees[1:10])
+    assert len(calls) == large == 2
+    monkeypatch.undo()
+    assert served == before  # decoded again, from the same bytes
+
+
 def test_the_tool_rebuilds_the_low_degrees_exactly(tmp_path):
     """tools/build_bch_table.py at degree 9 (formal_bch's engines at that degree: the dense one) writes the same
     blocks as the shipped table (built at its top degree by the sparse engine)."""

@@ -5,7 +5,7 @@ Computes ``log(e^A e^B)``, ``log(e^{A/2} e^B e^{A/2})`` and ``log(e^{B/2} e^A e^
 ``nambu_bch/bch/data/bch_series.bin`` (format: :mod:`nambu_bch.bch.table`) and sets
 ``TABLE_SHA256`` in ``nambu_bch/bch/table.py`` to the SHA-256 of its header.  Then it reads the new
 table back through the package and checks that every series it serves to ``--degree`` equals the
-engine's result exactly.  Prints the bytes each degree costs (compressed).
+engine's result exactly.  Prints the bytes each degree costs (as stored).
 
 Run:  python tools/build_bch_table.py [--degree 20]
 """
@@ -17,7 +17,6 @@ import hashlib
 import re
 import struct
 import sys
-import zlib
 from math import gcd
 from pathlib import Path
 
@@ -85,7 +84,7 @@ def build(n: int, path: Path) -> tuple:
 
         def add(data: bytes) -> list:
             nonlocal offset
-            data = zlib.compress(data, 9) if data else data
+            data = table.pack_block(data)
             blocks.append(data)
             offset += len(data)
             return [offset - len(data), len(data)]

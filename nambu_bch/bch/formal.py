@@ -722,17 +722,21 @@ def _from_table(comp, numerators, denominators, max_degree):
     ``numerators[i] / denominators[i]``.  The table holds the two-generator products of two or three
     factors; a degree it holds is served whatever the engines' size limits (without numba the dense engine
     stops at degree 19)."""
-    generators = tuple(sorted(set(comp.pieces)))
-    if len(generators) != 2 or len(comp.pieces) > 3:
+    pieces = comp.pieces
+    if len(pieces) > 3:
+        return None
+    generators = tuple(sorted(set(pieces)))
+    if len(generators) != 2:
         return None
     n = _positive_degree(max_degree)
     if n > _table.max_degree():
         return None
     q = lcm(*denominators)
     values = [a * (q // b) for a, b in zip(numerators, denominators)]
-    big = lcm(*range(1, n + 1))
-    dens = [factorial(d) * big * q**d for d in range(n + 1)]
-    letters = [generators.index(k) for k in comp.pieces]
+    dens = [lcm(*range(1, n + 1))]  # D_d = d! lcm(1..n) q^d, as the engines have it (_formal)
+    for d in range(1, n + 1):
+        dens.append(dens[-1] * d * q)
+    letters = [generators.index(k) for k in pieces]
     served = _table.serve(letters, values, q, generators, n, dens)
     return None if served is None else FormalBCH(comp, generators, n, served, None)
 

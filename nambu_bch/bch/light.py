@@ -124,6 +124,8 @@ def parse_word(spec, n_pieces=None):
     if n_pieces is not None and (type(n_pieces) is not int or not 1 <= n_pieces <= MAX_FACTORS):
         return None
     text = spec.strip()
+    if text.isdigit() and text.isascii():  # a digit word (the usual request): no character to check one by one
+        return None if "0" in text else _checked(spec, n_pieces, *_digits(text), text)
     if not all(ch.isascii() and (ch.isalnum() or ch in _PUNCTUATION) for ch in text):
         return None
     low = text.lower()
@@ -138,8 +140,6 @@ def parse_word(spec, n_pieces=None):
         if low == "strang":
             word += word[-2::-1]
         return _checked(spec, n_pieces, *_digits(word), word)
-    if text.isdigit():
-        return None if "0" in text else _checked(spec, n_pieces, *_digits(text), text)
     if ":" in text:
         return _pairs(spec, n_pieces, text)
     return None
@@ -147,7 +147,7 @@ def parse_word(spec, n_pieces=None):
 
 def _digits(word: str):
     """Pieces and coefficients of a digit word: a palindrome of odd length halves every step but the middle one."""
-    pieces = tuple(int(ch) for ch in word)
+    pieces = tuple(map(int, word))
     if len(word) % 2 == 1 and len(word) > 1 and word == word[::-1]:
         coefficients = [_HALF] * len(word)
         coefficients[len(word) // 2] = _ONE

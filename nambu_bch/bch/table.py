@@ -25,15 +25,24 @@ computes the series, and one warning line says why.  The digests are hashlib's (
 imported hashlib and CPython's built-in SHA-256 otherwise: the same digest, without mapping libcrypto (megabytes)
 into a fresh process that reads the table and nothing else.
 
+Once per process.  The header and the bytes of each degree read so far are checked once and kept, as checked, in
+memory (the verified image, at most the file's 1.2 MB): a later request decodes them from there (what was checked is what is decoded) and
+reads the file only for a degree it does not hold yet.
+:func:`nambu_bch.clear_caches` (through :func:`clear_decoded`) empties what was decoded from the image -- the
+standard factors, numerators, trees and words -- and keeps the image, which is the shipped data as read, not the
+result of a computation; :func:`clear_cache` forgets the image too.
+
 Memory.  Only the degrees asked are read; the numerators stay machine integers (:mod:`array`) until a degree's
 terms are asked for, and :class:`Served` builds them on each access (the trees, shared by every request, are the
 only Python objects kept).
 
-File format: ``b"NBCHTAB2"``, the header's length (4 bytes, little-endian), the header (:data:`PREAMBLE`, the
+File format: ``b"NBCHTAB3"``, the header's length (4 bytes, little-endian), the header (:data:`PREAMBLE`, the
 series' names in :data:`NAME_BYTES` each, one :func:`record_format` record per degree: fixed-size fields read
 by :mod:`struct` in one call, where a JSON header cost more than the blocks of a request to degree 10), then
 degree by degree the standard factors (int32: left indices, then right indices, into the flat list of the
-Lyndon words of all degrees) and the three series' numerators, each block zlib-compressed.
+Lyndon words of all degrees) and the three series' numerators, each block zlib-compressed unless it is small
+(:func:`pack_block`: a block is raw exactly when its size is its decoded size, known from the number of words and
+the bytes per numerator).
 
 References
 ----------
@@ -59,15 +68,34 @@ from fractions import Fraction
 from .collector import no_full_collection
 
 #: SHA-256 of the table's header (which holds the SHA-256 of each degree's bytes); written by tools/build_bch_table.py.
-TABLE_SHA256 = "a91b9da3201655559af7e275287661924dd283cf78ebf1349536fe54ffc382d9"
+TABLE_SHA256 = "429fe19eb6043f38848af4c8fab53b606d35ba48db3d219ec09a73754cbaabac"
 #: The table file shipped with the package.
 TABLE_PATH = os.path.join(os.path.dirname(__file__), "data", "bch_series.bin")
-MAGIC = b"NBCHTAB2"
+MAGIC = b"NBCHTAB3"
 #: The header's fixed part: format version, letters, number of series, top degree, bytes of a denominator ``T_d``.
 PREAMBLE = struct.Struct("<5H")
-FORMAT_VERSION = 2
+FORMAT_VERSION = 3
 #: Bytes of a series' name in the header (ASCII, NUL-padded).
 NAME_BYTES = 4
+#: A block of at most this many bytes is stored as is: zlib shortens so few by tens of bytes, while each compressed
+#: block costs a decompression call of its own (nineteen in a request to degree 10 when every block was compressed,
+#: two now; the file is 294 bytes longer).
+RAW_BYTES = 256
+
+
+def pack_block(data: bytes) -> bytes:
+    """A block as the table stores it: ``data`` as is when it has at most :data:`RAW_BYTES` bytes or zlib does not
+    shorten it, else zlib-compressed -- so a stored block is raw exactly when its size is ``len(data)`` (a
+    compressed block is always shorter), which :func:`unpack_block` reads back without a flag."""
+    if len(data) <= RAW_BYTES:
+        return data
+    compressed = zlib.compress(data, 9)
+    return compressed if len(compressed) < len(data) else data
+
+
+def unpack_block(block, size: int):
+    """The ``size`` bytes of a block stored by :func:`pack_block` (``block`` itself when it is stored raw)."""
+    return block if len(block) == size else zlib.decompress(block)
 
 
 def record_format(n_series: int, t_bytes: int) -> str:
@@ -117,21 +145,40 @@ _FIRST_BLOCKS = 16384
 #: array typecodes of the signed integer widths that convert in bulk
 _TYPECODES = {array(code).itemsize: code for code in "bhiq"}
 _INT32 = _TYPECODES[4]  # the standard factors' indices
-_HEADER: list = []  # [header dict] once read and verified; [None] when the table is unusable in this process
+#: [header dict] once read and verified; [None] when the table is unusable in this process.  The header holds the
+#: verified image of the file: the header's fields and the bytes of each degree read so far, each checked against
+#: its SHA-256 once and then kept (about a megabyte at the top degree), so that a later request, also after
+#: :func:`clear_decoded`, decodes them from memory instead of reading and checking the file again.
+_HEADER: list = []
 _TREES: dict = {}  # generators -> [flat list of the trees, degrees done]
 _WORDS: dict = {}  # generators -> [flat list of the Lyndon words as bytes of piece numbers, degrees done]
 _FACTORS: list = []  # per degree decoded so far: the standard factors (left indices + right indices)
-_NUMERATORS: dict = {}  # (series, degree) -> the stored numerators n_w as Python ints
+_NUMERATORS: dict = {}  # (series, degree) -> the stored numerators n_w (array of machine integers, or a list)
 _LOCK = _thread.allocate_lock()  # _thread: the threading module is not imported for one lock
 
 
+def clear_decoded() -> None:
+    """Forget what was decoded from the table (standard factors, numerators, trees, words), keeping its verified
+    image: the header and the degrees' bytes already checked against their SHA-256 (:data:`_HEADER`).
+
+    This is the package's :func:`~nambu_bch.caches.clear_caches` entry: the image is the shipped data as this
+    process read and checked it once (as it imports a module once), not the result of a computation; a request
+    after this call decodes the degrees it asks for again.  A table found unusable is tried again."""
+    with _LOCK:
+        if _HEADER == [None]:
+            _HEADER.clear()
+        _TREES.clear()
+        _WORDS.clear()
+        _FACTORS.clear()
+        _NUMERATORS.clear()
+
+
 def clear_cache() -> None:
-    """Forget the table's header, trees and decoded numerators (the next request reads the file again)."""
-    _HEADER.clear()
-    _TREES.clear()
-    _WORDS.clear()
-    _FACTORS.clear()
-    _NUMERATORS.clear()
+    """Forget the table entirely: its verified image and everything decoded (the next request reads the file and
+    checks its SHA-256 again)."""
+    with _LOCK:
+        _HEADER.clear()
+    clear_decoded()
 
 
 def _unusable(reason: str) -> None:
@@ -176,8 +223,11 @@ def _pread(fd: int, size: int, offset: int) -> bytes:
 def _header():
     """The verified header, or ``None`` (then a warning has been given once in this process).
 
-    ``{"max_degree", "series" (name -> position), "degrees" (one :func:`record_struct` tuple per degree),
-    "base" (where the blocks start in the file), "first_blocks"}``."""
+    ``{"max_degree", "series" (name -> position), "degrees" (one :func:`record_format` tuple per degree),
+    "base" (where the blocks start in the file), "first_blocks", "denominators" (name -> ``T_d`` of each degree as
+    ints), "starts" (the index of each degree's first word among the Lyndon words of all degrees), "blocks" (per
+    degree ``1, 2, ...`` whose bytes are checked against their SHA-256, its standard factors' block and
+    ``{series: (numerators' block, bytes per numerator)}``, as stored: :func:`unpack_block`)}``."""
     if _HEADER:
         return _HEADER[0]
     lead = len(MAGIC) + 4
@@ -202,14 +252,24 @@ def _header():
     names = raw[PREAMBLE.size : PREAMBLE.size + NAME_BYTES * n_series]
     record = record_format(n_series, t_bytes)  # struct keeps the compiled formats it has seen
     at = PREAMBLE.size + len(names)
+    degrees = list(struct.iter_unpack(record, raw[at : at + struct.calcsize(record) * top]))
+    # each name -> where its numerators' block lies in a record
+    series = {names[i : i + NAME_BYTES].rstrip(b"\0").decode("ascii"): 4 + 4 * (i // NAME_BYTES)
+              for i in range(0, len(names), NAME_BYTES)}
+    starts = [0]
+    for fields in degrees:
+        starts.append(starts[-1] + fields[0])
     header = {
         "max_degree": top,
-        # each name -> where its numerators' block lies in a record
-        "series": {names[i : i + NAME_BYTES].rstrip(b"\0").decode("ascii"): 4 + 4 * (i // NAME_BYTES)
-                   for i in range(0, len(names), NAME_BYTES)},
-        "degrees": list(struct.iter_unpack(record, raw[at : at + struct.calcsize(record) * top])),
+        "series": series,
+        "degrees": degrees,
         "base": len(MAGIC) + 4 + size,
-        "first_blocks": first_blocks,  # unverified bytes: each degree's SHA-256 is checked when it is decoded
+        "first_blocks": first_blocks,  # unverified bytes: each degree's SHA-256 is checked before it is kept
+        # read once here rather than in every request: T_d and where each degree's words start
+        "denominators": {name: [0] + [int.from_bytes(fields[k + 3], "little") for fields in degrees]
+                         for name, k in series.items()},
+        "starts": starts,
+        "blocks": [],
     }
     _HEADER[:] = [header]
     return header
@@ -218,7 +278,7 @@ def _header():
 def _numerators_block(header, d: int, series: str) -> tuple:
     """``(offset, size, bytes per numerator, T_d)`` of the numerators of ``series`` in degree ``d``."""
     record, at = header["degrees"][d - 1], header["series"][series]
-    return record[at], record[at + 1], record[at + 2], int.from_bytes(record[at + 3], "little")
+    return record[at], record[at + 1], record[at + 2], header["denominators"][series][d]
 
 
 def _decode(data: bytes, width: int):
@@ -235,14 +295,13 @@ def _decode(data: bytes, width: int):
     return [from_bytes(data[i : i + width], "little", signed=True) for i in range(0, len(data), width)]
 
 
-def _load(header, series: str, n: int) -> bool:
-    """Decode the standard factors and the numerators of ``series`` for the degrees ``<= n`` not decoded yet.
-
-    The degrees' bytes are read in one piece, from the first degree missing something to ``n``, and each
-    degree's bytes are checked against its SHA-256 in the header before anything of it is decoded."""
-    degrees = header["degrees"]
-    first = next((d for d in range(1, n + 1) if d > len(_FACTORS) or (series, d) not in _NUMERATORS), None)
-    if first is None:
+def _verify(header, n: int) -> bool:
+    """Extend the verified image (``header["blocks"]``) to degree ``n``: the degrees' bytes not checked yet are
+    read in one piece (or taken from the bytes read with the header) and each degree's bytes are kept only if
+    their SHA-256 equals the header's.  The caller holds :data:`_LOCK`."""
+    blocks, degrees = header["blocks"], header["degrees"]
+    first = len(blocks) + 1
+    if first > n:
         return True
     start = degrees[first - 2][1] if first > 1 else 0
     stop = degrees[n - 1][1]
@@ -260,8 +319,7 @@ def _load(header, series: str, n: int) -> bool:
             return False
     view = memoryview(data)
     sha256 = _sha256_function()
-    at = header["series"][series]
-    swap = sys.byteorder == "big"  # the table is little-endian
+    series = header["series"]
     low = start
     for d in range(first, n + 1):
         record = degrees[d - 1]
@@ -269,18 +327,39 @@ def _load(header, series: str, n: int) -> bool:
         if sha256(view[low - shift : end - shift]).digest() != record[-1]:
             _unusable(f"the bytes of degree {d} do not match their SHA-256")
             return False
+        # views of the bytes read, cut once here: what was checked is what is decoded, now and after clear_decoded
+        offset = record[2] - shift
+        blocks.append((view[offset : offset + record[3]],
+                       {name: (view[record[at] - shift : record[at] - shift + record[at + 1]], record[at + 2])
+                        for name, at in series.items()}))
         low = end
-        if d > len(_FACTORS):
-            offset, size = record[2] - shift, record[3]
-            factors = array(_INT32)
-            if size:
-                factors.frombytes(zlib.decompress(view[offset : offset + size]))
-                if swap:
-                    factors.byteswap()
-            _FACTORS.append(factors)
+    return True
+
+
+def _load(header, series: str, n: int) -> bool:
+    """Decode the standard factors and the numerators of ``series`` for the degrees ``<= n`` not decoded yet, from
+    the verified image (:func:`_verify` extends it first when a degree is missing).  The caller holds
+    :data:`_LOCK`.
+
+    Both are decoded degree by degree from degree 1 up, so what is decoded is always degrees ``1..m``: degree
+    ``n`` present means every lower one is."""
+    if len(_FACTORS) >= n and (series, n) in _NUMERATORS:
+        return True
+    image = header["blocks"]
+    if len(image) < n and not _verify(header, n):
+        return False
+    degrees = header["degrees"]
+    for d in range(len(_FACTORS), n):
+        factors = array(_INT32)
+        if d:  # degree 1 has no standard factors; degree d + 1 two int32 indices a word
+            factors.frombytes(unpack_block(image[d][0], 8 * degrees[d][0]))
+            if sys.byteorder == "big":  # the table is little-endian
+                factors.byteswap()
+        _FACTORS.append(factors)
+    for d in range(1, n + 1):
         if (series, d) not in _NUMERATORS:
-            offset, size, width = record[at] - shift, record[at + 1], record[at + 2]
-            _NUMERATORS[series, d] = _decode(zlib.decompress(view[offset : offset + size]), width) if width else []
+            block, width = image[d - 1][1][series]
+            _NUMERATORS[series, d] = _decode(unpack_block(block, width * degrees[d - 1][0]), width) if width else []
     return True
 
 
@@ -363,20 +442,20 @@ def serve(letters, values, q: int, generators: tuple, n: int, denominators):
         if not _load(header, series, n):
             return None
         factors = _FACTORS[:n]
-        stored = {d: _NUMERATORS[series, d] for d in range(1, n + 1)}
-    degrees = header["degrees"]
+        stored = [_NUMERATORS[series, d] for d in range(1, n + 1)]
+    common, starts = header["denominators"][series], header["starts"]
+    even = -1 if flip else 1  # the reversed product: the even degrees change sign
     parts = {}
-    start = 0
     for d in range(1, n + 1):
-        if stored[d]:
+        numerators = stored[d - 1]
+        if numerators:
             # D_d / T_d is an integer: T_d is the least common denominator of the degree, and D_d times every
             # coefficient is an integer (the engines' denominators, nambu_bch.bch.formal)
-            factor, rest = divmod(denominators[d], _numerators_block(header, d, series)[3])
+            factor, rest = divmod(denominators[d], common[d])
             if rest:
                 raise ArithmeticError(f"internal error: the BCH table's degree-{d} denominator does not divide "
                                       f"{denominators[d]}")
-            parts[d] = (denominators[d], -factor if flip and d % 2 == 0 else factor, stored[d], start)
-        start += degrees[d - 1][0]
+            parts[d] = (denominators[d], factor if d % 2 else even * factor, numerators, starts[d - 1])
     return Served(tuple(generators), factors, parts)
 
 
