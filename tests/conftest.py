@@ -48,6 +48,14 @@ LONG = (
     ("test_elimination.py", "test_solve_affine_matches_plain_domainmatrix"),  # 12 s at QQ<2^(1/3)>(a,b)
     ("test_notebooks.py", "test_notebook_executes"),                        # 3-8 s each, in a kernel process
     ("test_numeric.py", "test_exponential_flows_"),                         # 3-7 s each: Lotka-Volterra kernels, a C build
+    # compiled loops the fast tier compiles once per kind (DEEP), each kind's tests in a row so that one worker
+    # compiles it and reuses it in memory (in two workers at once, both would compile it: the disk cache helps only
+    # a later process).  The Lotka-Volterra batch loop (test_exponential_flows_agree_across_backends, 5-9 s) ...
+    ("test_numeric_parallel.py", "test_an_overflow_in_any_thread_is_reported"),  # ... reused here
+    ("test_hardening_numeric.py", "test_compiled_scan_agrees_with_numpy_guards"),  # the scan, ho3/32123's batch loop ...
+    ("test_numeric.py", "test_batch_numba_numpy_and_single_agree_bitwise"),  # ... reused here, its Kahan loop (3-4 s) ...
+    ("test_numeric.py", "test_batch_kernel_counts_non_finite_samples"),     # ... reused here
+    ("test_numeric_parallel.py", "test_"),                                  # ... and here (both loops in threads)
     ("test_testing.py", "test_example_suite_"),                             # two pytest subprocesses
     ("test_fi_route.py", "test_hull_members_have_the_brackets_field"),      # the rigid body's 992 h^4 hulls ...
     ("test_fi_route.py", "test_h4_hull_equals_brute_force_enumeration"),    # ... reused here
