@@ -767,19 +767,22 @@ def test_batch_kernel_counts_non_finite_samples(backend):
 @pytest.mark.parametrize("segment_work", [None, 3000])
 def test_batch_overflow_names_the_same_steps_as_the_single_run(monkeypatch, segment_work):
     """A batch whose one large state overflows mid-run raises the message of that state's own run (the
-    first non-finite sample), also when the run is cut into progress segments."""
+    first non-finite sample), also when the run is cut into progress segments.
+
+    At h = 2.5 (x1, x2) grows like 4^n and x3 like 16^n: the large state overflows near step 90, the others near
+    step 250.  ho3/32123's batch loop, compiled once for the fast tier's batch tests (tests/conftest.py LONG)."""
     import importlib
 
     from nambu_bch.numeric.iterate import SCAN_BATCH
 
-    X = np.ones((2, SCAN_BATCH + 10))
-    X[:, 3000] = [1e200, 0.0]
+    X = np.ones((3, SCAN_BATCH + 10))
+    X[:, 3000] = [1e100, 0.0, 0.0]
     with pytest.raises(NumericalRangeError, match="between steps") as single:
-        iterate("ho", "TVT", 2.5, 2000, X[:, 3000], every=40, check_stable=False)
+        iterate("ho3", "32123", 2.5, 2000, X[:, 3000], every=40, check_stable=False)
     if segment_work:
         monkeypatch.setattr(importlib.import_module("nambu_bch.numeric.iterate"), "_SEGMENT_WORK", segment_work)
     with pytest.raises(NumericalRangeError, match="between steps") as batch:
-        iterate("ho", "TVT", 2.5, 2000, X, every=40, check_stable=False, progress=bool(segment_work))
+        iterate("ho3", "32123", 2.5, 2000, X, every=40, check_stable=False, progress=bool(segment_work))
     assert str(batch.value) == str(single.value)
 
 
