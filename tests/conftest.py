@@ -43,10 +43,7 @@ LONG = (
     ("test_numeric.py", "test_exponential_flows_agree_across_backends"),
     ("test_numeric_parallel.py", "test_an_overflow_in_any_thread_is_reported"),  # ... reused here
     ("test_hardening_numeric.py", "test_compiled_scan_agrees_with_numpy_guards"),  # the scan, ho3/32123's batch loop ...
-    ("test_numeric.py", "test_batch_numba_numpy_and_single_agree_bitwise"),  # ... its Kahan batch loop (3-5 s) ...
-    ("test_numeric.py", "test_batch_kernel_counts_non_finite_samples"),     # ... reused here
-    ("test_numeric.py", "test_batch_overflow_names_the_same_steps_as_the_single_run"),  # ... here
-    ("test_numeric.py", "test_out_receives_the_samples_in_place"),          # ... here
+    ("test_numeric.py", "test_"),  # ... reused by the file's batch tests, with its Kahan batch loop (3-5 s) ...
     ("test_numeric_parallel.py", "test_"),                                  # ... and here (both loops in threads)
     ("test_cache_safety.py", "test_"),                                      # 15-30 s each: numba recompiles in subprocesses
     ("test_docs.py", "test_api_reference_builds_without_warnings"),         # a Sphinx build in a subprocess
@@ -59,7 +56,6 @@ LONG = (
     ("test_numeric_api_arguments.py", "test_default_x0_of_every_model_runs_a_long_orbit"),
     ("test_elimination.py", "test_solve_affine_matches_plain_domainmatrix"),  # 12 s at QQ<2^(1/3)>(a,b)
     ("test_notebooks.py", "test_notebook_executes"),                        # 3-8 s each, in a kernel process
-    ("test_numeric.py", "test_exponential_flows_"),                         # 3-7 s each: Lotka-Volterra kernels, a C build
     ("test_testing.py", "test_example_suite_"),                             # two pytest subprocesses
     ("test_fi_route.py", "test_hull_members_have_the_brackets_field"),      # the rigid body's 992 h^4 hulls ...
     ("test_fi_route.py", "test_h4_hull_equals_brute_force_enumeration"),    # ... reused here
@@ -77,7 +73,6 @@ LONG = (
     ("test_design.py", "test_optimize_finds_yoshidas_sixth_order_solution"),
     ("test_any_system.py", "test_lie_poisson_bch_member_with_casimir_kept"),
     ("test_shadow.py", "test_n4_full_split_is_obstructed"),
-    ("test_numeric.py", "test_series_pair_is_accurate"),
     ("test_runge_kutta_numeric.py", "test_compiled_equals_interpreted_bit_for_bit"),  # cold: numba compiles the RK loops
     ("test_text_door.py", "test_text_reaches_eval_only_in_the_parser"),     # the package's ASTs (shared_results) ...
     ("test_flint_seam.py", "test_only_the_seam_imports_flint"),             # ... reused here
