@@ -124,11 +124,9 @@ DEEP = (
     ("test_latex_compile.py", "test_cli_latex_compiles",
      ("shadow", "conserved", "exact --order 4", "bch", "fi", "models --format latex")),
     # another process start for what the fast tier checks once: the example suite with the plugin named explicitly
-    # (the entry-point run stays), the dask cluster (loky stays), the results pickled back by two spawned loky workers
-    # (the in-process round trips stay, and test_parallel's loky pool)
+    # (the entry-point run stays), the dask cluster (loky stays)
     ("test_testing.py", "test_example_suite_with_explicit_plugin", ()),
     ("test_parallel.py", "test_dask_local_cluster_equals_serial", ()),
-    ("test_pickle.py", "test_results_come_back_from_loky_workers", ()),
     # hostile text: every subcommand and every option once in the fast tier, all 105 pairs in the deep tier
     ("test_hardening_input.py", "test_hostile_text_every_subcommand_and_option",
      ("models--model", "bch--system", "fi--H", "shadow--G", "conserved--coords", "exact--param", "check--name",
