@@ -54,6 +54,7 @@ def test_compiles_of_the_test_that_first_imports_numba_are_recorded(tmp_path, mo
         "            pass\n")
     monkeypatch.syspath_prepend(str(tmp_path / "src"))
     monkeypatch.setattr(tool, "_DIR", str(tmp_path / "records"))
+    monkeypatch.setattr(tool, "_WORKER", "main")  # under xdist it names the worker
     monkeypatch.setattr(tool, "_DISPATCHER", name)
     monkeypatch.setattr(tool, "_state", {"test": "tests/test_a.py::test_first", "depth": 0, "file": None})
     monkeypatch.setattr(sys, "meta_path", list(sys.meta_path))
