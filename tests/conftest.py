@@ -277,7 +277,6 @@ DEEP = (
     ("test_bch_fast.py", "test_generic_separable_system_both_routes", ("12321",)),
 )
 
-
 #: The two ways :func:`cli_run` runs the command line; the fast tier keeps ``in-process``: the ``subprocess`` case
 #: carries the mark ``deep`` itself, so a new test asking for ``cli_run`` needs no entry in :data:`DEEP`.
 CLI_RUNNERS = ("in-process", pytest.param("subprocess", marks=pytest.mark.deep))
