@@ -36,10 +36,19 @@ sys.path.insert(0, str(Path(__file__).parent))
 # a result of a long one (tests/shared_results.py: computed once per worker process) follow it, so that both run
 # early in the same worker instead of each computing it (the rest of their file may be stolen by the other worker).
 LONG = (
+    # First the compiled loops that several tests share (compiled once per kind in the fast tier, DEEP): their tests in
+    # a row in the first worker, at the start, so that the loop is compiled once and reused in memory, and the other
+    # worker, reaching a test that uses it later, loads it from numba's cache in the run's NAMBU_BCH_CACHE (two
+    # workers that need it at the same time both compile it).  The Lotka-Volterra batch loop (5-9 s cold) ...
+    ("test_numeric.py", "test_exponential_flows_agree_across_backends"),
+    ("test_numeric_parallel.py", "test_an_overflow_in_any_thread_is_reported"),  # ... reused here
+    ("test_hardening_numeric.py", "test_compiled_scan_agrees_with_numpy_guards"),  # the scan, ho3/32123's batch loop ...
+    ("test_numeric.py", "test_"),  # ... reused by the file's batch tests, with its Kahan batch loop (3-5 s) ...
+    ("test_numeric_parallel.py", "test_"),                                  # ... and here (both loops in threads)
     ("test_cache_safety.py", "test_"),                                      # 15-30 s each: numba recompiles in subprocesses
     ("test_docs.py", "test_api_reference_builds_without_warnings"),         # a Sphinx build in a subprocess
     ("test_bch_modular.py", "test_sparse_engine_equals_dense_engine"),      # 9 s at [12-12], cold: numba compile
-    ("test_pickle.py", "test_results_come_back_from_spawned_workers"),      # a spawned worker imports and computes
+    ("test_pickle.py", "test_results_come_back_from_loky_workers"),         # two spawned workers import and compute
     ("test_cli.py", "test_every_subcommand_runs_as_a_subprocess"),          # 1-2 s each: a subprocess per subcommand
     ("test_packaging.py", "test_"),                                         # wheel and sdist built, installed, run
     ("test_fuzz_cli.py", "test_"),
@@ -47,7 +56,6 @@ LONG = (
     ("test_numeric_api_arguments.py", "test_default_x0_of_every_model_runs_a_long_orbit"),
     ("test_elimination.py", "test_solve_affine_matches_plain_domainmatrix"),  # 12 s at QQ<2^(1/3)>(a,b)
     ("test_notebooks.py", "test_notebook_executes"),                        # 3-8 s each, in a kernel process
-    ("test_numeric.py", "test_exponential_flows_"),                         # 3-7 s each: Lotka-Volterra kernels, a C build
     ("test_testing.py", "test_example_suite_"),                             # two pytest subprocesses
     ("test_fi_route.py", "test_hull_members_have_the_brackets_field"),      # the rigid body's 992 h^4 hulls ...
     ("test_fi_route.py", "test_h4_hull_equals_brute_force_enumeration"),    # ... reused here
@@ -65,7 +73,6 @@ LONG = (
     ("test_design.py", "test_optimize_finds_yoshidas_sixth_order_solution"),
     ("test_any_system.py", "test_lie_poisson_bch_member_with_casimir_kept"),
     ("test_shadow.py", "test_n4_full_split_is_obstructed"),
-    ("test_numeric.py", "test_series_pair_is_accurate"),
     ("test_runge_kutta_numeric.py", "test_compiled_equals_interpreted_bit_for_bit"),  # cold: numba compiles the RK loops
     ("test_text_door.py", "test_text_reaches_eval_only_in_the_parser"),     # the package's ASTs (shared_results) ...
     ("test_flint_seam.py", "test_only_the_seam_imports_flint"),             # ... reused here
@@ -117,11 +124,9 @@ DEEP = (
     ("test_latex_compile.py", "test_cli_latex_compiles",
      ("shadow", "conserved", "exact --order 4", "bch", "fi", "models --format latex")),
     # another process start for what the fast tier checks once: the example suite with the plugin named explicitly
-    # (the entry-point run stays), the dask cluster (loky stays), the spawned pickle worker (the in-process round trips
-    # stay)
+    # (the entry-point run stays), the dask cluster (loky stays)
     ("test_testing.py", "test_example_suite_with_explicit_plugin", ()),
     ("test_parallel.py", "test_dask_local_cluster_equals_serial", ()),
-    ("test_pickle.py", "test_results_come_back_from_spawned_workers", ()),
     # hostile text: every subcommand and every option once in the fast tier, all 105 pairs in the deep tier
     ("test_hardening_input.py", "test_hostile_text_every_subcommand_and_option",
      ("models--model", "bch--system", "fi--H", "shadow--G", "conserved--coords", "exact--param", "check--name",

@@ -253,8 +253,10 @@ def _base_table():
         "nambu_bch.numeric.numba_available": lambda v: {},
         "nambu_bch.numeric.observed_order": lambda v: dict(system=v["ho3"], word="12321", hs=(0.1, 0.05), T=0.2,
                                                            x0=(1.0, 1.0, 1.0)),
+        # the interpreter: compiling the two loops it times (1 s cold) is no concern of the argument checks
         "nambu_bch.numeric.precision_study": lambda v: dict(system=v["ho3"], word="12321", steps=10, every=5,
-                                                            mp_steps=5, dps=15, repeats=1, timing_steps=10),
+                                                            mp_steps=5, dps=15, repeats=1, timing_steps=10,
+                                                            backend="numpy"),
         "nambu_bch.numeric.quantities": lambda v: dict(system=v["ho3"], word="12321", h=0.1),
         "nambu_bch.numeric.sample_steps": lambda v: dict(steps=10),
         "nambu_bch.numeric.step_program": sys3,

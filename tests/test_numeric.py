@@ -744,38 +744,45 @@ def test_segmented_kahan_batch_carries_the_compensation(monkeypatch, capsys):
 @pytest.mark.parametrize("backend", [pytest.param("numba", marks=numba_only), "numpy"])
 def test_batch_kernel_counts_non_finite_samples(backend):
     """Kernel.run_batch returns 0 for a finite run and a positive count when a sample overflows; with
-    back=False the start states are only read, with start=True they are copied to out[0]."""
-    k = kernel(model("ho"), "TVT")
-    K = k.constants(2.5)                                   # omega h = 2.5: grows like 4^n
-    X = np.array([[1.0, 1e300, 0.5], [0.0, 0.0, 0.25]])
+    back=False the start states are only read, with start=True they are copied to out[0].
+
+    ho3/32123's batch loop: the one the fast tier compiles anyway (test_compiled_scan_agrees_with_numpy_guards,
+    test_batch_numba_numpy_and_single_agree_bitwise; tests/conftest.py LONG runs them in one worker); the count
+    is the same statement in every kernel's batch loop."""
+    k = kernel(model("ho3"), "32123")
+    K = k.constants(2.5)                # omega h = 2.5: (x1, x2) grows like 4^n, x3 += h x1 x2 / m like 16^n
+    X = np.array([[1.0, 1e100, 0.5], [0.0, 0.0, 0.25], [0.0, 0.0, 0.0]])
     keep = X.copy()
-    out = np.full((3, 2, 3), -7.0)
+    out = np.full((3, 3, 3), -7.0)
     assert k.run_batch(X, K, 2, 1, out, backend=backend, start=True, back=False) == 0
     assert np.array_equal(X, keep) and np.array_equal(out[0], X) and np.all(np.isfinite(out))
-    out = np.empty((3, 2, 3))
+    out = np.empty((3, 3, 3))
     with np.errstate(all="ignore"):
         assert k.run_batch(X, K, 300, 150, out, backend=backend, start=True, back=False) > 0
     assert np.array_equal(X, keep)
     Y = X[:, [0, 2]].copy()
-    assert k.run_batch(Y, K, 2, 2, np.empty((2, 2, 2)), backend=backend) == 0 and not np.array_equal(Y, keep[:, [0, 2]])
+    assert k.run_batch(Y, K, 2, 2, np.empty((2, 3, 2)), backend=backend) == 0 and not np.array_equal(Y, keep[:, [0, 2]])
 
 
 @pytest.mark.parametrize("segment_work", [None, 3000])
 def test_batch_overflow_names_the_same_steps_as_the_single_run(monkeypatch, segment_work):
     """A batch whose one large state overflows mid-run raises the message of that state's own run (the
-    first non-finite sample), also when the run is cut into progress segments."""
+    first non-finite sample), also when the run is cut into progress segments.
+
+    At h = 2.5 (x1, x2) grows like 4^n and x3 like 16^n: the large state overflows near step 90, the others near
+    step 250.  ho3/32123's batch loop, compiled once for the fast tier's batch tests (tests/conftest.py LONG)."""
     import importlib
 
     from nambu_bch.numeric.iterate import SCAN_BATCH
 
-    X = np.ones((2, SCAN_BATCH + 10))
-    X[:, 3000] = [1e200, 0.0]
+    X = np.ones((3, SCAN_BATCH + 10))
+    X[:, 3000] = [1e100, 0.0, 0.0]
     with pytest.raises(NumericalRangeError, match="between steps") as single:
-        iterate("ho", "TVT", 2.5, 2000, X[:, 3000], every=40, check_stable=False)
+        iterate("ho3", "32123", 2.5, 2000, X[:, 3000], every=40, check_stable=False)
     if segment_work:
         monkeypatch.setattr(importlib.import_module("nambu_bch.numeric.iterate"), "_SEGMENT_WORK", segment_work)
     with pytest.raises(NumericalRangeError, match="between steps") as batch:
-        iterate("ho", "TVT", 2.5, 2000, X, every=40, check_stable=False, progress=bool(segment_work))
+        iterate("ho3", "32123", 2.5, 2000, X, every=40, check_stable=False, progress=bool(segment_work))
     assert str(batch.value) == str(single.value)
 
 

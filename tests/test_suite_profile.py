@@ -33,3 +33,37 @@ def test_report_sums_tests_per_worker_and_file_and_lists_compiles(tmp_path):
     assert files == ["    2.8 tests/test_a.py", "    1.0 tests/test_b.py"]
     assert "  2.00   0.50 tests/test_a.py::test_x" in text and "test_z" not in text.split("--- tests")[1].split("---")[0]
     assert text.endswith("--- numba compiles: 1, 1.2 s\n  1.25 m.run  <- tests/test_a.py::test_x")
+
+
+def test_compiles_of_the_test_that_first_imports_numba_are_recorded(tmp_path, monkeypatch):
+    """The dispatcher is patched as its module is executed (a finder on sys.meta_path), not only between tests: a
+    stand-in module under another name, imported during a "test", has its compile recorded with that test."""
+    import sys
+
+    tool = _tool()
+    name = "suite_profile_stand_in_dispatcher"
+    (tmp_path / "src").mkdir()
+    (tmp_path / "src" / f"{name}.py").write_text(
+        "class Dispatcher:\n"
+        "    def __init__(self, fn):\n"
+        "        self.py_func = fn\n"
+        "    def compile(self, sig):\n"
+        "        import time\n"
+        "        end = time.process_time() + 0.06\n"  # above the plugin's 0.05 s of CPU
+        "        while time.process_time() < end:\n"
+        "            pass\n")
+    monkeypatch.syspath_prepend(str(tmp_path / "src"))
+    monkeypatch.setattr(tool, "_DIR", str(tmp_path / "records"))
+    monkeypatch.setattr(tool, "_WORKER", "main")  # under xdist it names the worker
+    monkeypatch.setattr(tool, "_DISPATCHER", name)
+    monkeypatch.setattr(tool, "_state", {"test": "tests/test_a.py::test_first", "depth": 0, "file": None})
+    monkeypatch.setattr(sys, "meta_path", list(sys.meta_path))
+    monkeypatch.delitem(sys.modules, name, raising=False)
+    tool.pytest_configure(None)
+    module = __import__(name)
+    module.Dispatcher(test_compiles_of_the_test_that_first_imports_numba_are_recorded).compile(("float64",))
+    tool._state["file"].close()
+    records = [json.loads(line) for line in (tmp_path / "records" / "main.jsonl").read_text().splitlines()]
+    assert [r["k"] for r in records] == ["start", "numba"]
+    assert records[1]["test"] == "tests/test_a.py::test_first" and records[1]["cpu"] > 0.05
+    assert records[1]["fn"].endswith("test_compiles_of_the_test_that_first_imports_numba_are_recorded")

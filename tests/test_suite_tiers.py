@@ -53,3 +53,24 @@ def test_cli_run_subprocess_case_is_deep():
     cases = {getattr(p, "values", (p,))[0]: getattr(p, "marks", ()) for p in CLI_RUNNERS}
     assert set(cases) == {"in-process", "subprocess"}
     assert [m.name for m in cases["subprocess"]] == ["deep"] and not cases["in-process"]
+
+
+
+
+def test_every_long_and_deep_entry_names_a_test_function():
+    """Each ``LONG`` and ``DEEP`` entry names a test function of its file, whatever this run collected: a renamed
+    test would silently leave the deep tier (test_every_deep_entry_and_kept_case_exists cannot tell a renamed test
+    from a file collected in part) or its ``LONG`` group (tests sharing a compiled loop or a shared result, run in a
+    row by one worker)."""
+    import re
+    from pathlib import Path
+
+    from conftest import DEEP, LONG
+
+    here, functions = Path(__file__).parent, {}
+    for f in {f for f, *_ in LONG + DEEP}:  # the def lines (parsing the ~60 files would take seconds)
+        functions[f] = set(re.findall(r"^[ \t]*def[ \t]+(test_\w+)", (here / f).read_text(encoding="utf-8"), re.M))
+    long_ = [(f, n) for f, n in LONG  # a name prefix; with a parameter id, the whole function name before it
+             if not any(name == n.partition("[")[0] if "[" in n else name.startswith(n) for name in functions[f])]
+    deep = [(f, n) for f, n, _ in DEEP if n not in functions[f]]
+    assert not long_ and not deep, f"tests/conftest.py names no test function: LONG {long_}, DEEP {deep}"

@@ -48,9 +48,37 @@ def _cpu() -> tuple:
     return own.ru_utime + own.ru_stime, children.ru_utime + children.ru_stime
 
 
+#: The module whose ``Dispatcher.compile`` is timed (a compile, or a load from numba's cache, of one signature).
+_DISPATCHER = "numba.core.dispatcher"
+
+
+class _WatchOnImport:
+    """A ``sys.meta_path`` finder that patches :data:`_DISPATCHER` as soon as it is executed: otherwise the compiles
+    of the test that first imports numba (in a worker) would be missed, since the patch is applied between tests."""
+
+    def find_spec(self, name, path, target=None):
+        if name != _DISPATCHER:
+            return None
+        for finder in sys.meta_path:
+            find = getattr(finder, "find_spec", None)
+            spec = None if finder is self or find is None else find(name, path, target)
+            if spec is not None:
+                break
+        else:
+            return None
+        loader, run = spec.loader, spec.loader.exec_module
+
+        def exec_module(module):
+            run(module)
+            _watch_numba()
+
+        loader.exec_module = exec_module  # this module's loader only
+        return spec
+
+
 def _watch_numba() -> None:
     """Time numba's top-level compiles (a compile nested in another is counted in its caller)."""
-    dispatcher = sys.modules.get("numba.core.dispatcher")
+    dispatcher = sys.modules.get(_DISPATCHER)
     if _DIR is None or dispatcher is None or getattr(dispatcher.Dispatcher.compile, "_profiled", False):
         return
     original = dispatcher.Dispatcher.compile
@@ -73,6 +101,8 @@ def _watch_numba() -> None:
 
 def pytest_configure(config):
     _write({"k": "start", "cpu": sum(_cpu()), "t": time.time(), "load": os.getloadavg()})
+    if _DIR is not None and not any(isinstance(f, _WatchOnImport) for f in sys.meta_path):
+        sys.meta_path.insert(0, _WatchOnImport())
 
 
 def pytest_collection_finish(session):
