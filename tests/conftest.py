@@ -270,6 +270,12 @@ DEEP = (
     # the fast tier; the non-symmetric 123 (0.75 s of backward error analysis) deep: both routes of a non-symmetric
     # word stay in the fast tier on a model (test_bch_concrete's lotka-volterra-123 row, to h^4)
     ("test_bch_fast.py", "test_generic_separable_system_both_routes", ("12321",)),
+    # s35 (symbolic tests, session 19): a second degree or word of an obstruction whose first case stays fast
+    # (test_shadow's rigid-body Phi^123 at degree 3 keeps the h^1 obstruction, test_ho3_123_obstruction_persists_at_
+    # higher_degree the persistence at higher degree; the N = 4 Phi^1234321 at h^2 keeps the N = 4 full split, the
+    # ho3 and rigid-body Phi^123 tests the non-symmetric words' failure at h^1)
+    ("test_shadow.py", "test_rigid_body_non_symmetric_word_is_obstructed_at_h1_degree_5", ()),
+    ("test_shadow.py", "test_n4_full_split_non_symmetric_word_is_obstructed_at_h1", ()),
 )
 
 #: The two ways :func:`cli_run` runs the command line; the fast tier keeps ``in-process``: the ``subprocess`` case
