@@ -383,7 +383,7 @@ def test_rigid_body_non_symmetric_word_is_obstructed_at_h1():
     """Free rigid body, full split, Phi^{123} (Lie-Trotter): NO polynomial shadow pair already at h^1 (degree 3 tried,
     also degree 5); certificate l = [x1 x2^2]Y^1 ... with l(Z_1) = (I1-I2)(I1-I3)/(2 I1^2 I2 I3) != 0."""
     S = model("rigid-body")
-    F = shadow_hamiltonians(S, "123", 2)
+    F = shared.family("rigid-body", "123", 2)   # also test_existence's and test_pickle's (tests/conftest.py LONG)
     assert not F.exists and F.failed_order == 1 and F.degree[1] == 3
     assert sympy.cancel(F.details.orders[0].obstruction_value - (I1 - I2) * (I1 - I3) / (2 * I1**2 * I2 * I3)) == 0
     _verify_certificate(S, "123", F)
