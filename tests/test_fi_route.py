@@ -405,11 +405,35 @@ def test_cli_fi_order_4_lists_hulls_with_limit(capsys):
     (("fi", "--model", "ho3", "--order", "4", "--limit", "0"), "--limit"),
     (("fi", "--model", "ho3", "--order", "9"), "between"),
     (("shadow", "--model", "ho3", "--route", "fi", "--order", "8"), "direct"),
-    (("fi", "--model", "rigid-body", "--order", "6"), "22272 brackets; pass --limit"),  # bounded work
+    (("fi", "--model", "rigid-body", "--order", "6"), "up to 22272 brackets; pass --limit"),  # bounded work
 ])
-def test_cli_bad_input_is_one_line(capsys, argv, fragment):
+def test_cli_bad_input_is_one_line(capsys, argv, fragment, monkeypatch):
+    # the size is decided from the piece-level trees: no term bracket is evaluated before the refusal
+    monkeypatch.setattr(fi_module, "_merged_trees", _no_term_brackets)
     code, out, err = run(capsys, *argv)
     assert code == 2 and len(err.strip().splitlines()) == 1 and fragment in err and "Traceback" not in err
+
+
+def _no_term_brackets(*args):
+    raise AssertionError("the brackets of Liouville terms were built before the refusal")
+
+
+@pytest.mark.parametrize("name, word, orders", [
+    ("ho3", "12321", (2, 3, 4, 5)), ("ho3", "123", (2, 3)), ("lotka-volterra", "12321", (2, 4)),
+    ("rigid-body", "12321", (2, 3, 4)), ("rigid-body", "123", (2, 3)), ("ho3-composite", "121", (2, 4)),
+])
+def test_bracket_bound_is_the_enumerated_count(name, word, orders):
+    """``bracket_bound`` (piece-level trees, products of the pieces' term counts, Eq. BCH3) equals the number of
+    brackets ``count_brackets`` enumerates with every term bracket evaluated, on systems whose pieces share no term."""
+    for order in orders:
+        assert fi_module.bracket_bound(model(name), word, order) == fi_module.count_brackets(model(name), word, order)
+
+
+def test_bracket_bound_bounds_the_count_when_pieces_share_terms():
+    """ho3-pair's pieces share Liouville terms: expanded trees coincide and merge, so the bound is strict."""
+    for order in (1, 2):
+        bound, count = (f(model("ho3-pair"), "123", order) for f in (fi_module.bracket_bound, fi_module.count_brackets))
+        assert bound > count > 0
 
 
 # ---------------------------------------------------------------------------------------------

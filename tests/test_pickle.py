@@ -19,6 +19,8 @@ import sympy
 
 import nambu_bch as nb
 
+import shared_results as shared
+
 SUBPACKAGES = ("algebra", "bch", "design", "exact", "integrators", "numeric", "shadow", "systems")
 
 
@@ -33,7 +35,7 @@ def _fi_route():
 
 @functools.lru_cache(maxsize=None)  # the numerical decision (a few seconds), shared by the tests that read it
 def _existence():
-    return nb.shadow_hamiltonians(nb.model("rigid-body"), "123", order=2).existence
+    return shared.family("rigid-body", "123", 2).existence
 
 
 def _triple_jump_field():
@@ -129,7 +131,7 @@ NOT_RESULTS = {
 EXTRA = {
     "ShadowFamily rigid-body h^2": lambda: nb.shadow_hamiltonians(nb.model("rigid-body"), "12321", order=2),
     "ShadowFamily ho h^4 fi": lambda: nb.shadow_hamiltonians(nb.model("ho"), "121", order=4, route="fi"),
-    "ShadowFamily none": lambda: nb.shadow_hamiltonians(nb.model("rigid-body"), "123", order=2),
+    "ShadowFamily none": lambda: shared.family("rigid-body", "123", 2),
     "EffectiveField triple jump (cube root of 2)": _triple_jump_field,
 }
 

@@ -198,26 +198,35 @@ PROBE = ("import sys\nfrom nambu_bch.cli import main\ncode = main({argv!r})\n"
 
 
 def test_help_and_errors_import_neither_sympy_nor_numpy(tmp_path):
-    """--help, a subcommand's --help and a bad flag answer without importing sympy/numpy (lazy imports)."""
-    for argv in (["--help"], ["shadow", "--help"], ["models", "--help"], ["shadow", "--order", "x"]):
-        done = _python(PROBE.format(argv=argv), tmp_path)
-        assert done.stderr.strip().splitlines()[-1] == "[]", (argv, done.stderr)
+    """--help, a subcommand's --help and a bad flag answer without importing sympy/numpy (lazy imports), and so does
+    importing the package with its pytest entry point.  One process for all of them: the heavy modules are listed
+    after each step, so the first step that imports one is named."""
+    argvs = [["--help"], ["shadow", "--help"], ["models", "--help"], ["shadow", "--order", "x"]]
     # nambu_bch._pytest_plugin: the pytest11 entry point, which pytest imports at the start of every test run
-    done = _python("import sys, nambu_bch, nambu_bch._pytest_plugin\nprint('sympy' in sys.modules)\n"
-                   "from nambu_bch import model\n"
-                   "print('sympy' in sys.modules, model('ho').N)", tmp_path)
-    assert done.stdout.split() == ["False", "True", "2"]  # the package imports lazily, and still works
+    code = ("import sys\nimport nambu_bch, nambu_bch._pytest_plugin\nfrom nambu_bch.cli import main\n"
+            "def heavy():\n    return sorted(m for m in ('sympy', 'numpy', 'numba') if m in sys.modules)\n"
+            "print('@@', 'import', heavy(), file=sys.stderr)\n"
+            f"for argv in {argvs!r}:\n    main(argv)\n    print('@@', argv, heavy(), file=sys.stderr)\n"
+            "from nambu_bch import model\nprint('sympy' in sys.modules, model('ho').N)\n")
+    done = _python(code, tmp_path)
+    steps = [line for line in done.stderr.splitlines() if line.startswith("@@ ")]
+    assert steps == ["@@ import []"] + [f"@@ {argv} []" for argv in argvs], done.stderr
+    assert done.stdout.splitlines()[-1].split() == ["True", "2"]  # the package imports lazily, and still works
 
 
-def test_models_listing_is_cached_and_identical(tmp_path):
-    """The built-in listing: computed once (sympy), then read from the cache without sympy, byte for byte."""
+def test_models_listing_is_cached_and_identical(tmp_path, monkeypatch, capsys):
+    """The built-in listing: computed once (sympy), then read from the cache without sympy, byte for byte; computed
+    again (here, in another process with another hash seed, with an empty cache) it is the same bytes."""
     argv = ["models", "--format", "json"]
     first = _python(PROBE.format(argv=argv), tmp_path)
     second = _python(PROBE.format(argv=argv), tmp_path)
     assert "sympy" in first.stderr.splitlines()[-1] and second.stderr.strip().splitlines()[-1] == "[]"
     assert first.stdout == second.stdout and '"ho3"' in first.stdout
-    fresh = _python(PROBE.format(argv=argv), tmp_path / "empty")
-    assert fresh.stdout == first.stdout
+    from nambu_bch.cli import main
+
+    monkeypatch.setenv("NAMBU_BCH_CACHE", str(tmp_path / "empty"))
+    assert main(argv) == 0
+    assert capsys.readouterr().out == first.stdout
 
 
 def test_models_cache_is_not_trusted_in_a_shared_directory(tmp_path, monkeypatch, capsys):
