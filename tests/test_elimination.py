@@ -26,7 +26,7 @@ from __future__ import annotations
 
 import pytest
 import sympy
-from hypothesis import given, settings
+from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 from sympy.polys.domains import QQ
 
@@ -142,65 +142,63 @@ ROUTES = [pytest.param(name, route, id=f"{route}-{name}")
           or (route == "flint" and DOMAINS[name].domain.is_QQ)]
 
 
+#: The random systems' tests: the route's switch (a function-scoped fixture) holds for every example of the test.
+SYSTEM_SETTINGS = dict(deadline=None, derandomize=True, suppress_health_check=[HealthCheck.function_scoped_fixture])
+
+
 @pytest.mark.parametrize("domain_name, route", ROUTES)
-def test_solve_affine_matches_plain_domainmatrix(domain_name, route, route_switch):
+@settings(max_examples=40, **SYSTEM_SETTINGS)
+@given(data=st.data())
+def test_solve_affine_matches_plain_domainmatrix(domain_name, route, route_switch, data):
     """solve_affine: same consistency, pivots, particular solutions, kernel and certificate as the plain path,
     and each verified by substitution."""
-
-    @settings(max_examples=40, deadline=None, derandomize=True)
-    @given(systems(domain_name))
-    def check(system):
-        domain, nrows, columns, rhs = system
-        L = E.SparseMatrix.from_columns(columns, nrows, domain)
-        new = E.solve_affine(L, rhs)
-        ref = _reference(E.solve_affine, L, rhs)
-        assert (new.consistent, new.failing_rhs, new.pivots) == (ref.consistent, ref.failing_rhs, ref.pivots)
-        assert len(new.kernel) == len(ref.kernel)
-        for k_new, k_ref in zip(new.kernel, ref.kernel):
-            assert _same(k_new, k_ref, domain)
-            assert not _apply(columns, k_new, domain)  # L k = 0
-        if new.consistent:
-            for x_new, x_ref, bk in zip(new.particular, ref.particular, rhs):
-                assert _same(x_new, x_ref, domain)
-                assert _same(_apply(columns, x_new, domain), bk, domain)  # L x = b
-        else:
-            y = new.certificate
-            assert _same(y, ref.certificate, domain)
-            for col in columns:  # y L = 0
-                assert not sum((y[i] * v for i, v in col.items() if i in y), domain.zero)
-            bk = rhs[new.failing_rhs]
-            assert sum((y[i] * v for i, v in bk.items() if i in y), domain.zero)  # y b != 0
-
-    check()
+    system = data.draw(systems(domain_name))
+    domain, nrows, columns, rhs = system
+    L = E.SparseMatrix.from_columns(columns, nrows, domain)
+    new = E.solve_affine(L, rhs)
+    ref = _reference(E.solve_affine, L, rhs)
+    assert (new.consistent, new.failing_rhs, new.pivots) == (ref.consistent, ref.failing_rhs, ref.pivots)
+    assert len(new.kernel) == len(ref.kernel)
+    for k_new, k_ref in zip(new.kernel, ref.kernel):
+        assert _same(k_new, k_ref, domain)
+        assert not _apply(columns, k_new, domain)  # L k = 0
+    if new.consistent:
+        for x_new, x_ref, bk in zip(new.particular, ref.particular, rhs):
+            assert _same(x_new, x_ref, domain)
+            assert _same(_apply(columns, x_new, domain), bk, domain)  # L x = b
+    else:
+        y = new.certificate
+        assert _same(y, ref.certificate, domain)
+        for col in columns:  # y L = 0
+            assert not sum((y[i] * v for i, v in col.items() if i in y), domain.zero)
+        bk = rhs[new.failing_rhs]
+        assert sum((y[i] * v for i, v in bk.items() if i in y), domain.zero)  # y b != 0
 
 
 @pytest.mark.parametrize("domain_name, route", ROUTES)
-def test_rank_nullspace_normal_form_match_plain(domain_name, route, route_switch):
+@settings(max_examples=30, **SYSTEM_SETTINGS)
+@given(data=st.data())
+def test_rank_nullspace_normal_form_match_plain(domain_name, route, route_switch, data):
     """rank, nullspace, kernel_rref and normal_form agree with the plain path (the rows of the random systems)."""
-
-    @settings(max_examples=30, deadline=None, derandomize=True)
-    @given(systems(domain_name))
-    def check(system):
-        domain, nrows, columns, rhs = system
-        ncols = len(columns)
-        vectors = [{j: col[i] for j, col in enumerate(columns) if i in col} for i in range(nrows)]
-        rows = {i: v for i, v in enumerate(vectors) if v}
-        M = E.SparseMatrix(rows, nrows, ncols, domain)
-        assert E.rank(E.SparseMatrix.from_rows(vectors, ncols, domain)) == _reference(E.rank, M)
-        kern = E.nullspace(M)
-        ref = _reference(E.nullspace, M)
-        assert len(kern) == len(ref) and all(_same(u, v, domain) for u, v in zip(kern, ref))
-        for k in kern:
-            assert all(not sum((r[j] * k[j] for j in r if j in k), domain.zero) for r in rows.values())
-        priority = list(reversed(range(ncols)))
-        if kern:
-            basis = E.kernel_rref(kern, priority, domain)
-            ref_basis = _reference(E.kernel_rref, kern, priority, domain)
-            assert len(basis) == len(ref_basis) and all(_same(u, v, domain) for u, v in zip(basis, ref_basis))
-            vec = {j: domain.one for j in range(ncols)}
-            assert _same(E.normal_form(vec, kern, priority, domain), _reference(E.normal_form, vec, kern, priority, domain), domain)
-
-    check()
+    system = data.draw(systems(domain_name))
+    domain, nrows, columns, rhs = system
+    ncols = len(columns)
+    vectors = [{j: col[i] for j, col in enumerate(columns) if i in col} for i in range(nrows)]
+    rows = {i: v for i, v in enumerate(vectors) if v}
+    M = E.SparseMatrix(rows, nrows, ncols, domain)
+    assert E.rank(E.SparseMatrix.from_rows(vectors, ncols, domain)) == _reference(E.rank, M)
+    kern = E.nullspace(M)
+    ref = _reference(E.nullspace, M)
+    assert len(kern) == len(ref) and all(_same(u, v, domain) for u, v in zip(kern, ref))
+    for k in kern:
+        assert all(not sum((r[j] * k[j] for j in r if j in k), domain.zero) for r in rows.values())
+    priority = list(reversed(range(ncols)))
+    if kern:
+        basis = E.kernel_rref(kern, priority, domain)
+        ref_basis = _reference(E.kernel_rref, kern, priority, domain)
+        assert len(basis) == len(ref_basis) and all(_same(u, v, domain) for u, v in zip(basis, ref_basis))
+        vec = {j: domain.one for j in range(ncols)}
+        assert _same(E.normal_form(vec, kern, priority, domain), _reference(E.normal_form, vec, kern, priority, domain), domain)
 
 
 def test_algebraic_split_round_trip():
