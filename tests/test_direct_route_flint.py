@@ -172,6 +172,36 @@ def test_fraction_free_fields_equal_liouville_field(flint, monkeypatch):
     assert isinstance(solver._plain_ring(), FlintRing) == flint
 
 
+def test_fraction_free_fields_clear_denominators_on_flint(monkeypatch):
+    """With python-flint a correction ``P`` is cleared to ``Q / D`` in flint's ``ZZ[params]`` (``D`` the lcm of its
+    coefficients' denominators): ``Q`` divided back by ``D`` is ``P`` coefficient by coefficient, and a sum of
+    fields runs without sympy's polynomial lcm or exact division (rigid body with symbolic I, orders 2 and 4)."""
+    from sympy.polys.rings import PolyElement
+
+    R = direct_route(model("rigid-body"), "12321", 4)
+    solver = dr._Solver(model("rigid-body"), R.composition, 4, None)
+    c, ctx, plain = R.corrections, solver._flint_context(), solver._plain_ring()
+    width = len(solver.alg.gens)
+    for P in (c[(0, 2)], c[(1, 4)]):
+        Q, D = solver._clear_flint(P, plain.from_terms, ctx)
+        assert not D.is_constant()  # the parameters do occur in the denominators
+        groups: dict = {}
+        for m, q in plain.terms(Q).items():
+            groups.setdefault(m[:width], {})[m[width:]] = q
+        assert dr._divided(groups, D, solver.alg.domain, ctx) == dict(P.items())
+
+    def refuse(*args):
+        raise AssertionError("sympy polynomial arithmetic on the denominators")
+
+    assignments = [[c[(0, 2)], c[(1, 2)]], [c[(0, 4)], c[(1, 2)]]]
+    expected = [liouville_field(solver.alg, *slots) for slots in assignments]
+    with monkeypatch.context() as m:
+        m.setattr(PolyElement, "lcm", refuse)
+        m.setattr(PolyElement, "exquo", refuse)
+        ours = solver._fields_cleared(assignments)
+    assert ours.components == (expected[0] + expected[1]).components
+
+
 def _digest(family):
     """srepr of the shadow pair, of the members alpha = 0, 1, of every order's corrections, members and gauge
     (everything ``to_dict`` and the printers are computed from)."""

@@ -63,12 +63,14 @@ from dataclasses import dataclass, field
 from itertools import product
 
 import sympy
+from sympy.polys.rings import PolyElement
 
 from ..algebra import VectorField, liouville_field
 from ..algebra.ansatz import Ansatz, Rows
 from ..algebra import elimination, frac_rref
 from ..algebra.elimination import SparseMatrix, elimination_cost, rank, signed_sums
-from ..algebra.flint_ring import polynomial_ring
+from ..algebra._flint import exponents
+from ..algebra.flint_ring import FlintRing, polynomial_ring
 from ..bch.backward import check_order
 from ..bch.collector import no_full_collection
 from ..checks import check_flag, show
@@ -295,7 +297,7 @@ def _divided(numerators: dict, denominator, domain, ctx=False) -> dict:
     """``{key: n / denominator}`` in ``domain = QQ(params)``, zero quotients left out.
 
     ``numerators``: ``{key: {exponent tuple: rational}}`` (polynomials in the parameters), ``denominator``
-    a non-zero polynomial of the field's ring.  Each quotient is a reduced fraction, cancelled by flint's
+    a non-zero polynomial of the field's ring (or, with ``ctx``, an ``fmpz_mpoly`` of ``ctx``).  Each quotient is a reduced fraction, cancelled by flint's
     gcd when python-flint is available (:mod:`nambu_bch.algebra.frac_rref`, the same normal form), else by
     sympy's field.  ``ctx``: the flint context of ``domain`` or ``None`` (sympy's field), when the caller
     has chosen already (:meth:`_Solver._flint_context`).
@@ -310,12 +312,19 @@ def _divided(numerators: dict, denominator, domain, ctx=False) -> dict:
             if v:
                 out[k] = v
         return out
-    D = frac_rref.integer_poly(denominator, ctx)
+    # a flint polynomial of ctx (the fraction-free fields' own lcm) is already the integer form P / 1
+    D = frac_rref.integer_poly(denominator, ctx) if isinstance(denominator, PolyElement) else (denominator, 1)
     for k, n in numerators.items():
         pair = frac_rref.quotient_terms(n, D, ctx)
         if pair is not None:
             out[k] = frac_rref.to_field(pair, domain)
     return out
+
+
+def _lcm(a, b):
+    """The lcm of two flint ``fmpz_mpoly`` with positive leading coefficients (positive leading coefficient)."""
+    g = a.gcd(b)
+    return a * b if g.is_one() else a * (b / g)
 
 
 def _total_degree(p, n):
@@ -461,28 +470,38 @@ class _Solver:
         pad = (0,) * width
         plain = self._plain_ring()
         make = plain.from_terms
+        # the denominators in flint's ZZ[params] when the plain ring is flint's (no sympy lcm or product), else in
+        # sympy's QQ[params]: any non-zero multiple of the lcm serves, since each quotient is reduced afterwards
+        ctx = self._flint_context() if isinstance(plain, FlintRing) else None
+        one = field.ring.one if ctx is None else ctx.constant(1)
         parts = []
         for slots in assignments:
-            cleared, total = [], field.ring.one
+            cleared, total = [], one
             for p in slots:
                 hit = self._cleared.get(id(p)) if any(p is q for q in self.hams) else None
                 if hit is None:
-                    hit = self._clear(p, make)
+                    hit = self._clear(p, make) if ctx is None else self._clear_flint(p, make, ctx)
                     if any(p is q for q in self.hams):  # the Hamiltonians: cleared once per solve
                         self._cleared[id(p)] = hit
                 cleared.append(hit[0])
-                if not hit[1].is_one:
+                if hit[1] != one:
                     total = total * hit[1]
             parts.append((liouville_field(plain, *cleared).components, total))
         T = parts[0][1]
         for _, total in parts[1:]:
             if total != T:
-                T = T.lcm(total)
+                T = T.lcm(total) if ctx is None else _lcm(T, total)
         sums = None
         for comps, total in parts:
-            scale = T.exquo(total) if total != T else 1
-            if scale != 1:
-                factor = make({pad + m: c for m, c in scale.items()})
+            if total == T:
+                scale = None
+            elif ctx is None:
+                scale = {pad + m: c for m, c in T.exquo(total).items()}
+            else:
+                quotient = T / total  # exact: T is a multiple of total
+                scale = {pad + m: c for m, c in zip(exponents(quotient), quotient.coeffs())}
+            if scale is not None:
+                factor = make(scale)
                 comps = [c * factor for c in comps]
             sums = list(comps) if sums is None else [a + b for a, b in zip(sums, comps)]
         components = []
@@ -493,6 +512,23 @@ class _Solver:
             components.append(alg.ring.from_dict(_divided(groups, T, alg.domain, self._flint_context()))
                               if groups else alg.zero)
         return VectorField(alg, components)
+
+    @staticmethod
+    def _clear_flint(p, make, ctx):
+        """:meth:`_clear` with ``D`` in flint's ``ZZ[params]`` (``ctx``): the coefficients as normalised fraction pairs
+        (:func:`~nambu_bch.algebra.frac_rref.from_field`, shared with the eliminations' conversions), ``D`` the lcm of
+        their denominators and ``Q = sum_m x^m n_m (D / d_m)``, every product and exact division in C."""
+        pairs = [(m, frac_rref.from_field(c, ctx)) for m, c in p.items()]
+        D = ctx.constant(1)
+        for _, (_, d) in pairs:
+            if d != D:
+                D = _lcm(D, d)
+        terms: dict = {}
+        for m, (n, d) in pairs:
+            num = n if d == D else n * (D / d)
+            for e, q in zip(exponents(num), num.coeffs()):
+                terms[m + e] = q
+        return make(terms), D
 
     @staticmethod
     def _clear(p, make):
