@@ -293,14 +293,15 @@ def _flint_on() -> bool:
     return elimination.FAST_PATHS and elimination.flint_available()
 
 
-def _divided(numerators: dict, denominator, domain, ctx=False) -> dict:
+def _divided(numerators: dict, denominator, domain, ctx=False, pairs: bool = False) -> dict:
     """``{key: n / denominator}`` in ``domain = QQ(params)``, zero quotients left out.
 
     ``numerators``: ``{key: {exponent tuple: rational}}`` (polynomials in the parameters), ``denominator``
     a non-zero polynomial of the field's ring (or, with ``ctx``, an ``fmpz_mpoly`` of ``ctx``).  Each quotient is a reduced fraction, cancelled by flint's
     gcd when python-flint is available (:mod:`nambu_bch.algebra.frac_rref`, the same normal form), else by
     sympy's field.  ``ctx``: the flint context of ``domain`` or ``None`` (sympy's field), when the caller
-    has chosen already (:meth:`_Solver._flint_context`).
+    has chosen already (:meth:`_Solver._flint_context`).  ``pairs`` (with a flint ``ctx``): the quotients as
+    normalised flint pairs, not converted to the field.
     """
     if ctx is False:
         ctx = frac_rref.context(domain) if _flint_on() else None
@@ -317,7 +318,7 @@ def _divided(numerators: dict, denominator, domain, ctx=False) -> dict:
     for k, n in numerators.items():
         pair = frac_rref.quotient_terms(n, D, ctx)
         if pair is not None:
-            out[k] = frac_rref.to_field(pair, domain)
+            out[k] = pair if pairs else frac_rref.to_field(pair, domain)
     return out
 
 
@@ -450,7 +451,7 @@ class _Solver:
             return self._fields_cleared([slots])
         return liouville_field(self.alg, *slots)
 
-    def _fields_cleared(self, assignments):
+    def _fields_cleared(self, assignments, as_pairs: bool = False):
         """``sum_k X_{slots_k}`` over ``QQ(params)`` without fraction arithmetic: the same field, exactly.
 
         ``X_{P_1 .. P_{N-1}}`` is multilinear in its slots over the constants, so with ``P_a = Q_a / D_a``
@@ -462,7 +463,8 @@ class _Solver:
         ``assignments`` are summed there over the lcm ``T`` of their denominators, and each coefficient of
         the sum is divided by ``T`` once (one cancellation per coefficient instead of one per product term
         and per sum: :func:`_divided`).  Field elements are reduced fractions either way, so the result is
-        the same ring element.
+        the same ring element.  ``as_pairs`` (python-flint on): the components as ``{monomial: flint pair}``
+        dicts instead (:meth:`_subtracted` takes them).
         """
         alg = self.alg
         field = alg.domain.field
@@ -509,9 +511,12 @@ class _Solver:
             groups: dict = {}
             for m, q in plain.terms(comp).items():
                 groups.setdefault(m[:width], {})[m[width:]] = q
+            if as_pairs:
+                components.append(_divided(groups, T, alg.domain, ctx, pairs=True))
+                continue
             components.append(alg.ring.from_dict(_divided(groups, T, alg.domain, self._flint_context()))
                               if groups else alg.zero)
-        return VectorField(alg, components)
+        return components if as_pairs else VectorField(alg, components)
 
     @staticmethod
     def _clear_flint(p, make, ctx):
@@ -559,8 +564,9 @@ class _Solver:
             self._plain = polynomial_ring(alg.coordinates, alg.constants + alg.parameters, _flint_on())
         return self._plain
 
-    def _cross(self, j, corrections):
-        """``sum`` over assignments of lower orders to two or more slots (the cross terms at ``h^j``)."""
+    def _cross(self, j, corrections, as_pairs: bool = False):
+        """``sum`` over assignments of lower orders to two or more slots (the cross terms at ``h^j``); ``as_pairs``:
+        the components as ``{monomial: flint pair}`` when the fraction-free fields run on flint (else a field)."""
         assignments = []
         for orders in product(range(j), repeat=self.slots):
             if sum(orders) != j or sum(1 for o in orders if o) < 2:
@@ -579,12 +585,38 @@ class _Solver:
         if not assignments:
             return None
         if self._cleared_ok():
-            return self._fields_cleared(assignments)
+            return self._fields_cleared(assignments, as_pairs and isinstance(self._plain_ring(), FlintRing)
+                                        and self._flint_context() is not None)
         total = None
         for slots in assignments:
             X = liouville_field(self.alg, *slots)
             total = X if total is None else total + X
         return total
+
+    def _subtracted(self, c, x):
+        """``c - x`` for a ring element ``c`` over ``QQ(params)`` and ``x = {monomial: flint pair}``, the differences
+        on flint pairs (:func:`~nambu_bch.algebra.frac_rref.sub`: gcds in C, not sympy's field) and converted once,
+        recorded in the scope's conversions so that the elimination reads them back without converting.
+
+        The same ring element as sympy's ``c - x`` with its terms in the order sympy's subtraction leaves them
+        (``c``'s, a cancelled one removed, then ``x``'s new ones): field elements have one normal form, and the
+        order, which interns the rows of the elimination, is kept so that nothing downstream can tell.
+        """
+        if not x:
+            return c
+        ctx, domain = self._flint_context(), self.alg.domain
+        out = dict(c.items())
+        for m, v in x.items():
+            old = out.get(m)
+            if old is None:
+                out[m] = frac_rref.to_field((-v[0], v[1]), domain)
+                continue
+            d = frac_rref.sub(frac_rref.from_field(old, ctx), v)
+            if d[0].is_zero():
+                del out[m]
+            else:
+                out[m] = frac_rref.to_field(d, domain)
+        return self.alg.ring.from_dict(out) if out else self.alg.zero
 
     def _needed_degree(self, rhs_deg):
         return needed_degree(self.gdeg, rhs_deg)
@@ -594,9 +626,11 @@ class _Solver:
         alg = self.alg
         Z = self.effective[j]
         comps = [_lift(alg, c) for c in Z.components]
-        cross = self._cross(j, corrections)
-        if cross is not None:
+        cross = self._cross(j, corrections, as_pairs=True)
+        if isinstance(cross, VectorField):
             comps = [c - x for c, x in zip(comps, cross.components)]
+        elif cross is not None:
+            comps = [self._subtracted(c, x) for c, x in zip(comps, cross)]
         rhs = VectorField(alg, comps)
         if all(not c for c in comps):
             return OrderSolution(j, "vanishes", corrections=(sympy.Integer(0),) * self.slots, rhs=rhs)
