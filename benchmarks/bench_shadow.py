@@ -9,6 +9,8 @@ Run:  /work/venv/bin/python benchmarks/bench_shadow.py --targets  (the targets o
       /work/venv/bin/python benchmarks/bench_shadow.py --issue14 --rows=ab  (rows a and b only)
       /work/venv/bin/python benchmarks/bench_shadow.py --growth   (the cost per two orders h^6..h^12 by phase, with
                                                                    the sizes that bound each phase)
+      /work/venv/bin/python benchmarks/bench_shadow.py --compare=BASELINE,. [--repeats=3]  (targets b and d in two
+                                                                   checkouts, interleaved, each call cold)
 
 Prints, measured in this one run (process CPU time, best of a few repeats):
 * all six ho3 words through the FI route and the direct route at O(h^2);
@@ -549,7 +551,7 @@ def phases(limit: float = 600.0):
 #: the phases of :data:`PHASES` that run inside another one (left out of the sum that gives "rest")
 NESTED = ("  of which Gauss-Jordan on flint pairs", "flint pair -> sympy field element (all)")
 GROWTH_ORDERS = (6, 8, 10, 12)
-GROWTH_SYSTEMS = ("rigid-body", "lotka-volterra")
+GROWTH_SYSTEMS = ("rigid-body", "rigid-body[I=1,2,3]", "lotka-volterra")
 
 
 def _sizes(fam) -> dict:
@@ -639,8 +641,61 @@ def growth(limit: float = 900.0, systems=GROWTH_SYSTEMS, orders=GROWTH_ORDERS):
     return ok
 
 
+#: the rows of :func:`compare`: targets b (the rigid body with symbolic and numeric moments at h^8) and d
+COMPARE_ROWS = [(name, k) for name in GROWTH_SYSTEMS for k in GROWTH_ORDERS]
+
+
+def _one(name, order):
+    """``--one NAME ORDER``: one ``shadow_hamiltonians(..).shadows`` in this process, printed as ``CPU s, wall s``."""
+    system = make_system(name)
+    t, w = time.process_time(), time.perf_counter()
+    shadow_hamiltonians(system, "12321", order).shadows
+    print(f"{time.process_time() - t:.4f} {time.perf_counter() - w:.4f}")
+
+
+def compare(trees, repeats: int = 1, limit: float = 900.0):
+    """The rows of :data:`COMPARE_ROWS` in each checkout of ``trees``, interleaved (tree after tree for each row and
+    repeat), each call cold in a fresh process (``PYTHONPATH`` the checkout): the best CPU s per tree, the ratio to
+    the first tree, and the growth per two orders of each tree for the rows of target d."""
+    import os
+    import subprocess
+
+    print(f"both trees interleaved, each call cold in a fresh process, best CPU s of {repeats}; trees: "
+          + ", ".join(f"[{i}] {t}" for i, t in enumerate(trees)) + f"  [{_load()}]", flush=True)
+    best: dict = {}
+    for name, order in COMPARE_ROWS:
+        for _ in range(repeats):
+            for i, tree in enumerate(trees):
+                env = dict(os.environ, PYTHONPATH=os.path.abspath(tree))
+                run = subprocess.run([sys.executable, os.path.abspath(__file__), "--one", name, str(order)],
+                                     env=env, capture_output=True, text=True, timeout=limit)
+                cpu_s = float(run.stdout.split()[0]) if run.returncode == 0 else float("nan")
+                key = (name, order, i)
+                best[key] = min(best.get(key, cpu_s), cpu_s)
+        values = [best[(name, order, i)] for i in range(len(trees))]
+        print(f"{name:22s} h^{order:<3d}" + "".join(f" [{i}] {v:7.3f} s" for i, v in enumerate(values))
+              + "".join(f"  [{i}]/[0] {v / values[0]:.2f}" for i, v in enumerate(values) if i)
+              + f"  [{_load()}]", flush=True)
+    for name in GROWTH_SYSTEMS:
+        for i in range(len(trees)):
+            ts = [best[(name, k, i)] for k in GROWTH_ORDERS]
+            steps = ", ".join(f"h^{a}->h^{b} {y / x:.2f}x" for a, b, x, y in zip(GROWTH_ORDERS, GROWTH_ORDERS[1:], ts, ts[1:]))
+            print(f"per two orders, {name} [{i}]: {steps}")
+    b = [best[("rigid-body", 8, i)] / best[("rigid-body[I=1,2,3]", 8, i)] for i in range(len(trees))]
+    print("target b, symbolic / numeric at h^8: " + ", ".join(f"[{i}] {v:.1f}x" for i, v in enumerate(b)), flush=True)
+    return True
+
+
 if __name__ == "__main__":
     ok = True
+    if "--one" in sys.argv:
+        at = sys.argv.index("--one")
+        _one(sys.argv[at + 1], int(sys.argv[at + 2]))
+        sys.exit(0)
+    if any(a.startswith("--compare=") for a in sys.argv):
+        trees = next(a.split("=", 1)[1] for a in sys.argv if a.startswith("--compare=")).split(",")
+        repeats = int(next((a.split("=", 1)[1] for a in sys.argv if a.startswith("--repeats=")), 1))
+        sys.exit(0 if compare(trees, repeats) else 1)
     if "--growth" in sys.argv:
         sys.exit(0 if growth() else 1)
     if "--phases" in sys.argv:
