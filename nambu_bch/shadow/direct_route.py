@@ -297,11 +297,12 @@ def _divided(numerators: dict, denominator, domain, ctx=False, pairs: bool = Fal
     """``{key: n / denominator}`` in ``domain = QQ(params)``, zero quotients left out.
 
     ``numerators``: ``{key: {exponent tuple: rational}}`` (polynomials in the parameters), ``denominator``
-    a non-zero polynomial of the field's ring (or, with ``ctx``, an ``fmpz_mpoly`` of ``ctx``).  Each quotient is a reduced fraction, cancelled by flint's
-    gcd when python-flint is available (:mod:`nambu_bch.algebra.frac_rref`, the same normal form), else by
-    sympy's field.  ``ctx``: the flint context of ``domain`` or ``None`` (sympy's field), when the caller
-    has chosen already (:meth:`_Solver._flint_context`).  ``pairs`` (with a flint ``ctx``): the quotients as
-    normalised flint pairs, not converted to the field.
+    a non-zero polynomial of the field's ring (or, with ``ctx``, an ``fmpz_mpoly`` of ``ctx``).  Each quotient
+    is a reduced fraction, cancelled by flint's gcd when python-flint is available
+    (:mod:`nambu_bch.algebra.frac_rref`, the same normal form), else by sympy's field.  ``ctx``: the flint
+    context of ``domain`` or ``None`` (sympy's field), when the caller has chosen already
+    (:meth:`_Solver._flint_context`).  ``pairs`` (with a flint ``ctx``): the quotients as normalised flint pairs,
+    not converted to the field.
     """
     if ctx is False:
         ctx = frac_rref.context(domain) if _flint_on() else None
@@ -323,7 +324,8 @@ def _divided(numerators: dict, denominator, domain, ctx=False, pairs: bool = Fal
 
 
 def _lcm(a, b):
-    """The lcm of two flint ``fmpz_mpoly`` with positive leading coefficients (positive leading coefficient)."""
+    """The lcm of two flint ``fmpz_mpoly`` with positive leading coefficients, its own leading coefficient positive
+    (flint's gcd has a positive leading coefficient, and exact quotients of such polynomials keep the sign)."""
     g = a.gcd(b)
     return a * b if g.is_one() else a * (b / g)
 
