@@ -643,20 +643,29 @@ def growth(limit: float = 900.0, systems=GROWTH_SYSTEMS, orders=GROWTH_ORDERS):
 
 #: the rows of :func:`compare`: targets b (the rigid body with symbolic and numeric moments at h^8) and d
 COMPARE_ROWS = [(name, k) for name in GROWTH_SYSTEMS for k in GROWTH_ORDERS]
+#: the phase :func:`compare` prints beside the whole call (the one this session's change is in)
+COMPARE_PHASE = "cross terms"
 
 
 def _one(name, order):
-    """``--one NAME ORDER``: one ``shadow_hamiltonians(..).shadows`` in this process, printed as ``CPU s, wall s``."""
+    """``--one NAME ORDER``: one ``shadow_hamiltonians(..).shadows`` in this process, its phases timed
+    (:data:`PHASES`), printed as one JSON line ``{"cpu": s, "wall": s, "phases": {label: s}}``."""
+    import json
+
+    spent = _install_phase_timers()
     system = make_system(name)
     t, w = time.process_time(), time.perf_counter()
     shadow_hamiltonians(system, "12321", order).shadows
-    print(f"{time.process_time() - t:.4f} {time.perf_counter() - w:.4f}")
+    print(json.dumps({"cpu": time.process_time() - t, "wall": time.perf_counter() - w, "phases": dict(spent)}))
 
 
 def compare(trees, repeats: int = 1, limit: float = 900.0):
     """The rows of :data:`COMPARE_ROWS` in each checkout of ``trees``, interleaved (tree after tree for each row and
     repeat), each call cold in a fresh process (``PYTHONPATH`` the checkout): the best CPU s per tree, the ratio to
-    the first tree, and the growth per two orders of each tree for the rows of target d."""
+    the first tree, and the growth per two orders of each tree for the rows of target d.  Every call runs with the
+    phase timers of :data:`PHASES` (the same small overhead in every tree); the best CPU s of :data:`COMPARE_PHASE`
+    is printed beside the call's."""
+    import json
     import os
     import subprocess
 
@@ -669,12 +678,18 @@ def compare(trees, repeats: int = 1, limit: float = 900.0):
                 env = dict(os.environ, PYTHONPATH=os.path.abspath(tree))
                 run = subprocess.run([sys.executable, os.path.abspath(__file__), "--one", name, str(order)],
                                      env=env, capture_output=True, text=True, timeout=limit)
-                cpu_s = float(run.stdout.split()[0]) if run.returncode == 0 else float("nan")
+                out = json.loads(run.stdout.strip().splitlines()[-1]) if run.returncode == 0 else None
+                cpu_s = out["cpu"] if out else float("nan")
+                phase_s = out["phases"].get(COMPARE_PHASE, 0.0) if out else float("nan")
                 key = (name, order, i)
                 best[key] = min(best.get(key, cpu_s), cpu_s)
+                best[key + ("phase",)] = min(best.get(key + ("phase",), phase_s), phase_s)
         values = [best[(name, order, i)] for i in range(len(trees))]
+        phase = [best[(name, order, i, "phase")] for i in range(len(trees))]
         print(f"{name:22s} h^{order:<3d}" + "".join(f" [{i}] {v:7.3f} s" for i, v in enumerate(values))
               + "".join(f"  [{i}]/[0] {v / values[0]:.2f}" for i, v in enumerate(values) if i)
+              + f"  | {COMPARE_PHASE}:" + "".join(f" [{i}] {v:6.3f} s" for i, v in enumerate(phase))
+              + "".join(f"  [{i}]/[0] {v / phase[0]:.2f}" for i, v in enumerate(phase) if i and phase[0] > 0)
               + f"  [{_load()}]", flush=True)
     for name in GROWTH_SYSTEMS:
         for i in range(len(trees)):
