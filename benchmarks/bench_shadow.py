@@ -7,6 +7,10 @@ Run:  /work/venv/bin/python benchmarks/bench_shadow.py --targets  (the targets o
       /work/venv/bin/python benchmarks/bench_shadow.py --printing (text/LaTeX/JSON: flint factors vs sympy.factor)
       /work/venv/bin/python benchmarks/bench_shadow.py --phases   (target b by phase: symbolic vs I = (1, 2, 3), h^8)
       /work/venv/bin/python benchmarks/bench_shadow.py --issue14 --rows=ab  (rows a and b only)
+      /work/venv/bin/python benchmarks/bench_shadow.py --growth   (the cost per two orders h^6..h^12 by phase, with
+                                                                   the sizes that bound each phase)
+      /work/venv/bin/python benchmarks/bench_shadow.py --compare=BASELINE,. [--repeats=3]  (targets b and d in two
+                                                                   checkouts, interleaved, each call cold)
 
 Prints, measured in this one run (process CPU time, best of a few repeats):
 * all six ho3 words through the FI route and the direct route at O(h^2);
@@ -494,10 +498,19 @@ PHASES = [
 
 def _timed_phases(args, queue):
     """One ``shadow_hamiltonians(...).shadows`` in a fresh process: ``(CPU s, {label: CPU s})`` by :data:`PHASES`."""
+    name, word, order = args
+    spent = _install_phase_timers()
+    system = make_system(name)
+    t = time.process_time()
+    shadow_hamiltonians(system, word, order).shadows
+    queue.put((time.process_time() - t, dict(spent)))
+
+
+def _install_phase_timers():
+    """Wrap the functions of :data:`PHASES` so that each adds its CPU seconds to the returned counter (by label)."""
     import importlib
     from collections import Counter
 
-    name, word, order = args
     spent: Counter = Counter()
     for module, path, label in PHASES:
         owner = importlib.import_module(module)
@@ -517,10 +530,7 @@ def _timed_phases(args, queue):
                 spent[_label] += time.process_time() - t
 
         setattr(owner, attr, staticmethod(timed) if isinstance(inner, staticmethod) else timed)
-    system = make_system(name)
-    t = time.process_time()
-    shadow_hamiltonians(system, word, order).shadows
-    queue.put((time.process_time() - t, dict(spent)))
+    return spent
 
 
 def phases(limit: float = 600.0):
@@ -538,8 +548,171 @@ def phases(limit: float = 600.0):
     return True
 
 
+#: the phases of :data:`PHASES` that run inside another one (left out of the sum that gives "rest")
+NESTED = ("  of which Gauss-Jordan on flint pairs", "flint pair -> sympy field element (all)")
+GROWTH_ORDERS = (6, 8, 10, 12)
+GROWTH_SYSTEMS = ("rigid-body", "rigid-body[I=1,2,3]", "lotka-volterra")
+
+
+def _sizes(fam) -> dict:
+    """The sizes that bound a direct-route call's phases, read off its exact result (outside the timed part).
+
+    unknowns / rank: summed over the solved orders (``slots * C(D + n, n)`` columns, rank = columns - kernel);
+    top unknowns: of the highest order; exact terms: the corrections' (monomial, numerator term) pairs, the size of
+    the exact output; output terms: the terms of the printed sums ``H_S, G_S``; numerator / denominator degree: the
+    largest total degree in the parameters of a coefficient of the corrections (0 without parameters).
+    """
+    R = fam.details
+    n, slots = R.algebra.n, len(R.hamiltonians)
+    from nambu_bch.algebra.ansatz import Ansatz
+
+    solved = [o for o in R.orders if o.status == "solved"]
+    unknowns = [Ansatz.size(n, o.degree, slots) for o in solved]
+    rank = sum(u - o.kernel_dim for u, o in zip(unknowns, solved))
+    exact, num_deg, den_deg = 0, 0, 0
+    fraction = getattr(R.algebra.domain, "is_FractionField", False)
+    for c in R.corrections.values():
+        for v in c.values():
+            if not fraction:  # a rational number
+                exact += 1
+                continue
+            numer, denom = v.numer, v.denom
+            exact += len(numer)
+            num_deg = max(num_deg, max(sum(e) for e in numer.keys()))
+            den_deg = max(den_deg, max(sum(e) for e in denom.keys()))
+    terms = sum(len(sympy.Add.make_args(S)) for S in fam.shadows)
+    return {"unknowns (all orders)": sum(unknowns), "unknowns (top order)": unknowns[-1] if unknowns else 0,
+            "rank (all orders)": rank, "exact output terms": exact, "printed output terms": terms,
+            "numerator degree (params)": num_deg, "denominator degree (params)": den_deg}
+
+
+def _timed_growth(args, queue):
+    """One ``shadow_hamiltonians(...).shadows`` by phase (:func:`_timed_phases`) and its :func:`_sizes`."""
+    name, word, order = args
+    spent = _install_phase_timers()
+    system = make_system(name)
+    t = time.process_time()
+    fam = shadow_hamiltonians(system, word, order)
+    fam.shadows
+    whole = time.process_time() - t
+    queue.put((whole, dict(spent), _sizes(fam)))
+
+
+def growth(limit: float = 900.0, systems=GROWTH_SYSTEMS, orders=GROWTH_ORDERS):
+    """The cost per two orders, phase by phase, next to the sizes that bound each phase (issue 23, target d).
+
+    For each system and each order of ``orders`` one cold process computes ``shadow_hamiltonians(system, "12321",
+    order).shadows`` with the phases of :data:`PHASES` timed (CPU s), then reads the sizes of :func:`_sizes`; the
+    table prints each row per order and its growth factor per two orders.  ``rest`` is the whole call less the
+    outermost phases (conversions of the input, the ansatz and row interning, the effective field's setup).
+    No algorithm is cheaper than writing its output, so a phase that grows like the output terms is at its floor
+    in growth; one that grows faster is the one to cut.
+    """
+    print(f"growth per two orders, 12321 (CPU s by phase, each order cold in a fresh process; {_load()})", flush=True)
+    ok = True
+    for name in systems:
+        runs = {}
+        for k in orders:
+            r = _child(_timed_growth, (name, "12321", k), limit)
+            if r is None:
+                print(f"{name} h^{k}: stopped at {limit:g} s", flush=True)
+                ok = False
+                break
+            runs[k] = r
+        ks = [k for k in orders if k in runs]
+        if not ks:
+            continue
+        rows = []
+        for _, _, label in PHASES:
+            rows.append((label, [runs[k][1].get(label, 0.0) for k in ks], True))
+        outer = [label for _, _, label in PHASES if label not in NESTED]
+        rows.append(("rest", [runs[k][0] - sum(runs[k][1].get(l, 0.0) for l in outer) for k in ks], True))
+        rows.append(("whole call", [runs[k][0] for k in ks], True))
+        for label in runs[ks[0]][2]:
+            rows.append((label, [runs[k][2][label] for k in ks], False))
+        heads = "".join(f"{'h^%d' % k:>9s}" for k in ks)
+        steps = "".join(f"{'%d->%d' % (a, b):>8s}" for a, b in zip(ks, ks[1:]))
+        print(f"\n{name}  [{_load()}]\n{'':40s}{heads}  per two orders:{steps}")
+        for label, values, is_time in rows:
+            shown = "".join(f"{v:9.3f}" if is_time else f"{v:9d}" for v in values)
+            ratios = "".join(f"{b / a:7.2f}x" if a > 0 else f"{'-':>8s}" for a, b in zip(values, values[1:]))
+            print(f"{label:40s}{shown}  {'':15s}{ratios}")
+        sys.stdout.flush()
+    return ok
+
+
+#: the rows of :func:`compare`: targets b (the rigid body with symbolic and numeric moments at h^8) and d
+COMPARE_ROWS = [(name, k) for name in GROWTH_SYSTEMS for k in GROWTH_ORDERS]
+#: the phase :func:`compare` prints beside the whole call (the one this session's change is in)
+COMPARE_PHASE = "cross terms"
+
+
+def _one(name, order):
+    """``--one NAME ORDER``: one ``shadow_hamiltonians(..).shadows`` in this process, its phases timed
+    (:data:`PHASES`), printed as one JSON line ``{"cpu": s, "wall": s, "phases": {label: s}}``."""
+    import json
+
+    spent = _install_phase_timers()
+    system = make_system(name)
+    t, w = time.process_time(), time.perf_counter()
+    shadow_hamiltonians(system, "12321", order).shadows
+    print(json.dumps({"cpu": time.process_time() - t, "wall": time.perf_counter() - w, "phases": dict(spent)}))
+
+
+def compare(trees, repeats: int = 1, limit: float = 900.0):
+    """The rows of :data:`COMPARE_ROWS` in each checkout of ``trees``, interleaved (tree after tree for each row and
+    repeat), each call cold in a fresh process (``PYTHONPATH`` the checkout): the best CPU s per tree, the ratio to
+    the first tree, and the growth per two orders of each tree for the rows of target d.  Every call runs with the
+    phase timers of :data:`PHASES` (the same small overhead in every tree); the best CPU s of :data:`COMPARE_PHASE`
+    is printed beside the call's."""
+    import json
+    import os
+    import subprocess
+
+    print(f"both trees interleaved, each call cold in a fresh process, best CPU s of {repeats}; trees: "
+          + ", ".join(f"[{i}] {t}" for i, t in enumerate(trees)) + f"  [{_load()}]", flush=True)
+    best: dict = {}
+    for name, order in COMPARE_ROWS:
+        for _ in range(repeats):
+            for i, tree in enumerate(trees):
+                env = dict(os.environ, PYTHONPATH=os.path.abspath(tree))
+                run = subprocess.run([sys.executable, os.path.abspath(__file__), "--one", name, str(order)],
+                                     env=env, capture_output=True, text=True, timeout=limit)
+                out = json.loads(run.stdout.strip().splitlines()[-1]) if run.returncode == 0 else None
+                cpu_s = out["cpu"] if out else float("nan")
+                phase_s = out["phases"].get(COMPARE_PHASE, 0.0) if out else float("nan")
+                key = (name, order, i)
+                best[key] = min(best.get(key, cpu_s), cpu_s)
+                best[key + ("phase",)] = min(best.get(key + ("phase",), phase_s), phase_s)
+        values = [best[(name, order, i)] for i in range(len(trees))]
+        phase = [best[(name, order, i, "phase")] for i in range(len(trees))]
+        print(f"{name:22s} h^{order:<3d}" + "".join(f" [{i}] {v:7.3f} s" for i, v in enumerate(values))
+              + "".join(f"  [{i}]/[0] {v / values[0]:.2f}" for i, v in enumerate(values) if i)
+              + f"  | {COMPARE_PHASE}:" + "".join(f" [{i}] {v:6.3f} s" for i, v in enumerate(phase))
+              + "".join(f"  [{i}]/[0] {v / phase[0]:.2f}" for i, v in enumerate(phase) if i and phase[0] > 0)
+              + f"  [{_load()}]", flush=True)
+    for name in GROWTH_SYSTEMS:
+        for i in range(len(trees)):
+            ts = [best[(name, k, i)] for k in GROWTH_ORDERS]
+            steps = ", ".join(f"h^{a}->h^{b} {y / x:.2f}x" for a, b, x, y in zip(GROWTH_ORDERS, GROWTH_ORDERS[1:], ts, ts[1:]))
+            print(f"per two orders, {name} [{i}]: {steps}")
+    b = [best[("rigid-body", 8, i)] / best[("rigid-body[I=1,2,3]", 8, i)] for i in range(len(trees))]
+    print("target b, symbolic / numeric at h^8: " + ", ".join(f"[{i}] {v:.1f}x" for i, v in enumerate(b)), flush=True)
+    return True
+
+
 if __name__ == "__main__":
     ok = True
+    if "--one" in sys.argv:
+        at = sys.argv.index("--one")
+        _one(sys.argv[at + 1], int(sys.argv[at + 2]))
+        sys.exit(0)
+    if any(a.startswith("--compare=") for a in sys.argv):
+        trees = next(a.split("=", 1)[1] for a in sys.argv if a.startswith("--compare=")).split(",")
+        repeats = int(next((a.split("=", 1)[1] for a in sys.argv if a.startswith("--repeats=")), 1))
+        sys.exit(0 if compare(trees, repeats) else 1)
+    if "--growth" in sys.argv:
+        sys.exit(0 if growth() else 1)
     if "--phases" in sys.argv:
         sys.exit(0 if phases() else 1)
     if "--printing" in sys.argv:

@@ -172,6 +172,65 @@ def test_fraction_free_fields_equal_liouville_field(flint, monkeypatch):
     assert isinstance(solver._plain_ring(), FlintRing) == flint
 
 
+def test_fraction_free_fields_clear_denominators_on_flint(monkeypatch):
+    """With python-flint a correction ``P`` is cleared to ``Q / D`` in flint's ``ZZ[params]`` (``D`` the lcm of its
+    coefficients' denominators): ``Q`` divided back by ``D`` is ``P`` coefficient by coefficient, and a sum of
+    fields runs without sympy's polynomial lcm or exact division (rigid body with symbolic I, orders 2 and 4)."""
+    from sympy.polys.rings import PolyElement
+
+    R = direct_route(model("rigid-body"), "12321", 4)
+    solver = dr._Solver(model("rigid-body"), R.composition, 4, None)
+    c, ctx, plain = R.corrections, solver._flint_context(), solver._plain_ring()
+    width = len(solver.alg.gens)
+    for P in (c[(0, 2)], c[(1, 4)]):
+        Q, D = solver._clear_flint(P, plain.from_terms, ctx)
+        assert not D.is_constant()  # the parameters do occur in the denominators
+        groups: dict = {}
+        for m, q in plain.terms(Q).items():
+            groups.setdefault(m[:width], {})[m[width:]] = q
+        assert dr._divided(groups, D, solver.alg.domain, ctx) == dict(P.items())
+
+    def refuse(*args):
+        raise AssertionError("sympy polynomial arithmetic on the denominators")
+
+    assignments = [[c[(0, 2)], c[(1, 2)]], [c[(0, 4)], c[(1, 2)]]]
+    expected = [liouville_field(solver.alg, *slots) for slots in assignments]
+    with monkeypatch.context() as m:
+        m.setattr(PolyElement, "lcm", refuse)
+        m.setattr(PolyElement, "exquo", refuse)
+        ours = solver._fields_cleared(assignments)
+    assert ours.components == (expected[0] + expected[1]).components
+
+
+def test_right_hand_side_difference_on_flint_pairs(monkeypatch):
+    """The right-hand side ``Z_j - (cross terms)`` of Eq. (*) subtracted on flint pairs is sympy's ``Z_j - cross``,
+    the same elements with the terms in the same order (they intern the elimination's rows), without sympy's field
+    subtraction (rigid body with symbolic I, h^4; and a difference in which a term cancels and one is new)."""
+    from sympy.polys.fields import FracElement
+
+    R = direct_route(model("rigid-body"), "12321", 4)
+    solver = dr._Solver(model("rigid-body"), R.composition, 4, None)
+    alg, ctx = solver.alg, solver._flint_context()
+    Z = [dr._lift(alg, z) for z in solver.effective[4].components]
+    expected = [z - x for z, x in zip(Z, solver._cross(4, R.corrections).components)]
+
+    def refuse(*args):
+        raise AssertionError("sympy's field subtraction")
+
+    with monkeypatch.context() as m:
+        m.setattr(FracElement, "__sub__", refuse)
+        cross = solver._cross(4, R.corrections, as_pairs=True)
+        ours = [solver._subtracted(z, x) for z, x in zip(Z, cross)]
+    assert [list(p.items()) for p in ours] == [list(p.items()) for p in expected] and any(expected)
+    c = next(z for z in Z if len(z) > 1)
+    (m0, v0), (m1, _) = list(c.items())[:2]
+    new = tuple(e + 1 for e in m0[:alg.n]) + m0[alg.n:]
+    x = {m0: frac_rref.from_field(v0, ctx), new: frac_rref.from_field(v0 * 2, ctx)}
+    other = alg.ring.from_dict({m0: v0, new: v0 * 2})
+    assert list(solver._subtracted(c, x).items()) == list((c - other).items())
+    assert m0 not in solver._subtracted(c, x) and m1 in solver._subtracted(c, x)
+
+
 def _digest(family):
     """srepr of the shadow pair, of the members alpha = 0, 1, of every order's corrections, members and gauge
     (everything ``to_dict`` and the printers are computed from)."""

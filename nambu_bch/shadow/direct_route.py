@@ -63,12 +63,14 @@ from dataclasses import dataclass, field
 from itertools import product
 
 import sympy
+from sympy.polys.rings import PolyElement
 
 from ..algebra import VectorField, liouville_field
 from ..algebra.ansatz import Ansatz, Rows
 from ..algebra import elimination, frac_rref
 from ..algebra.elimination import SparseMatrix, elimination_cost, rank, signed_sums
-from ..algebra.flint_ring import polynomial_ring
+from ..algebra._flint import exponents
+from ..algebra.flint_ring import FlintRing, polynomial_ring
 from ..bch.backward import check_order
 from ..bch.collector import no_full_collection
 from ..checks import check_flag, show
@@ -291,14 +293,16 @@ def _flint_on() -> bool:
     return elimination.FAST_PATHS and elimination.flint_available()
 
 
-def _divided(numerators: dict, denominator, domain, ctx=False) -> dict:
+def _divided(numerators: dict, denominator, domain, ctx=False, pairs: bool = False) -> dict:
     """``{key: n / denominator}`` in ``domain = QQ(params)``, zero quotients left out.
 
     ``numerators``: ``{key: {exponent tuple: rational}}`` (polynomials in the parameters), ``denominator``
-    a non-zero polynomial of the field's ring.  Each quotient is a reduced fraction, cancelled by flint's
-    gcd when python-flint is available (:mod:`nambu_bch.algebra.frac_rref`, the same normal form), else by
-    sympy's field.  ``ctx``: the flint context of ``domain`` or ``None`` (sympy's field), when the caller
-    has chosen already (:meth:`_Solver._flint_context`).
+    a non-zero polynomial of the field's ring (or, with ``ctx``, an ``fmpz_mpoly`` of ``ctx``).  Each quotient
+    is a reduced fraction, cancelled by flint's gcd when python-flint is available
+    (:mod:`nambu_bch.algebra.frac_rref`, the same normal form), else by sympy's field.  ``ctx``: the flint
+    context of ``domain`` or ``None`` (sympy's field), when the caller has chosen already
+    (:meth:`_Solver._flint_context`).  ``pairs`` (with a flint ``ctx``): the quotients as normalised flint pairs,
+    not converted to the field.
     """
     if ctx is False:
         ctx = frac_rref.context(domain) if _flint_on() else None
@@ -310,12 +314,20 @@ def _divided(numerators: dict, denominator, domain, ctx=False) -> dict:
             if v:
                 out[k] = v
         return out
-    D = frac_rref.integer_poly(denominator, ctx)
+    # a flint polynomial of ctx (the fraction-free fields' own lcm) is already the integer form P / 1
+    D = frac_rref.integer_poly(denominator, ctx) if isinstance(denominator, PolyElement) else (denominator, 1)
     for k, n in numerators.items():
         pair = frac_rref.quotient_terms(n, D, ctx)
         if pair is not None:
-            out[k] = frac_rref.to_field(pair, domain)
+            out[k] = pair if pairs else frac_rref.to_field(pair, domain)
     return out
+
+
+def _lcm(a, b):
+    """The lcm of two flint ``fmpz_mpoly`` with positive leading coefficients, its own leading coefficient positive
+    (flint's gcd has a positive leading coefficient, and exact quotients of such polynomials keep the sign)."""
+    g = a.gcd(b)
+    return a * b if g.is_one() else a * (b / g)
 
 
 def _total_degree(p, n):
@@ -441,7 +453,7 @@ class _Solver:
             return self._fields_cleared([slots])
         return liouville_field(self.alg, *slots)
 
-    def _fields_cleared(self, assignments):
+    def _fields_cleared(self, assignments, as_pairs: bool = False):
         """``sum_k X_{slots_k}`` over ``QQ(params)`` without fraction arithmetic: the same field, exactly.
 
         ``X_{P_1 .. P_{N-1}}`` is multilinear in its slots over the constants, so with ``P_a = Q_a / D_a``
@@ -453,7 +465,8 @@ class _Solver:
         ``assignments`` are summed there over the lcm ``T`` of their denominators, and each coefficient of
         the sum is divided by ``T`` once (one cancellation per coefficient instead of one per product term
         and per sum: :func:`_divided`).  Field elements are reduced fractions either way, so the result is
-        the same ring element.
+        the same ring element.  ``as_pairs`` (python-flint on): the components as ``{monomial: flint pair}``
+        dicts instead (:meth:`_subtracted` takes them).
         """
         alg = self.alg
         field = alg.domain.field
@@ -461,28 +474,38 @@ class _Solver:
         pad = (0,) * width
         plain = self._plain_ring()
         make = plain.from_terms
+        # the denominators in flint's ZZ[params] when the plain ring is flint's (no sympy lcm or product), else in
+        # sympy's QQ[params]: any non-zero multiple of the lcm serves, since each quotient is reduced afterwards
+        ctx = self._flint_context() if isinstance(plain, FlintRing) else None
+        one = field.ring.one if ctx is None else ctx.constant(1)
         parts = []
         for slots in assignments:
-            cleared, total = [], field.ring.one
+            cleared, total = [], one
             for p in slots:
                 hit = self._cleared.get(id(p)) if any(p is q for q in self.hams) else None
                 if hit is None:
-                    hit = self._clear(p, make)
+                    hit = self._clear(p, make) if ctx is None else self._clear_flint(p, make, ctx)
                     if any(p is q for q in self.hams):  # the Hamiltonians: cleared once per solve
                         self._cleared[id(p)] = hit
                 cleared.append(hit[0])
-                if not hit[1].is_one:
+                if hit[1] != one:
                     total = total * hit[1]
             parts.append((liouville_field(plain, *cleared).components, total))
         T = parts[0][1]
         for _, total in parts[1:]:
             if total != T:
-                T = T.lcm(total)
+                T = T.lcm(total) if ctx is None else _lcm(T, total)
         sums = None
         for comps, total in parts:
-            scale = T.exquo(total) if total != T else 1
-            if scale != 1:
-                factor = make({pad + m: c for m, c in scale.items()})
+            if total == T:
+                scale = None
+            elif ctx is None:
+                scale = {pad + m: c for m, c in T.exquo(total).items()}
+            else:
+                quotient = T / total  # exact: T is a multiple of total
+                scale = {pad + m: c for m, c in zip(exponents(quotient), quotient.coeffs())}
+            if scale is not None:
+                factor = make(scale)
                 comps = [c * factor for c in comps]
             sums = list(comps) if sums is None else [a + b for a, b in zip(sums, comps)]
         components = []
@@ -490,9 +513,29 @@ class _Solver:
             groups: dict = {}
             for m, q in plain.terms(comp).items():
                 groups.setdefault(m[:width], {})[m[width:]] = q
+            if as_pairs:
+                components.append(_divided(groups, T, alg.domain, ctx, pairs=True))
+                continue
             components.append(alg.ring.from_dict(_divided(groups, T, alg.domain, self._flint_context()))
                               if groups else alg.zero)
-        return VectorField(alg, components)
+        return components if as_pairs else VectorField(alg, components)
+
+    @staticmethod
+    def _clear_flint(p, make, ctx):
+        """:meth:`_clear` with ``D`` in flint's ``ZZ[params]`` (``ctx``): the coefficients as normalised fraction pairs
+        (:func:`~nambu_bch.algebra.frac_rref.from_field`, shared with the eliminations' conversions), ``D`` the lcm of
+        their denominators and ``Q = sum_m x^m n_m (D / d_m)``, every product and exact division in C."""
+        pairs = [(m, frac_rref.from_field(c, ctx)) for m, c in p.items()]
+        D = ctx.constant(1)
+        for _, (_, d) in pairs:
+            if d != D:
+                D = _lcm(D, d)
+        terms: dict = {}
+        for m, (n, d) in pairs:
+            num = n if d == D else n * (D / d)
+            for e, q in zip(exponents(num), num.coeffs()):
+                terms[m + e] = q
+        return make(terms), D
 
     @staticmethod
     def _clear(p, make):
@@ -523,8 +566,9 @@ class _Solver:
             self._plain = polynomial_ring(alg.coordinates, alg.constants + alg.parameters, _flint_on())
         return self._plain
 
-    def _cross(self, j, corrections):
-        """``sum`` over assignments of lower orders to two or more slots (the cross terms at ``h^j``)."""
+    def _cross(self, j, corrections, as_pairs: bool = False):
+        """``sum`` over assignments of lower orders to two or more slots (the cross terms at ``h^j``); ``as_pairs``:
+        the components as ``{monomial: flint pair}`` when the fraction-free fields run on flint (else a field)."""
         assignments = []
         for orders in product(range(j), repeat=self.slots):
             if sum(orders) != j or sum(1 for o in orders if o) < 2:
@@ -543,12 +587,38 @@ class _Solver:
         if not assignments:
             return None
         if self._cleared_ok():
-            return self._fields_cleared(assignments)
+            return self._fields_cleared(assignments, as_pairs and isinstance(self._plain_ring(), FlintRing)
+                                        and self._flint_context() is not None)
         total = None
         for slots in assignments:
             X = liouville_field(self.alg, *slots)
             total = X if total is None else total + X
         return total
+
+    def _subtracted(self, c, x):
+        """``c - x`` for a ring element ``c`` over ``QQ(params)`` and ``x = {monomial: flint pair}``, the differences
+        on flint pairs (:func:`~nambu_bch.algebra.frac_rref.sub`: gcds in C, not sympy's field) and converted once,
+        recorded in the scope's conversions so that the elimination reads them back without converting.
+
+        The same ring element as sympy's ``c - x`` with its terms in the order sympy's subtraction leaves them
+        (``c``'s, a cancelled one removed, then ``x``'s new ones): field elements have one normal form, and the
+        order, which interns the rows of the elimination, is kept so that nothing downstream can tell.
+        """
+        if not x:
+            return c
+        ctx, domain = self._flint_context(), self.alg.domain
+        out = dict(c.items())
+        for m, v in x.items():
+            old = out.get(m)
+            if old is None:
+                out[m] = frac_rref.to_field((-v[0], v[1]), domain)
+                continue
+            d = frac_rref.sub(frac_rref.from_field(old, ctx), v)
+            if d[0].is_zero():
+                del out[m]
+            else:
+                out[m] = frac_rref.to_field(d, domain)
+        return self.alg.ring.from_dict(out) if out else self.alg.zero
 
     def _needed_degree(self, rhs_deg):
         return needed_degree(self.gdeg, rhs_deg)
@@ -558,9 +628,11 @@ class _Solver:
         alg = self.alg
         Z = self.effective[j]
         comps = [_lift(alg, c) for c in Z.components]
-        cross = self._cross(j, corrections)
-        if cross is not None:
+        cross = self._cross(j, corrections, as_pairs=True)
+        if isinstance(cross, VectorField):
             comps = [c - x for c, x in zip(comps, cross.components)]
+        elif cross is not None:
+            comps = [self._subtracted(c, x) for c, x in zip(comps, cross)]
         rhs = VectorField(alg, comps)
         if all(not c for c in comps):
             return OrderSolution(j, "vanishes", corrections=(sympy.Integer(0),) * self.slots, rhs=rhs)
