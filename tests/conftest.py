@@ -69,7 +69,10 @@ LONG = (
     ("test_any_system.py", "test_toda_h2_and_fpu_h2"),                      # ... and here
     ("test_fi_route.py", "test_cli_bad_input_is_one_line[argv3"),           # counts 22272 brackets at h^6
     ("test_any_system.py", "test_concrete_equals_generic_substituted_to_h4"),
-    ("test_shadow.py", "test_rigid_body_non_symmetric_word_is_obstructed_at_h1"),
+    ("test_shadow.py", "test_rigid_body_non_symmetric_word_is_obstructed_at_h1"),  # the rigid body's 123 family ...
+    ("test_existence.py", "test_rigid_body_lie_trotter_certified_numerically_with_drift"),  # ... reused here
+    ("test_pickle.py", "test_result_round_trip[Existence"),                 # ... and here
+    ("test_pickle.py", "test_more_results_round_trip[ShadowFamily none"),   # ... and here
     ("test_design.py", "test_optimize_finds_yoshidas_sixth_order_solution"),
     ("test_any_system.py", "test_lie_poisson_bch_member_with_casimir_kept"),
     ("test_shadow.py", "test_n4_full_split_is_obstructed"),
