@@ -270,6 +270,12 @@ DEEP = (
     # the fast tier; the non-symmetric 123 (0.75 s of backward error analysis) deep: both routes of a non-symmetric
     # word stay in the fast tier on a model (test_bch_concrete's lotka-volterra-123 row, to h^4)
     ("test_bch_fast.py", "test_generic_separable_system_both_routes", ("12321",)),
+    # a set of four paper figures drawn again (1.4-2 s each, cold: matplotlib's text layout) for a concern a lighter
+    # fast test keeps: the write failure through the CLI (test_paper_figures_all_or_nothing keeps the all-or-nothing
+    # write, test_cli_edges the one-line output errors of main), the default-length figures at the default dpi
+    # (test_paper_figures_returns_figures_with_parameters and test_cli.py's test_plot write the four PNGs)
+    ("test_hardening_numeric.py", "test_cli_plot_file_error_one_line", ()),
+    ("test_numeric_diagnostics.py", "test_paper_figures_are_written", ()),
 )
 
 #: The two ways :func:`cli_run` runs the command line; the fast tier keeps ``in-process``: the ``subprocess`` case
