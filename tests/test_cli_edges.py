@@ -181,6 +181,11 @@ def test_main_builds_its_parser_once_and_a_parse_leaves_it_unchanged(capsys, mon
     refused(capsys, ["models", "--model", "ho3", "--model", "ho"], "given twice")
     assert run(capsys, "models", "--model", "ho")[0] == 0
     assert _main._parser().parse_args(["compare"]).integrators is None
+    # the subcommand's run as its module holds it now (a monkeypatched run is called, as with a parser per call)
+    import nambu_bch.cli.models as models
+
+    monkeypatch.setattr(models, "run", lambda args: print("replaced"))
+    assert run(capsys, "models")[:2] == (0, "replaced\n")
     assert built == [1]
 
 
