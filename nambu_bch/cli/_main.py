@@ -104,10 +104,11 @@ _PARSER: list = []
 def _parser() -> argparse.ArgumentParser:
     """The parser :func:`main` uses, built once per process.
 
-    Building it imports and registers the ten subcommands (~8 ms); a parse leaves it unchanged (the values go to a
-    fresh namespace, the ``append`` defaults are ``None`` and copied, ``_StoreOnce`` records its flags in the
-    namespace), so an in-process caller of :func:`main` (a notebook, the test suite's hundreds of argv) need not
-    rebuild it per call.  :func:`build_parser` still returns a new parser, which its caller may change.
+    Building it registers the ten subcommands, about fifty times the CPU of a parse
+    (``benchmarks/bench_cli_parser.py``); a parse leaves it unchanged (the values go to a fresh namespace, the
+    ``append`` defaults are ``None`` and copied, ``_StoreOnce`` records its flags in the namespace), so an
+    in-process caller of :func:`main` (a notebook, the test suite's hundreds of argv) need not rebuild it per call.
+    :func:`build_parser` still returns a new parser, which its caller may change.
     """
     if not _PARSER:
         _PARSER.append(build_parser())

@@ -210,8 +210,8 @@ class _FloatStack:
     """The nested list of :class:`_PolyEval` of one name (``F``, ``J``, ``C`` ...) evaluated in float64 together.
 
     The float Newton iterations and projections evaluate ~``m n^2`` small polynomials per step; one at a time, each
-    paid numpy's per-call overhead five times over (order 4 with 5 stages: 1.72 -> 1.48 s of CPU for the whole
-    optimisation, one process at load 8.5; the symbolic defects and the mpmath polish are the rest).  Here the terms of all of them are one array (the same
+    paid numpy's per-call overhead five times over (``benchmarks/bench_optimize.py``: ~15 % of a whole optimisation;
+    the symbolic defects and the mpmath polish are the rest).  Here the terms of all of them are one array (the same
     elementwise products as :meth:`_PolyEval.float`), and each polynomial's value is ``np.sum`` of its contiguous
     slice, so the values are bit for bit those of :meth:`_PolyEval.float`.
     """
