@@ -278,7 +278,7 @@ DEEP = (
     # the fast tier; the non-symmetric 123 (0.75 s of backward error analysis) deep: both routes of a non-symmetric
     # word stay in the fast tier on a model (test_bch_concrete's lotka-volterra-123 row, to h^4)
     ("test_bch_fast.py", "test_generic_separable_system_both_routes", ("12321",)),
-    # s35 (symbolic tests, session 19): a second degree or word of an obstruction whose first case stays fast
+    # a second degree or word of an obstruction whose first case stays fast
     # (test_shadow's rigid-body Phi^123 at degree 3 keeps the h^1 obstruction, test_ho3_123_obstruction_persists_at_
     # higher_degree the persistence at higher degree; the N = 4 Phi^1234321 at h^2 keeps the N = 4 full split, the
     # ho3 and rigid-body Phi^123 tests the non-symmetric words' failure at h^1)
@@ -291,6 +291,12 @@ DEEP = (
     # state: test_any_system's test_generic_nambu_no_universal_shadow_pair_at_h2[12321] asserts the same answer from
     # the shared result
     ("generic_nambu.py", "nambu_bch.shadow.generic_nambu.generic_nambu_h2", ()),
+    # a set of four paper figures drawn again (1.4-2 s each, cold: matplotlib's text layout) for a concern a lighter
+    # fast test keeps: the write failure through the CLI (test_paper_figures_all_or_nothing keeps the all-or-nothing
+    # write, test_cli_edges the one-line output errors of main), the default-length figures at the default dpi
+    # (test_paper_figures_returns_figures_with_parameters and test_cli.py's test_plot write the four PNGs)
+    ("test_hardening_numeric.py", "test_cli_plot_file_error_one_line", ()),
+    ("test_numeric_diagnostics.py", "test_paper_figures_are_written", ()),
 )
 
 #: The two ways :func:`cli_run` runs the command line; the fast tier keeps ``in-process``: the ``subprocess`` case

@@ -168,6 +168,32 @@ def test_catalog_methods_orders_and_bounds():
     assert nb.composition("suzuki", 3) == suzuki
 
 
+def test_coefficient_field_is_built_once_per_composition(monkeypatch):
+    """The order analyses, error constants and backward error analysis of one composition asked sympy for the
+    primitive element of its coefficients (QQ(2^(1/3)) for the triple jump, 10-100 ms) on every call; the field of
+    a coefficient tuple is now memoised (nambu_bch.algebra.fields.number_field) and equal to sympy's."""
+    import sympy.polys.numberfields as numberfields
+    from sympy.polys.constructor import construct_domain
+
+    from nambu_bch.algebra.fields import _number_field, number_field
+
+    calls = []
+    original = numberfields.primitive_element
+    monkeypatch.setattr(numberfields, "primitive_element", lambda *a, **k: calls.append(1) or original(*a, **k))
+    _number_field.cache_clear()  # this memo only: nb.clear_caches() would make the tests after this one recompute
+    comp = nb.composition("triple-jump:12321")
+    ho3 = nb.model("ho3").splitting
+    first = (error_constant(comp, 3), composition_order(comp, 3), nb.effective_field(ho3, comp, order=2))
+    made = len(calls)
+    assert made >= 1
+    assert (error_constant(comp, 3), composition_order(comp, 3), nb.effective_field(ho3, comp, order=2)) == first
+    assert len(calls) == made
+    K, elems = number_field(comp.coefficients)
+    assert (K, elems) == construct_domain(list(comp.coefficients), extension=True)
+    elems.append(None)  # a new list each call: the memo cannot be changed through it
+    assert len(number_field(comp.coefficients)[1]) == len(comp.coefficients)
+
+
 def test_catalog_names_and_errors():
     assert lookup("12321") is None and lookup("yoshida:121") is None
     assert nb.composition("kahan-li", 2).name == "kahan-li:121"

@@ -176,3 +176,31 @@ def test_mclachlan_1995_methods(name, order, stages):
     """McLachlan, SIAM J. Sci. Comput. 16 (1995) 151: S2, S4, S5 with their published orders and stages."""
     comp = nb.composition(name)
     assert error_analysis(comp, 2).order == order and comp.pieces.count(2) == stages and comp.symmetric
+
+
+@pytest.mark.parametrize("conditions", [2, 0])
+def test_float_evaluation_of_the_lagrange_system_is_bit_for_bit_per_polynomial(conditions, monkeypatch):
+    """The float Newton of optimize_composition evaluates every polynomial of f, F, grad f, Hess f, J and its
+    derivatives at each step; they are now evaluated as one array (numpy's per-call overhead was paid per
+    polynomial), each value the np.sum of its own terms: bit for bit the per-polynomial value, so the critical
+    points found do not change."""
+    import numpy as np
+
+    from nambu_bch.design.optimize import _PolyEval, _Problem
+
+    a, b, c = sympy.symbols("a b c")
+    objective = sympy.Poly(a**4 / 3 + a * b**3 - sympy.Rational(7, 5) * c**2 * a + b / 11 + 1, a, b, c)
+    constraints = [2 * a + 2 * b + c - 1, 2 * a**3 + 2 * b**3 + c**3, a * b * c - sympy.Rational(1, 7)][:conditions]
+    prob = _Problem(objective, constraints, [a, b, c])
+
+    def one_by_one(obj, x):
+        return [one_by_one(o, x) for o in obj] if isinstance(obj, list) else obj.float(x)
+
+    rng = np.random.default_rng(5)
+    for x in rng.normal(size=(50, 3)) * 3:
+        for name in ("f", "F", "g", "H", "J", "C"):
+            got, want = prob.values(name, list(x), "float"), one_by_one(getattr(prob, name), list(x))
+            assert got == want and repr(got) == repr(want), name
+    want = one_by_one(prob.C, [1.0, 2.0, 3.0])
+    monkeypatch.setattr(_PolyEval, "float", lambda self, x: pytest.fail("evaluated one polynomial at a time"))
+    assert prob.kkt(np.arange(3.0 + conditions), "float")[1] and prob.values("C", [1.0, 2.0, 3.0], "float") == want

@@ -472,6 +472,9 @@ def test_cli_plot_file_error_one_line(tmp_path):
     proc = _cli("plot", "--outdir", str(tmp_path), "--steps", "2000", "--every", "10", "--short-steps", "50")
     assert proc.returncode == 2 and len(proc.stderr.strip().splitlines()) == 1 and "Traceback" not in proc.stderr
     assert not (tmp_path / "fig1.png").exists()
+
+
+def test_cli_plot_help_names_the_default_run():
     helptext = _cli("plot", "--help").stdout
     assert "32123 on ho3" in " ".join(helptext.split())
 

@@ -79,10 +79,12 @@ def test_shadow_gauge_directions_are_in_the_kernel(capsys):
 
 
 def test_obstructed_shadow_has_the_certificate_as_data(capsys, monkeypatch):
-    """rigid-body under 123 (non-symmetric): obstructed at h^1 (README, existence results); the certificate is data."""
+    """ho3 under 123 (non-symmetric): obstructed at h^1 (test_shadow.py's non-symmetric words); the certificate is
+    data.  The README's rigid body under 123 is the same JSON over QQ(I1, I2, I3) at three times the cost; its
+    obstruction at h^1 is test_shadow.py's test_rigid_body_non_symmetric_word_is_obstructed_at_h1."""
     # the measured drift's runs on the interpreter (the same bits): compiling their loop is no concern of the schema
     monkeypatch.setenv("NAMBU_BCH_DISABLE_NUMBA", "1")
-    data = run(capsys, "shadow", "--model", "rigid-body", "--integrator", "123")
+    data = run(capsys, "shadow", "--model", "ho3", "--integrator", "123")
     validator("shadow").validate(data)
     assert data["exists"] is False and data["H_S"] is None and data["series"] == {}
     cert = data["certificate"]
@@ -91,7 +93,7 @@ def test_obstructed_shadow_has_the_certificate_as_data(capsys, monkeypatch):
     assert read(data, cert["value"]) != 0
     # the same numbers as the human-readable obstruction text
     assert str(read(data, cert["value"])) in data["obstruction"] or cert["value"] in data["obstruction"]
-    fi = run(capsys, "shadow", "--model", "rigid-body", "--integrator", "123", "--route", "fi", "--order", "1")
+    fi = run(capsys, "shadow", "--model", "ho3", "--integrator", "123", "--route", "fi", "--order", "1")
     validator("shadow").validate(fi)
     assert fi["exists"] is False and fi["certificate"]["kind"] == "fi-rows"
 

@@ -283,8 +283,8 @@ def test_henon_heiles_default_is_a_bounded_orbit_used_by_check_and_compare():
     q1, q2, p1, p2 = DEFAULT_X0["henon-heiles"]
     energy = float(hh.H.subs(dict(zip(hh.coordinates, (q1, q2, p1, p2)))))
     assert 0 < energy < 1 / 6  # below the escape energy: the orbit stays in the well
-    r = numeric.check(hh, "121", 0.1, 500)
-    assert r.x0 == list(DEFAULT_X0["henon-heiles"])
+    r = numeric.check(hh, "121", 0.1, 500, include=("H",))  # the orbit is the concern, not the exact quantities
+    assert r.x0 == list(DEFAULT_X0["henon-heiles"]) and np.isfinite(r.max_abs_error["H"])
     C = design.compare(hh, ["121"], t_end=5.0, steps=(20, 40))
     assert C.x0 == DEFAULT_X0["henon-heiles"] and np.isfinite(C.rows[0]["best_error"])
 

@@ -159,8 +159,12 @@ def test_paper_figures_are_written(tmp_path):
     for p in paths.values():
         data = p.read_bytes()
         assert data[:8] == b"\x89PNG\r\n\x1a\n" and len(data) > 5000
+
+
+def test_paper_figures_refuse_an_unknown_format(tmp_path):
     with pytest.raises(InvalidRunError, match="format"):
         paper_figures(tmp_path, fmt="bmp")
+    assert list(tmp_path.iterdir()) == []
 
 
 def test_committed_figures_exist():

@@ -54,7 +54,6 @@ from math import lcm
 from typing import Protocol, runtime_checkable
 
 import sympy
-from sympy.polys.constructor import construct_domain
 from sympy.polys.domains import ZZ
 from sympy.polys.rings import PolyElement, ring
 
@@ -62,7 +61,7 @@ from ..checks import check_type
 from ..errors import NambuBCHError
 from . import _flint
 from ._flint import exponents
-from .fields import CoefficientField
+from .fields import CoefficientField, number_field
 from .ring import check_ring
 from .vector_field import VectorField
 
@@ -476,7 +475,7 @@ class PolynomialBackend:
         numbers = list(numbers)
         if not numbers:
             return []
-        K, elems = construct_domain(numbers, extension=True)
+        K, elems = number_field(numbers)
         if K == self.domain:
             return list(elems)
         if K.is_ZZ or K.is_QQ:

@@ -98,6 +98,23 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+_PARSER: list = []
+
+
+def _parser() -> argparse.ArgumentParser:
+    """The parser :func:`main` uses, built once per process.
+
+    Building it registers the ten subcommands, about fifty times the CPU of a parse
+    (``benchmarks/bench_cli_parser.py``); a parse leaves it unchanged (the values go to a fresh namespace, the
+    ``append`` defaults are ``None`` and copied, ``_StoreOnce`` records its flags in the namespace), so an
+    in-process caller of :func:`main` (a notebook, the test suite's hundreds of argv) need not rebuild it per call.
+    :func:`build_parser` still returns a new parser, which its caller may change.
+    """
+    if not _PARSER:
+        _PARSER.append(build_parser())
+    return _PARSER[0]
+
+
 class _progress_off:
     """``--no-progress``: ``NAMBU_BCH_PROGRESS=0`` for the run (read by :mod:`nambu_bch.progress`), then restored."""
 
@@ -150,7 +167,7 @@ def main(argv=None) -> int:
     prog = PROG
     try:
         _reserve_standard_descriptors()
-        parser = build_parser()
+        parser = _parser()
         args, extras = parser.parse_known_args(argv)
         if extras:
             command = getattr(args, "command", None)

@@ -9,6 +9,8 @@ errors answer without it.
 from __future__ import annotations
 
 import argparse
+import functools
+import sys
 
 from ..checks import MAX_ORDER as MAX_CLI_ORDER  # the API's range of orders (light module: no sympy here)
 from ..errors import MAX_MESSAGE, InvalidSystemError, NambuBCHError, one_line, shown  # noqa: F401 -- re-exported to the cli modules
@@ -324,10 +326,20 @@ def numeric_options(parser, defaults):
     parser.add_argument("--every", metavar="K", type=str, help=f"sample every K steps (default {defaults['every']})")
 
 def add_subcommand(sub, name: str, help: str, examples: str, run):
-    """Register subcommand ``name`` on the sub-parsers ``sub``; ``run(args)`` does the work."""
+    """Register subcommand ``name`` on the sub-parsers ``sub``; ``run(args)`` does the work.
+
+    ``args.func`` calls ``nambu_bch.cli.<name>.run`` as that module holds it when the command runs (``run`` itself
+    when there is no such module), not as it was when the parser was built: the parser of :func:`nambu_bch.cli.main`
+    is built once per process, and a replaced ``run`` (a test's monkeypatch) must be the one called, as with a parser
+    built per call.
+    """
     p = sub.add_parser(name, help=help, description=help, epilog=examples, formatter_class=_Formatter)
-    p.set_defaults(func=run)
+    p.set_defaults(func=functools.partial(_run_current, f"{__package__}.{name}", run))
     return p
+
+
+def _run_current(module: str, run, args):
+    return getattr(sys.modules.get(module), "run", run)(args)
 
 
 def normalise(args):

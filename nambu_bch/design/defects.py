@@ -22,9 +22,9 @@ from itertools import product
 from math import factorial
 
 import sympy
-from sympy.polys.constructor import construct_domain
 from sympy.polys.domains import QQ
 
+from ..algebra.fields import number_field
 from ..errors import InvalidOrderError
 from .words import MAX_WORK, log_coefficients, lyndon_defect_words, lyndon_defects, work
 
@@ -41,7 +41,7 @@ class _Exact:
     """The exact coefficient field of a composition (QQ or an algebraic field) and its factors in it."""
 
     def __init__(self, comp):
-        K, elems = construct_domain(list(comp.coefficients), extension=True)
+        K, elems = number_field(comp.coefficients)
         if K.is_ZZ:
             K, elems = QQ, [QQ.convert(e) for e in elems]
         self.K = K

@@ -40,9 +40,9 @@ from dataclasses import dataclass
 from math import factorial
 
 import sympy
-from sympy.polys.constructor import construct_domain
 from sympy.polys.domains import QQ
 
+from ..algebra.fields import number_field
 from ..checks import is_int, show
 from ..errors import InvalidCompositionError, InvalidOrderError
 from .structure import _residual, _squared_norm, check_structure
@@ -175,7 +175,7 @@ class _Series:
 
 
 def _field(numbers):
-    K, elems = construct_domain(list(numbers), extension=True)
+    K, elems = number_field(numbers)
     if K.is_ZZ:
         K, elems = QQ, [QQ.convert(e) for e in elems]
     return K, elems

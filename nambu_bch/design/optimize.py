@@ -174,6 +174,7 @@ class _Problem:
         self.J = [[E(d) for d in row] for row in jac]
         self.C = [[[E(d.diff(v)) for v in x] for d in row] for row in jac]
         self.top = max(P.top for P in [self.f, *self.F, *_leaves([self.g, self.H, self.J, self.C])])
+        self._stacks = {}
 
     def values(self, name, x, lib):
         if lib == "mp":  # one table of powers for every polynomial of the point
@@ -181,11 +182,12 @@ class _Problem:
 
             def ev(obj):
                 return [ev(o) for o in obj] if isinstance(obj, list) else obj.mp(x, powers)
-        else:
-            def ev(obj):
-                return [ev(o) for o in obj] if isinstance(obj, list) else obj.float(x)
 
-        return ev(getattr(self, name))
+            return ev(getattr(self, name))
+        stack = self._stacks.get(name)
+        if stack is None:
+            stack = self._stacks[name] = _FloatStack(getattr(self, name))
+        return stack(x)
 
     def kkt(self, z, lib):
         """``(G, DG)`` of the Lagrange system at ``z = (x, lambda)``; ``lib`` is ``"float"`` or ``"mp"``."""
@@ -202,6 +204,39 @@ class _Problem:
 def _leaves(nested) -> list:
     """The polynomials of nested lists."""
     return [leaf for o in nested for leaf in (_leaves(o) if isinstance(o, list) else [o])]
+
+
+class _FloatStack:
+    """The nested list of :class:`_PolyEval` of one name (``F``, ``J``, ``C`` ...) evaluated in float64 together.
+
+    The float Newton iterations and projections evaluate ~``m n^2`` small polynomials per step; one at a time, each
+    paid numpy's per-call overhead five times over (``benchmarks/bench_optimize.py``: ~15 % of a whole optimisation;
+    the symbolic defects and the mpmath polish are the rest).  Here the terms of all of them are one array (the same
+    elementwise products as :meth:`_PolyEval.float`), and each polynomial's value is ``np.sum`` of its contiguous
+    slice, so the values are bit for bit those of :meth:`_PolyEval.float`.
+    """
+
+    def __init__(self, nested):
+        polys = _leaves(nested) if isinstance(nested, list) else [nested]
+        self.shape = _shape(nested) if isinstance(nested, list) else None
+        self.monoms = np.concatenate([P.monoms for P in polys]) if polys else None
+        self.cf = np.concatenate([P.cf for P in polys]) if polys else None
+        ends = np.cumsum([len(P.cf) for P in polys]).tolist()
+        self.bounds = list(zip([0, *ends[:-1]], ends))
+
+    def __call__(self, x):
+        if not self.bounds:  # no conditions: F, J and C are empty lists
+            return np.empty(self.shape).tolist()
+        terms = self.cf * np.prod(np.power(np.asarray(x, float), self.monoms), axis=1)
+        flat = [float(np.sum(terms[a:b])) for a, b in self.bounds]
+        if self.shape is None:
+            return flat[0]
+        return np.array(flat, dtype=object).reshape(self.shape).tolist()
+
+
+def _shape(nested) -> tuple:
+    """The rectangular shape of nested lists (``[m][n][n]`` ...)."""
+    return (len(nested), *(_shape(nested[0]) if nested and isinstance(nested[0], list) else ()))
 
 
 def _newton_float(prob, z, steps=80):
