@@ -190,13 +190,55 @@ def test_property_invariant_along_exact_rational_orbits(word, state, params):
         assert (Hc.xreplace(point), Gc.xreplace(point)) == start
 
 
-def test_invariant_search_too_large_is_refused_up_front():
-    """Bounded work: the rigid body's 12321 at ansatz degree 4 (about 142 000 image terms,
-    200 s) is refused from the size estimate in one line; degree 2 (the default) still runs."""
+def _never(*args, **kwargs):
+    raise AssertionError("the composed map was built")
+
+
+def test_invariant_search_too_large_is_refused_up_front(monkeypatch):
+    """Bounded work: the rigid body's 12321 at ansatz degree 4 (at most 153 723 image terms, 142 455 on the composed
+    map, 200 s) is refused in one line from a bound on the sub-flows, before the composed map is built (that alone
+    took 0.75 s); so is a long word, whose composed map would itself be the hang."""
+    import nambu_bch.exact.invariants as inv
     from nambu_bch.errors import ResourceLimitError
 
-    with pytest.raises(ResourceLimitError, match="lower the degree"):
+    monkeypatch.setattr(inv, "composed_map", _never)
+    with pytest.raises(ResourceLimitError, match=r"degree 4 on rigid-body with the word 12321 needs images of up to "
+                                                 r"153723 terms.*\(at most 40000\); lower the degree"):
         conserved_quantities(model("rigid-body"), "12321", degree=4)
+    with pytest.raises(ResourceLimitError, match="degree 1 on rigid-body with the word triple-jump:12321 .* 13 sub-flows"):
+        conserved_quantities(model("rigid-body"), "yoshida", degree=1)
+
+
+@pytest.mark.parametrize("name,word", [("ho3", "12321"), ("ho3", "32123"), ("ho3-pair", "31213"),
+                                       ("henon-heiles", "VTV")])
+def test_size_bound_is_never_below_the_composed_map(name, word):
+    """The bound from the sub-flows is an upper bound: per component at least the composed map's terms and degree."""
+    import nambu_bch.exact.invariants as inv
+    from nambu_bch.integrators import composition_for
+    from nambu_bch.integrators.flows import exact_flow
+
+    system = model(name)
+    comp = composition_for(word, system)
+    flows = [exact_flow(system.splitting[k], system.coordinates) for k, _ in comp.factors()]
+    counts, degrees = inv.composed_map_shape(flows, system.coordinates)
+    for e, t, d in zip(composed_map(system.splitting, comp), counts, degrees):
+        p = sympy.Poly(sympy.expand(e), *system.coordinates)
+        assert len(p.terms()) <= t and p.total_degree() <= d
+
+
+@pytest.mark.parametrize("name,degree,bound", [("ho3", 8, 35141), ("rigid-body", 3, 39616)])
+def test_size_bound_admits_what_ran_before(name, degree, bound):
+    """The largest requests that ran with the estimate on the composed map (ho3 at degree 8, 15 s; the rigid body's
+    12321 at degree 3, 13 s) stay under the limit with the bound from the sub-flows (checked without running them)."""
+    import nambu_bch.exact.invariants as inv
+    from nambu_bch.integrators import composition_for
+    from nambu_bch.integrators.flows import exact_flow
+
+    system = model(name)
+    comp = composition_for("12321", system)
+    flows = [exact_flow(system.splitting[k], system.coordinates) for k, _ in comp.factors()]
+    monos = inv.Ansatz(3, degree, lowest=1, order="graded").monomials
+    assert inv.image_terms(*inv.composed_map_shape(flows, system.coordinates), monos) == bound <= inv.MAX_IMAGE_TERMS
 
 
 def test_rotation_sub_flows_are_refused_before_the_map_is_composed(monkeypatch):
@@ -205,9 +247,6 @@ def test_rotation_sub_flows_are_refused_before_the_map_is_composed(monkeypatch):
     import nambu_bch.exact.invariants as inv
     from nambu_bch.errors import NoExactResultError
 
-    def never(*args, **kwargs):
-        raise AssertionError("the composed map was built")
-
-    monkeypatch.setattr(inv, "composed_map", never)
+    monkeypatch.setattr(inv, "composed_map", _never)
     with pytest.raises(NoExactResultError, match="trigonometric sub-flows"):
         conserved_quantities(model("rigid-body-lp"), "12321")

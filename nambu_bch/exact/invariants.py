@@ -64,9 +64,10 @@ H_STEP = sympy.Symbol("h")
 _MAX_CANDIDATES = 4000
 #: Largest ansatz degree accepted (the ansatz has C(N + d, d) unknowns).
 MAX_DEGREE = 8
-#: Most terms, summed over the ansatz monomials, of the images ``x^mu(Phi_h(x))`` (estimated before any
-#: work): ho3 at degree 8 is 34 265 (15 s), the rigid body's 12321 at degree 3 is 28 963 (13 s), at
-#: degree 4 it is 142 455 (200 s) and is refused.
+#: Most terms, summed over the ansatz monomials, of the images ``x^mu(Phi_h(x))``, bounded from the sub-flows
+#: before the map is composed (:func:`composed_map_shape`, :func:`image_terms`): ho3's 12321 at degree 8 is at most 35 141
+#: (34 265 on the composed map, 15 s), the rigid body's 12321 at degree 3 at most 39 616 (28 963, 13 s), at
+#: degree 4 at most 153 723 (142 455, 200 s) and is refused.
 MAX_IMAGE_TERMS = 40_000
 
 
@@ -82,21 +83,32 @@ def _total_degree(expr, coords) -> int:
 
 
 class _Setup:
-    """The ring ``K[x]`` with ``K = QQ<ext>(parameters, h)`` and the map in it."""
+    """The ring ``K[x]`` with ``K = QQ<ext>(parameters, h)`` and the map in it, for an ansatz of ``degree``."""
 
-    def __init__(self, system, comp):
+    def __init__(self, system, comp, degree):
         self.system = system
         self.coords = system.coordinates
         # the package's exact ring, with h among the parameters: K = QQ<ext>(parameters, h)
         algebra = PolynomialAlgebra(self.coords, (*system.parameters, H_STEP), extension=comp.extension)
         self.K, self.R, self.gens = algebra.domain, algebra.ring, algebra.gens
-        if any(e.has(sympy.sin, sympy.cos, sympy.tan)
-               for k, _ in comp.factors() for e in exact_flow(system.splitting[k], self.coords).expressions):
+        flows = [exact_flow(system.splitting[k], self.coords) for k, _ in comp.factors()]
+        if any(e.has(sympy.sin, sympy.cos, sympy.tan) for f in flows for e in f.expressions):
             # rotations (Lie-Poisson rigid body): powers of the composed cos/sin expressions blow up and the
             # exponential-generator bookkeeping of _exp_images does not apply; refused before composing (bounded work)
             raise NoExactResultError(
                 f"the composed map on {system.name} has trigonometric sub-flows (rotations); "
                 "polynomial invariants are not searched for it")
+        if all(f.polynomial for f in flows):
+            # bounded work: the images' size is bounded from the sub-flows before the map is composed (composing
+            # the rigid body's 12321 alone takes ~0.5 s, and a longer word or a larger system is the hang itself)
+            counts, degrees = composed_map_shape(flows, self.coords)
+            size = image_terms(counts, degrees, self.monomials(degree))
+            if size > MAX_IMAGE_TERMS:
+                raise ResourceLimitError(
+                    f"an invariant ansatz of degree {degree} on {system.name} with the word {_word_name(comp)} "
+                    f"needs images of up to {size} terms, estimated from the word's {len(flows)} sub-flows "
+                    f"(at most {MAX_IMAGE_TERMS}); lower the degree or shorten the word"
+                )
         phi = composed_map(system.splitting, comp)
         self.phi_exprs = tuple(sympy.sympify(e, strict=True) for e in phi)
         try:
@@ -109,12 +121,39 @@ class _Setup:
         return list(Ansatz(len(self.coords), degree, lowest=1, order="graded").monomials)
 
 
-def image_terms(phi, monos) -> int:
-    """An upper bound on the terms of all images ``x^mu(Phi_h(x))``: per ``mu`` the smaller of the product
-    of the components' term counts and the number of monomials of the image's degree."""
-    n = len(phi)
-    counts = [len(p) for p in phi]
-    degrees = [max((sum(m) for m in p.keys()), default=0) for p in phi]
+def composed_map_shape(flows, coords) -> tuple:
+    """Upper bounds ``(counts, degrees)`` on the number of terms and the total degree in ``coords`` of each
+    component of the composition of the polynomial ``flows`` (applied first to last), without composing them.
+
+    Composing ``f`` after a map whose component ``j`` has at most ``t_j`` terms of degree at most ``d_j`` gives
+    ``f_i(x)`` with, per monomial ``x^m`` of ``f_i``, at most ``min(prod_j t_j^m_j, C(N + <m, d>, N))`` terms of
+    degree at most ``<m, d>``; summing over the monomials (and capping by ``C(N + deg, N)``) bounds the terms of
+    ``f_i``.  The bounds ignore cancellation, so they are never below the composed map's true shape.
+    """
+    n = len(coords)
+    counts, degrees = [1] * n, [1] * n  # the identity map
+    monomials = {}  # a word repeats its pieces: each flow's monomials are read once
+    for flow in flows:
+        if id(flow) not in monomials:
+            monomials[id(flow)] = [sympy.Poly(sympy.expand(e), *coords).monoms() for e in flow.expressions]
+        new_counts, new_degrees = [], []
+        for monos in monomials[id(flow)]:
+            count, degree = 0, 0
+            for m in monos:
+                d = sum(k * dj for k, dj in zip(m, degrees))
+                count += min(prod(t**k for t, k in zip(counts, m)), comb(n + d, n))
+                degree = max(degree, d)
+            new_counts.append(min(count, comb(n + degree, n)))
+            new_degrees.append(degree)
+        counts, degrees = new_counts, new_degrees
+    return counts, degrees
+
+
+def image_terms(counts, degrees, monos) -> int:
+    """An upper bound on the terms of all images ``x^mu(Phi_h(x))`` when component ``i`` of ``Phi_h`` has at most
+    ``counts[i]`` terms of total degree at most ``degrees[i]``: per ``mu`` the smaller of the product of the
+    components' term counts and the number of monomials of the image's degree."""
+    n = len(counts)
     return sum(min(prod(t**k for t, k in zip(counts, mu)), comb(n + sum(k * d for k, d in zip(mu, degrees)), n))
                for mu in monos)
 
@@ -122,13 +161,6 @@ def image_terms(phi, monos) -> int:
 def _ring_images(setup: _Setup, monos):
     """``{monomial: coefficient}`` of ``x^mu(Phi_h(x)) - x^mu`` for each ``mu``, in the sparse ring."""
     R, phi = setup.R, setup.phi
-    size = image_terms(phi, monos)
-    if size > MAX_IMAGE_TERMS:
-        degree = max(sum(mu) for mu in monos)
-        raise ResourceLimitError(
-            f"an invariant ansatz of degree {degree} on {setup.system.name} needs images with about {size} terms "
-            f"(at most {MAX_IMAGE_TERMS}); lower the degree"
-        )
     powers = [[R.one] for _ in phi]
 
     def power(i, k):
@@ -449,7 +481,7 @@ def conserved_quantities(system, word, degree=None) -> ConservedQuantities:
 
 @lru_cache(maxsize=64)
 def _conserved(system, name, comp, degree, auto):
-    setup = _Setup(system, comp)
+    setup = _Setup(system, comp, degree)
     basis = _invariant_basis(setup, degree)
     # the normalised H_c, G_c are looked for among the invariants of the Hamiltonians' degree
     low = basis if degree <= auto else _invariant_basis(setup, auto)
