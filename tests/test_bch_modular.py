@@ -387,7 +387,7 @@ def test_importing_the_compiled_modules_does_not_import_numba(tmp_path):
 
     code = ("import sys\nimport nambu_bch.bch.modular as m, nambu_bch.numeric.scan\n"
             "print('numba' in sys.modules)\n"
-            "print(m._solve.signatures, 'numba' in sys.modules, type(m._duval_count).__name__)\n")
+            "print(m._solve.signatures, 'numba' in sys.modules, type(m._chains).__name__)\n")
     env = {**os.environ, "PYTHONPATH": str(Path(__file__).resolve().parents[1]), "NAMBU_BCH_CACHE": str(tmp_path)}
     done = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True, timeout=300)
     assert done.returncode == 0, done.stderr

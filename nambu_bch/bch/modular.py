@@ -76,6 +76,7 @@ import numpy as np
 import sympy
 
 from ..compiled import njit
+from .lyndon import witt_dimension
 
 #: Primes below 2^28: a product of two residues is below 2^56, so up to 128 products (and every inner sum
 #: of the kernels, at most 64 terms for degrees <= 64) add up in int64 with one reduction at the end.
@@ -122,10 +123,6 @@ def _zeros_int32(size):
     return np.zeros((size + 1) // 2, dtype=np.int64).view(np.int32)[:size]
 
 
-@njit(inline="always")
-def _zeros_int8(size):
-    """A zeroed int8 array of ``size`` entries (an int64 array's bytes, seen as int8)."""
-    return np.zeros((size + 7) // 8, dtype=np.int64).view(np.int8)[:size]
 
 
 @njit(inline="always")
@@ -153,17 +150,6 @@ def _duval_next(w, length, n, g):
 
 
 @njit(inline="always")
-def _duval_count(g, n):
-    w = _filled(n + 1, -1)
-    length, count = np.int64(1), 0  # np.int64: a literal 1 would compile _duval_next once more for Literal[int](1)
-    while length > 0:
-        w[length - 1] += 1
-        count += 1
-        length = _duval_next(w, length, n, g)
-    return count
-
-
-@njit(inline="always")
 def _find(codes, by_length, start, L, code):
     """Duval index of the Lyndon word of length ``L`` with base-``g`` code ``code``, or -1 (binary search:
     within one length Duval order is numeric order of codes)."""
@@ -180,10 +166,10 @@ def _find(codes, by_length, start, L, code):
 
 
 @njit()
-def _lyndon_table_kernel(g, n):
-    """Lyndon words of length <= n in Duval (lexicographic) order, lengths, and standard factors."""
-    count = _duval_count(g, n)
-    words = _zeros_int8(count * n).reshape((count, n))
+def _lyndon_table_kernel(words, g, n):
+    """Lyndon words of length <= n in Duval (lexicographic) order into ``words`` (zeroed, one row per word), their
+    lengths, and standard factors."""
+    count = words.shape[0]
     lengths = np.zeros(count, dtype=np.int64)
     code_of = np.zeros(count, dtype=np.int64)
     left = _filled(count, -1)
@@ -226,13 +212,18 @@ def _lyndon_table_kernel(g, n):
                     code = code * g + words[k, i]
                 left[k] = _find(codes, by_length, start, first, code)
                 break
-    return words, lengths, left, right
+    return lengths, left, right
 
 
 @lru_cache(maxsize=16)
 def lyndon_table(g: int, n: int):
-    """``(words, lengths, left, right)`` for all Lyndon words of length ``<= n`` over ``0..g-1``, Duval order."""
-    return _lyndon_table_kernel(g, n)
+    """``(words, lengths, left, right)`` for all Lyndon words of length ``<= n`` over ``0..g-1``, Duval order.
+
+    The table's size is Witt's count (Reutenauer, Cor. 4.14), so the int8 rows are allocated here, by numpy: the
+    compiled kernel needs no int8 allocation of its own (one compile fewer) and no counting pass."""
+    count = sum(witt_dimension(g, length) for length in range(1, n + 1))
+    words = np.zeros((count, n), dtype=np.int8)
+    return (words, *_lyndon_table_kernel(words, g, n))
 
 
 # -- the Lyndon matrix <P_v, w>, through the chains v = a^k u -------------------------------------------------
@@ -390,7 +381,7 @@ def _solve(z, primes, inv, words, lengths, left, right, K, core, lead, span, mem
     ``z != 0``.  Returns the number of program nodes run (times lanes)."""
     k = primes.shape[0]
     m = members.shape[0]
-    live = _zeros_int8(m)  # 0 / 1
+    live = _zeros_int32(m)  # 0 / 1 (int32: the one narrow type numba compiles here, for X)
     x = _zeros2(_LANES, 64)
     acc = np.zeros(_LANES * d * k, dtype=np.int64).reshape((_LANES, d, k))
     lane_span = np.zeros(_LANES, dtype=np.int64)
