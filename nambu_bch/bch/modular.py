@@ -68,8 +68,7 @@ from __future__ import annotations
 from fractions import Fraction
 from functools import lru_cache
 from itertools import compress
-import math
-from math import factorial
+from math import factorial, floor
 from time import process_time
 
 import numpy as np
@@ -95,7 +94,7 @@ def _reduce(x, p, inv):
 
     ``x * inv`` is within ``2^-17`` of ``x / p`` (53-bit mantissas, ``|x / p| < 2^34``), so
     ``floor`` is off by at most one and ``x - q p`` lies in ``(-p, 2p)`` (no integer division)."""
-    q = math.floor(np.float64(x) * inv)  # (math.floor, not np.floor: numba types a ufunc anew at every call site)
+    q = floor(np.float64(x) * inv)  # (math.floor, not np.floor: numba types a ufunc anew at every call site)
     r = x - q * p
     if r < 0:
         r += p
@@ -107,9 +106,10 @@ def _reduce(x, p, inv):
 # -- allocation ----------------------------------------------------------------------------------------------------
 # numba compiles np.zeros / np.full / np.empty / np.arange once per (number of dimensions, dtype), with the
 # np.empty and the zero fill beneath it: 0.1-0.3 s each on a cold start.  Every array here is allocated as a
-# zeroed one-dimensional int64 array (one compilation), seen as int32 or int8 through ``view`` where narrower
-# entries are wanted, filled by a loop and reshaped (views: no compilation).  The helpers are inlined into their
-# callers (no compilation of their own either).
+# zeroed one-dimensional int64 array (one compilation), seen as int32 through ``view`` where narrower entries are
+# wanted (one more), filled by a loop and reshaped (a view: no compilation); the Lyndon table's int8 rows are
+# allocated by numpy (:func:`lyndon_table`).  The helpers are inlined into their callers (no compilation of their
+# own either).
 
 @njit(inline="always")
 def _zeros2(rows, cols):
@@ -121,8 +121,6 @@ def _zeros2(rows, cols):
 def _zeros_int32(size):
     """A zeroed int32 array of ``size`` entries (the first half of an int64 array's bytes, seen as int32)."""
     return np.zeros((size + 1) // 2, dtype=np.int64).view(np.int32)[:size]
-
-
 
 
 @njit(inline="always")
