@@ -178,7 +178,9 @@ def run_case(tree: str, source: str, stages: bool = False) -> dict:
                "PYTHONDONTWRITEBYTECODE": "1"}
         env.pop("NAMBU_BCH_DISABLE_NUMBA", None)
         child = _CHILD.replace("CASE", source).replace("if STAGES:", f"if {stages}:")
-        done = subprocess.run([sys.executable, "-c", child], env=env,
+        # cwd: the empty cache directory, as ``python -c`` puts the working directory first on sys.path (a run
+        # from inside a source tree would import that tree's package whatever --tree says)
+        done = subprocess.run([sys.executable, "-c", child], env=env, cwd=cache,
                               capture_output=True, text=True, timeout=900)
         if done.returncode:
             raise SystemExit(f"{tree}: {done.stderr.strip().splitlines()[-1:]}")
