@@ -6,11 +6,17 @@ apart), then makes the first call (compilation) and times it by CPU; numba's com
 CPU to each top-level compiled function (callees compiled on the way are included in their caller's
 figure, as numba compiles them while typing it).  The warm figure is the best of five later calls (CPU).
 
+``--stages`` also splits the first call's CPU by stage, summed over every function compiled: each numba pass
+(type inference, lowering to LLVM IR, ...; exclusive of what is compiled inside it) and LLVM's four steps
+(``add_ir_module``: parsing and verifying the IR; ``_optimize_functions``: the per-function passes;
+``_optimize_final_module``: the module passes after linking the callees' code in; ``_finalize_specific``: machine
+code), with the number of lines of LLVM IR numba generated.
+
 With several ``--tree`` directories (source trees: the PYTHONPATH of the child) the cases run interleaved,
 tree after tree, ``--repeats`` rounds; the table gives the median per tree and the load average at the start
 and end.  Use it to compare a change against its base:
 
-    python benchmarks/bench_compile.py --tree /path/to/base --tree . --repeats 3
+    python benchmarks/bench_compile.py --tree /path/to/base --tree . --repeats 3 [--stages]
 """
 
 from __future__ import annotations
@@ -31,8 +37,44 @@ import json, sys
 from time import process_time
 started = process_time()
 import numba
-from numba.core import event
+from numba.core import codegen, event
 numba_import = process_time() - started
+stages, frames, ir_lines = {}, [], [0]
+
+def _push(name):
+    frames.append([name, process_time(), 0.0])
+
+def _pop():
+    name, t0, inner = frames.pop()
+    spent = process_time() - t0
+    stages[name] = stages.get(name, 0.0) + spent - inner  # exclusive of the stages nested in it
+    if frames:
+        frames[-1][2] += spent
+
+class Passes(event.Listener):
+    def on_start(self, e):
+        _push("compile, other" if e.kind == "numba:compile" else "numba " + e.data["name"].split(" [")[0])
+    def on_end(self, e):
+        _pop()
+
+def _timed(method):
+    original = getattr(codegen.JITCodeLibrary, method)
+    def timed(self, *args):
+        if method == "add_ir_module":
+            ir_lines[0] += str(args[0]).count("\n")
+        _push("LLVM " + method)
+        try:
+            return original(self, *args)
+        finally:
+            _pop()
+    setattr(codegen.JITCodeLibrary, method, timed)
+
+if STAGES:
+    passes = Passes()
+    event.register("numba:compile", passes)
+    event.register("numba:run_pass", passes)
+    for method in ("add_ir_module", "_optimize_functions", "_optimize_final_module", "_finalize_specific"):
+        _timed(method)
 
 class Compiles(event.Listener):
     def __init__(self):
@@ -56,12 +98,16 @@ started = process_time()
 first()
 first_cpu = process_time() - started
 event.unregister("numba:compile", listener)
+if STAGES:
+    event.unregister("numba:compile", passes)
+    event.unregister("numba:run_pass", passes)
 best = float("inf")
 for _ in range(5):
     t = process_time()
     warm()
     best = min(best, process_time() - t)
-print(json.dumps({"numba_import": numba_import, "first": first_cpu, "compiles": listener.rows, "warm": best}))
+print(json.dumps({"numba_import": numba_import, "first": first_cpu, "compiles": listener.rows, "warm": best,
+                  "stages": stages, "ir_lines": ir_lines[0]}))
 '''
 
 #: name -> source defining ``first()`` and ``warm()`` (the same calls on every tree).
@@ -125,13 +171,16 @@ def warm():
 }
 
 
-def run_case(tree: str, source: str) -> dict:
+def run_case(tree: str, source: str, stages: bool = False) -> dict:
     cache = tempfile.mkdtemp(prefix="nambu_bch_compile_")
     try:
         env = {**os.environ, "PYTHONPATH": str(Path(tree).resolve()), "NAMBU_BCH_CACHE": cache,
                "PYTHONDONTWRITEBYTECODE": "1"}
         env.pop("NAMBU_BCH_DISABLE_NUMBA", None)
-        done = subprocess.run([sys.executable, "-c", _CHILD.replace("CASE", source)], env=env,
+        child = _CHILD.replace("CASE", source).replace("if STAGES:", f"if {stages}:")
+        # cwd: the empty cache directory, as ``python -c`` puts the working directory first on sys.path (a run
+        # from inside a source tree would import that tree's package whatever --tree says)
+        done = subprocess.run([sys.executable, "-c", child], env=env, cwd=cache,
                               capture_output=True, text=True, timeout=900)
         if done.returncode:
             raise SystemExit(f"{tree}: {done.stderr.strip().splitlines()[-1:]}")
@@ -145,6 +194,7 @@ def main(argv=None):
     ap.add_argument("--tree", action="append", help="a source tree (default: this repository)")
     ap.add_argument("--repeats", type=int, default=1)
     ap.add_argument("--only", default="", help="run the cases whose name contains this")
+    ap.add_argument("--stages", action="store_true", help="split the first call by numba pass and LLVM step")
     args = ap.parse_args(argv)
     trees = args.tree or [str(Path(__file__).resolve().parents[1])]
     cases = {k: v for k, v in CASES.items() if args.only in k}
@@ -153,7 +203,7 @@ def main(argv=None):
     for _ in range(args.repeats):
         for case, source in cases.items():
             for tree in trees:
-                results[case, tree].append(run_case(tree, source))
+                results[case, tree].append(run_case(tree, source, args.stages))
     print(f"# cold numba compilation, CPU s (median of {args.repeats}), fresh process and empty cache per run; "
           f"load {load0:.1f} at the start, {os.getloadavg()[0]:.1f} at the end")
     print("# trees: " + ", ".join(f"[{i}] {Path(t).resolve()}" for i, t in enumerate(trees)))
@@ -167,6 +217,22 @@ def main(argv=None):
                            ("warm", "warm call, best of 5, CPU s")):
             cols = [statistics.median(r[key] for r in results[case, t]) for t in trees]
             print(f"  {label:48s}" + "".join(f" [{i}] {c:8.5f}" for i, c in enumerate(cols)))
+        if args.stages:
+            print("  stages of the first call (CPU s, median; the largest, then the rest together):")
+            totals: dict = {}  # for the ranking only: every run of every tree
+            for t in trees:
+                for r in results[case, t]:
+                    for n, v in r["stages"].items():
+                        totals[n] = totals.get(n, 0.0) + v
+            shown = sorted(totals, key=totals.get, reverse=True)[:10]
+            for name in shown:
+                cols = [statistics.median(r["stages"].get(name, 0.0) for r in results[case, t]) for t in trees]
+                print(f"    {name:46s}" + "".join(f" [{i}] {c:6.2f}" for i, c in enumerate(cols)))
+            cols = [statistics.median(sum(v for n, v in r["stages"].items() if n not in shown)
+                                      for r in results[case, t]) for t in trees]
+            print(f"    {'the other stages':46s}" + "".join(f" [{i}] {c:6.2f}" for i, c in enumerate(cols)))
+            cols = [statistics.median(r["ir_lines"] for r in results[case, t]) for t in trees]
+            print(f"    {'lines of LLVM IR generated':46s}" + "".join(f" [{i}] {c:6.0f}" for i, c in enumerate(cols)))
 
 
 if __name__ == "__main__":

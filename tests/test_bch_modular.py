@@ -351,9 +351,28 @@ def test_the_solve_compiles_each_helper_for_one_signature():
     callee again for ``int64``: the class loop's start must not be a literal (five helpers compiled twice cost
     ~3 s of a cold start).  Checked where the engine was compiled in this process (a cold cache)."""
     formal_bch("123", 5)
-    for helper in (modular._class_chains, modular._mark_live, modular._group_stop, modular._add_earlier,
-                   modular._finish_group):
+    for helper in (modular._class_chains, modular._add_earlier, modular._finish_group):
         assert len(helper.signatures) <= 1, (helper, helper.signatures)
+
+
+def test_the_engine_compiles_only_what_a_series_needs():
+    """Each compiled function, each numpy call numba specialises and each CPython wrapper is a separate compile on a
+    cold start: Eq. (3) (two letters, even degree) and the chains are entry points of their own (a three-letter series
+    never compiles Eq. (3)), the helpers called only from compiled code have no CPython wrapper, and the kernels call
+    no ``min``/``max``/``astype`` (one more compile each).  Read from the source and the
+    options, so nothing is compiled here."""
+    solve = set(modular._solve.py_func.__code__.co_names)
+    assert not {"_even_top", "_chains"} & solve
+    kernels = [modular._lyndon_table_kernel, modular._chains, modular._class_chains, modular._add_earlier,
+               modular._finish_group, modular._solve, modular._word_coefficients, modular._even_top,
+               modular._class_program, modular._run_program]
+    for kernel in kernels:
+        names = set(kernel.py_func.__code__.co_names)
+        assert not {"min", "max", "astype"} & names, (kernel, names)
+    for helper in (modular._class_chains, modular._add_earlier, modular._finish_group, modular._class_program,
+                   modular._run_program):
+        options = getattr(helper, "targetoptions", None) or helper.options  # a numba dispatcher once made
+        assert options.get("no_cpython_wrapper"), helper
 
 
 # -- numba is imported on first use ------------------------------------------------------------------------
@@ -368,7 +387,7 @@ def test_importing_the_compiled_modules_does_not_import_numba(tmp_path):
 
     code = ("import sys\nimport nambu_bch.bch.modular as m, nambu_bch.numeric.scan\n"
             "print('numba' in sys.modules)\n"
-            "print(m._solve.signatures, 'numba' in sys.modules, type(m._duval_count).__name__)\n")
+            "print(m._solve.signatures, 'numba' in sys.modules, type(m._chains).__name__)\n")
     env = {**os.environ, "PYTHONPATH": str(Path(__file__).resolve().parents[1]), "NAMBU_BCH_CACHE": str(tmp_path)}
     done = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True, timeout=300)
     assert done.returncode == 0, done.stderr

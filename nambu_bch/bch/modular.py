@@ -68,13 +68,14 @@ from __future__ import annotations
 from fractions import Fraction
 from functools import lru_cache
 from itertools import compress
-from math import factorial
+from math import factorial, floor
 from time import process_time
 
 import numpy as np
 import sympy
 
 from ..compiled import njit
+from .lyndon import witt_dimension
 
 #: Primes below 2^28: a product of two residues is below 2^56, so up to 128 products (and every inner sum
 #: of the kernels, at most 64 terms for degrees <= 64) add up in int64 with one reduction at the end.
@@ -93,7 +94,7 @@ def _reduce(x, p, inv):
 
     ``x * inv`` is within ``2^-17`` of ``x / p`` (53-bit mantissas, ``|x / p| < 2^34``), so
     ``floor`` is off by at most one and ``x - q p`` lies in ``(-p, 2p)`` (no integer division)."""
-    q = np.int64(np.floor(np.float64(x) * inv))
+    q = floor(np.float64(x) * inv)  # (math.floor, not np.floor: numba types a ufunc anew at every call site)
     r = x - q * p
     if r < 0:
         r += p
@@ -103,15 +104,23 @@ def _reduce(x, p, inv):
 
 
 # -- allocation ----------------------------------------------------------------------------------------------------
-# numba compiles np.zeros / np.full / np.empty / np.arange once per (function, number of dimensions, dtype):
-# 0.1-0.17 s each on a cold start, 13 of them in this module.  Every array here is allocated as a zeroed
-# one-dimensional int64, int32 or int8 array (three compilations), filled by a loop and reshaped (a view:
-# no compilation).  The helpers are inlined into their callers (no compilation of their own either).
+# numba compiles np.zeros / np.full / np.empty / np.arange once per (number of dimensions, dtype), with the
+# np.empty and the zero fill beneath it: 0.1-0.3 s each on a cold start.  Every array here is allocated as a
+# zeroed one-dimensional int64 array (one compilation), seen as int32 through ``view`` where narrower entries are
+# wanted (one more), filled by a loop and reshaped (a view: no compilation); the Lyndon table's int8 rows are
+# allocated by numpy (:func:`lyndon_table`).  The helpers are inlined into their callers (no compilation of their
+# own either).
 
 @njit(inline="always")
-def _zeros2(rows, cols, dtype):
-    """A zeroed C-contiguous ``(rows, cols)`` array of ``dtype``."""
-    return np.zeros(rows * cols, dtype=dtype).reshape((rows, cols))
+def _zeros2(rows, cols):
+    """A zeroed C-contiguous int64 ``(rows, cols)`` array."""
+    return np.zeros(rows * cols, dtype=np.int64).reshape((rows, cols))
+
+
+@njit(inline="always")
+def _zeros_int32(size):
+    """A zeroed int32 array of ``size`` entries (the first half of an int64 array's bytes, seen as int32)."""
+    return np.zeros((size + 1) // 2, dtype=np.int64).view(np.int32)[:size]
 
 
 @njit(inline="always")
@@ -125,7 +134,7 @@ def _filled(size, value):
 
 # -- Lyndon table -------------------------------------------------------------------------------------------------
 
-@njit()
+@njit(inline="always")
 def _duval_next(w, length, n, g):
     """Duval's step after the Lyndon word ``w[:length]`` has been used: extend periodically to length ``n``, drop
     trailing maximal letters; returns the new length (0: done).  The caller increments ``w[length - 1]``."""
@@ -138,18 +147,7 @@ def _duval_next(w, length, n, g):
     return length
 
 
-@njit()
-def _duval_count(g, n):
-    w = _filled(n + 1, -1)
-    length, count = np.int64(1), 0  # np.int64: a literal 1 would compile _duval_next once more for Literal[int](1)
-    while length > 0:
-        w[length - 1] += 1
-        count += 1
-        length = _duval_next(w, length, n, g)
-    return count
-
-
-@njit()
+@njit(inline="always")
 def _find(codes, by_length, start, L, code):
     """Duval index of the Lyndon word of length ``L`` with base-``g`` code ``code``, or -1 (binary search:
     within one length Duval order is numeric order of codes)."""
@@ -166,10 +164,10 @@ def _find(codes, by_length, start, L, code):
 
 
 @njit()
-def _lyndon_table_kernel(g, n):
-    """Lyndon words of length <= n in Duval (lexicographic) order, lengths, and standard factors."""
-    count = _duval_count(g, n)
-    words = _zeros2(count, n, np.int8)
+def _lyndon_table_kernel(words, g, n):
+    """Lyndon words of length <= n in Duval (lexicographic) order into ``words`` (zeroed, one row per word), their
+    lengths, and standard factors."""
+    count = words.shape[0]
     lengths = np.zeros(count, dtype=np.int64)
     code_of = np.zeros(count, dtype=np.int64)
     left = _filled(count, -1)
@@ -212,13 +210,18 @@ def _lyndon_table_kernel(g, n):
                     code = code * g + words[k, i]
                 left[k] = _find(codes, by_length, start, first, code)
                 break
-    return words, lengths, left, right
+    return lengths, left, right
 
 
 @lru_cache(maxsize=16)
 def lyndon_table(g: int, n: int):
-    """``(words, lengths, left, right)`` for all Lyndon words of length ``<= n`` over ``0..g-1``, Duval order."""
-    return _lyndon_table_kernel(g, n)
+    """``(words, lengths, left, right)`` for all Lyndon words of length ``<= n`` over ``0..g-1``, Duval order.
+
+    The table's size is Witt's count (Reutenauer, Cor. 4.14), so the int8 rows are allocated here, by numpy: the
+    compiled kernel needs no int8 allocation of its own (one compile fewer) and no counting pass."""
+    count = sum(witt_dimension(g, length) for length in range(1, n + 1))
+    words = np.zeros((count, n), dtype=np.int8)
+    return (words, *_lyndon_table_kernel(words, g, n))
 
 
 # -- the Lyndon matrix <P_v, w>, through the chains v = a^k u -------------------------------------------------
@@ -257,7 +260,7 @@ def _chains(words, lengths, left, right):
 _LANES = 8  # words evaluated together by one program sweep (8 x int32: one AVX2 vector)
 
 
-@njit()
+@njit(no_cpython_wrapper=True)
 def _class_chains(z, members, span, right, r0, r1, d, k):
     """``chain[r, j]``: the index of ``members[r0 + r][j:]`` (the suffixes still starting with the class's smallest
     letter), and whether any of them has ``z != 0``."""
@@ -276,17 +279,7 @@ def _class_chains(z, members, span, right, r0, r1, d, k):
     return chain, any_nonzero
 
 
-@njit()
-def _mark_live(live, z, chain, members, span, r0, r1, k):
-    """A class left as it is (all zero, or one member): mark its members with a non-zero suffix."""
-    for r in range(r1 - r0):
-        for j in range(span[members[r0 + r]] + 1):
-            for i in range(k):
-                if z[chain[r, j], i] != 0:
-                    live[r0 + r] = 1
-
-
-@njit()
+@njit(inline="always")
 def _group_stop(live, roots, r0, b0, b1):
     """The last program node a group ``b0 .. b1 - 1`` needs: the largest root of a member before its last word that
     is (or may still become) non-zero; -1 when none."""
@@ -297,7 +290,7 @@ def _group_stop(live, roots, r0, b0, b1):
     return stop
 
 
-@njit()
+@njit(no_cpython_wrapper=True)
 def _add_earlier(acc, z, X, live, roots, chain, members, K, span, lane_span, lane_lead, primes, inv, r0, b0, nb, block):
     """``acc[lane, j] += c z`` over the members before the group (final): one row of ``X`` for all lanes.
 
@@ -314,7 +307,8 @@ def _add_earlier(acc, z, X, live, roots, chain, members, K, span, lane_span, lan
                     c = np.int64(X[root, lane])
                     if c != 0:
                         hit = True
-                        for j in range(min(sv, lane_span[lane]) + 1):
+                        jt = sv if sv < lane_span[lane] else lane_span[lane]  # (min() is one more compile)
+                        for j in range(jt + 1):
                             v = chain[q - r0, j]
                             for i in range(k):
                                 acc[lane, j, i] += c * z[v, i]
@@ -328,7 +322,7 @@ def _add_earlier(acc, z, X, live, roots, chain, members, K, span, lane_span, lan
                     terms = 0
 
 
-@njit()
+@njit(no_cpython_wrapper=True)
 def _finish_group(acc, z, X, live, roots, chain, members, K, span, lane_span, lane_lead, primes, inv, r0, b0, b1,
                   ran):
     """Each word ``w`` of the group in turn: add the group's members before it (final by now), subtract the sum from
@@ -342,7 +336,8 @@ def _finish_group(acc, z, X, live, roots, chain, members, K, span, lane_span, la
                 if live[q] != 0 and K[members[q]] <= la:
                     c = np.int64(X[roots[q - r0], lane])
                     if c != 0:
-                        for j in range(min(span[members[q]], kw) + 1):
+                        jt = span[members[q]] if span[members[q]] < kw else kw
+                        for j in range(jt + 1):
                             v = chain[q - r0, j]
                             for i in range(k):
                                 acc[lane, j, i] += c * z[v, i]
@@ -357,9 +352,9 @@ def _finish_group(acc, z, X, live, roots, chain, members, K, span, lane_span, la
 
 
 @njit()
-def _solve(z, primes, beta, words, lengths, left, right, members, class_start, g, n, d):
-    """Eq. (1) in place, all primes at once, for every degree ``<= d`` through the content classes of degree ``d``;
-    then, if ``d < n``, the even degree ``n`` by Eq. (3) (:func:`_even_top`, with ``beta``).
+def _solve(z, primes, inv, words, lengths, left, right, K, core, lead, span, members, class_start, g, d):
+    """Eq. (1) in place, all primes at once, for every degree ``<= d`` through the content classes of degree ``d``
+    (``inv = 1.0 / primes``; ``K, core, lead, span`` of :func:`_chains`).
 
     Chains.  Let ``a`` be the smallest letter of a class (every member starts with it) and
     ``v = a^k u`` with ``P_v = ad_a^k P_u`` (``k <= K_v``).  A Lyndon word ``w`` of length ``>= 2``
@@ -382,20 +377,18 @@ def _solve(z, primes, beta, words, lengths, left, right, members, class_start, g
     2^(|u|-1)``, exact for ``|u| <= 31``); the matrix is never stored, a class whose word
     coefficients all vanish is skipped, and ``c`` is used only when a suffix of ``v`` has
     ``z != 0``.  Returns the number of program nodes run (times lanes)."""
-    K, core, lead, span = _chains(words, lengths, left, right)
     k = primes.shape[0]
-    inv = 1.0 / primes.astype(np.float64)
     m = members.shape[0]
-    live = np.zeros(m, dtype=np.int8)  # 0 / 1
-    x = _zeros2(_LANES, 64, np.int64)
+    live = _zeros_int32(m)  # 0 / 1 (int32: the one narrow type numba compiles here, for X)
+    x = _zeros2(_LANES, 64)
     acc = np.zeros(_LANES * d * k, dtype=np.int64).reshape((_LANES, d, k))
     lane_span = np.zeros(_LANES, dtype=np.int64)
-    memo = np.zeros(lengths.shape[0] * d, dtype=np.int32)  # node numbers of _class_program
+    memo = _zeros_int32(lengths.shape[0] * d)  # node numbers of _class_program
     for i in range(memo.shape[0]):
         memo[i] = -1
     memo = memo.reshape((lengths.shape[0], d))
     lane_lead = np.zeros(_LANES, dtype=np.int64)
-    block = 1 << max(0, 35 - d)
+    block = 1 << (35 - d if d < 35 else 0)
     work = 0
     r0 = np.int64(0)  # not a literal 0: the helpers taking r0 would be compiled twice (Literal[int](0), int64)
     while r0 < m:
@@ -403,53 +396,58 @@ def _solve(z, primes, beta, words, lengths, left, right, members, class_start, g
         while r1 < m and class_start[r1] == r0:
             r1 += 1
         chain, any_nonzero = _class_chains(z, members, span, right, r0, r1, d, k)
-        if not any_nonzero or r1 - r0 == 1:
-            _mark_live(live, z, chain, members, span, r0, r1, k)
+        if not any_nonzero or r1 - r0 == 1:  # left as it is: a lone member is live if a suffix is non-zero
+            if any_nonzero:
+                live[r0] = 1
             r0 = r1
             continue
         kids, roots = _class_program(members[r0:r1], core, K, words, lengths, left, right, g, d, memo)
-        X = _zeros2(g * d + kids.shape[0], _LANES, np.int32)
+        X = _zeros_int32((g * d + kids.shape[0]) * _LANES).reshape((g * d + kids.shape[0], _LANES))
         for b0 in range(r0, r1, _LANES):
-            b1 = min(b0 + _LANES, r1)
+            b1 = b0 + _LANES if b0 + _LANES < r1 else r1
             stop = _group_stop(live, roots, r0, b0, b1)
             if stop >= 0:
                 for r in range(b0, b1):
                     for i in range(d):
                         x[r - b0, i] = words[members[r], i]
                 _run_program(kids, x, g, d, stop, X)
-                work += max(0, stop + 1 - g * d) * _LANES
+                if stop + 1 > g * d:
+                    work += (stop + 1 - g * d) * _LANES
             nb = b1 - b0
             for lane in range(nb):
                 lane_span[lane], lane_lead[lane] = span[members[b0 + lane]], lead[members[b0 + lane]]
             if stop >= 0:
-                acc[:nb] = 0
+                for lane in range(nb):
+                    for j in range(d):
+                        for i in range(k):
+                            acc[lane, j, i] = 0
                 _add_earlier(acc, z, X, live, roots, chain, members, K, span, lane_span, lane_lead, primes, inv,
                              r0, b0, nb, block)
             _finish_group(acc, z, X, live, roots, chain, members, K, span, lane_span, lane_lead, primes, inv,
                           r0, b0, b1, stop >= 0)
         r0 = r1
-    if d < n:
-        _even_top(z, primes, lengths, right, K, beta, n)
     return work
 
 
 @njit()
-def _word_coefficients(letters, cpow, logk, primes, g, n, count, top):
+def _word_coefficients(letters, cpow, logk, primes, inv, g, n, count, top):
     """``<log Phi, w> mod p`` for the Lyndon words ``w`` of length ``<= n`` in Duval order, every prime at once.
 
     Words longer than ``top`` are skipped (left 0).
 
-    ``cpow[i, t, r] = c_t^r / r!`` and ``logk[i, k] = (-1)^(k+1) / k`` modulo ``primes[i]``."""
+    ``cpow[i, t, r] = c_t^r / r!`` and ``logk[i, k] = (-1)^(k+1) / k`` modulo ``primes[i]``; ``inv = 1.0 / primes``."""
     s = letters.shape[0]
     k = primes.shape[0]
-    inv = 1.0 / primes.astype(np.float64)
-    out = _zeros2(count, k, np.int64)
+    out = _zeros2(count, k)
     # F[m, j, t] = <E_1..E_t, w[j:m]>, A[m, kk] = <(Phi - 1)^kk, w[:m]>
     F = np.zeros((n + 1) * (n + 1) * (s + 1) * k, dtype=np.int64).reshape((n + 1, n + 1, s + 1, k))
     A = np.zeros((n + 1) * (n + 1) * k, dtype=np.int64).reshape((n + 1, n + 1, k))
-    for m in range(n + 1):
-        F[m, m, :, :] = 1
-    A[0, 0, :] = 1
+    for m in range(n + 1):  # (loops, not slice assignments: numba compiles a broadcast for those)
+        for t in range(s + 1):
+            for i in range(k):
+                F[m, m, t, i] = 1
+    for i in range(k):
+        A[0, 0, i] = 1
     w = _filled(n + 1, -1)
     run = np.zeros(n + 1, dtype=np.int64)  # run[m]: length of the trailing run of equal letters of w[:m]
     acc = np.zeros(k, dtype=np.int64)
@@ -480,7 +478,7 @@ def _word_coefficients(letters, cpow, logk, primes, g, n, count, top):
                     for i in range(k):
                         acc[i] = F[m, j, t - 1, i]
                     if letters[t - 1] == a:
-                        for r in range(1, min(run[m], m - j) + 1):
+                        for r in range(1, (run[m] if run[m] < m - j else m - j) + 1):
                             for i in range(k):
                                 acc[i] += F[m - r, j, t - 1, i] * cpow[i, t - 1, r]
                         for i in range(k):
@@ -492,7 +490,7 @@ def _word_coefficients(letters, cpow, logk, primes, g, n, count, top):
             for kk in range(1, m + 1):
                 for i in range(k):
                     acc[i] = 0
-                for j in range(max(kk - 1, lo), m):
+                for j in range(kk - 1 if kk - 1 > lo else lo, m):
                     for i in range(k):
                         acc[i] += A[j, kk - 1, i] * F[m, j, s, i]
                 for i in range(k):
@@ -660,7 +658,7 @@ def _tanh_half_coefficients(n: int) -> dict:
 
 
 @njit()
-def _even_top(z, primes, lengths, right, K, beta, n):
+def _even_top(z, primes, inv, lengths, right, K, beta, n):
     """The even top degree ``n`` of ``Z = log(e^{aA} e^{bB})`` from its odd degrees (Eriksen 1968, Sect. III.A).
 
     ``e^{aA} e^{bB} = e^{aA} (e^{bB} e^{aA}) e^{-aA}`` and ``log(e^{bB} e^{aA}) = sum_d (-1)^(d+1) Z_d``
@@ -668,14 +666,16 @@ def _even_top(z, primes, lengths, right, K, beta, n):
     ``ad_A^k P_v = P_{A^k v}`` for a Lyndon word ``v != A``, so
 
         ``z_w = sum_{k odd, k <= K_w} beta_k z_{w[k:]}``,  ``beta_k = +-[x^k] tanh(x/2) a^k``.    (3)
+
+    (``inv = 1.0 / primes``, ``K`` of :func:`_chains`.)
     """
     k = primes.shape[0]
-    inv = 1.0 / primes.astype(np.float64)
     acc = np.zeros(k, dtype=np.int64)
     for w in range(lengths.shape[0]):
         if lengths[w] != n:
             continue
-        acc[:] = 0
+        for i in range(k):
+            acc[i] = 0
         c = w
         for j in range(1, K[w] + 1):
             c = right[c]
@@ -692,14 +692,19 @@ def _engine(letters, cpow, logk, primes, beta, g, n, top, words, lengths, left, 
 
     ``clock`` (a list) gets the CPU time after each of the two (for ``stats`` of :func:`lyndon_numerators`).
 
-    Two compiled entry points called from Python, not one compiled driver calling them: numba links a
+    Compiled entry points called from Python, not one compiled driver calling them: numba links a
     callee's code into its caller and optimises the linked module again, so a driver would cost the
     optimisation of both twice on a cold start (1.2 s of 6.5 s measured); an entry point costs a
-    cache load (a few ms) in a fresh process."""
-    z = _word_coefficients(letters, cpow, logk, primes, g, n, lengths.shape[0], top)
+    cache load (a few ms) in a fresh process.  For the same reason the chains and Eq. (3) are entry
+    points of their own: Eq. (3) is compiled only by a series that needs it (two letters, even degree)."""
+    inv = 1.0 / primes.astype(np.float64)
+    z = _word_coefficients(letters, cpow, logk, primes, inv, g, n, lengths.shape[0], top)
     if clock is not None:
         clock.append(process_time())
-    work = _solve(z, primes, beta, words, lengths, left, right, members, class_start, g, n, top)
+    K, core, lead, span = _chains(words, lengths, left, right)
+    work = _solve(z, primes, inv, words, lengths, left, right, K, core, lead, span, members, class_start, g, top)
+    if top < n:
+        _even_top(z, primes, inv, lengths, right, K, beta, n)
     if clock is not None:
         clock.append(process_time())
     return z, work
@@ -755,7 +760,7 @@ def _garner(residues, moduli) -> list:
     return [v - M if v > half else v for v in out]
 
 
-@njit()
+@njit(no_cpython_wrapper=True)
 def _class_program(members, core, K, words, lengths, left, right, g, d, memo):
     """A straight-line program for ``<P_u, x[K_v:]>``, ``u`` the core of ``v``, every ``v`` in ``members``.
 
@@ -766,11 +771,11 @@ def _class_program(members, core, K, words, lengths, left, right, g, d, memo):
     evaluating up to the root of a member evaluates all it needs; a core that is a letter has a
     leaf as its root.  ``memo[u, l]`` (all ``-1`` on entry and again on return) numbers the nodes."""
     cap = 64
-    kids = _zeros2(cap, 4, np.int64)
-    keys = _zeros2(cap, 2, np.int64)
+    kids = _zeros2(cap, 4)
+    keys = _zeros2(cap, 2)
     count = g * d
     roots = np.zeros(members.shape[0], dtype=np.int64)
-    stack = _zeros2(4 * d * d + 8, 2, np.int64)
+    stack = _zeros2(4 * d * d + 8, 2)
     ks = np.zeros(4, dtype=np.int64)
     for r in range(members.shape[0]):
         u0, l0 = core[members[r]], K[members[r]]
@@ -810,8 +815,8 @@ def _class_program(members, core, K, words, lengths, left, right, g, d, memo):
                 cap *= 2
                 # element loops, not slice assignments: a slice assignment makes numba compile its
                 # broadcasting error path with the unicode machinery (seconds of cold compile time)
-                grown = _zeros2(cap, 4, np.int64)
-                grown_keys = _zeros2(cap, 2, np.int64)
+                grown = _zeros2(cap, 4)
+                grown_keys = _zeros2(cap, 2)
                 for i in range(inner):
                     for c in range(4):
                         grown[i, c] = kids[i, c]
@@ -830,7 +835,7 @@ def _class_program(members, core, K, words, lengths, left, right, g, d, memo):
     return kids[: count - g * d].copy(), roots
 
 
-@njit()
+@njit(no_cpython_wrapper=True)
 def _run_program(kids, x, g, d, stop, X):
     """Evaluate the program of :func:`_class_program` on the words ``x[lane]`` up to node ``stop``."""
     for a in range(g):
