@@ -335,6 +335,20 @@ class TestLiouvilleField:
             ALG2.convert(liouville_field(ALG2, H).apply(f)) - ALG2.convert(poisson_bracket(ALG2, f, H))
         )
 
+    def test_canonical_field_is_the_brackets_of_the_coordinates_with_one_conversion(self, monkeypatch):
+        """Eq. (HamiltonEq) on 2n > 2 coordinates: X_H^i = {x_i, H}, each component the same ring element as
+        poisson_bracket's; H is converted once, not once per coordinate."""
+        q1, q2, p1, p2, a = sympy.symbols("x1 x2 x3 x4 a")
+        alg = PolynomialAlgebra([q1, q2, p1, p2], [a])
+        H = p1**2 / 2 + p2**2 / 2 + a * q1**4 + q1 * q2**3 / 7 + sympy.Rational(1, 3) * q2 * p1 * p2
+        expected = [poisson_bracket(alg, x, H) for x in alg.gens[:4]]
+        calls = []
+        convert = alg.convert
+        monkeypatch.setattr(alg, "convert", lambda f: calls.append(f) or convert(f))
+        X = liouville_field(alg, H)
+        assert list(X.components) == expected
+        assert sum(isinstance(f, sympy.Basic) for f in calls) == 1  # H, from sympy once
+
     def test_ho3_pieces_hX1_hX3(self):
         """Eqs. (hX1)-(hX3) with A, B, C, D of Eqs. (AB), (CD)."""
         assert field(ALG3, liouville_field(ALG3, A_, C_)) == (x2 / m, 0, 0)

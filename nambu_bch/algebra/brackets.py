@@ -119,8 +119,12 @@ def liouville_field(algebra: PolynomialAlgebra, *hamiltonians) -> VectorField:
     """
     check_ring(algebra, "algebra")
     if len(hamiltonians) == 1 and algebra.n % 2 == 0 and algebra.n > 2:
-        H = hamiltonians[0]
-        return VectorField(algebra, [poisson_bracket(algebra, x, H) for x in algebra.gens[: algebra.n]])
+        # {q_k, H} = dH/dp_k and {p_k, H} = -dH/dq_k (Eq. Poisson with f a coordinate): H converted and
+        # differentiated once, not once per coordinate; the same normal form as poisson_bracket's
+        n = algebra.n // 2
+        grad = _gradient(algebra, hamiltonians[0])
+        components = [grad[k + n] for k in range(n)] + [-grad[k] for k in range(n)]
+        return VectorField(algebra, [c if algebra.is_polynomial(c) else sympy.expand(c) for c in components])
     if len(hamiltonians) == 2 and algebra.n % 3 == 0 and algebra.n > 3:
         return triplet_field(algebra, *hamiltonians)
     if len(hamiltonians) != algebra.n - 1:
