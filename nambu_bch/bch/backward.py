@@ -194,8 +194,8 @@ def _backward_graded(backend, comp, order) -> tuple:
         series = [ops.load(x)] + [zero] * top
         for k, c in reversed(list(zip(comp.pieces, backend.constants(comp.coefficients)))):
             series = exp_pullback(fields[k], c, series)
-        pulled.append(series)
-    return _modified_field(backend, ops, pulled, order)
+        pulled.append([ops.unload(f) for f in series])
+    return modified_field_of_map(backend, pulled, order)
 
 
 def modified_field_of_map(backend, pulled, order) -> tuple:
@@ -207,12 +207,8 @@ def modified_field_of_map(backend, pulled, order) -> tuple:
     (Hairer-Lubich-Wanner IX.1).
     """
     ops = _series_arithmetic(backend)
-    return _modified_field(backend, ops, [[ops.load(f) for f in series] for series in pulled], order)
-
-
-def _modified_field(backend, ops, pulled, order) -> tuple:
-    """:func:`modified_field_of_map` on series already in ``ops``' representation (:func:`_series_arithmetic`)."""
     coords, zero = [ops.load(x) for x in backend.coordinates], ops.zero
+    pulled = [[ops.load(f) for f in series] for series in pulled]
     n = len(coords)
     top = order + 1
     Z = []
@@ -286,11 +282,11 @@ class _BackendSeries:
 
 
 class _FlintSeries:
-    """Series coefficients as flint ``fmpq_mpoly`` in the Laurent value ring of ``backend``, from the first
-    function loaded to the last coefficient returned.
+    """Series coefficients as flint ``fmpq_mpoly`` in the Laurent value ring of ``backend``, between one
+    :meth:`load` and one :meth:`unload`.
 
     Every coefficient of a series is met by several Lie derivatives and sums: kept in flint, it is converted to
-    and from sympy's ring once (:meth:`load`, :meth:`unload`) instead of at every ``apply`` and its sums run in C.
+    and from sympy's ring once (:meth:`load`, :meth:`unload`) instead of at every ``apply``, and its sums run in C.
     Products are brought to the canonical Laurent form (no term holding both ``p`` and ``p_inv``) exactly where
     the backend's own ``apply`` brings them there, so every coefficient is the same polynomial."""
 
