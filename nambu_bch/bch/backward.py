@@ -24,6 +24,7 @@ from dataclasses import dataclass
 import sympy
 
 from ..algebra import VectorField
+from ..algebra._flint import exponents
 from ..algebra.backend import field_backend
 from ..checks import MAX_ORDER, check_flag, check_int, show
 from ..errors import InvalidOrderError
@@ -169,8 +170,8 @@ def _backward_graded(backend, comp, order) -> tuple:
     ``l <= n - k``; so ``Z_j^i = [h^(j+1)] Phi^* x_i - sum_{k >= 2} [h^(j+1)] U_k / k!``
     and every ``[h^n] U_k`` is computed once (Hairer-Lubich-Wanner IX.1).
     """
-    coords, zero = backend.coordinates, backend.zero
-    n = len(coords)
+    ops = _series_arithmetic(backend)
+    zero = ops.zero
     top = order + 1
     one = backend.rational(sympy.Integer(1))
 
@@ -180,19 +181,20 @@ def _backward_graded(backend, comp, order) -> tuple:
             term, scale = f, one
             for k in range(0, top - m + 1):
                 if k:
-                    term = backend.apply(field, term)
+                    term = ops.apply(field, term)
                     scale = scale * c * backend.rational(sympy.Rational(1, k))
-                if backend.is_zero_function(term):
+                if ops.is_zero_function(term):
                     break
                 out[m + k] = out[m + k] + term * scale
         return out
 
+    fields = {k: ops.field_of(X) for k, X in backend.fields.items()}
     pulled = []
-    for x in coords:
-        series = [x] + [zero] * top
+    for x in backend.coordinates:
+        series = [ops.load(x)] + [zero] * top
         for k, c in reversed(list(zip(comp.pieces, backend.constants(comp.coefficients)))):
-            series = exp_pullback(backend.fields[k], c, series)
-        pulled.append(series)
+            series = exp_pullback(fields[k], c, series)
+        pulled.append([ops.unload(f) for f in series])
     return modified_field_of_map(backend, pulled, order)
 
 
@@ -204,7 +206,9 @@ def modified_field_of_map(backend, pulled, order) -> tuple:
     (a composition's pull-back, a Runge--Kutta step expanded by Taylor) has this modified field
     (Hairer-Lubich-Wanner IX.1).
     """
-    coords, zero = backend.coordinates, backend.zero
+    ops = _series_arithmetic(backend)
+    coords, zero = [ops.load(x) for x in backend.coordinates], ops.zero
+    pulled = [[ops.load(f) for f in series] for series in pulled]
     n = len(coords)
     top = order + 1
     Z = []
@@ -225,13 +229,113 @@ def modified_field_of_map(backend, pulled, order) -> tuple:
                 for l in live:
                     if l > m - k:
                         break
-                    value = value + backend.apply(Z[l], Ui[k - 1][m - 1 - l])
+                    value = value + ops.apply(Z[l], Ui[k - 1][m - 1 - l])
                 Ui[k][m] = value
                 rest = rest + value * inverse_factorial[k]
             comps.append(pulled[i][m] - rest)
-        Z.append(backend.field(comps))
-        if not backend.is_zero(Z[j]):
+        Z.append(ops.field(comps))
+        if not ops.is_zero(Z[j]):
             live.append(j)
         for i in range(n):
             U[i][1][m] = comps[i]
-    return tuple(backend.vector_field(backend.values(Zj)) for Zj in Z)
+    return tuple(backend.vector_field([ops.unload(c) for c in ops.values(Zj)]) for Zj in Z)
+
+
+def _series_arithmetic(backend):
+    """The arithmetic of the series above: :class:`_FlintSeries` when ``backend`` applies fields on flint
+    (the Laurent backend with python-flint), else :class:`_BackendSeries` (the backend's own ring)."""
+    if getattr(backend, "flint_q", None) is not None:
+        return _FlintSeries(backend)
+    return _BackendSeries(backend)
+
+
+class _BackendSeries:
+    """Series coefficients as the backend's own functions, fields as its fields."""
+
+    def __init__(self, backend):
+        self.backend = backend
+        self.zero = backend.zero
+
+    def load(self, f):
+        return f
+
+    def unload(self, f):
+        return f
+
+    def field_of(self, X):
+        return X
+
+    def field(self, comps):
+        return self.backend.field(comps)
+
+    def values(self, X):
+        return self.backend.values(X)
+
+    def apply(self, X, f):
+        return self.backend.apply(X, f)
+
+    def is_zero(self, X) -> bool:
+        return self.backend.is_zero(X)
+
+    def is_zero_function(self, f) -> bool:
+        return self.backend.is_zero_function(f)
+
+
+class _FlintSeries:
+    """Series coefficients as flint ``fmpq_mpoly`` in the Laurent value ring of ``backend``, between one
+    :meth:`load` and one :meth:`unload`.
+
+    Every coefficient of a series is met by several Lie derivatives and sums: kept in flint, it is converted to
+    and from sympy's ring once (:meth:`load`, :meth:`unload`) instead of at every ``apply``, and its sums run in C.
+    Products are brought to the canonical Laurent form (no term holding both ``p`` and ``p_inv``) exactly where
+    the backend's own ``apply`` brings them there, so every coefficient is the same polynomial."""
+
+    def __init__(self, backend):
+        self.backend = backend
+        self.ctx = backend.flint_q
+        self.zero = self.ctx.from_dict({})
+        self.pairs = backend._pairs  # the (p, p_inv) generator pairs of the Laurent ring
+        self.memo: dict = {}  # flint's exponent tuples -> Python ints, shared by every conversion of the series
+
+    def load(self, f):
+        return self.ctx.from_dict(dict(f))
+
+    def unload(self, f):
+        if not f:
+            return self.backend.zero
+        return self.backend.ring.dtype(zip(exponents(f, self.memo), f.coeffs()))
+
+    def field_of(self, X):
+        """A backend field as the tuple of its value-ring components in flint (``None`` for a zero one)."""
+        return tuple(self.load(c) if c else None for c in self.backend.values(X))
+
+    def field(self, comps):
+        return tuple(c if c else None for c in comps)
+
+    def values(self, X):
+        return [self.zero if c is None else c for c in X]
+
+    @staticmethod
+    def is_zero(X) -> bool:
+        return all(c is None for c in X)
+
+    @staticmethod
+    def is_zero_function(f) -> bool:
+        return not f
+
+    def apply(self, X, f):
+        """``X f = sum_i X^i D_i f`` in canonical Laurent form (as ``PolynomialBackend.apply``)."""
+        if not f:
+            return self.zero
+        total = None
+        for i, c in enumerate(X):
+            if c is not None:
+                d = f.derivative(i)
+                if d:
+                    total = c * d if total is None else total + c * d
+        if total is None or not total:
+            return self.zero
+        degrees = total.degrees()
+        if any(degrees[i] > 0 and degrees[j] > 0 for i, j in self.pairs):
+            return self.load(self.backend.reduce(self.unload(total)))
+        return total
