@@ -599,7 +599,7 @@ def _timed_growth(args, queue):
 
 
 def growth(limit: float = 900.0, systems=GROWTH_SYSTEMS, orders=GROWTH_ORDERS):
-    """The cost per two orders, phase by phase, next to the sizes that bound each phase (issue 23, target d).
+    """The cost per two orders, phase by phase, next to the sizes that bound each phase (target d of the exact-data redesign).
 
     For each system and each order of ``orders`` one cold process computes ``shadow_hamiltonians(system, "12321",
     order).shadows`` with the phases of :data:`PHASES` timed (CPU s), then reads the sizes of :func:`_sizes`; the
