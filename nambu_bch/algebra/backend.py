@@ -323,10 +323,15 @@ class PolynomialBackend:
         ZZ_ = ring.domain
         return ring.dtype(zip(exponents(p), map(ZZ_.dtype, map(int, p.coeffs())))) if not p.is_zero() else ring.zero
 
+    def holds_laurent_pairs(self, p) -> bool:
+        """Whether a flint polynomial in the ring's generators holds some ``p`` and its ``p_inv`` (by its degrees):
+        only then can a term need :meth:`reduce`."""
+        degrees = p.degrees()
+        return any(degrees[i] > 0 and degrees[j] > 0 for i, j in self._pairs)
+
     def _reduce_flint(self, p):
         """:meth:`reduce` of an ``fmpz_mpoly``: untouched unless some ``p`` and ``p_inv`` both occur (degrees)."""
-        degrees = p.degrees()
-        if not any(degrees[i] > 0 and degrees[j] > 0 for i, j in self._pairs):
+        if not self.holds_laurent_pairs(p):
             return p
         poly = self.reduce(self.from_flint(p))
         return self.flint.from_dict({m: int(c) for m, c in poly.items()})
@@ -444,20 +449,14 @@ class PolynomialBackend:
         ctx = self.flint_q
         if X.flint_values is None:
             X.flint_values = tuple(ctx.from_dict(dict(c)) if c else None for c in self.values(X))
-        g = ctx.from_dict(dict(f))
-        total = None
-        for i, c in enumerate(X.flint_values):
-            if c is not None:
-                d = g.derivative(i)
-                if not d.is_zero():
-                    total = c * d if total is None else total + c * d
-        if total is None or total.is_zero():
+        total = flint_lie_derivative(X.flint_values, ctx.from_dict(dict(f)))
+        if total is None:
             return self.zero
         # flint's exponents are fmpz, which must not reach sympy's ring; a series of backward error analysis meets
         # the same few thousand monomials again and again, and a dictionary lookup costs a fifth of converting them
         poly = self.ring.dtype(zip(exponents(total, self._exponents), total.coeffs()))
-        degrees = total.degrees()  # no term holds both p and p_inv unless both occur: then no reduction to do
-        return self.reduce(poly) if any(degrees[i] > 0 and degrees[j] > 0 for i, j in self._pairs) else poly
+        # no term holds both p and p_inv unless both occur: then no reduction to do
+        return self.reduce(poly) if self.holds_laurent_pairs(total) else poly
 
     @staticmethod
     def is_zero(X: _Field) -> bool:
@@ -573,6 +572,19 @@ class PolynomialBackend:
             den = pring.from_dict({tuple(shift): pring.domain.one})
             out[head] = field.new(num, den)
         return algebra.ring.from_dict(out)
+
+
+def flint_lie_derivative(values, g):
+    """``X g = sum_i X^i d_i g`` on flint polynomials: ``values`` the field's components (``None`` for a zero one),
+    ``g`` a polynomial of the same context; ``None`` when the result is zero.  Not brought to the Laurent form
+    (:meth:`PolynomialBackend.holds_laurent_pairs` says whether it may need :meth:`PolynomialBackend.reduce`)."""
+    total = None
+    for i, c in enumerate(values):
+        if c is not None:
+            d = g.derivative(i)
+            if not d.is_zero():
+                total = c * d if total is None else total + c * d
+    return None if total is None or total.is_zero() else total
 
 
 def _normal(expr):

@@ -25,7 +25,7 @@ import sympy
 
 from ..algebra import VectorField
 from ..algebra._flint import exponents
-from ..algebra.backend import field_backend
+from ..algebra.backend import field_backend, flint_lie_derivative
 from ..checks import MAX_ORDER, check_flag, check_int, show
 from ..errors import InvalidOrderError
 from ..integrators.composition import composition_for
@@ -294,7 +294,6 @@ class _FlintSeries:
         self.backend = backend
         self.ctx = backend.flint_q
         self.zero = self.ctx.from_dict({})
-        self.pairs = backend._pairs  # the (p, p_inv) generator pairs of the Laurent ring
         self.memo: dict = {}  # flint's exponent tuples -> Python ints, shared by every conversion of the series
 
     def load(self, f):
@@ -325,17 +324,9 @@ class _FlintSeries:
 
     def apply(self, X, f):
         """``X f = sum_i X^i D_i f`` in canonical Laurent form (as ``PolynomialBackend.apply``)."""
-        if not f:
+        total = flint_lie_derivative(X, f) if f else None
+        if total is None:
             return self.zero
-        total = None
-        for i, c in enumerate(X):
-            if c is not None:
-                d = f.derivative(i)
-                if d:
-                    total = c * d if total is None else total + c * d
-        if total is None or not total:
-            return self.zero
-        degrees = total.degrees()
-        if any(degrees[i] > 0 and degrees[j] > 0 for i, j in self.pairs):
+        if self.backend.holds_laurent_pairs(total):
             return self.load(self.backend.reduce(self.unload(total)))
         return total
