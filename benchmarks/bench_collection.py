@@ -112,7 +112,8 @@ def _run_pytest(args, cwd, tmp: Path, plugin_dirs=()) -> dict:
     proc = subprocess.run([sys.executable, "-m", "pytest", "-p", "bench_collection", "-p", "no:cacheprovider", *args],
                           cwd=cwd, env=env, capture_output=True, text=True, timeout=3600)
     if not out.exists():
-        raise SystemExit(f"pytest wrote no record (exit {proc.returncode}):\n{proc.stdout[-2000:]}{proc.stderr[-2000:]}")
+        tail = proc.stdout[-2000:] + proc.stderr[-2000:]
+        raise SystemExit(f"pytest wrote no record (exit {proc.returncode}):\n{tail}")
     return json.loads(out.read_text(encoding="utf-8"))
 
 
