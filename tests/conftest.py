@@ -372,12 +372,26 @@ def _deep_run(config) -> bool:
         return "deep" in expr.split() and "not" not in expr.split()
 
 
-def _in_deep_tier(item) -> bool:
+def _index_tiers():
+    """:data:`DEEP` by (file, test name) (the first entry of a pair wins) and :data:`LONG` by file, in order: each
+    item is then matched against its own file's few entries, not against every entry."""
+    deep, long_ = {}, {}
     for f, n, keep in DEEP:
-        if item.path.name == f and (item.name == n or item.name.startswith(n + "[")):
-            pid = item.name[len(n) + 1:-1] if item.name != n else ""
-            return not (keep(pid) if callable(keep) else pid in keep)
-    return False
+        deep.setdefault((f, n), keep)
+    for i, (f, n) in enumerate(LONG):
+        long_.setdefault(f, []).append((i, n))
+    return deep, long_
+
+
+def _in_deep_tier(file: str, name: str, deep_index: dict) -> bool:
+    """Whether the test ``name`` of ``file`` is deep.  A DEEP entry names a test function (no ``[``: checked by
+    tests/test_suite_tiers.py), so the entry of ``name`` is that of its function's name, the part before ``[``."""
+    n, bracket, _ = name.partition("[")
+    keep = deep_index.get((file, n))
+    if keep is None:
+        return False
+    pid = name[len(n) + 1:-1] if bracket else ""
+    return not (keep(pid) if callable(keep) else pid in keep)
 
 
 def _scale_hypothesis(item, deep: bool) -> None:
@@ -400,20 +414,20 @@ _FULL_SETTINGS: dict = {}
 
 def pytest_collection_modifyitems(session, config, items):
     deep = _deep_run(config)
+    names = [(item.path.name, item.name) for item in items]
     # every collected (file, test name) before selection, for tests/test_suite_tiers.py's check of DEEP
-    config.nambu_bch_collected = {(item.path.name, item.name) for item in items}
+    config.nambu_bch_collected = set(names)
     config.nambu_bch_deep = DEEP
-    for item in items:
-        if _in_deep_tier(item):
+    deep_index, long_index = _index_tiers()
+    ranks = []
+    for item, (f, name) in zip(items, names):
+        if _in_deep_tier(f, name, deep_index):
             item.add_marker(pytest.mark.deep)
         elif deep and getattr(getattr(item, "obj", None), "is_hypothesis_test", False):
             item.add_marker(pytest.mark.deep)  # the deep tier runs the hypothesis tests again, at full counts
         _scale_hypothesis(item, deep)
+        # the first LONG entry whose name prefix the test's name has, else after all of them
+        ranks.append(next((i for i, n in long_index.get(f, ()) if name.startswith(n)), len(LONG)))
 
-    def rank(item) -> int:
-        for i, (f, n) in enumerate(LONG):
-            if item.path.name == f and item.name.startswith(n):
-                return i
-        return len(LONG)
-
-    items.sort(key=rank)
+    order = sorted(range(len(items)), key=ranks.__getitem__)  # stable: the order among equal ranks is kept
+    items[:] = [items[i] for i in order]

@@ -80,3 +80,29 @@ def test_every_long_and_deep_entry_names_a_test_function():
              if not any(name == n.partition("[")[0] if "[" in n else name.startswith(n) for name in functions[f])]
     deep = [(f, n) for f, n, _ in DEEP if n not in functions[f]]
     assert not long_ and not deep, f"tests/conftest.py names no test function: LONG {long_}, DEEP {deep}"
+
+
+def test_indexed_tier_lookup_is_the_first_matching_deep_entry(request):
+    """conftest looks a test up in ``DEEP`` by (file, function name) (linear in the items); the answer is the
+    definition's: the first ``DEEP`` entry of the file naming the test's function decides, by its kept cases."""
+    from conftest import DEEP, _in_deep_tier, _index_tiers
+
+    collected = getattr(request.config, "nambu_bch_collected", None)
+    if collected is None:
+        pytest.skip("tests/conftest.py did not record the collection")
+    by_file = {}
+    for f, n, keep in DEEP:
+        by_file.setdefault(f, []).append((n, keep))
+    deep_index, _ = _index_tiers()
+    checked = 0
+    for f, name in collected:
+        for n, keep in by_file.get(f, ()):
+            if name == n or name.startswith(n + "["):
+                pid = name[len(n) + 1:-1] if name != n else ""
+                expected = not (keep(pid) if callable(keep) else pid in keep)
+                break
+        else:
+            expected = False
+        assert _in_deep_tier(f, name, deep_index) == expected, (f, name)
+        checked += 1
+    assert checked == len(collected)
