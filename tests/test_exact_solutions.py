@@ -182,3 +182,21 @@ def test_numeric_scalar_time_and_errors():
 def test_no_closed_form_for_rigid_body():
     with pytest.raises(NoExactResultError):
         modified_solution(model("rigid-body"), "12321", "o")
+
+
+def test_shadow_solution_stretches_the_conserved_one_without_solving_again(monkeypatch):
+    """Eq. (SHsol): ``x^s(t) = x^c(F(omega h) t)``; kind "s" takes the (cached) closed form of kind "c" instead of
+    solving the same equations a second time -- and gives what that second solution gave."""
+    from nambu_bch.exact import solutions
+
+    system = model("ho")
+    conserved = modified_solution(system, "TVT", "c")
+    solved = []
+    real = solutions._closed_form
+    monkeypatch.setattr(solutions, "_closed_form", lambda *a: solved.append(a) or real(*a))
+    shadow = solutions._solution.__wrapped__(system, "TVT", "s")   # past the cache: the work of a first call
+    assert solved == []
+    base, x0, Omega = real(system, modified_equations(system, "TVT", "c"), solutions.TIME)
+    factor = solutions.exact_shadow_hamiltonians(system, "TVT").factor
+    assert shadow.expressions == tuple(e.subs(solutions.TIME, factor * solutions.TIME) for e in base)
+    assert shadow.initial_symbols == x0 == conserved.initial_symbols and shadow.frequency == factor * Omega

@@ -79,7 +79,8 @@ BUILDERS = {
     "TruncationStudy": lambda: importlib.import_module("nambu_bch.numeric").truncation_study(
         "ho3", "32123", orders=(2,), steps=100, every=10, x0=(1, 1, 1)),
     "PrecisionStudy": lambda: importlib.import_module("nambu_bch.numeric").precision_study(
-        "ho3", "32123", h=0.1, steps=200, every=10, mp_steps=50, dps=20, repeats=1, timing_steps=100, x0=(1, 1, 1)),
+        "ho3", "32123", h=0.1, steps=200, every=10, mp_steps=50, dps=20, repeats=1, timing_steps=100, x0=(1, 1, 1),
+        backend="numpy"),  # "auto" would compile (or load) two numba loops for the timings: not what is pickled
     "ShadowTrajectory": lambda: nb.shadow_along(_ho3(), "12321", nb.iterate(_ho3(), "12321", 0.1, 20, (1, 1, 1)), 0.1),
     "NumericalShadow": lambda: importlib.import_module("nambu_bch.numeric").numerical_shadow(
         *np.hsplit(nb.iterate("ho", "212", 0.1, 20, (1.0, 0.0)), 2), "ho", 0.1),

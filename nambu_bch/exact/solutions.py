@@ -261,11 +261,12 @@ def modified_solution(system, word, kind) -> ModifiedSolution:
 def _solution(system, word, kind):
     eqs = modified_equations(system, word, kind)
     if kind == "s":
-        base, x0, Omega = _closed_form(system, modified_equations(system, word, "c"), TIME)
+        # Eq. (SHsol): x^s(t) = x^c(F t), so the closed form of kind "c" (cached) is stretched, not solved again
+        conserved = _solution(system, word, "c")
         shadow = exact_shadow_hamiltonians(system, word)
-        exprs = tuple(e.subs(TIME, shadow.factor * TIME) for e in base)
-        return ModifiedSolution(exprs, x0, shadow.factor * Omega, eqs, kind, word, system,
-                                step_frequency=shadow.frequency)
+        exprs = tuple(e.subs(TIME, shadow.factor * TIME) for e in conserved.expressions)
+        return ModifiedSolution(exprs, conserved.initial_symbols, shadow.factor * conserved.frequency, eqs, kind, word,
+                                system, step_frequency=shadow.frequency)
     exprs, x0, Omega = _closed_form(system, eqs, TIME)
     omega = frequency(system) if kind == "c" else Omega
     return ModifiedSolution(exprs, x0, Omega, eqs, kind, word, system, step_frequency=omega)
