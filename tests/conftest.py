@@ -301,6 +301,11 @@ DEEP = (
     # reversed, 0.5-1.3 s): the fast tier keeps the ho3 row, and test_time_reversal_symbolic's lotka-volterra-12321
     # row composes and reverses the same exponential flows
     ("test_integrators.py", "test_no_time_reversal_for_123", ("ho3",)),
+    # Auzinger's first table (CheckMethods, test_catalog_published): the three rows of 0.2-0.3 s CPU each whose kind a
+    # lighter row keeps in the fast tier -- an order-6 real method (Y 8-6 keeps KL 10-6 and BM 11-6 PRK) and a complex
+    # one (Emb 3/2 A c and the Milne 2/2 c rows keep A 3-3 c); every published row is still checked by the deep tier
+    ("test_catalog_published.py", "test_ab_table_of_check_methods",
+     lambda pid: pid not in ("KL 10-6", "BM 11-6 PRK", "A 3-3 c")),
 )
 
 #: The two ways :func:`cli_run` runs the command line; the fast tier keeps ``in-process``: the ``subprocess`` case

@@ -507,6 +507,24 @@ class TestPolynomialAlgebra:
         with pytest.raises(InvalidSystemError, match="x1"):
             PolynomialAlgebra([x1, x2], [x1])
 
+    def test_an_expression_is_converted_once(self, monkeypatch):
+        """Brackets convert the same Hamiltonians again and again: ``ring.from_expr`` runs once per expression and
+        algebra (an equal algebra shares it), and each caller gets its own ring element (a dict) to change."""
+        from sympy.polys.rings import PolyRing
+
+        calls = []
+        from_expr = PolyRing.from_expr
+        monkeypatch.setattr(PolyRing, "from_expr", lambda ring, e: calls.append(e) or from_expr(ring, e))
+        u, v, k = sympy.symbols("u_conv v_conv k_conv")  # names no other test converts
+        H = u**3 * v / (7 * k) + v**2
+        first = PolynomialAlgebra([u, v], [k]).convert(H)
+        again = PolynomialAlgebra([u, v], [k]).convert(H)
+        assert len(calls) == 1 and first == again and first is not again
+        first[(0, 0)] = first.ring.domain.one
+        assert PolynomialAlgebra([u, v], [k]).convert(H) == again and len(calls) == 1
+        poisson_bracket(PolynomialAlgebra([u, v], [k]), H, H)  # both slots: the memoised conversion
+        assert len(calls) == 1
+
 
 # --------------------------------------------------------------------------------------------------
 # Structure conditions: Eq. (Symplectic) and Eq. (Condition1)

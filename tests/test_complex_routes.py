@@ -84,6 +84,22 @@ def test_effective_field_of_the_oscillator_is_the_log_of_the_complex_step_matrix
     assert X[3].to_sympy() == (-sympy.I * omega**4 * x1 / 16, sympy.I * omega**4 * x2 / 16)
 
 
+def test_coefficients_reach_the_domain_through_one_conversion_of_the_generator(monkeypatch):
+    """A composition's coefficients, elements of a number field K = QQ(theta) (here sympy's QQ_I), become scalars of
+    the backend as polynomials in theta's image: one ``from_sympy`` (a minimal polynomial and a primitive-element
+    computation each, ~20 ms) per field, not one per number; the values are from_sympy's own."""
+    from nambu_bch.algebra.backend import PolynomialBackend
+
+    comp = nb.composition(S2)
+    backend = PolynomialBackend.build(nb.model("ho").algebra.with_constants(h, extension=comp.extension), {})
+    calls = []
+    from_sympy = type(backend.domain).from_sympy
+    monkeypatch.setattr(type(backend.domain), "from_sympy", lambda self, a: calls.append(a) or from_sympy(self, a))
+    values = backend.constants(comp.coefficients)
+    assert len(calls) == 1
+    assert values == [backend.domain.from_sympy(c) for c in comp.coefficients]
+
+
 @pytest.fixture(scope="module")
 def triple_jump_field():
     return effective_field(nb.model("ho").splitting, TRIPLE_JUMP, 4)

@@ -34,7 +34,8 @@ from nambu_bch.algebra import PolynomialAlgebra, elimination, frac_rref
 from nambu_bch.algebra.flint_ring import FlintRing
 from nambu_bch.caches import clear_caches
 from nambu_bch.shadow import shadow_hamiltonians
-from nambu_bch.shadow.direct_route import direct_route
+
+import shared_results as shared
 
 pytest.importorskip("flint")
 
@@ -157,9 +158,9 @@ def test_flint_ring_liouville_field_equals_sympy_ring(n, hams):
 def test_fraction_free_fields_equal_liouville_field(flint, monkeypatch):
     """The direct route's fraction-free sum of fields (cross terms of orders 2 + 2 and 2 + 4, rigid body with
     symbolic I) equals the sum of liouville_field over QQ(I1, I2, I3), with and without python-flint."""
+    R = shared.direct("rigid-body", "12321", 4)  # the input (the route is the same with and without flint)
     if not flint:
         monkeypatch.setenv("NAMBU_BCH_DISABLE_FLINT", "1")
-    R = direct_route(model("rigid-body"), "12321", 4)
     solver = dr._Solver(model("rigid-body"), R.composition, 4, None)
     c = R.corrections
     assignments = [[c[(0, 2)], c[(1, 2)]], [c[(0, 4)], c[(1, 2)]], [solver.hams[0], c[(1, 4)]]]
@@ -178,7 +179,7 @@ def test_fraction_free_fields_clear_denominators_on_flint(monkeypatch):
     fields runs without sympy's polynomial lcm or exact division (rigid body with symbolic I, orders 2 and 4)."""
     from sympy.polys.rings import PolyElement
 
-    R = direct_route(model("rigid-body"), "12321", 4)
+    R = shared.direct("rigid-body", "12321", 4)
     solver = dr._Solver(model("rigid-body"), R.composition, 4, None)
     c, ctx, plain = R.corrections, solver._flint_context(), solver._plain_ring()
     width = len(solver.alg.gens)
@@ -208,7 +209,7 @@ def test_right_hand_side_difference_on_flint_pairs(monkeypatch):
     subtraction (rigid body with symbolic I, h^4; and a difference in which a term cancels and one is new)."""
     from sympy.polys.fields import FracElement
 
-    R = direct_route(model("rigid-body"), "12321", 4)
+    R = shared.direct("rigid-body", "12321", 4)
     solver = dr._Solver(model("rigid-body"), R.composition, 4, None)
     alg, ctx = solver.alg, solver._flint_context()
     Z = [dr._lift(alg, z) for z in solver.effective[4].components]

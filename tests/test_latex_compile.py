@@ -20,11 +20,12 @@ from nambu_bch import (
     exact_shadow_hamiltonians,
     formal_bch,
     model,
-    shadow_hamiltonians,
 )
 from nambu_bch.cli import main
 from nambu_bch.errors import InvalidSystemError
 from nambu_bch.printing import PREAMBLE, latex_text
+
+import shared_results as shared
 
 PDFLATEX = shutil.which("pdflatex")
 pytestmark = pytest.mark.skipif(PDFLATEX is None, reason="no pdflatex installed (CI installs TeX Live)")
@@ -84,7 +85,7 @@ def test_api_blocks_compile_in_display_math(tmp_path):
     r"""``sympy.latex(result)`` is an ``aligned`` block: it compiles inside ``\[ ... \]`` (README: where it belongs)."""
     ho3 = model("ho3")
     objects = [
-        shadow_hamiltonians(ho3, "12321"), shadow_hamiltonians(model("rigid-body"), "123"),
+        shared.family("ho3", "12321"), shared.family("rigid-body", "123", 2),  # test_shadow's, computed once
         conserved_quantities(ho3, "32123"), exact_shadow_hamiltonians(ho3, "12321"),
         formal_bch("12321", 5), effective_field(ho3.splitting, "12321", 2),
     ]

@@ -356,7 +356,7 @@ def _verify_certificate(S, word, F):
         for (x, mono), c in cert.items():
             poly = sympy.Poly(sympy.expand(comps[index[x]]), *S.coordinates)
             total += c * poly.coeff_monomial(mono)
-        return sympy.simplify(total)
+        return sympy.cancel(total)  # a rational function of the parameters: zero iff its cancelled form is
 
     monos = [x1**a * x2**b * x3**c for a in range(D + 1) for b in range(D + 1) for c in range(D + 1) if a + b + c <= D]
     for mono in monos:

@@ -254,6 +254,30 @@ class TestSingleSplit:
         # the Lotka-Volterra equations dx_i/dt = x_i (x_{i+1} - x_{i-1})
         assert same(lotka_volterra.equations_of_motion(), (x1 * (x2 - x3), x2 * (x3 - x1), x3 * (x1 - x2)))
 
+    def test_lie_poisson_rotations_are_written_without_a_matrix_exponential(self, monkeypatch):
+        """Piece i of the Lie-Poisson rigid body (McLachlan 1993) rotates the other two axes by the angle t x_i / I_i:
+        its flow is written in closed form, with no matrix exponential (a Jordan form and simplify, ~0.5 s a piece,
+        paid by every first use of the model's splitting)."""
+        from sympy.matrices.matrixbase import MatrixBase
+
+        from nambu_bch.systems.piece_flows import piece_flow
+
+        calls = []
+        exp = MatrixBase.exp
+        monkeypatch.setattr(MatrixBase, "exp", lambda self: calls.append(self) or exp(self))
+        S = model("rigid-body-lp")
+        t = sympy.Symbol("t")
+        X = S.coordinates
+        for i, piece in enumerate(S.splitting.pieces):
+            flow = piece_flow.__wrapped__(piece, X)  # uncached: the work is counted
+            a, b = (j for j in range(3) if j != i)
+            w = X[i] / S.parameters[i] * (-1) ** i  # dx_a/dt = -w x_b, dx_b/dt = w x_a
+            c, s = sympy.cos(t * w), sympy.sin(t * w)
+            expected = list(X)
+            expected[a], expected[b] = sympy.expand(X[a] * c - X[b] * s), sympy.expand(X[a] * s + X[b] * c)
+            assert (flow.kind, flow.polynomial, flow.expressions) == ("rotation", False, tuple(expected))
+        assert calls == []
+
     def test_ho3_composite(self, ho3_composite):
         """(q^2, p^2, qp) oscillator: H = x2/2m + m w^2 x1/2, G = 2 x3^2 - 2 x1 x2; pieces X_{H_i, G}."""
         sp = ho3_composite.splitting

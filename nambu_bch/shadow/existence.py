@@ -261,9 +261,11 @@ def reversing_involutions(system, gs) -> list:
     out = []
     for size in range(1, n + 1, 2):
         for flip in combinations(range(n), size):
+            # symbols replaced by symbols: xreplace (one rebuild of the tree) is subs(simultaneous=True) without
+            # its pattern matching, ~6x faster on the integrands of a quartic pair (80 terms)
             sub = {coords[i]: -coords[i] for i in flip}
-            if all(sympy.expand(H.subs(sub, simultaneous=True) - H) == 0 for H in system.hamiltonians) and \
-                    all(sympy.expand(g.subs(sub, simultaneous=True) + g) == 0 for g in gs):
+            if all(sympy.expand(H.xreplace(sub) - H) == 0 for H in system.hamiltonians) and \
+                    all(sympy.expand(g.xreplace(sub) + g) == 0 for g in gs):
                 out.append(flip)
     return out
 
