@@ -88,7 +88,9 @@ runs = 0
 
 # -- modular reduction ----------------------------------------------------------------------------------------
 
-@njit(inline="always")
+# Compiled once and called (LLVM inlines it, a few instructions, into every caller's machine code): numba's
+# inline="always" copied and typed it again at each of its call sites, 1.7 s of the solve's cold compile.
+@njit(no_cpython_wrapper=True)
 def _reduce(x, p, inv):
     """``x mod p`` for ``|x| < 2^62``, ``p < 2^28``, ``inv = 1.0 / p``: a float64 quotient, one correction each way.
 
@@ -487,13 +489,13 @@ def _word_coefficients(letters, cpow, logk, primes, inv, g, n, count, top):
                         F[m, j, t] = acc
                 A[m, 0] = 0
                 for kk in range(1, m + 1):
-                    acc = 0
+                    acc = np.int64(0)  # (not a literal: one compiled _reduce)
                     for j in range(kk - 1 if kk - 1 > lo else lo, m):
                         acc += A[j, kk - 1] * F[m, j, s]
                     A[m, kk] = _reduce(acc, p, pinv)
             if not extend:
                 if m <= top:
-                    total = 0
+                    total = np.int64(0)
                     for kk in range(1, m + 1):
                         total += logk[i, kk] * A[m, kk]
                     out[idx, i] = _reduce(total, p, pinv)
