@@ -383,7 +383,8 @@ def _solve(z, primes, inv, words, lengths, left, right, K, core, lead, span, mem
     m = members.shape[0]
     live = _zeros_int32(m)  # 0 / 1 (int32: the one narrow type numba compiles here, for X)
     x = _zeros2(_LANES, 64)
-    acc = np.zeros(_LANES * d * k, dtype=np.int64).reshape((_LANES, d, k))
+    acc_flat = np.zeros(_LANES * d * k, dtype=np.int64)
+    acc = acc_flat.reshape((_LANES, d, k))  # a view: lanes 0 .. nb - 1 are the first nb d k entries of acc_flat
     lane_span = np.zeros(_LANES, dtype=np.int64)
     memo = _zeros_int32(lengths.shape[0] * d)  # node numbers of _class_program
     for i in range(memo.shape[0]):
@@ -419,10 +420,8 @@ def _solve(z, primes, inv, words, lengths, left, right, K, core, lead, span, mem
             for lane in range(nb):
                 lane_span[lane], lane_lead[lane] = span[members[b0 + lane]], lead[members[b0 + lane]]
             if stop >= 0:
-                for lane in range(nb):
-                    for j in range(d):
-                        for i in range(k):
-                            acc[lane, j, i] = 0
+                for i in range(nb * d * k):  # (one loop, not three: each loop nest is compiled code of its own)
+                    acc_flat[i] = 0
                 _add_earlier(acc, z, X, live, roots, chain, members, K, span, lane_span, lane_lead, primes, inv,
                              r0, b0, nb, block)
             _finish_group(acc, z, X, live, roots, chain, members, K, span, lane_span, lane_lead, primes, inv,
