@@ -379,7 +379,7 @@ def test_the_word_coefficients_and_the_reduction_are_compiled_once_each():
     """A loop over the primes in a statement costs numba and LLVM about as much to compile as the statement: the word
     coefficients walk the Lyndon words once per prime with scalar recurrences (one loop over the primes, around the
     walk), and the modular reduction is compiled once and called (LLVM inlines it), not copied and typed again by
-    numba at each call site (``inline="always"``: 1.7 s of the solve's cold compile).  Read from the source and the
+    numba at each call site (``inline="always"``).  Read from the source and the
     options, so nothing is compiled here."""
     import inspect
 

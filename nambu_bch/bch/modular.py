@@ -89,7 +89,7 @@ runs = 0
 # -- modular reduction ----------------------------------------------------------------------------------------
 
 # Compiled once and called (LLVM inlines it, a few instructions, into every caller's machine code): numba's
-# inline="always" copied and typed it again at each of its call sites, 1.7 s of the solve's cold compile.
+# inline="always" copied and typed it again at each of its call sites (cold compile time, no speed).
 @njit(no_cpython_wrapper=True)
 def _reduce(x, p, inv):
     """``x mod p`` for ``|x| < 2^62``, ``p < 2^28``, ``inv = 1.0 / p``: a float64 quotient, one correction each way.
