@@ -10,7 +10,8 @@ figure, as numba compiles them while typing it).  The warm figure is the best of
 (type inference, lowering to LLVM IR, ...; exclusive of what is compiled inside it) and LLVM's four steps
 (``add_ir_module``: parsing and verifying the IR; ``_optimize_functions``: the per-function passes;
 ``_optimize_final_module``: the module passes after linking the callees' code in; ``_finalize_specific``: machine
-code), with the number of lines of LLVM IR numba generated.
+code), with the number of lines of LLVM IR numba generated, in all and per compiled function (numba's own
+implementations of ``np.zeros`` and the like included: each is a compile of its own).
 
 With several ``--tree`` directories (source trees: the PYTHONPATH of the child) the cases run interleaved,
 tree after tree, ``--repeats`` rounds; the table gives the median per tree and the load average at the start
@@ -39,7 +40,7 @@ started = process_time()
 import numba
 from numba.core import codegen, event
 numba_import = process_time() - started
-stages, frames, ir_lines = {}, [], [0]
+stages, frames, ir_lines, ir_by_function = {}, [], [0], {}
 
 def _push(name):
     frames.append([name, process_time(), 0.0])
@@ -61,7 +62,9 @@ def _timed(method):
     original = getattr(codegen.JITCodeLibrary, method)
     def timed(self, *args):
         if method == "add_ir_module":
-            ir_lines[0] += str(args[0]).count("\n")
+            lines = str(args[0]).count("\n")
+            ir_lines[0] += lines
+            ir_by_function[self.name] = ir_by_function.get(self.name, 0) + lines
         _push("LLVM " + method)
         try:
             return original(self, *args)
@@ -107,7 +110,7 @@ for _ in range(5):
     warm()
     best = min(best, process_time() - t)
 print(json.dumps({"numba_import": numba_import, "first": first_cpu, "compiles": listener.rows, "warm": best,
-                  "stages": stages, "ir_lines": ir_lines[0]}))
+                  "stages": stages, "ir_lines": ir_lines[0], "ir_by_function": ir_by_function}))
 '''
 
 #: name -> source defining ``first()`` and ``warm()`` (the same calls on every tree).
@@ -233,6 +236,15 @@ def main(argv=None):
             print(f"    {'the other stages':46s}" + "".join(f" [{i}] {c:6.2f}" for i, c in enumerate(cols)))
             cols = [statistics.median(r["ir_lines"] for r in results[case, t]) for t in trees]
             print(f"    {'lines of LLVM IR generated':46s}" + "".join(f" [{i}] {c:6.0f}" for i, c in enumerate(cols)))
+            print("  lines of LLVM IR generated per compiled function (median; the largest):")
+            sizes: dict = {}
+            for t in trees:
+                for r in results[case, t]:
+                    for n, v in r["ir_by_function"].items():
+                        sizes[n] = max(sizes.get(n, 0), v)
+            for name in sorted(sizes, key=sizes.get, reverse=True)[:12]:
+                cols = [statistics.median(r["ir_by_function"].get(name, 0) for r in results[case, t]) for t in trees]
+                print(f"    {name[:46]:46s}" + "".join(f" [{i}] {c:6.0f}" for i, c in enumerate(cols)))
 
 
 if __name__ == "__main__":

@@ -351,7 +351,7 @@ def test_the_solve_compiles_each_helper_for_one_signature():
     callee again for ``int64``: the class loop's start must not be a literal (five helpers compiled twice cost
     ~3 s of a cold start).  Checked where the engine was compiled in this process (a cold cache)."""
     formal_bch("123", 5)
-    for helper in (modular._class_chains, modular._add_earlier, modular._finish_group):
+    for helper in (modular._class_chains, modular._add_earlier, modular._finish_group, modular._reduce):
         assert len(helper.signatures) <= 1, (helper, helper.signatures)
 
 
@@ -373,6 +373,19 @@ def test_the_engine_compiles_only_what_a_series_needs():
                    modular._run_program):
         options = getattr(helper, "targetoptions", None) or helper.options  # a numba dispatcher once made
         assert options.get("no_cpython_wrapper"), helper
+
+
+def test_the_word_coefficients_and_the_reduction_are_compiled_once_each():
+    """A loop over the primes in a statement costs numba and LLVM about as much to compile as the statement: the word
+    coefficients walk the Lyndon words once per prime with scalar recurrences (one loop over the primes, around the
+    walk), and the modular reduction is compiled once and called (LLVM inlines it), not copied and typed again by
+    numba at each call site (``inline="always"``).  Read from the source and the
+    options, so nothing is compiled here."""
+    import inspect
+
+    assert inspect.getsource(modular._word_coefficients.py_func).count("in range(k)") == 1
+    options = getattr(modular._reduce, "targetoptions", None) or modular._reduce.options
+    assert options.get("inline", "never") == "never" and options.get("no_cpython_wrapper")
 
 
 # -- numba is imported on first use ------------------------------------------------------------------------

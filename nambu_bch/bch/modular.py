@@ -88,7 +88,9 @@ runs = 0
 
 # -- modular reduction ----------------------------------------------------------------------------------------
 
-@njit(inline="always")
+# Compiled once and called (LLVM inlines it, a few instructions, into every caller's machine code): numba's
+# inline="always" copied and typed it again at each of its call sites (cold compile time, no speed).
+@njit(no_cpython_wrapper=True)
 def _reduce(x, p, inv):
     """``x mod p`` for ``|x| < 2^62``, ``p < 2^28``, ``inv = 1.0 / p``: a float64 quotient, one correction each way.
 
@@ -381,7 +383,8 @@ def _solve(z, primes, inv, words, lengths, left, right, K, core, lead, span, mem
     m = members.shape[0]
     live = _zeros_int32(m)  # 0 / 1 (int32: the one narrow type numba compiles here, for X)
     x = _zeros2(_LANES, 64)
-    acc = np.zeros(_LANES * d * k, dtype=np.int64).reshape((_LANES, d, k))
+    acc_flat = np.zeros(_LANES * d * k, dtype=np.int64)
+    acc = acc_flat.reshape((_LANES, d, k))  # a view: lanes 0 .. nb - 1 are the first nb d k entries of acc_flat
     lane_span = np.zeros(_LANES, dtype=np.int64)
     memo = _zeros_int32(lengths.shape[0] * d)  # node numbers of _class_program
     for i in range(memo.shape[0]):
@@ -417,10 +420,8 @@ def _solve(z, primes, inv, words, lengths, left, right, K, core, lead, span, mem
             for lane in range(nb):
                 lane_span[lane], lane_lead[lane] = span[members[b0 + lane]], lead[members[b0 + lane]]
             if stop >= 0:
-                for lane in range(nb):
-                    for j in range(d):
-                        for i in range(k):
-                            acc[lane, j, i] = 0
+                for i in range(nb * d * k):  # (one loop, not three: each loop nest is compiled code of its own)
+                    acc_flat[i] = 0
                 _add_earlier(acc, z, X, live, roots, chain, members, K, span, lane_span, lane_lead, primes, inv,
                              r0, b0, nb, block)
             _finish_group(acc, z, X, live, roots, chain, members, K, span, lane_span, lane_lead, primes, inv,
@@ -431,87 +432,82 @@ def _solve(z, primes, inv, words, lengths, left, right, K, core, lead, span, mem
 
 @njit()
 def _word_coefficients(letters, cpow, logk, primes, inv, g, n, count, top):
-    """``<log Phi, w> mod p`` for the Lyndon words ``w`` of length ``<= n`` in Duval order, every prime at once.
+    """``<log Phi, w> mod p`` for the Lyndon words ``w`` of length ``<= n`` in Duval order, every prime in turn.
 
     Words longer than ``top`` are skipped (left 0).
 
-    ``cpow[i, t, r] = c_t^r / r!`` and ``logk[i, k] = (-1)^(k+1) / k`` modulo ``primes[i]``; ``inv = 1.0 / primes``."""
+    ``cpow[i, t, r] = c_t^r / r!`` and ``logk[i, k] = (-1)^(k+1) / k`` modulo ``primes[i]``; ``inv = 1.0 / primes``.
+    The walk of the Lyndon words is repeated per prime, so the recurrences are scalar: a loop over the primes
+    inside every statement would cost numba and LLVM as much to compile again at each of a dozen places (the
+    walk itself is bookkeeping, a small part of a row's arithmetic)."""
     s = letters.shape[0]
     k = primes.shape[0]
     out = _zeros2(count, k)
-    # F[m, j, t] = <E_1..E_t, w[j:m]>, A[m, kk] = <(Phi - 1)^kk, w[:m]>
-    F = np.zeros((n + 1) * (n + 1) * (s + 1) * k, dtype=np.int64).reshape((n + 1, n + 1, s + 1, k))
-    A = np.zeros((n + 1) * (n + 1) * k, dtype=np.int64).reshape((n + 1, n + 1, k))
-    for m in range(n + 1):  # (loops, not slice assignments: numba compiles a broadcast for those)
+    # F[m, j, t] = <E_1..E_t, w[j:m]>, A[m, kk] = <(Phi - 1)^kk, w[:m]> (one prime)
+    F = np.zeros((n + 1) * (n + 1) * (s + 1), dtype=np.int64).reshape((n + 1, n + 1, s + 1))
+    A = _zeros2(n + 1, n + 1)
+    for m in range(n + 1):  # (loops, not slice assignments: numba compiles a broadcast for those); never overwritten
         for t in range(s + 1):
-            for i in range(k):
-                F[m, m, t, i] = 1
-    for i in range(k):
-        A[0, 0, i] = 1
+            F[m, m, t] = 1
+    A[0, 0] = 1
     w = _filled(n + 1, -1)
     run = np.zeros(n + 1, dtype=np.int64)  # run[m]: length of the trailing run of equal letters of w[:m]
-    acc = np.zeros(k, dtype=np.int64)
-    length, idx, period = 1, 0, 1
-    extend = False
-    while length > 0:
-        if not extend:
-            w[length - 1] += 1
-        m = length
-        if extend and m == n:  # a full-length extension is not a Lyndon word: no row needed
+    for i in range(k):
+        p, pinv = primes[i], inv[i]
+        for m in range(n + 1):
+            w[m] = -1
+        length, idx, period = 1, 0, 1
+        extend = False
+        while length > 0:
+            if not extend:
+                w[length - 1] += 1
+            m = length
+            if extend and m == n:  # a full-length extension is not a Lyndon word: no row needed
+                while length > 0 and w[length - 1] == g - 1:
+                    length -= 1
+                extend = False
+                continue
+            if m <= top:
+                a = w[m - 1]
+                run[m] = run[m - 1] + 1 if m > 1 and w[m - 2] == a else 1
+                # <Phi, w[j:m]> = 0 unless w[j:m] is in X_{k_1}^* ... X_{k_s}^*: j >= lo (greedy from the right),
+                # and then so is every prefix w[j:m-r] (rows of shorter prefixes are valid from lo on)
+                lo = m
+                for t in range(s - 1, -1, -1):
+                    while lo > 0 and w[lo - 1] == letters[t]:
+                        lo -= 1
+                for j in range(lo, m):
+                    F[m, j, 0] = 0
+                    top_r = run[m] if run[m] < m - j else m - j
+                    for t in range(1, s + 1):
+                        acc = F[m, j, t - 1]
+                        if letters[t - 1] == a:
+                            for r in range(1, top_r + 1):
+                                acc += F[m - r, j, t - 1] * cpow[i, t - 1, r]
+                            acc = _reduce(acc, p, pinv)
+                        F[m, j, t] = acc
+                A[m, 0] = 0
+                for kk in range(1, m + 1):
+                    acc = np.int64(0)  # (not a literal: one compiled _reduce)
+                    for j in range(kk - 1 if kk - 1 > lo else lo, m):
+                        acc += A[j, kk - 1] * F[m, j, s]
+                    A[m, kk] = _reduce(acc, p, pinv)
+            if not extend:
+                if m <= top:
+                    total = np.int64(0)
+                    for kk in range(1, m + 1):
+                        total += logk[i, kk] * A[m, kk]
+                    out[idx, i] = _reduce(total, p, pinv)
+                idx += 1
+                period = m
+            if length < n:  # Duval: extend periodically, one letter (one row) at a time
+                w[length] = w[length - period]
+                length += 1
+                extend = True
+                continue
             while length > 0 and w[length - 1] == g - 1:
                 length -= 1
             extend = False
-            continue
-        if m <= top:
-            a = w[m - 1]
-            run[m] = run[m - 1] + 1 if m > 1 and w[m - 2] == a else 1
-            # <Phi, w[j:m]> = 0 unless w[j:m] is in X_{k_1}^* ... X_{k_s}^*: j >= lo (greedy from the right),
-            # and then so is every prefix w[j:m-r] (rows of shorter prefixes are valid from lo on)
-            lo = m
-            for t in range(s - 1, -1, -1):
-                while lo > 0 and w[lo - 1] == letters[t]:
-                    lo -= 1
-            for j in range(lo, m):
-                for i in range(k):
-                    F[m, j, 0, i] = 0
-                for t in range(1, s + 1):
-                    for i in range(k):
-                        acc[i] = F[m, j, t - 1, i]
-                    if letters[t - 1] == a:
-                        for r in range(1, (run[m] if run[m] < m - j else m - j) + 1):
-                            for i in range(k):
-                                acc[i] += F[m - r, j, t - 1, i] * cpow[i, t - 1, r]
-                        for i in range(k):
-                            acc[i] = _reduce(acc[i], primes[i], inv[i])
-                    for i in range(k):
-                        F[m, j, t, i] = acc[i]
-            for i in range(k):
-                A[m, 0, i] = 0
-            for kk in range(1, m + 1):
-                for i in range(k):
-                    acc[i] = 0
-                for j in range(kk - 1 if kk - 1 > lo else lo, m):
-                    for i in range(k):
-                        acc[i] += A[j, kk - 1, i] * F[m, j, s, i]
-                for i in range(k):
-                    A[m, kk, i] = _reduce(acc[i], primes[i], inv[i])
-        if not extend:
-            if m <= top:
-                for i in range(k):
-                    total = 0
-                    for kk in range(1, m + 1):
-                        total += logk[i, kk] * A[m, kk, i]
-                    out[idx, i] = _reduce(total, primes[i], inv[i])
-            idx += 1
-            period = m
-        if length < n:  # Duval: extend periodically, one letter (one row) at a time
-            w[length] = w[length - period]
-            length += 1
-            extend = True
-            continue
-        while length > 0 and w[length - 1] == g - 1:
-            length -= 1
-        extend = False
     return out
 
 
