@@ -9,8 +9,8 @@ from pathlib import Path
 TOOL = Path(__file__).resolve().parents[1] / "tools" / "suite_profile.py"
 
 
-def _tool():
-    spec = importlib.util.spec_from_file_location("suite_profile_tool", TOOL)
+def _tool(path=TOOL):
+    spec = importlib.util.spec_from_file_location(path.stem + "_tool", path)
     module = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(module)
     return module
@@ -91,3 +91,12 @@ def test_report_names_a_loop_compiled_more_than_once_and_where(tmp_path):
         "  0.75 m.run: 2 times, 2 directories",
         "         0.50 gw1 t.py::test_p",
         "         0.25 gw1 t.py::test_q"]
+
+
+def test_compile_cost_takes_triples_and_says_how_otherwise(capsys):
+    """tools/compile_cost.py (docs/suite_time.md's per-kind compile table): arguments come in triples; anything else
+    is its usage line and exit 2, before numba or the package is imported."""
+    tool = _tool(TOOL.with_name("compile_cost.py"))
+    for argv in ([], ["ho3", "32123"], ["ho3", "32123", "run", "ho"]):
+        assert tool.main(argv) == 2
+        assert capsys.readouterr().err.startswith("usage: compile_cost.py SYSTEM WORD LOOP")
