@@ -10,7 +10,8 @@ condition of .ci/run), then report:
 Each pytest process (the xdist workers, the controller) appends JSON lines to ``DIR/<worker>.jsonl``: its CPU
 at start, after collection and at the end (with the load average), and per test the process's own CPU (user +
 sys) and that of the child processes it reaped during the test, plus every top-level numba compile above
-0.05 s of CPU with the test that caused it.  Without ``SUITE_PROFILE_DIR`` the plugin records nothing.
+0.05 s of CPU with the test that caused it, the loop's fast-math variant and the directory of its source (the report
+lists each loop compiled more than once).  Without ``SUITE_PROFILE_DIR`` the plugin records nothing.
 """
 
 from __future__ import annotations
