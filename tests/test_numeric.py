@@ -697,12 +697,15 @@ def test_batch_reads_x0_in_place_and_leaves_it_unchanged(backend):
 @pytest.mark.parametrize("backend", [pytest.param("numba", marks=numba_only), "numpy"])
 def test_out_receives_the_samples_in_place(backend):
     """out= is filled in place and returned, every element written (garbage in it does not matter),
-    with the bits of a run that allocates its own result: single, batch, Kahan, progress segments."""
+    with the bits of a run that allocates its own result: single, batch, Kahan, progress segments.  The Kahan batch
+    on ho/TVT, whose Kahan batch loop the fast tier compiles (test_batch_numba_numpy_and_single_agree_bitwise[True])."""
     X = np.random.default_rng(5).normal(size=(3, 50))
-    for x0, kw in ((X, {}), (X, {"kahan": True}), (X[:, 3], {}), (X[:, 3], {"kahan": True})):
-        want = iterate("ho3", "32123", 0.1, 40, x0, every=7, backend=backend, **kw)
+    cases = (("ho3", "32123", X, {}), ("ho", "TVT", X[:2], {"kahan": True}), ("ho3", "32123", X[:, 3], {}),
+             ("ho3", "32123", X[:, 3], {"kahan": True}))
+    for name, word, x0, kw in cases:
+        want = iterate(name, word, 0.1, 40, x0, every=7, backend=backend, **kw)
         out = np.full(want.shape, np.nan)
-        got = iterate("ho3", "32123", 0.1, 40, x0, every=7, backend=backend, out=out, **kw)
+        got = iterate(name, word, 0.1, 40, x0, every=7, backend=backend, out=out, **kw)
         assert got is out and np.array_equal(out, want)
     out = np.full((1, 3, 50), 7.0)
     assert np.array_equal(iterate("ho3", "32123", 0.1, 0, X, out=out, backend=backend), X[None])
