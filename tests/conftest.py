@@ -43,7 +43,7 @@ LONG = (
     ("test_numeric.py", "test_exponential_flows_agree_across_backends"),
     ("test_numeric_parallel.py", "test_an_overflow_in_any_thread_is_reported"),  # ... reused here
     ("test_hardening_numeric.py", "test_compiled_scan_agrees_with_numpy_guards"),  # the scan, ho3/32123's batch loop ...
-    ("test_numeric.py", "test_"),  # ... reused by the file's batch tests, with its Kahan batch loop (3-5 s) ...
+    ("test_numeric.py", "test_"),  # ... reused by the file's batch tests, with ho/TVT's Kahan batch loop (3-4 s) ...
     ("test_numeric_parallel.py", "test_"),                                  # ... and here (both loops in threads)
     ("test_cache_safety.py", "test_"),                                      # 15-30 s each: numba recompiles in subprocesses
     ("test_docs.py", "test_api_reference_builds_without_warnings"),         # a Sphinx build in a subprocess
@@ -208,9 +208,9 @@ DEEP = (
     ("test_numeric_api_arguments.py", "test_default_x0_of_every_model_runs_a_long_orbit", ()),
     # Eqs. (1AX)-(2BY) for generic functions (jets); the fast tier checks them on the models (test_fi_route's h^2 hull)
     ("test_shadow.py", "test_eight_representations_for_generic_functions", ()),
-    # threaded batches: the oscillator's kernels in the fast tier; the exponential flows' (a 4-8 s compile of the
-    # Lotka-Volterra batch loops) in the deep tier
-    ("test_numeric_parallel.py", "test_threads_give_the_one_thread_bits", ("False-ho3-32123", "True-ho3-32123")),
+    # threaded batches: the oscillators' kernels in the fast tier (ho3/32123's plain and ho/TVT's Kahan batch loop, the
+    # ones test_numeric.py compiles); the exponential flows' (a 4-8 s compile of the Lotka-Volterra batch loops) deep
+    ("test_numeric_parallel.py", "test_threads_give_the_one_thread_bits", ("ho3-32123-False", "ho-TVT-True")),
     # the generic T|V answer against the concrete systems: d = 1 and 2 in the fast tier, the d = 3 quartic (4-6 s)
     ("test_generic_separable.py", "test_substituted_equals_the_concrete_shadow_hamiltonian_d3", ()),
     # the command line as a subprocess (cli_run's "subprocess" case, 1.4-2.2 s each) is deep by the fixture's own
@@ -239,11 +239,12 @@ DEEP = (
     ("test_bseries.py", "test_shadow_pair_field_equals_modified_field", ("ho3-midpoint", "lotka-volterra-midpoint")),
     ("test_bch_concrete.py", "test_fast_and_plain_representations_agree",
      ("ho3-12321", "lotka-volterra-123", "ho-forest-ruth")),
-    # compiled code once per kind in the fast tier: ho3/32123's single-step and batch loops (which
-    # test_hardening_numeric's probes and test_numeric_parallel's threads compile anyway), the Lotka-Volterra batch loop
-    # (test_exponential_flows_agree_across_backends), the Runge-Kutta loop, the compiled scan and the sparse BCH engine
-    # once each; the other systems' generated loops of this table (0.3-0.9 s of compile each, cold) are deep.  Their
-    # generated source is still run on the interpreter by the fast tier (iterate's numpy backend and backend="auto")
+    # compiled code once per kind in the fast tier: ho3/32123's single-step and batch loops, ho/TVT's Kahan batch loop
+    # (which test_hardening_numeric's probes and test_numeric_parallel's threads compile anyway), the Lotka-Volterra
+    # batch loop (test_exponential_flows_agree_across_backends), the Runge-Kutta loop, the compiled scan and the sparse
+    # BCH engine once each; the other systems' generated loops of this table (0.3-0.9 s of compile each, cold) are
+    # deep.  Their generated source is still run on the interpreter by the fast tier (iterate's numpy backend and
+    # backend="auto")
     ("test_numeric.py", "test_numba_and_numpy_agree_bitwise", ("False-ho3-32123", "True-ho3-32123")),
     # the kernel cache's damage probes recompile ho3/32123 in an empty cache each: the fast tier keeps garbage in place
     # of the source and an index naming a path outside the cache; the empty files and the unparsable index are deep

@@ -345,12 +345,16 @@ def test_numba_and_numpy_agree_bitwise(name, word, kahan):
 @numba_only
 @pytest.mark.parametrize("kahan", [False, True])
 def test_batch_numba_numpy_and_single_agree_bitwise(kahan):
+    """The compiled batch loop, the numpy one and the single run give the same bits: ho3/32123's plain batch loop, and
+    the Kahan batch loop on ho/TVT -- the fast tier's one compile of that kind, ho's the cheaper (3.0 s cold against
+    ho3/32123's 4.1 s, tools/compile_cost.py; docs/suite_time.md)."""
+    name, word = ("ho", "TVT") if kahan else ("ho3", "32123")
     rng = np.random.default_rng(1)
-    X = rng.normal(size=(3, 301))                       # not a multiple of the chunk sizes
-    a = iterate("ho3", "32123", 0.1, 50, X, every=10, kahan=kahan, backend="numba")
-    b = iterate("ho3", "32123", 0.1, 50, X, every=10, kahan=kahan, backend="numpy", chunk=64)
+    X = rng.normal(size=(model(name).N, 301))           # not a multiple of the chunk sizes
+    a = iterate(name, word, 0.1, 50, X, every=10, kahan=kahan, backend="numba")
+    b = iterate(name, word, 0.1, 50, X, every=10, kahan=kahan, backend="numpy", chunk=64)
     assert np.array_equal(a, b)
-    single = iterate("ho3", "32123", 0.1, 50, X[:, 123], every=10, kahan=kahan)
+    single = iterate(name, word, 0.1, 50, X[:, 123], every=10, kahan=kahan)
     assert np.array_equal(a[:, :, 123], single)
 
 
@@ -693,12 +697,15 @@ def test_batch_reads_x0_in_place_and_leaves_it_unchanged(backend):
 @pytest.mark.parametrize("backend", [pytest.param("numba", marks=numba_only), "numpy"])
 def test_out_receives_the_samples_in_place(backend):
     """out= is filled in place and returned, every element written (garbage in it does not matter),
-    with the bits of a run that allocates its own result: single, batch, Kahan, progress segments."""
+    with the bits of a run that allocates its own result: single, batch, Kahan, progress segments.  The Kahan batch
+    on ho/TVT, whose Kahan batch loop the fast tier compiles (test_batch_numba_numpy_and_single_agree_bitwise[True])."""
     X = np.random.default_rng(5).normal(size=(3, 50))
-    for x0, kw in ((X, {}), (X, {"kahan": True}), (X[:, 3], {}), (X[:, 3], {"kahan": True})):
-        want = iterate("ho3", "32123", 0.1, 40, x0, every=7, backend=backend, **kw)
+    cases = (("ho3", "32123", X, {}), ("ho", "TVT", X[:2], {"kahan": True}), ("ho3", "32123", X[:, 3], {}),
+             ("ho3", "32123", X[:, 3], {"kahan": True}))
+    for name, word, x0, kw in cases:
+        want = iterate(name, word, 0.1, 40, x0, every=7, backend=backend, **kw)
         out = np.full(want.shape, np.nan)
-        got = iterate("ho3", "32123", 0.1, 40, x0, every=7, backend=backend, out=out, **kw)
+        got = iterate(name, word, 0.1, 40, x0, every=7, backend=backend, out=out, **kw)
         assert got is out and np.array_equal(out, want)
     out = np.full((1, 3, 50), 7.0)
     assert np.array_equal(iterate("ho3", "32123", 0.1, 0, X, out=out, backend=backend), X[None])
@@ -729,15 +736,16 @@ def test_out_is_refused_unless_it_can_take_the_samples_in_place():
 
 def test_segmented_kahan_batch_carries_the_compensation(monkeypatch, capsys):
     """A Kahan batch cut into progress segments (each starting from the last sample written, the
-    compensation carried in place) gives the bits of the uncut run and of each state's own run."""
+    compensation carried in place) gives the bits of the uncut run and of each state's own run.  On ho/TVT: the
+    Kahan batch loop the fast tier compiles (test_batch_numba_numpy_and_single_agree_bitwise[True])."""
     import importlib
 
-    X = np.random.default_rng(2).normal(size=(3, 40))
-    whole = iterate("ho3", "32123", 0.01, 700, X, every=70, kahan=True)
+    X = np.random.default_rng(2).normal(size=(2, 40))
+    whole = iterate("ho", "TVT", 0.01, 700, X, every=70, kahan=True)
     monkeypatch.setattr(importlib.import_module("nambu_bch.numeric.iterate"), "_SEGMENT_WORK", 5000)
-    cut = iterate("ho3", "32123", 0.01, 700, X, every=70, kahan=True, progress=True)
+    cut = iterate("ho", "TVT", 0.01, 700, X, every=70, kahan=True, progress=True)
     assert np.array_equal(whole, cut)
-    assert np.array_equal(whole[:, :, 7], iterate("ho3", "32123", 0.01, 700, X[:, 7], every=70, kahan=True))
+    assert np.array_equal(whole[:, :, 7], iterate("ho", "TVT", 0.01, 700, X[:, 7], every=70, kahan=True))
     capsys.readouterr()
 
 

@@ -18,8 +18,10 @@ RNG = np.random.default_rng(7)
 iterate_module = importlib.import_module("nambu_bch.numeric.iterate")  # the package re-exports the function
 
 
-@pytest.mark.parametrize("model, word", [("ho3", "32123"), ("lotka-volterra", "12321")])
-@pytest.mark.parametrize("kahan", [False, True])
+# each batch loop once: ho3/32123's plain and ho/TVT's Kahan batch loops (the fast tier's compiles of those kinds,
+# test_numeric.py's test_batch_numba_numpy_and_single_agree_bitwise), Lotka-Volterra's two (deep, tests/conftest.py)
+@pytest.mark.parametrize("model, word, kahan", [("ho3", "32123", False), ("ho", "TVT", True),
+                                                ("lotka-volterra", "12321", False), ("lotka-volterra", "12321", True)])
 def test_threads_give_the_one_thread_bits(model, word, kahan):
     S = nb.model(model)
     X = RNG.uniform(0.5, 1.5, (S.N, 1100))  # chunks of 256: five, split unevenly over the threads

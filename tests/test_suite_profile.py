@@ -9,8 +9,8 @@ from pathlib import Path
 TOOL = Path(__file__).resolve().parents[1] / "tools" / "suite_profile.py"
 
 
-def _tool():
-    spec = importlib.util.spec_from_file_location("suite_profile_tool", TOOL)
+def _tool(path=TOOL):
+    spec = importlib.util.spec_from_file_location(path.stem + "_tool", path)
     module = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(module)
     return module
@@ -67,3 +67,36 @@ def test_compiles_of_the_test_that_first_imports_numba_are_recorded(tmp_path, mo
     assert [r["k"] for r in records] == ["start", "numba"]
     assert records[1]["test"] == "tests/test_a.py::test_first" and records[1]["cpu"] > 0.05
     assert records[1]["fn"].endswith("test_compiles_of_the_test_that_first_imports_numba_are_recorded")
+
+
+def test_report_names_a_loop_compiled_more_than_once_and_where(tmp_path):
+    """A loop compiled twice in one cache directory (two workers at once) and a second fast-math variant of a function
+    (fma=True's "+contract") are told apart: the variant is its own loop, the repeat is listed with worker and test."""
+    records = {
+        "gw0": [{"k": "numba", "test": "t.py::test_a", "fn": "m.run_batch", "cpu": 2.5, "variant": "", "where": "/c"},
+                {"k": "numba", "test": "t.py::test_f", "fn": "m.run_batch", "cpu": 2.0, "variant": "+contract",
+                 "where": "/c"}],
+        "gw1": [{"k": "numba", "test": "t.py::test_b", "fn": "m.run_batch", "cpu": 2.25, "variant": "", "where": "/c"},
+                {"k": "numba", "test": "t.py::test_p", "fn": "m.run", "cpu": 0.5, "variant": "", "where": "/tmp/1"},
+                {"k": "numba", "test": "t.py::test_q", "fn": "m.run", "cpu": 0.25, "variant": "", "where": "/tmp/2"}],
+    }
+    for worker, lines in records.items():
+        (tmp_path / f"{worker}.jsonl").write_text("".join(json.dumps(r) + "\n" for r in lines))
+    text = _tool().report(tmp_path)
+    assert "  2.00 m.run_batch+contract  <- t.py::test_f" in text
+    assert text.split("--- compiled more than once\n")[1].splitlines() == [
+        "  4.75 m.run_batch: 2 times, one directory",
+        "         2.50 gw0 t.py::test_a",
+        "         2.25 gw1 t.py::test_b",
+        "  0.75 m.run: 2 times, 2 directories",
+        "         0.50 gw1 t.py::test_p",
+        "         0.25 gw1 t.py::test_q"]
+
+
+def test_compile_cost_takes_triples_and_says_how_otherwise(capsys):
+    """tools/compile_cost.py (docs/suite_time.md's per-kind compile table): arguments come in triples; anything else
+    is its usage line and exit 2, before numba or the package is imported."""
+    tool = _tool(TOOL.with_name("compile_cost.py"))
+    for argv in ([], ["ho3", "32123"], ["ho3", "32123", "run", "ho"]):
+        assert tool.main(argv) == 2
+        assert capsys.readouterr().err.startswith("usage: compile_cost.py SYSTEM WORD LOOP")

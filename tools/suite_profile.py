@@ -10,7 +10,8 @@ condition of .ci/run), then report:
 Each pytest process (the xdist workers, the controller) appends JSON lines to ``DIR/<worker>.jsonl``: its CPU
 at start, after collection and at the end (with the load average), and per test the process's own CPU (user +
 sys) and that of the child processes it reaped during the test, plus every top-level numba compile above
-0.05 s of CPU with the test that caused it.  Without ``SUITE_PROFILE_DIR`` the plugin records nothing.
+0.05 s of CPU with the test that caused it, the loop's fast-math variant and the directory of its source (the report
+lists each loop compiled more than once).  Without ``SUITE_PROFILE_DIR`` the plugin records nothing.
 """
 
 from __future__ import annotations
@@ -93,7 +94,12 @@ def _watch_numba() -> None:
             spent = time.process_time() - start
             if _state["depth"] == 0 and spent > 0.05:
                 fn = self.py_func
-                _write({"k": "numba", "test": _state["test"], "fn": f"{fn.__module__}.{fn.__qualname__}", "cpu": spent})
+                # the fast-math flags and the source's directory tell a second loop of the same function (fma=True's
+                # "+contract") and a probe's own cache from a true second compile of one loop
+                fastmath = getattr(self, "targetoptions", {}).get("fastmath") or ()
+                _write({"k": "numba", "test": _state["test"], "fn": f"{fn.__module__}.{fn.__qualname__}", "cpu": spent,
+                        "variant": "".join("+" + flag for flag in sorted(fastmath)) if fastmath else "",
+                        "where": os.path.dirname(fn.__code__.co_filename)})
 
     compile._profiled = True
     dispatcher.Dispatcher.compile = compile
@@ -149,8 +155,29 @@ def report(directory, n_tests: int = 60, n_files: int = 30) -> str:
     lines.append("--- tests (own, children)")
     lines += [f"{t['own']:6.2f} {t['ch']:6.2f} {t['test']}" for t in sorted(tests, key=cost, reverse=True)[:n_tests]]
     lines.append(f"--- numba compiles: {len(compiles)}, {sum(c['cpu'] for c in compiles):.1f} s")
-    lines += [f"{c['cpu']:6.2f} {c['fn']}  <- {c['test']}" for c in sorted(compiles, key=lambda c: -c["cpu"])]
+    lines += [f"{c['cpu']:6.2f} {c['fn']}{c.get('variant', '')}  <- {c['test']}"
+              for c in sorted(compiles, key=lambda c: -c["cpu"])]
+    lines += _repeated(compiles)
     return "\n".join(lines)
+
+
+def _repeated(compiles) -> list:
+    """Lines naming each loop (function and fast-math variant) compiled more than once, with the worker and test of
+    each compile: in the same source directory (one cache: two workers needing it at once, or a lost cache entry)
+    or in several (a probe's own cache directory, whose compile is its subject)."""
+    groups = collections.defaultdict(list)
+    for c in compiles:
+        groups[c["fn"] + c.get("variant", "")].append(c)
+    repeated = {key: group for key, group in groups.items() if len(group) > 1}
+    if not repeated:
+        return []
+    lines = ["--- compiled more than once"]
+    for key, group in sorted(repeated.items(), key=lambda kv: -sum(c["cpu"] for c in kv[1])):
+        places = len({c.get("where") for c in group})
+        where = "one directory" if places == 1 else f"{places} directories"
+        lines.append(f"{sum(c['cpu'] for c in group):6.2f} {key}: {len(group)} times, {where}")
+        lines += [f"       {c['cpu']:6.2f} {c['worker']} {c['test']}" for c in group]
+    return lines
 
 
 def main(argv=None) -> int:
