@@ -14,7 +14,7 @@ from hypothesis import strategies as st
 from nambu_bch import PAPER_WORDS, System, composed_map, liouville_field, model
 from nambu_bch.bch import effective_field
 from nambu_bch.errors import InvalidOrderError, NambuBCHError
-from nambu_bch.exact import conserved_quantities, is_invariant
+from nambu_bch.exact import conserved_quantities, invariants, is_invariant
 
 x1, x2, x3, m, omega, h = sympy.symbols("x1 x2 x3 m omega h")
 H2 = x2**2 / (2 * m) + m * omega**2 * x1**2 / 2  # Eq. (HO1)
@@ -131,6 +131,45 @@ def test_no_invariant_near_H_for_rigid_body():
     assert cq.H_c is None and cq.G_c is None
     data = cq.to_dict()
     assert {k: data[k] for k in ("H_c", "G_c", "series")} == {"H_c": None, "G_c": None, "series": {}}
+
+
+@pytest.fixture(scope="module")
+def rigid_body_setup():
+    """The rigid body's 12321 prepared for a degree-2 search (the map composed once for the tests below)."""
+    from nambu_bch import composition
+
+    return invariants._Setup(model("rigid-body"), composition("12321", 3), 2)
+
+
+def test_rigid_body_none_is_certified_at_a_point_without_the_exact_images(rigid_body_setup, monkeypatch):
+    """"No invariant of degree <= 2" is decided by the rank at one rational point: the map is never converted to
+    K[x] = QQ(I1, I2, I3, h)[x] and nothing is eliminated over K (that route took ~3.6 s of images)."""
+    setup = rigid_body_setup
+    monkeypatch.setattr(invariants, "nullspace", lambda matrix: pytest.fail("eliminated over K"))
+    assert invariants._invariant_basis(setup, 2) == []
+    assert "phi" not in setup.__dict__
+
+
+def test_point_certificate_skips_points_where_a_denominator_vanishes(rigid_body_setup, monkeypatch):
+    """The map divides by I1, I2, I3: a point with I1 = 0 is not used (the next one is), and with no usable point
+    there is no certificate (the caller eliminates over K)."""
+    setup, monos = rigid_body_setup, rigid_body_setup.monomials(2)
+    monkeypatch.setattr(invariants, "_POINTS", ((0, 5, 7, 11), (3, 5, 7, 11)))
+    assert invariants._no_invariant_at_a_point(setup, monos)
+    monkeypatch.setattr(invariants, "_POINTS", ((3, 0, 7, 11),))
+    assert not invariants._no_invariant_at_a_point(setup, monos)
+    monkeypatch.setattr(invariants, "_POINTS", ((3, 5, 7),))  # fewer values than parameters and h
+    assert not invariants._no_invariant_at_a_point(setup, monos)
+
+
+def test_point_certificate_never_claims_none_when_invariants_exist():
+    """ho3's 12321 has H_c and G_c: the matrix is rank-deficient at every point, the certificate declines and the
+    exact elimination finds both (Eqs. (CQ12321H), (CQ12321G))."""
+    from nambu_bch import composition
+
+    setup = invariants._Setup(model("ho3"), composition("12321", 3), 2)
+    assert not invariants._no_invariant_at_a_point(setup, setup.monomials(2))
+    assert len(invariants._invariant_basis(setup, 2)) == 2
 
 
 def test_user_system_and_composition_object():

@@ -41,11 +41,13 @@ Horikoshi, Eqs. (CQPV), (CQ12321H), (CQ12321G), Table (table); Kobayashi (2021).
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from functools import lru_cache
+from functools import cached_property, lru_cache
 from itertools import combinations
 from math import comb, prod
 
 import sympy
+from sympy.polys.domains import QQ
+from sympy.polys.rings import PolyRing
 
 from ..algebra import PolynomialAlgebra
 from ..systems.spec import as_system
@@ -109,12 +111,19 @@ class _Setup:
                     f"needs images of up to {size} terms, estimated from the word's {len(flows)} sub-flows "
                     f"(at most {MAX_IMAGE_TERMS}); lower the degree or shorten the word"
                 )
+        self.polynomial = all(f.polynomial for f in flows)
         phi = composed_map(system.splitting, comp)
         self.phi_exprs = tuple(sympy.sympify(e, strict=True) for e in phi)
+
+    @cached_property
+    def phi(self):
+        """The map in ``K[x]``, or ``None`` when it is not polynomial there (exp(...) flows: :func:`_exp_images`).
+
+        Converted on first use: a search that :func:`_no_invariant_at_a_point` settles never needs it."""
         try:
-            self.phi = tuple(self.R.from_expr(e) for e in self.phi_exprs)
+            return tuple(self.R.from_expr(e) for e in self.phi_exprs)
         except Exception:  # CoercionFailed & co: exp(...) flows (Lotka-Volterra), see _exp_images
-            self.phi = None
+            return None
 
     def monomials(self, degree):
         """The ansatz's monomials: total degree ``1..degree``, graded (:mod:`nambu_bch.algebra.ansatz`)."""
@@ -158,9 +167,8 @@ def image_terms(counts, degrees, monos) -> int:
                for mu in monos)
 
 
-def _ring_images(setup: _Setup, monos):
-    """``{monomial: coefficient}`` of ``x^mu(Phi_h(x)) - x^mu`` for each ``mu``, in the sparse ring."""
-    R, phi = setup.R, setup.phi
+def _ring_images(R, phi, monos):
+    """``{monomial: coefficient}`` of ``x^mu(Phi_h(x)) - x^mu`` for each ``mu``, in the sparse ring ``R``."""
     powers = [[R.one] for _ in phi]
 
     def power(i, k):
@@ -174,7 +182,7 @@ def _ring_images(setup: _Setup, monos):
         for i, k in enumerate(mu):
             if k:
                 image = image * power(i, k)
-        columns.append(dict(image - R({mu: setup.K.one})))
+        columns.append(dict(image - R({mu: R.domain.one})))
     return columns
 
 
@@ -216,11 +224,55 @@ def _exp_images(setup: _Setup, monos):
     return columns
 
 
+#: The rational points ``(parameters..., h)`` at which :func:`_no_invariant_at_a_point` specialises the map, in order.
+_POINTS = ((3, 5, 7, 11, 13, 17, 19, 23, 29, 31), (37, 41, 43, 47, 53, 59, 61, 67, 71, 73))
+
+
+def _no_invariant_at_a_point(setup: _Setup, monos) -> bool:
+    """``True`` when the map has no polynomial invariant on ``monos`` (the ansatz), certified at one rational point.
+
+    The search's matrix ``M`` (column ``mu``: the coefficients of ``x^mu(Phi_h(x)) - x^mu``) has entries in
+    ``K = QQ(parameters, h)``, each an integer polynomial in the coefficients of the map ``Phi_h``.  At a
+    rational point ``a`` of ``(parameters, h)`` where no denominator of the map vanishes, evaluation is a
+    ring homomorphism from the rational functions defined at ``a`` to ``QQ``, so the matrix built from the
+    specialised map ``Phi_a`` is ``M(a)``, and every minor of ``M(a)`` is the value at ``a`` of the same minor of
+    ``M``.  If ``M(a)`` has full column rank, some maximal minor of ``M`` is non-zero, ``M`` has full column rank
+    over ``K`` and its nullspace, the space of invariants of the ansatz, is ``{0}``.  Specialising can only lower
+    the rank, so a rank-deficient ``M(a)`` proves nothing: the caller then eliminates over ``K``.  (The same
+    argument as :func:`nambu_bch.algebra.elimination.rank`'s full-rank test at a point, applied before the
+    images are built: over ``QQ`` they cost no polynomial gcds.)
+
+    The map's sympy form is a sum of rational numbers times products of integer powers of symbols; the point
+    is used only when the base of every negative power is non-zero there, so that substituting it divides by
+    no zero.  ``False`` (no certificate) when no point qualifies or the specialised map is not a polynomial
+    over ``QQ`` (an algebraic number such as ``2**(1/3)``, a constant such as ``exp(2)``).
+    """
+    symbols = (*setup.system.parameters, H_STEP)
+    bases = {b for e in setup.phi_exprs for b, k in (a.as_base_exp() for a in e.atoms(sympy.Pow)) if k.is_negative}
+    ring = PolyRing(setup.coords, QQ)
+    for point in _POINTS:
+        if len(symbols) > len(point):
+            return False
+        values = dict(zip(symbols, map(sympy.Integer, point)))
+        if any(b.xreplace(values) == 0 for b in bases):
+            continue  # a denominator vanishes here: the next point
+        try:
+            phi = tuple(ring.from_expr(e.xreplace(values)) for e in setup.phi_exprs)
+        except Exception:  # noqa: BLE001 - CoercionFailed & co: not a polynomial over QQ, no certificate
+            return False
+        rows = Rows()
+        vectors = [rows.vector(c) for c in _ring_images(ring, phi, monos)]
+        return bool(len(rows)) and rank(SparseMatrix.from_columns(vectors, len(rows), QQ)) == len(monos)
+    return False
+
+
 def _invariant_basis(setup: _Setup, degree: int):
     """Polynomials (ring elements) spanning the invariants of degree ``1..degree``."""
-    R, phi = setup.R, setup.phi
     monos = setup.monomials(degree)
-    columns = _ring_images(setup, monos) if phi is not None else _exp_images(setup, monos)
+    if setup.polynomial and _no_invariant_at_a_point(setup, monos):
+        return []
+    R, phi = setup.R, setup.phi
+    columns = _ring_images(R, phi, monos) if phi is not None else _exp_images(setup, monos)
     rows = Rows()
     vectors = [rows.vector(diff) for diff in columns]
     if not len(rows):  # the map is the identity: every monomial is invariant
