@@ -13,6 +13,11 @@ exponentials (Lotka-Volterra) are handled by treating the combined
 exponential of each term as one more generator, which finds ``G = x1 x2 x3``
 there (sound; identities between different exponentials are not used).
 
+Shortcuts, same results.  "No invariant of degree ``<= d``" is certified by the matrix's full column rank at
+one rational point of ``(parameters, h)``, built over ``QQ`` before any image over ``K``
+(:func:`_no_invariant_at_a_point`; the rigid body's answer); a map ``x_i -> x_i exp(a_i)`` (Lotka-Volterra) has
+``x^mu`` invariant exactly when ``<mu, a> = 0``, read off the exponents without expanding images.
+
 Normalisation.  The invariants form a ``K``-vector space ``V`` of dimension
 ``r``, so "the" conserved quantity that tends to ``H`` as ``h -> 0`` is fixed
 only by a rule.  For each target ``T`` (``H``, then ``G``) we take every
@@ -266,12 +271,31 @@ def _no_invariant_at_a_point(setup: _Setup, monos) -> bool:
     return False
 
 
+def _exponents(setup: _Setup):
+    """``(a_1, ..., a_N)`` when each component of the map is ``x_i`` times exponentials, ``x_i exp(a_i)`` (the
+    Lotka-Volterra pieces ``X_{x_i, G}`` compose to such maps), else ``None``."""
+    exponents = []
+    for x, e in zip(setup.coords, setup.phi_exprs):
+        factors = sympy.Mul.make_args(e)
+        if [f for f in factors if not isinstance(f, sympy.exp)] != [x]:
+            return None
+        exponents.append(sympy.Add(*[f.args[0] for f in factors if f != x]))
+    return exponents
+
+
 def _invariant_basis(setup: _Setup, degree: int):
     """Polynomials (ring elements) spanning the invariants of degree ``1..degree``."""
     monos = setup.monomials(degree)
     if setup.polynomial and _no_invariant_at_a_point(setup, monos):
         return []
     R, phi = setup.R, setup.phi
+    exponents = _exponents(setup) if phi is None else None
+    if exponents is not None:
+        # x^mu(Phi_h(x)) - x^mu = x^mu (exp(<mu, a>) - 1): a column of _exp_images is zero when <mu, a> expands to
+        # zero and otherwise alone on its row (x^mu, 1), a pivot; the nullspace is the zero columns' unit vectors.
+        # expand is additive, so each a_i is expanded once and <mu, a> is their sum with integer weights.
+        expanded = [sympy.expand(a, power_exp=False) for a in exponents]
+        return [R({mu: setup.K.one}) for mu in monos if sympy.Add(*[k * a for k, a in zip(mu, expanded)]) == 0]
     columns = _ring_images(R, phi, monos) if phi is not None else _exp_images(setup, monos)
     rows = Rows()
     vectors = [rows.vector(diff) for diff in columns]
