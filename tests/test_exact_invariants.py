@@ -162,6 +162,23 @@ def test_point_certificate_skips_points_where_a_denominator_vanishes(rigid_body_
     assert not invariants._no_invariant_at_a_point(setup, monos)
 
 
+def test_map_at_a_point_is_exact_and_refuses_what_it_cannot_evaluate():
+    """The specialised map is evaluated node by node over QQ: a zero denominator is a ZeroDivisionError (the point
+    is skipped), and an algebraic number, exp(2) or a coordinate in a denominator is no certificate at all."""
+    from sympy.polys.domains import QQ
+    from sympy.polys.rings import PolyRing
+
+    ring = PolyRing((x1, x2), QQ)
+    values = {m: ring(3), omega: ring(0), h: ring(5), x1: ring.gens[0], x2: ring.gens[1]}
+    at = invariants._at_point
+    assert at(x1 + h**2 * x2 / (2 * m) - x1**2 * m**-2, values, ring) == ring.from_expr(x1 + 25 * x2 / 6 - x1**2 / 9)
+    with pytest.raises(ZeroDivisionError):
+        at(x1 + h * x2 / (m * omega), values, ring)
+    for bad in (sympy.cbrt(2) * x1, sympy.exp(2) * x1, h / x1, sympy.Symbol("other") * x1):
+        with pytest.raises(invariants._NotRational):
+            at(bad, values, ring)
+
+
 def test_point_certificate_never_claims_none_when_invariants_exist():
     """ho3's 12321 has H_c and G_c: the matrix is rank-deficient at every point, the certificate declines and the
     exact elimination finds both (Eqs. (CQ12321H), (CQ12321G))."""

@@ -247,28 +247,60 @@ def _no_invariant_at_a_point(setup: _Setup, monos) -> bool:
     argument as :func:`nambu_bch.algebra.elimination.rank`'s full-rank test at a point, applied before the
     images are built: over ``QQ`` they cost no polynomial gcds.)
 
-    The map's sympy form is a sum of rational numbers times products of integer powers of symbols; the point
-    is used only when the base of every negative power is non-zero there, so that substituting it divides by
-    no zero.  ``False`` (no certificate) when no point qualifies or the specialised map is not a polynomial
-    over ``QQ`` (an algebraic number such as ``2**(1/3)``, a constant such as ``exp(2)``).
+    The specialised map is evaluated node by node from its sympy form in exact arithmetic (:func:`_at_point`); a
+    point where some node divides by zero is not used (the next one is).  ``False`` (no certificate) when no
+    point qualifies or the map is not built from rational numbers, symbols, sums, products and integer powers
+    (an algebraic number such as ``2**(1/3)``, a constant such as ``exp(2)``).
     """
     symbols = (*setup.system.parameters, H_STEP)
-    bases = {b for e in setup.phi_exprs for b, k in (a.as_base_exp() for a in e.atoms(sympy.Pow)) if k.is_negative}
     ring = PolyRing(setup.coords, QQ)
     for point in _POINTS:
         if len(symbols) > len(point):
             return False
-        values = dict(zip(symbols, map(sympy.Integer, point)))
-        if any(b.xreplace(values) == 0 for b in bases):
-            continue  # a denominator vanishes here: the next point
+        values = {s: ring.ground_new(QQ(v)) for s, v in zip(symbols, point)}
+        values.update(zip(setup.coords, ring.gens))
         try:
-            phi = tuple(ring.from_expr(e.xreplace(values)) for e in setup.phi_exprs)
-        except Exception:  # noqa: BLE001 - CoercionFailed & co: not a polynomial over QQ, no certificate
+            phi = tuple(_at_point(e, values, ring) for e in setup.phi_exprs)
+        except ZeroDivisionError:
+            continue  # a denominator vanishes here: the next point
+        except _NotRational:
             return False
         rows = Rows()
         vectors = [rows.vector(c) for c in _ring_images(ring, phi, monos)]
         return bool(len(rows)) and rank(SparseMatrix.from_columns(vectors, len(rows), QQ)) == len(monos)
     return False
+
+
+class _NotRational(Exception):
+    """A node that is not a rational number, a symbol, a sum, a product or an integer power."""
+
+
+def _at_point(expr, values, ring):
+    """``expr`` in ``ring`` (a polynomial ring over ``QQ``) with the symbols replaced by ``values`` (ring elements).
+
+    Evaluated node by node: ``ZeroDivisionError`` when a negative power's base is zero at the point, so a value
+    returned is the value there of the rational function ``expr`` (each node's); :class:`_NotRational` for any
+    other kind of node."""
+    if expr.is_Symbol:
+        if expr not in values:
+            raise _NotRational(expr)
+        return values[expr]
+    if expr.is_Rational:
+        return ring.ground_new(QQ(int(expr.p), int(expr.q)))
+    if expr.is_Add or expr.is_Mul:
+        parts = [_at_point(a, values, ring) for a in expr.args]
+        out = parts[0]
+        for part in parts[1:]:
+            out = out + part if expr.is_Add else out * part
+        return out
+    if expr.is_Pow and expr.exp.is_Integer:
+        base, k = _at_point(expr.base, values, ring), int(expr.exp)
+        if k >= 0:
+            return base**k
+        if not base.is_ground:
+            raise _NotRational(expr)  # a coordinate in a denominator: not a polynomial map
+        return ring.ground_new(QQ.one / base.LC) ** -k  # QQ raises ZeroDivisionError at a zero base
+    raise _NotRational(expr)
 
 
 def _exponents(setup: _Setup):
