@@ -11,7 +11,9 @@ Two searches that the fast tier and every user's ``check`` run (``conserved_quan
 
 Each row: the map composed once (untimed, shared), then ``--repeat`` rounds alternating the two routes on a fresh
 ``_Setup`` copy of it, sympy's cache cleared before each; the median CPU seconds of ``_invariant_basis`` per route, the load average before the
-rounds, and whether the two bases agree.  Usage: ``python benchmarks/bench_invariant_none.py [--repeat N]``.
+rounds, and whether the two bases agree.  ``--profile``: instead, each case's ``conserved_quantities`` cold in a
+fresh process (empty cache) under cProfile, its CPU and the package's functions by cumulative time.
+Usage: ``python benchmarks/bench_invariant_none.py [--repeat N | --profile]``.
 """
 
 from __future__ import annotations
@@ -20,6 +22,9 @@ import argparse
 import copy
 import os
 import statistics
+import subprocess
+import sys
+import tempfile
 import time
 
 from sympy.core.cache import clear_cache
@@ -45,10 +50,35 @@ def _timed(setup, degree, exact: bool):
         invariants._no_invariant_at_a_point, invariants._exponents = saved
 
 
+_PROFILE = """
+import cProfile, os, pstats, sys, time
+from nambu_bch import model
+from nambu_bch.exact import conserved_quantities
+name, word = sys.argv[1:3]
+profile, start = cProfile.Profile(), time.process_time()
+profile.enable()
+conserved_quantities(model(name), word)
+profile.disable()
+print(f"{name} {word}: CPU {time.process_time() - start:.2f} s, load {os.getloadavg()[0]:.2f}")
+pstats.Stats(profile).sort_stats("cumulative").print_stats("nambu_bch", 12)
+"""
+
+
+def profile() -> None:
+    for name, word, _ in CASES:
+        with tempfile.TemporaryDirectory(prefix="bench_invariant_none_") as cache:
+            env = dict(os.environ, NAMBU_BCH_CACHE=cache)
+            subprocess.run([sys.executable, "-c", _PROFILE, name, word], env=env, check=True)
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--repeat", type=int, default=3)
+    parser.add_argument("--profile", action="store_true")
     args = parser.parse_args()
+    if args.profile:
+        profile()
+        return
     print(f"{'search':28s} {'degree':>6s} {'shortcut CPU':>13s} {'exact CPU':>10s} {'load':>5s}  same basis")
     for name, word, degree in CASES:
         setup = invariants._Setup(model(name), composition(word, 3), degree)
