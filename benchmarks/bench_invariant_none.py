@@ -9,10 +9,11 @@ Two searches that the fast tier and every user's ``check`` run (``conserved_quan
   exponents of ``x_i -> x_i exp(a_i)`` (:func:`nambu_bch.exact.invariants._exponents`); the exact route expands
   every image (``_exp_images``) and eliminates.
 
-Each row: the map composed once (untimed, shared), then ``--repeat`` rounds alternating the two routes on a fresh
-``_Setup`` copy of it, sympy's cache cleared before each; the median CPU seconds of ``_invariant_basis`` per route, the load average before the
-rounds, and whether the two bases agree.  ``--profile``: instead, each case's ``conserved_quantities`` cold in a
-fresh process (empty cache) under cProfile, its CPU and the package's functions by cumulative time.
+Each row: the map composed once (untimed, shared), then ``--repeat`` rounds alternating the two routes on a
+fresh ``_Setup`` copy of it, sympy's cache cleared before each; the median CPU seconds of ``_invariant_basis``
+per route, the load average before the rounds, and whether the two bases agree.  ``--profile``: instead, each
+case's ``conserved_quantities`` cold in a fresh process (empty cache) under cProfile, its CPU and the package's
+functions by cumulative time.
 Usage: ``python benchmarks/bench_invariant_none.py [--repeat N | --profile]``.
 """
 

@@ -48,7 +48,8 @@ def main() -> None:
                     cpu = after.ru_utime - before.ru_utime + after.ru_stime - before.ru_stime
                     call = re.search(r"([\d.]+)s call", out)
                     status = "ok" if "passed" in out and "failed" not in out else "FAIL"
-                    print(f"round {r} {side:4s} {test.split('::')[1][:45]:45s} call {call.group(1) if call else '-':>5s} s"
+                    name, took = test.split("::")[1][:45], call.group(1) if call else "-"
+                    print(f"round {r} {side:4s} {name:45s} call {took:>5s} s"
                           f"  process wall {wall:5.2f} s cpu {cpu:5.2f} s  load {load:.2f}  {status}", flush=True)
 
 
