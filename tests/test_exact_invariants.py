@@ -14,7 +14,7 @@ from hypothesis import strategies as st
 from nambu_bch import PAPER_WORDS, System, composed_map, liouville_field, model
 from nambu_bch.bch import effective_field
 from nambu_bch.errors import InvalidOrderError, NambuBCHError
-from nambu_bch.exact import conserved_quantities, is_invariant
+from nambu_bch.exact import conserved_quantities, invariants, is_invariant
 
 x1, x2, x3, m, omega, h = sympy.symbols("x1 x2 x3 m omega h")
 H2 = x2**2 / (2 * m) + m * omega**2 * x1**2 / 2  # Eq. (HO1)
@@ -133,6 +133,62 @@ def test_no_invariant_near_H_for_rigid_body():
     assert {k: data[k] for k in ("H_c", "G_c", "series")} == {"H_c": None, "G_c": None, "series": {}}
 
 
+@pytest.fixture(scope="module")
+def rigid_body_setup():
+    """The rigid body's 12321 prepared for a degree-2 search (the map composed once for the tests below)."""
+    from nambu_bch import composition
+
+    return invariants._Setup(model("rigid-body"), composition("12321", 3), 2)
+
+
+def test_rigid_body_none_is_certified_at_a_point_without_the_exact_images(rigid_body_setup, monkeypatch):
+    """"No invariant of degree <= 2" is decided by the rank at one rational point: the map is never converted to
+    K[x] = QQ(I1, I2, I3, h)[x] and nothing is eliminated over K (that route took ~3.6 s of images)."""
+    setup = rigid_body_setup
+    monkeypatch.setattr(invariants, "nullspace", lambda matrix: pytest.fail("eliminated over K"))
+    assert invariants._invariant_basis(setup, 2) == []
+    assert "phi" not in setup.__dict__
+
+
+def test_point_certificate_skips_points_where_a_denominator_vanishes(rigid_body_setup, monkeypatch):
+    """The map divides by I1, I2, I3: a point with I1 = 0 is not used (the next one is), and with no usable point
+    there is no certificate (the caller eliminates over K)."""
+    setup, monos = rigid_body_setup, rigid_body_setup.monomials(2)
+    monkeypatch.setattr(invariants, "_POINTS", ((0, 5, 7, 11), (3, 5, 7, 11)))
+    assert invariants._no_invariant_at_a_point(setup, monos)
+    monkeypatch.setattr(invariants, "_POINTS", ((3, 0, 7, 11),))
+    assert not invariants._no_invariant_at_a_point(setup, monos)
+    monkeypatch.setattr(invariants, "_POINTS", ((3, 5, 7),))  # fewer values than parameters and h
+    assert not invariants._no_invariant_at_a_point(setup, monos)
+
+
+def test_map_at_a_point_is_exact_and_refuses_what_it_cannot_evaluate():
+    """The specialised map is evaluated node by node over QQ: a zero denominator is a ZeroDivisionError (the point
+    is skipped), and an algebraic number, exp(2) or a coordinate in a denominator is no certificate at all."""
+    from sympy.polys.domains import QQ
+    from sympy.polys.rings import PolyRing
+
+    ring = PolyRing((x1, x2), QQ)
+    values = {m: ring(3), omega: ring(0), h: ring(5), x1: ring.gens[0], x2: ring.gens[1]}
+    at = invariants._at_point
+    assert at(x1 + h**2 * x2 / (2 * m) - x1**2 * m**-2, values, ring) == ring.from_expr(x1 + 25 * x2 / 6 - x1**2 / 9)
+    with pytest.raises(ZeroDivisionError):
+        at(x1 + h * x2 / (m * omega), values, ring)
+    for bad in (sympy.cbrt(2) * x1, sympy.exp(2) * x1, h / x1, sympy.Symbol("other") * x1):
+        with pytest.raises(invariants._NotRational):
+            at(bad, values, ring)
+
+
+def test_point_certificate_never_claims_none_when_invariants_exist():
+    """ho3's 12321 has H_c and G_c: the matrix is rank-deficient at every point, the certificate declines and the
+    exact elimination finds both (Eqs. (CQ12321H), (CQ12321G))."""
+    from nambu_bch import composition
+
+    setup = invariants._Setup(model("ho3"), composition("12321", 3), 2)
+    assert not invariants._no_invariant_at_a_point(setup, setup.monomials(2))
+    assert len(invariants._invariant_basis(setup, 2)) == 2
+
+
 def test_user_system_and_composition_object():
     from nambu_bch import composition
 
@@ -151,14 +207,35 @@ def test_bad_degree(degree):
         conserved_quantities(model("ho3"), "12321", degree=degree)
 
 
-def test_exponential_map_lotka_volterra():
-    """The Lotka-Volterra pieces X_{x_i, G} conserve G = x1 x2 x3 exactly; no polynomial invariant tends to H."""
+def test_exponential_map_lotka_volterra(monkeypatch):
+    """The Lotka-Volterra pieces X_{x_i, G} conserve G = x1 x2 x3 exactly; no polynomial invariant tends to H.
+
+    Each component of the map is x_i exp(a_i): x^mu is invariant exactly when <mu, a> expands to zero, read off
+    without expanding the images (_exp_images, ~3 s at degree 3, is not called)."""
+    from nambu_bch import composition
+
     lv = model("lotka-volterra")
+    with monkeypatch.context() as patch:
+        patch.setattr(invariants, "_exp_images", lambda setup, monos: pytest.fail("images expanded"))
+        setup = invariants._Setup(lv, composition("12321", 3), 3)
+        assert invariants._invariant_basis(setup, 3) == [setup.R.from_expr(x1 * x2 * x3)]
     cq = conserved_quantities(lv, "12321")  # (a word over all three pieces; 121 would leave piece 3 out)
     assert cq.H_c is None
     assert sympy.expand(cq.G_c - x1 * x2 * x3) == 0
     assert cq.quantities == (cq.G_c,)
     assert is_invariant(lv, "12321", cq.G_c)
+
+
+def test_exponents_only_of_monomial_times_exponential_maps():
+    """The read-off applies to maps x_i -> x_i exp(a_i) only; a sum, a coefficient or another coordinate in front
+    falls back to the images."""
+    from types import SimpleNamespace
+
+    a, b = h * x2, -h * x1 * sympy.exp(h * x2)
+    setup = SimpleNamespace(coords=(x1, x2), phi_exprs=(x1 * sympy.exp(a) * sympy.exp(b), x2))
+    assert invariants._exponents(setup) == [a + b, 0]
+    for first in (x1 * sympy.exp(a) + x2, 2 * x1 * sympy.exp(a), x2 * sympy.exp(a), x1**2 * sympy.exp(a)):
+        assert invariants._exponents(SimpleNamespace(coords=(x1, x2), phi_exprs=(first, x2))) is None
 
 
 def test_bad_word():

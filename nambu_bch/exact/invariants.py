@@ -13,6 +13,11 @@ exponentials (Lotka-Volterra) are handled by treating the combined
 exponential of each term as one more generator, which finds ``G = x1 x2 x3``
 there (sound; identities between different exponentials are not used).
 
+Shortcuts, same results.  "No invariant of degree ``<= d``" is certified by the matrix's full column rank at
+one rational point of ``(parameters, h)``, built over ``QQ`` before any image over ``K``
+(:func:`_no_invariant_at_a_point`; the rigid body's answer); a map ``x_i -> x_i exp(a_i)`` (Lotka-Volterra) has
+``x^mu`` invariant exactly when ``<mu, a> = 0``, read off the exponents without expanding images.
+
 Normalisation.  The invariants form a ``K``-vector space ``V`` of dimension
 ``r``, so "the" conserved quantity that tends to ``H`` as ``h -> 0`` is fixed
 only by a rule.  For each target ``T`` (``H``, then ``G``) we take every
@@ -41,11 +46,13 @@ Horikoshi, Eqs. (CQPV), (CQ12321H), (CQ12321G), Table (table); Kobayashi (2021).
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from functools import lru_cache
+from functools import cached_property, lru_cache
 from itertools import combinations
 from math import comb, prod
 
 import sympy
+from sympy.polys.domains import QQ
+from sympy.polys.rings import PolyRing
 
 from ..algebra import PolynomialAlgebra
 from ..systems.spec import as_system
@@ -109,12 +116,19 @@ class _Setup:
                     f"needs images of up to {size} terms, estimated from the word's {len(flows)} sub-flows "
                     f"(at most {MAX_IMAGE_TERMS}); lower the degree or shorten the word"
                 )
+        self.polynomial = all(f.polynomial for f in flows)
         phi = composed_map(system.splitting, comp)
         self.phi_exprs = tuple(sympy.sympify(e, strict=True) for e in phi)
+
+    @cached_property
+    def phi(self):
+        """The map in ``K[x]``, or ``None`` when it is not polynomial there (exp(...) flows: :func:`_exp_images`).
+
+        Converted on first use: a search that :func:`_no_invariant_at_a_point` settles never needs it."""
         try:
-            self.phi = tuple(self.R.from_expr(e) for e in self.phi_exprs)
+            return tuple(self.R.from_expr(e) for e in self.phi_exprs)
         except Exception:  # CoercionFailed & co: exp(...) flows (Lotka-Volterra), see _exp_images
-            self.phi = None
+            return None
 
     def monomials(self, degree):
         """The ansatz's monomials: total degree ``1..degree``, graded (:mod:`nambu_bch.algebra.ansatz`)."""
@@ -158,9 +172,8 @@ def image_terms(counts, degrees, monos) -> int:
                for mu in monos)
 
 
-def _ring_images(setup: _Setup, monos):
-    """``{monomial: coefficient}`` of ``x^mu(Phi_h(x)) - x^mu`` for each ``mu``, in the sparse ring."""
-    R, phi = setup.R, setup.phi
+def _ring_images(R, phi, monos):
+    """``{monomial: coefficient}`` of ``x^mu(Phi_h(x)) - x^mu`` for each ``mu``, in the sparse ring ``R``."""
     powers = [[R.one] for _ in phi]
 
     def power(i, k):
@@ -174,7 +187,7 @@ def _ring_images(setup: _Setup, monos):
         for i, k in enumerate(mu):
             if k:
                 image = image * power(i, k)
-        columns.append(dict(image - R({mu: setup.K.one})))
+        columns.append(dict(image - R({mu: R.domain.one})))
     return columns
 
 
@@ -216,11 +229,106 @@ def _exp_images(setup: _Setup, monos):
     return columns
 
 
+#: The rational points ``(parameters..., h)`` at which :func:`_no_invariant_at_a_point` specialises the map, in order.
+_POINTS = ((3, 5, 7, 11, 13, 17, 19, 23, 29, 31), (37, 41, 43, 47, 53, 59, 61, 67, 71, 73))
+
+
+def _no_invariant_at_a_point(setup: _Setup, monos) -> bool:
+    """``True`` when the map has no polynomial invariant on ``monos`` (the ansatz), certified at one rational point.
+
+    The search's matrix ``M`` (column ``mu``: the coefficients of ``x^mu(Phi_h(x)) - x^mu``) has entries in
+    ``K = QQ(parameters, h)``, each an integer polynomial in the coefficients of the map ``Phi_h``.  At a
+    rational point ``a`` of ``(parameters, h)`` where no denominator of the map vanishes, evaluation is a
+    ring homomorphism from the rational functions defined at ``a`` to ``QQ``, so the matrix built from the
+    specialised map ``Phi_a`` is ``M(a)``, and every minor of ``M(a)`` is the value at ``a`` of the same minor of
+    ``M``.  If ``M(a)`` has full column rank, some maximal minor of ``M`` is non-zero, ``M`` has full column rank
+    over ``K`` and its nullspace, the space of invariants of the ansatz, is ``{0}``.  Specialising can only lower
+    the rank, so a rank-deficient ``M(a)`` proves nothing: the caller then eliminates over ``K``.  (The same
+    argument as :func:`nambu_bch.algebra.elimination.rank`'s full-rank test at a point, applied before the
+    images are built: over ``QQ`` they cost no polynomial gcds.)
+
+    The specialised map is evaluated node by node from its sympy form in exact arithmetic (:func:`_at_point`); a
+    point where some node divides by zero is not used (the next one is).  ``False`` (no certificate) when no
+    point qualifies or the map is not built from rational numbers, symbols, sums, products and integer powers
+    (an algebraic number such as ``2**(1/3)``, a constant such as ``exp(2)``).
+    """
+    symbols = (*setup.system.parameters, H_STEP)
+    ring = PolyRing(setup.coords, QQ)
+    for point in _POINTS:
+        if len(symbols) > len(point):
+            return False
+        values = {s: ring.ground_new(QQ(v)) for s, v in zip(symbols, point)}
+        values.update(zip(setup.coords, ring.gens))
+        try:
+            phi = tuple(_at_point(e, values, ring) for e in setup.phi_exprs)
+        except ZeroDivisionError:
+            continue  # a denominator vanishes here: the next point
+        except _NotRational:
+            return False
+        rows = Rows()
+        vectors = [rows.vector(c) for c in _ring_images(ring, phi, monos)]
+        return bool(len(rows)) and rank(SparseMatrix.from_columns(vectors, len(rows), QQ)) == len(monos)
+    return False
+
+
+class _NotRational(Exception):
+    """A node that is not a rational number, a symbol, a sum, a product or an integer power."""
+
+
+def _at_point(expr, values, ring):
+    """``expr`` in ``ring`` (a polynomial ring over ``QQ``) with the symbols replaced by ``values`` (ring elements).
+
+    Evaluated node by node: ``ZeroDivisionError`` when a negative power's base is zero at the point, so a value
+    returned is the value there of the rational function ``expr`` (each node's); :class:`_NotRational` for any
+    other kind of node."""
+    if expr.is_Symbol:
+        if expr not in values:
+            raise _NotRational(expr)
+        return values[expr]
+    if expr.is_Rational:
+        return ring.ground_new(QQ(int(expr.p), int(expr.q)))
+    if expr.is_Add or expr.is_Mul:
+        parts = [_at_point(a, values, ring) for a in expr.args]
+        out = parts[0]
+        for part in parts[1:]:
+            out = out + part if expr.is_Add else out * part
+        return out
+    if expr.is_Pow and expr.exp.is_Integer:
+        base, k = _at_point(expr.base, values, ring), int(expr.exp)
+        if k >= 0:
+            return base**k
+        if not base.is_ground:
+            raise _NotRational(expr)  # a coordinate in a denominator: not a polynomial map
+        return ring.ground_new(QQ.one / base.LC) ** -k  # QQ raises ZeroDivisionError at a zero base
+    raise _NotRational(expr)
+
+
+def _exponents(setup: _Setup):
+    """``(a_1, ..., a_N)`` when each component of the map is ``x_i`` times exponentials, ``x_i exp(a_i)`` (the
+    Lotka-Volterra pieces ``X_{x_i, G}`` compose to such maps), else ``None``."""
+    exponents = []
+    for x, e in zip(setup.coords, setup.phi_exprs):
+        factors = sympy.Mul.make_args(e)
+        if [f for f in factors if not isinstance(f, sympy.exp)] != [x]:
+            return None
+        exponents.append(sympy.Add(*[f.args[0] for f in factors if f != x]))
+    return exponents
+
+
 def _invariant_basis(setup: _Setup, degree: int):
     """Polynomials (ring elements) spanning the invariants of degree ``1..degree``."""
-    R, phi = setup.R, setup.phi
     monos = setup.monomials(degree)
-    columns = _ring_images(setup, monos) if phi is not None else _exp_images(setup, monos)
+    if setup.polynomial and _no_invariant_at_a_point(setup, monos):
+        return []
+    R, phi = setup.R, setup.phi
+    exponents = _exponents(setup) if phi is None else None
+    if exponents is not None:
+        # x^mu(Phi_h(x)) - x^mu = x^mu (exp(<mu, a>) - 1): a column of _exp_images is zero when <mu, a> expands to
+        # zero and otherwise alone on its row (x^mu, 1), a pivot; the nullspace is the zero columns' unit vectors.
+        # expand is additive, so each a_i is expanded once and <mu, a> is their sum with integer weights.
+        expanded = [sympy.expand(a, power_exp=False) for a in exponents]
+        return [R({mu: setup.K.one}) for mu in monos if sympy.Add(*[k * a for k, a in zip(mu, expanded)]) == 0]
+    columns = _ring_images(R, phi, monos) if phi is not None else _exp_images(setup, monos)
     rows = Rows()
     vectors = [rows.vector(diff) for diff in columns]
     if not len(rows):  # the map is the identity: every monomial is invariant
