@@ -69,7 +69,8 @@ def _prefix_coefficients(word, letters, values):
 
 
 def _log_word_coefficient(word, letters, values, q):
-    """``[w] log P`` for ``P = prod_i exp((values_i / q) X_{letters_i})``, from ``log P = sum_k (-1)^(k-1) (P-1)^k / k``:
+    """``[w] log P`` for ``P = prod_i exp((values_i / q) X_{letters_i})``, from
+    ``log P = sum_k (-1)^(k-1) (P-1)^k / k``:
     the sum over the splittings ``w = v_1 .. v_k`` into non-empty words of ``(-1)^(k-1)/k prod [v_i] P`` (the
     word-coefficient form of the BCH series, Goldberg 1956), by dynamic programming over the cut points in integers
     scaled by ``j! q^j`` -- independent of the engines, which work in the Lyndon basis."""
@@ -337,7 +338,8 @@ def test_a_request_to_degree_10_reads_only_the_header_and_the_first_blocks(monke
     in one opening, and no more: one positional read of the lead and one of the header with the first blocks."""
     reads = []
     pread = table._pread
-    monkeypatch.setattr(table, "_pread", lambda fd, size, offset: reads.append((offset, size)) or pread(fd, size, offset))
+    monkeypatch.setattr(table, "_pread",
+                        lambda fd, size, offset: reads.append((offset, size)) or pread(fd, size, offset))
     assert formal_bch("12", 10) == _engine("12", 10)
     header = table._header()
     lead = len(table.MAGIC) + 4

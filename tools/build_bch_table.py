@@ -9,7 +9,7 @@ engine's result exactly (the three stored series against the engine results the 
 for that: the reverse ``log(e^B e^A)`` against an engine run of its own).  Prints the bytes each degree costs
 (as stored).
 
-Run:  python tools/build_bch_table.py [--degree 22]
+Run:  python tools/build_bch_table.py [--degree 22]   (degree 22: 446 s of CPU under load 4-13, peak RSS 1.4 GB)
 """
 
 from __future__ import annotations

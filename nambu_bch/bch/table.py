@@ -36,8 +36,8 @@ result of a computation; :func:`clear_cache` forgets the image too.
 
 Memory.  Only the degrees asked are read; the numerators stay machine integers (:mod:`array`) until a degree's
 terms are asked for where they fit in 8 bytes (``log(e^A e^B)`` to degree 22: 63 bits at degrees 21-22; the symmetric
-series need 9 bytes at degree 19 and 11 at degree 21 and are decoded into Python ints), and :class:`Served` builds them on each access (the trees, shared by every request, are the
-only Python objects kept).
+series need 9 bytes at degree 19 and 11 at degree 21 and are decoded into Python ints), and :class:`Served` builds
+them on each access (the trees, shared by every request, are the only Python objects kept).
 
 File format: ``b"NBCHTAB4"``, the header's length (4 bytes, little-endian), the header (:data:`PREAMBLE`, the
 series' names in :data:`NAME_BYTES` each, one :func:`record_format` record per degree: fixed-size fields read
@@ -87,19 +87,18 @@ NAME_BYTES = 4
 #: two now; the file is 294 bytes longer).
 RAW_BYTES = 256
 #: A compressed block of more than this many bytes (decoded) is stored by byte planes (:func:`byte_planes`), a smaller
-#: one as its bytes are.  Regrouping the planes back is a strided copy of about 4 ns a byte (15 us for a small block):
-#: by planes from 16 kB on, the file was 3.95 MB instead of 4.15 MB but a request to degree 20 took 10 ms instead of
-#: 7; from 512 kB on, only the blocks of degrees 21-22 are (0.6 MB smaller, 10 ms more for a request to 22) and the
-#: blocks of degrees 1-20 are those of the table to degree 20, byte for byte.
+#: one as its bytes are.  Interleaving the planes back is a strided copy of every byte, dear for a small block, so
+#: only the blocks of degrees 21-22 are (0.6 MB of the file); every block above 16 kB would save 0.2 MB more at the
+#: price of that copy in every request from degree 15 on, and the blocks of degrees 1-20 stay byte for byte those
+#: of the table to degree 20 (``benchmarks/bch_table_format.py`` prints each encoding's size and decoding time).
 PLANE_BYTES = 1 << 19
 
 
 def pack_block(data: bytes, width: int = 1) -> bytes:
     """A block as the table stores it: ``data`` as is when it has at most :data:`RAW_BYTES` bytes or zlib does not
     shorten it, else zlib-compressed, by byte planes (:func:`byte_planes`, ``width`` bytes an integer) when it has
-    more than :data:`PLANE_BYTES` bytes -- so a stored
-    block is raw exactly when its size is ``len(data)`` (a compressed block is always shorter), which
-    :func:`unpack_block` reads back without a flag."""
+    more than :data:`PLANE_BYTES` bytes -- so a stored block is raw exactly when its size is ``len(data)`` (a
+    compressed block is always shorter), which :func:`unpack_block` reads back without a flag."""
     if len(data) <= RAW_BYTES:
         return data
     compressed = zlib.compress(byte_planes(data, width) if len(data) > PLANE_BYTES else data, 9)
@@ -110,7 +109,7 @@ def byte_planes(data: bytes, width: int) -> bytes:
     """The ``width``-byte integers of ``data`` byte plane by byte plane: every integer's first byte, then every
     second byte, ...  The top bytes of numerators narrower than their width and the slowly varying top bytes of
     the standard factors' indices form long runs that zlib shortens far better than interleaved (degrees 21-22: the
-    standard factors 2.5x, the numerators 3-14% smaller)."""
+    standard factors 2.3-2.5x, the numerators 3-13% smaller)."""
     return data if width == 1 else b"".join([data[k::width] for k in range(width)])
 
 
@@ -161,8 +160,8 @@ def _sha256(data):
 
 
 #: Bytes checked at once from which hashlib is imported when it is not yet: importing it costs a fresh process about
-#: 5 ms and 3.6 MB (libcrypto), CPython's own SHA-256 about 5.4 ms a MB against hashlib's 0.7 (measured under load
-#: 3.7-3.8), so it pays for the degrees 21-22 (2.9 MB) and not for a request to degree 20 or less (1.2 MB at most)
+#: 5 ms and 3.6 MB (libcrypto) and CPython's own SHA-256 several times hashlib's (``benchmarks/bch_table_format.py``
+#: prints both), so it pays for the degrees 21-22 (2.9 MB) and not for a request to degree 20 or less (1.2 MB at most)
 HASHLIB_BYTES = 1 << 21
 
 
