@@ -23,8 +23,9 @@ the denominators and the SHA-256 of the degree's bytes) is trusted only when its
 :data:`TABLE_SHA256`, written into this module by the tool; a degree's bytes are decoded only when
 their SHA-256 equals the header's.  A missing, damaged or replaced file is not used: the engine
 computes the series, and one warning line says why.  The digests are hashlib's (OpenSSL) in a process that has
-imported hashlib and CPython's built-in SHA-256 otherwise: the same digest, without mapping libcrypto (megabytes)
-into a fresh process that reads the table and nothing else.
+imported hashlib or when :data:`HASHLIB_BYTES` or more are checked at once (degrees 21-22), and CPython's built-in
+SHA-256 otherwise: the same digest, without mapping libcrypto (megabytes) into a fresh process that reads a few
+degrees of the table and nothing else.
 
 Once per process.  The header and the bytes of each degree read so far are checked once and kept, as checked, in
 memory (the verified image: the bytes of the degrees asked, at most the file's 4.1 MB, 1.2 MB to degree 20): a later
