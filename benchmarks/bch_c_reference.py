@@ -16,7 +16,7 @@ Two measurements per row, the sides interleaved:
   ``libbch.so`` (the Lie series built and freed, nothing printed); on ours ``formal_bch`` in this process
   with numba started and every in-memory cache of the package cleared before each call
   (``nambu_bch.clear_caches``: Lyndon tables rebuilt, as the C routine rebuilds its own).  Where the
-  shipped table serves the series (``12`` and ``121`` to its top degree, column ``by`` = ``table``) that
+  shipped table serves the series (``12`` and ``121`` to its top degree, 22, column ``by`` = ``table``) that
   call reads the word (no sympy) and decodes the standard factors and the numerators of the degrees asked
   into machine integers, from the table's verified image: the header and the bytes of each degree, read
   and checked against their SHA-256 once per process (by the untimed call) and kept as checked, which
@@ -49,6 +49,8 @@ words and compared coefficient by coefficient with the file our cold process wro
 
 Run:  python benchmarks/bch_c_reference.py /path/to/BCH [--degrees 10,14,18,20] [--sym-degrees 11,15,19]
       [--three-degrees 9,11,13] [--repeat 3] [--build]
+      (the table's top degrees: --degrees 21,22 --sym-degrees 21 --three-degrees "" --repeat 1; each row served by
+      the table also runs the engine --repeat times, about 12 s a call at degree 22)
 """
 
 from __future__ import annotations
@@ -275,7 +277,8 @@ def our_terms(path: Path) -> dict:
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("checkout", type=Path, help="local checkout of github.com/HaraldHofstaetter/BCH (not vendored)")
-    ap.add_argument("--degrees", default="10,12,14,16,18,20", help="log(e^A e^B); 22 takes a minute or more")
+    ap.add_argument("--degrees", default="10,12,14,16,18,20",
+                    help="log(e^A e^B); 21-22 take minutes (the C program's and the engine's calls)")
     ap.add_argument("--sym-degrees", default="11,15,19", help="log(e^{A/2} e^B e^{A/2})")
     ap.add_argument("--three-degrees", default="9,11,13", help="the three-generator word 12321")
     ap.add_argument("--repeat", type=int, default=3, help="warm calls per side (median reported)")

@@ -8,8 +8,9 @@ different expansion in the Lyndon basis over ``A < B``, not a renaming).  These 
 universal, so three of them are computed once and stored; the reverse follows from ``Z`` by
 ``log(e^B e^A) = -log(e^{-A} e^{-B})``, whose degree-``d`` part is ``(-1)^(d+1) Z_d``.
 
-The table (``data/bch_series.bin``, written by ``tools/build_bch_table.py`` with the engine of
-:mod:`nambu_bch.bch.formal`) holds, per degree ``d``: the Lyndon words of length ``d`` in
+The table (``data/bch_series.bin``, 4.1 MB, written by ``tools/build_bch_table.py`` with the engine of
+:mod:`nambu_bch.bch.formal`) holds to degree 22 (the symmetric series: their odd degrees to 21; their even
+degrees vanish), per degree ``d``: the Lyndon words of length ``d`` in
 lexicographic order as their standard factors (``P_w = [P_u, P_v]``, indices of shorter words), and
 per series the numerators ``n_w`` over the least common denominator ``T_d`` of the degree, as
 fixed-width little-endian integers.  A request to degree ``n`` rescales ``n_w`` to the denominators
@@ -22,27 +23,32 @@ the denominators and the SHA-256 of the degree's bytes) is trusted only when its
 :data:`TABLE_SHA256`, written into this module by the tool; a degree's bytes are decoded only when
 their SHA-256 equals the header's.  A missing, damaged or replaced file is not used: the engine
 computes the series, and one warning line says why.  The digests are hashlib's (OpenSSL) in a process that has
-imported hashlib and CPython's built-in SHA-256 otherwise: the same digest, without mapping libcrypto (megabytes)
-into a fresh process that reads the table and nothing else.
+imported hashlib or when :data:`HASHLIB_BYTES` or more are checked at once (degrees 21-22), and CPython's built-in
+SHA-256 otherwise: the same digest, without mapping libcrypto (megabytes) into a fresh process that reads a few
+degrees of the table and nothing else.
 
 Once per process.  The header and the bytes of each degree read so far are checked once and kept, as checked, in
-memory (the verified image, at most the file's 1.2 MB): a later request decodes them from there (what was checked is what is decoded) and
-reads the file only for a degree it does not hold yet.
+memory (the verified image: the bytes of the degrees asked, at most the file's 4.1 MB, 1.2 MB to degree 20): a later
+request decodes them from there (what was checked is what is decoded) and reads the file only for a degree it does not
+hold yet.
 :func:`nambu_bch.clear_caches` (through :func:`clear_decoded`) empties what was decoded from the image -- the
 standard factors, numerators, trees and words -- and keeps the image, which is the shipped data as read, not the
 result of a computation; :func:`clear_cache` forgets the image too.
 
 Memory.  Only the degrees asked are read; the numerators stay machine integers (:mod:`array`) until a degree's
-terms are asked for, and :class:`Served` builds them on each access (the trees, shared by every request, are the
-only Python objects kept).
+terms are asked for where they fit in 8 bytes (``log(e^A e^B)`` to degree 22: 63 bits at degrees 21-22; the symmetric
+series need 9 bytes at degree 19 and 11 at degree 21 and are decoded into Python ints), and :class:`Served` builds
+them on each access (the trees, shared by every request, are the only Python objects kept).
 
-File format: ``b"NBCHTAB3"``, the header's length (4 bytes, little-endian), the header (:data:`PREAMBLE`, the
+File format: ``b"NBCHTAB4"``, the header's length (4 bytes, little-endian), the header (:data:`PREAMBLE`, the
 series' names in :data:`NAME_BYTES` each, one :func:`record_format` record per degree: fixed-size fields read
 by :mod:`struct` in one call, where a JSON header cost more than the blocks of a request to degree 10), then
 degree by degree the standard factors (int32: left indices, then right indices, into the flat list of the
 Lyndon words of all degrees) and the three series' numerators, each block zlib-compressed unless it is small
 (:func:`pack_block`: a block is raw exactly when its size is its decoded size, known from the number of words and
-the bytes per numerator).
+the bytes per numerator), the blocks beyond :data:`PLANE_BYTES` (those of degrees 21-22) by byte planes
+(:func:`byte_planes`: 0.6 MB smaller); the blocks of degrees 1-20 are byte for byte those of the table to degree 20
+(format 3), so that a request to degree 20 or less reads and decodes what it did.
 
 References
 ----------
@@ -68,34 +74,59 @@ from fractions import Fraction
 from .collector import no_full_collection
 
 #: SHA-256 of the table's header (which holds the SHA-256 of each degree's bytes); written by tools/build_bch_table.py.
-TABLE_SHA256 = "429fe19eb6043f38848af4c8fab53b606d35ba48db3d219ec09a73754cbaabac"
+TABLE_SHA256 = "3061923e064f40f8dce6aa7d81ea401e8e1d37c6f0f7705b2982fa9ac462bdce"
 #: The table file shipped with the package.
 TABLE_PATH = os.path.join(os.path.dirname(__file__), "data", "bch_series.bin")
-MAGIC = b"NBCHTAB3"
+MAGIC = b"NBCHTAB4"
 #: The header's fixed part: format version, letters, number of series, top degree, bytes of a denominator ``T_d``.
 PREAMBLE = struct.Struct("<5H")
-FORMAT_VERSION = 3
+FORMAT_VERSION = 4
 #: Bytes of a series' name in the header (ASCII, NUL-padded).
 NAME_BYTES = 4
 #: A block of at most this many bytes is stored as is: zlib shortens so few by tens of bytes, while each compressed
 #: block costs a decompression call of its own (nineteen in a request to degree 10 when every block was compressed,
 #: two now; the file is 294 bytes longer).
 RAW_BYTES = 256
+#: A compressed block of more than this many bytes (decoded) is stored by byte planes (:func:`byte_planes`), a smaller
+#: one as its bytes are.  Interleaving the planes back is a strided copy of every byte, dear for a small block, so
+#: only the blocks of degrees 21-22 are (0.6 MB of the file); every block above 16 kB would save 0.2 MB more at the
+#: price of that copy in every request from degree 15 on, and the blocks of degrees 1-20 stay byte for byte those
+#: of the table to degree 20 (``benchmarks/bch_table_format.py`` prints each encoding's size and decoding time).
+PLANE_BYTES = 1 << 19
 
 
-def pack_block(data: bytes) -> bytes:
+def pack_block(data: bytes, width: int = 1) -> bytes:
     """A block as the table stores it: ``data`` as is when it has at most :data:`RAW_BYTES` bytes or zlib does not
-    shorten it, else zlib-compressed -- so a stored block is raw exactly when its size is ``len(data)`` (a
+    shorten it, else zlib-compressed, by byte planes (:func:`byte_planes`, ``width`` bytes an integer) when it has
+    more than :data:`PLANE_BYTES` bytes -- so a stored block is raw exactly when its size is ``len(data)`` (a
     compressed block is always shorter), which :func:`unpack_block` reads back without a flag."""
     if len(data) <= RAW_BYTES:
         return data
-    compressed = zlib.compress(data, 9)
+    compressed = zlib.compress(byte_planes(data, width) if len(data) > PLANE_BYTES else data, 9)
     return compressed if len(compressed) < len(data) else data
 
 
-def unpack_block(block, size: int):
-    """The ``size`` bytes of a block stored by :func:`pack_block` (``block`` itself when it is stored raw)."""
-    return block if len(block) == size else zlib.decompress(block)
+def byte_planes(data: bytes, width: int) -> bytes:
+    """The ``width``-byte integers of ``data`` byte plane by byte plane: every integer's first byte, then every
+    second byte, ...  The top bytes of numerators narrower than their width and the slowly varying top bytes of
+    the standard factors' indices form long runs that zlib shortens far better than interleaved (degrees 21-22: the
+    standard factors 2.3-2.5x, the numerators 3-13% smaller)."""
+    return data if width == 1 else b"".join([data[k::width] for k in range(width)])
+
+
+def unpack_block(block, size: int, width: int = 1):
+    """The ``size`` bytes of a block stored by :func:`pack_block` with ``width`` (``block`` itself when it is stored
+    raw, else decompressed and its byte planes interleaved again)."""
+    if len(block) == size:
+        return block
+    planes = zlib.decompress(block)
+    if width == 1 or size <= PLANE_BYTES:
+        return planes
+    count = size // width
+    data = bytearray(size)
+    for k in range(width):  # one strided copy a plane, in C
+        data[k::width] = planes[k * count : (k + 1) * count]
+    return data
 
 
 def record_format(n_series: int, t_bytes: int) -> str:
@@ -129,11 +160,18 @@ def _sha256(data):
     return _sha256_function()(data)
 
 
-def _sha256_function():
-    """The SHA-256 constructor: hashlib's (OpenSSL, several times faster) when hashlib is imported already, else
-    CPython's own -- importing hashlib maps libcrypto, megabytes of a fresh process that reads the table."""
+#: Bytes checked at once from which hashlib is imported when it is not yet: importing it costs a fresh process about
+#: 5 ms and 3.6 MB (libcrypto) and CPython's own SHA-256 several times hashlib's (``benchmarks/bch_table_format.py``
+#: prints both), so it pays for the degrees 21-22 (2.9 MB) and not for a request to degree 20 or less (1.2 MB at most)
+HASHLIB_BYTES = 1 << 21
+
+
+def _sha256_function(size: int = 0):
+    """The SHA-256 constructor: hashlib's (OpenSSL, several times faster) when hashlib is imported already or
+    ``size`` bytes are to be checked, at least :data:`HASHLIB_BYTES`, else CPython's own -- importing hashlib maps
+    libcrypto, megabytes of a fresh process that reads a few degrees of the table."""
     hashlib = sys.modules.get("hashlib")
-    if hashlib is None and _builtin_sha256 is not None:
+    if hashlib is None and _builtin_sha256 is not None and size < HASHLIB_BYTES:
         return _builtin_sha256
     if hashlib is None:
         import hashlib
@@ -318,7 +356,7 @@ def _verify(header, n: int) -> bool:
             _unusable("it is shorter than its header says")
             return False
     view = memoryview(data)
-    sha256 = _sha256_function()
+    sha256 = _sha256_function(stop - start)
     series = header["series"]
     low = start
     for d in range(first, n + 1):
@@ -352,14 +390,15 @@ def _load(header, series: str, n: int) -> bool:
     for d in range(len(_FACTORS), n):
         factors = array(_INT32)
         if d:  # degree 1 has no standard factors; degree d + 1 two int32 indices a word
-            factors.frombytes(unpack_block(image[d][0], 8 * degrees[d][0]))
+            factors.frombytes(unpack_block(image[d][0], 8 * degrees[d][0], 4))
             if sys.byteorder == "big":  # the table is little-endian
                 factors.byteswap()
         _FACTORS.append(factors)
     for d in range(1, n + 1):
         if (series, d) not in _NUMERATORS:
             block, width = image[d - 1][1][series]
-            _NUMERATORS[series, d] = _decode(unpack_block(block, width * degrees[d - 1][0]), width) if width else []
+            _NUMERATORS[series, d] = (_decode(unpack_block(block, width * degrees[d - 1][0], width), width)
+                                      if width else [])
     return True
 
 
