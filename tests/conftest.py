@@ -226,6 +226,9 @@ DEEP = (
     ("test_shadow_exact_data.py", "test_symbolic_rigid_body_h10_is_solved_within_the_budget", ()),
     # the table served in a fresh process (a process start; the in-process serving is fast-tier)
     ("test_bch_table.py", "test_a_fresh_process_serves_without_numba_or_the_effective_field_modules", ()),
+    # the table's top degrees against the full engine (degree 22, ~24 s and ~430 MB): the fast tier checks them against
+    # an independent word-coefficient computation on a sample of words (test_the_top_degrees_equal_an_independent_computation)
+    ("test_bch_table.py", "test_the_top_degrees_equal_the_engine", ()),
     # the rigid body (over QQ(I1, I2, I3)) and the other 1.2-3 s rows of tables whose lighter rows stay in the fast tier
     # (the parametric field: test_elimination's QQ(a,b) row, test_direct_route_flint; the rigid body's numerics and
     # families: test_numeric, test_shadow, test_any_system's Lie-Poisson member)
