@@ -73,6 +73,7 @@ LONG = (
     ("test_existence.py", "test_rigid_body_lie_trotter_certified_numerically_with_drift"),  # ... reused here
     ("test_pickle.py", "test_result_round_trip[Existence"),                 # ... and here
     ("test_pickle.py", "test_more_results_round_trip[ShadowFamily none"),   # ... and here
+    ("test_latex_compile.py", "test_api_blocks_compile_in_display_math"),   # ... and here
     ("test_design.py", "test_optimize_finds_yoshidas_sixth_order_solution"),
     ("test_any_system.py", "test_lie_poisson_bch_member_with_casimir_kept"),
     ("test_shadow.py", "test_n4_full_split_is_obstructed"),
