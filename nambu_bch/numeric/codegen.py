@@ -1003,7 +1003,7 @@ def source_hash(source: str) -> str:
 
 # -- Runge--Kutta steps -------------------------------------------------------------------------------------------
 #: Bump when the generated Runge--Kutta source changes meaning.
-RK_TEMPLATE_VERSION = "4"
+RK_TEMPLATE_VERSION = "5"
 
 _RK_TEMPLATE = '''
 
@@ -1091,71 +1091,24 @@ def rk_newton(x, h, P, A, K, Y, F, J, M, r, maxit, tol):
             for k in range(n):
                 K[i, k] -= r[i * n + k]
         it += 1
+'''
 
 
-def rk_explicit(x, h, P, A, K, Y):
-    """The stages of an explicit method in order: K_i = f(x + h sum_{j<i} a_ij K_j)."""
-    s = K.shape[0]
+#: The run loop every entry point shares: ``{stages}`` computes the increment ``inc`` of one step (or returns
+#: ``step - 1`` with ``info[1]`` set); the update (compensated or not), the range check and the sampling are common.
+_RK_RUN = """
+
+def {name}(x, c, compensated, h, P, A, b, steps, every, out, maxit, tol, info):
+    \"\"\"{what}.
+    steps steps from x (updated in place); out[j] gets the state after step j*every (and the last step);
+    {work}.  On failure info[1] = 1 (singular), 2 (no convergence) or 3 (not finite),
+    info[2] = the step.  Returns the steps done.  A[k] (s x s) and b[k] (s) are the tableau of component k.\"\"\"
     n = x.shape[0]
-    for i in range(s):
-        for k in range(n):
-            acc = 0.0
-            for j in range(i):
-                acc += A[k, i, j] * K[j, k]
-            Y[i, k] = x[k] + h * acc
-        rk_field(Y[i], P, K[i])
-
-
-def rk_run(x, c, compensated, mode, h, P, A, b, steps, every, out, maxit, tol, info):
-    """steps steps from x (updated in place); out[j] gets the state after step j*every (and the last step).
-    mode: 1 -- Kahan's step x' = x + h (I - h/2 f'(x))^-1 f(x), one linear solve; 2 -- an explicit method,
-    its stages in order; 0 -- the Runge--Kutta step with Newton's method.  info[0] += Newton iterations
-    (mode 1: solves); on failure info[1] = 1 (singular), 2 (no convergence) or 3 (not finite) and info[2] = the
-    step; returns the steps done.  A[k] (s x s) and b[k] (s) are the tableau of component k."""
-    s = b.shape[1]
-    n = x.shape[0]
-    m = s * n
-    K = np.zeros((s, n))
-    Y = np.zeros((s, n))
-    F = np.zeros((s, n))
-    J = np.zeros((n, n))
-    M = np.zeros((m, m))
-    r = np.zeros(m)
+{arrays}
     inc = np.zeros(n)
     j = 1
     for step in range(1, steps + 1):
-        if mode == 2:
-            rk_explicit(x, h, P, A, K, Y)
-            for k in range(n):
-                acc = 0.0
-                for i in range(s):
-                    acc += b[k, i] * K[i, k]
-                inc[k] = h * acc
-        elif mode == 1:
-            rk_field(x, P, r)
-            rk_jacobian(x, P, J)
-            for a in range(n):
-                for e in range(n):
-                    M[a, e] = (1.0 if a == e else 0.0) - 0.5 * h * J[a, e]
-            if not rk_solve(M, r, n):
-                info[1] = 1
-                info[2] = step
-                return step - 1
-            info[0] += 1
-            for k in range(n):
-                inc[k] = h * r[k]
-        else:
-            it = rk_newton(x, h, P, A, K, Y, F, J, M, r, maxit, tol)
-            if it < 0:
-                info[1] = 1 if it == -1 else 2
-                info[2] = step
-                return step - 1
-            info[0] += it
-            for k in range(n):
-                acc = 0.0
-                for i in range(s):
-                    acc += b[k, i] * K[i, k]
-                inc[k] = h * acc
+{stages}
         finite = True
         for k in range(n):
             if compensated:
@@ -1176,7 +1129,67 @@ def rk_run(x, c, compensated, mode, h, P, A, b, steps, every, out, maxit, tol, i
                 out[j, k] = x[k]
             j += 1
     return steps
-'''
+"""
+
+#: inc = h sum_i b_i K_i, per component.
+_RK_INCREMENT = """\
+        for k in range(n):
+            acc = 0.0
+            for i in range(s):
+                acc += b[k, i] * K[i, k]
+            inc[k] = h * acc"""
+
+#: The three entry points, one per kind of step (:func:`nambu_bch.numeric.runge_kutta.iterate_runge_kutta` calls
+#: the one its tableau needs, so numba compiles only that one's call graph): name -> (what, work, arrays, stages).
+_RK_RUNS = {
+    "rk_run_explicit": (
+        "An explicit method, its stages in order: K_i = f(x + h sum_{q<i} a_iq K_q)", "info[0] is left as it is",
+        "    s = b.shape[1]\n    K = np.zeros((s, n))\n    Y = np.zeros((s, n))",
+        """\
+        for i in range(s):
+            for k in range(n):
+                acc = 0.0
+                for q in range(i):
+                    acc += A[k, i, q] * K[q, k]
+                Y[i, k] = x[k] + h * acc
+            rk_field(Y[i], P, K[i])
+""" + _RK_INCREMENT),
+    "rk_run_kahan": (
+        "Kahan's method, x' = x + h (I - h/2 f'(x))^-1 f(x): one linear solve a step (A, b unused)",
+        "info[0] += 1 per solve",
+        "    J = np.zeros((n, n))\n    M = np.zeros((n, n))\n    r = np.zeros(n)",
+        """\
+        rk_field(x, P, r)
+        rk_jacobian(x, P, J)
+        for a in range(n):
+            for e in range(n):
+                M[a, e] = (1.0 if a == e else 0.0) - 0.5 * h * J[a, e]
+        if not rk_solve(M, r, n):
+            info[1] = 1
+            info[2] = step
+            return step - 1
+        info[0] += 1
+        for k in range(n):
+            inc[k] = h * r[k]"""),
+    "rk_run_newton": (
+        "The Runge--Kutta step, its stages by Newton's method (rk_newton)", "info[0] += the Newton iterations",
+        "    s = b.shape[1]\n    m = s * n\n    K = np.zeros((s, n))\n    Y = np.zeros((s, n))\n"
+        "    F = np.zeros((s, n))\n    J = np.zeros((n, n))\n    M = np.zeros((m, m))\n    r = np.zeros(m)",
+        """\
+        it = rk_newton(x, h, P, A, K, Y, F, J, M, r, maxit, tol)
+        if it < 0:
+            info[1] = 1 if it == -1 else 2
+            info[2] = step
+            return step - 1
+        info[0] += it
+""" + _RK_INCREMENT),
+}
+
+
+def _rk_runs() -> str:
+    """The entry points of :data:`_RK_RUNS` written out from :data:`_RK_RUN`."""
+    return "".join(_RK_RUN.format(name=name, what=what, work=work, arrays=arrays, stages=stages)
+                   for name, (what, work, arrays, stages) in _RK_RUNS.items())
 
 
 def runge_kutta_source(system) -> str:
@@ -1203,4 +1216,4 @@ def runge_kutta_source(system) -> str:
     lines += [f"    out[{i}] = {checked(e, 'the vector field')}" for i, e in enumerate(field)]
     lines += ["", "", "def rk_jacobian(y, P, J):", *load]
     lines += [f"    J[{i}, {k}] = {checked(jac[i, k], 'the Jacobian')}" for i in range(len(s)) for k in range(len(s))]
-    return "\n".join(lines) + "\n" + _RK_TEMPLATE
+    return "\n".join(lines) + "\n" + _RK_TEMPLATE + _rk_runs()
