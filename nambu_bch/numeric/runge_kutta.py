@@ -125,10 +125,9 @@ def is_linearly_implicit(tableau) -> bool:
 
 
 #: The functions of the generated Runge--Kutta module, callees first.
-_RK_FUNCTIONS = ("rk_field", "rk_jacobian", "rk_solve", "rk_newton",
-                 "rk_run_explicit", "rk_run_kahan", "rk_run_newton")
-#: The entry point of each kind of step (numba compiles a function on its first call, with the callees it reaches:
-#: an explicit run never compiles the Newton iteration or the linear solve).
+_RK_FUNCTIONS = ("rk_field", "rk_jacobian", "rk_run_explicit", "rk_run_kahan", "rk_run_newton")
+#: The entry point of each kind of step, its loops inline (numba compiles a function on its first call, with the
+#: callees it reaches: an explicit run compiles the field and its own loop, never Newton's iteration or the solve).
 _RK_ENTRIES = {"explicit": "rk_run_explicit", "kahan": "rk_run_kahan", "newton": "rk_run_newton"}
 
 
