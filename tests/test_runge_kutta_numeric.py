@@ -83,6 +83,13 @@ def test_newton_failure_names_h_and_step():
         iterate("rigid-body", "midpoint", 0.1, 3, X0, P, dps=30)
 
 
+def test_interpreted_math_error_is_a_range_error():
+    """The interpreter's ``math.sin(inf)`` (an explicit stage past the float64 range) raises ValueError where the
+    compiled loop gets nan: the run refuses it as the compiled one does, naming the method and h."""
+    with pytest.raises(NumericalRangeError, match=r"rk4 on .*float64 range \(h = 1e\+200\); lower h"):
+        iterate_runge_kutta("pendulum", "rk4", 1e200, 3, [1.0, 0.2], backend="numpy")
+
+
 def test_method_names_and_symmetry():
     assert runge_kutta_method("Gauss4") is TABLEAUX["gauss4"] and runge_kutta_method("12321") is None
     # every collocation method of the table is symmetric except the explicit ones and implicit Euler

@@ -277,7 +277,12 @@ def iterate_runge_kutta(system, method, h, steps, x0=None, params=None, every=1,
         c = compensation if compensation is not None and single else np.zeros(system.N)
         info = np.zeros(3, dtype=np.int64)
         with np.errstate(all="ignore"):
-            done = run(x, c, kahan, h, P, A, b, steps, every, samples, max_newton, NEWTON_TOL, info)
+            try:
+                done = run(x, c, kahan, h, P, A, b, steps, every, samples, max_newton, NEWTON_TOL, info)
+            except (OverflowError, ValueError, ZeroDivisionError):  # the interpreter's math.sin(inf), math.exp(1e3),
+                # 1/0 raise where the compiled loop gets nan or inf and stops at the step (reported below)
+                raise NumericalRangeError(f"{tableau.name} on {what}: the state left the float64 range (h = {h:g}); "
+                                          "lower h") from None
         total += int(info[0])
         if done < steps:
             why = {1: "the Newton matrix is singular", 2: f"Newton's method did not converge in {max_newton} iterations",
