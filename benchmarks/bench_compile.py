@@ -163,13 +163,29 @@ def first():
 def warm():
     iterate("ho3", "32123", 0.1, 400, X, every=100, backend="numba")
 ''',
-    "rigid-body gauss4 (rk_run)": '''
+    "rigid-body gauss4 (Runge-Kutta, Newton's method)": '''
 from nambu_bch.numeric.runge_kutta import iterate_runge_kutta
 P = {"I1": 1.0, "I2": 2.0, "I3": 3.0}
 def first():
     iterate_runge_kutta("rigid-body", "gauss4", 0.1, 50, [1.0, 0.5, 0.2], P, every=10, backend="numba")
 def warm():
-    iterate_runge_kutta("rigid-body", "gauss4", 0.1, 2000, [1.0, 0.5, 0.2], P, every=10, backend="numba")
+    iterate_runge_kutta("rigid-body", "gauss4", 0.01, 200000, [1.0, 0.5, 0.2], P, every=10, backend="numba")
+''',
+    "rigid-body rk4 (Runge-Kutta, explicit)": '''
+from nambu_bch.numeric.runge_kutta import iterate_runge_kutta
+P = {"I1": 1.0, "I2": 2.0, "I3": 3.0}
+def first():
+    iterate_runge_kutta("rigid-body", "rk4", 0.1, 50, [1.0, 0.5, 0.2], P, every=10, backend="numba")
+def warm():
+    iterate_runge_kutta("rigid-body", "rk4", 0.001, 2000000, [1.0, 0.5, 0.2], P, every=10, backend="numba")
+''',
+    "rigid-body kahan (Runge-Kutta, one linear solve)": '''
+from nambu_bch.numeric.runge_kutta import iterate_runge_kutta
+P = {"I1": 1.0, "I2": 2.0, "I3": 3.0}
+def first():
+    iterate_runge_kutta("rigid-body", "kahan", 0.1, 50, [1.0, 0.5, 0.2], P, every=10, backend="numba")
+def warm():
+    iterate_runge_kutta("rigid-body", "kahan", 0.001, 2000000, [1.0, 0.5, 0.2], P, every=10, backend="numba")
 ''',
 }
 

@@ -314,6 +314,10 @@ DEEP = (
     # one (Emb 3/2 A c and the Milne 2/2 c rows keep A 3-3 c); every published row is still checked by the deep tier
     ("test_catalog_published.py", "test_ab_table_of_check_methods",
      lambda pid: pid not in ("KL 10-6", "BM 11-6 PRK", "A 3-3 c")),
+    # the Runge-Kutta module's explicit and Kahan loops compiled against the interpreter (1.5-3 s each cold): the fast
+    # tier keeps Newton's loop compiled bit for bit (test_compiled_equals_interpreted_bit_for_bit, gauss4), both
+    # kinds interpreted against the reference (test_generated_step_matches_reference) and each entry point's callees
+    ("test_runge_kutta_numeric.py", "test_explicit_and_kahan_loops_compiled_equal_interpreted_bit_for_bit", ()),
 )
 
 #: The two ways :func:`cli_run` runs the command line; the fast tier keeps ``in-process``: the ``subprocess`` case

@@ -55,6 +55,77 @@ def test_quadratic_invariants_kept_by_iteration(method):
     assert np.abs(Hy - Hy[0]).max() > 1e-8
 
 
+@pytest.mark.parametrize("method", ["rk4", "kahan"])
+def test_explicit_and_kahan_loops_compiled_equal_interpreted_bit_for_bit(method, monkeypatch):
+    """The two entry points besides Newton's (compiled above): compiled equals interpreted bit for bit, plain and
+    compensated, one trajectory and a batch; and a run of one kind compiles its own entry point only."""
+    pytest.importorskip("numba")
+    import nambu_bch.numeric.runge_kutta as rk
+    from nambu_bch.systems.spec import as_system
+
+    monkeypatch.setattr(rk, "_MODULES", {})  # new dispatchers, none compiled (numba's cache may still be warm)
+    for x in (X0, np.array([X0, [0.3, -0.2, 1.0]]).T):
+        for kahan in (False, True):
+            a = iterate_runge_kutta("rigid-body", method, 0.1, 50, x, P, every=10, kahan=kahan, backend="numba")
+            b = iterate_runge_kutta("rigid-body", method, 0.1, 50, x, P, every=10, kahan=kahan, backend="numpy")
+            assert np.array_equal(a, b)
+    module = rk._MODULES[as_system("rigid-body"), "numba"]
+    compiled = [f for f in rk._RK_ENTRIES.values() if getattr(module, f).signatures]
+    assert compiled == [rk._RK_ENTRIES["explicit" if method == "rk4" else "kahan"]]
+
+def test_each_entry_point_reaches_only_what_its_step_needs():
+    """numba compiles a function with every function it calls: an explicit run reaches the field alone (not Newton's
+    iteration, the linear solve or the Jacobian), Kahan's and Newton's runs the field and its Jacobian."""
+    import ast
+
+    from nambu_bch.numeric.codegen import runge_kutta_source
+    from nambu_bch.numeric.runge_kutta import _RK_ENTRIES, _RK_FUNCTIONS
+    from nambu_bch.systems.spec import as_system
+
+    tree = ast.parse(runge_kutta_source(as_system("rigid-body")))
+    defs = {f.name: f for f in tree.body if isinstance(f, ast.FunctionDef)}
+
+    def calls(name):
+        return {n.func.id for n in ast.walk(defs[name])
+                if isinstance(n, ast.Call) and isinstance(n.func, ast.Name) and n.func.id in defs}
+
+    assert set(defs) == set(_RK_FUNCTIONS) == {"rk_field", "rk_jacobian", *_RK_ENTRIES.values()}
+    assert calls("rk_run_explicit") == {"rk_field"}
+    assert calls("rk_run_kahan") == calls("rk_run_newton") == {"rk_field", "rk_jacobian"}
+    assert calls("rk_field") == calls("rk_jacobian") == set()
+
+
+def test_auto_interprets_a_short_run_until_its_own_entry_point_is_compiled(monkeypatch):
+    """A compiled Newton loop does not make a short explicit run compile its own (seconds): ``backend="auto"``
+    interprets it, and calls the compiled explicit loop once that one exists."""
+    from types import SimpleNamespace
+
+    import nambu_bch.numeric.runge_kutta as rk
+    from nambu_bch.numeric.kernels import numba_available
+    from nambu_bch.systems.spec import as_system
+
+    if not numba_available():
+        pytest.skip("numba not installed or disabled")
+    called = []
+
+    def loop(compiled):
+        def run(*args):
+            if not compiled:
+                raise AssertionError("a short run compiled a loop")
+            called.append(args[7])  # steps
+            return args[7]
+        run.signatures = ["(float64[::1], ...)"] if compiled else []
+        return run
+
+    fake = SimpleNamespace(rk_run_newton=loop(True), rk_run_kahan=loop(False), rk_run_explicit=loop(False))
+    monkeypatch.setattr(rk, "_MODULES", {(as_system("rigid-body"), "numba"): fake})
+    interpreted = iterate_runge_kutta("rigid-body", "rk4", 0.1, 10, X0, P, backend="auto")
+    assert np.array_equal(interpreted, iterate_runge_kutta("rigid-body", "rk4", 0.1, 10, X0, P, backend="numpy"))
+    assert called == []
+    fake.rk_run_explicit = loop(True)
+    iterate_runge_kutta("rigid-body", "rk4", 0.1, 10, X0, P, backend="auto")
+    assert called == [10]
+
 def test_kahan_is_one_linear_solve_per_step():
     stats = {}
     iterate_runge_kutta("rigid-body", "kahan", 0.1, 30, X0, P, backend="numpy", stats=stats)
@@ -81,6 +152,13 @@ def test_newton_failure_names_h_and_step():
         iterate("rigid-body", "gauss6", 50.0, 5, [3.0, 2.0, 1.0], P, backend="numpy")
     with pytest.raises(InvalidRunError, match="float64 only"):
         iterate("rigid-body", "midpoint", 0.1, 3, X0, P, dps=30)
+
+
+def test_interpreted_math_error_is_a_range_error():
+    """The interpreter's ``math.sin(inf)`` (an explicit stage past the float64 range) raises ValueError where the
+    compiled loop gets nan: the run refuses it as the compiled one does, naming the method and h."""
+    with pytest.raises(NumericalRangeError, match=r"rk4 on .*float64 range \(h = 1e\+200\); lower h"):
+        iterate_runge_kutta("pendulum", "rk4", 1e200, 3, [1.0, 0.2], backend="numpy")
 
 
 def test_method_names_and_symmetry():

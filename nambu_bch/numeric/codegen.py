@@ -40,6 +40,7 @@ from __future__ import annotations
 
 import hashlib
 import math
+import textwrap
 from dataclasses import dataclass
 from fractions import Fraction
 from functools import lru_cache
@@ -570,6 +571,7 @@ Every name below is internal (s_i state, k_j constants, P[i] parameters); the ca
 verifies this file against the digest recorded when it was generated.
 """
 import math
+import textwrap
 import numpy as np
 
 _exp, _expm1, _log, _sqrt = math.exp, math.expm1, math.log, math.sqrt
@@ -1003,159 +1005,117 @@ def source_hash(source: str) -> str:
 
 # -- Runge--Kutta steps -------------------------------------------------------------------------------------------
 #: Bump when the generated Runge--Kutta source changes meaning.
-RK_TEMPLATE_VERSION = "4"
+RK_TEMPLATE_VERSION = "5"
 
-_RK_TEMPLATE = '''
+# The generated module is the field, its Jacobian and one entry point per kind of step, each a single function
+# with the loops it needs written inline: numba compiles a function on its first call with every function it
+# reaches (typed, lowered and optimised apart, then optimised again when linked into the caller), so an explicit
+# run compiles two functions, not the Newton iteration and the linear solve besides, and an implicit one pays for
+# no second optimisation of a callee.  The fragments below are indented into the entry points by _rk_runs.
 
-def rk_solve(M, r, m):
-    """Gaussian elimination with partial pivoting: r <- M^-1 r (M is overwritten); False if M is singular."""
-    for k in range(m):
-        p = k
-        big = abs(M[k, k])
-        for i in range(k + 1, m):
-            if abs(M[i, k]) > big:
-                big = abs(M[i, k])
-                p = i
-        if not (big > 0.0 and big < _INF):
-            return False
-        if p != k:
-            for j in range(m):
-                t = M[k, j]
-                M[k, j] = M[p, j]
-                M[p, j] = t
-            t = r[k]
-            r[k] = r[p]
-            r[p] = t
-        for i in range(k + 1, m):
-            q = M[i, k] / M[k, k]
-            if q != 0.0:
-                for j in range(k + 1, m):
-                    M[i, j] -= q * M[k, j]
-                r[i] -= q * r[k]
-    for k in range(m - 1, -1, -1):
+#: ``r <- M^-1 r`` for the leading ``{m} x {m}`` block by Gaussian elimination with partial pivoting (``M``
+#: overwritten); ``ok`` is False, and ``r`` left half done, when ``M`` is singular.
+_RK_SOLVE = """\
+ok = True
+for k in range({m}):
+    p = k
+    big = abs(M[k, k])
+    for i in range(k + 1, {m}):
+        if abs(M[i, k]) > big:
+            big = abs(M[i, k])
+            p = i
+    if not (big > 0.0 and big < _INF):
+        ok = False
+        break
+    if p != k:
+        for e in range({m}):
+            t = M[k, e]
+            M[k, e] = M[p, e]
+            M[p, e] = t
         t = r[k]
-        for j in range(k + 1, m):
-            t -= M[k, j] * r[j]
-        r[k] = t / M[k, k]
-    return True
+        r[k] = r[p]
+        r[p] = t
+    for i in range(k + 1, {m}):
+        g = M[i, k] / M[k, k]
+        if g != 0.0:
+            for e in range(k + 1, {m}):
+                M[i, e] -= g * M[k, e]
+            r[i] -= g * r[k]
+if ok:
+    for k in range({m} - 1, -1, -1):
+        t = r[k]
+        for e in range(k + 1, {m}):
+            t -= M[k, e] * r[e]
+        r[k] = t / M[k, k]"""
 
-
-def rk_newton(x, h, P, A, K, Y, F, J, M, r, maxit, tol):
-    """The stages K_i = f(x + h sum_j a_ij K_j) by Newton's method, from K_i = f(x), until the residual no
-    longer shrinks (round-off); the iterations used, -1 when the Newton matrix is singular, -2 when the
-    residual did not reach tol * (1 + max|K|) within maxit iterations.  A[k] is the tableau of component k
-    (one tableau for all, or a partitioned pair's two)."""
-    s = K.shape[0]
-    n = x.shape[0]
-    m = s * n
-    rk_field(x, P, F[0])
-    for i in range(s):
-        for k in range(n):
-            K[i, k] = F[0, k]
-    best = _INF
-    it = 0
-    while True:
-        for i in range(s):
-            for k in range(n):
-                acc = 0.0
-                for j in range(s):
-                    acc += A[k, i, j] * K[j, k]
-                Y[i, k] = x[k] + h * acc
-            rk_field(Y[i], P, F[i])
-        size = 0.0
-        scale = 0.0
-        for i in range(s):
-            for k in range(n):
-                d = K[i, k] - F[i, k]
-                r[i * n + k] = d
-                if abs(d) > size:
-                    size = abs(d)
-                if abs(K[i, k]) > scale:
-                    scale = abs(K[i, k])
-        if not (size < _INF):
-            return -2
-        if size <= 4.0 * 2.220446049250313e-16 * scale or (size >= best and best <= tol * (1.0 + scale)):
-            return it
-        if size >= best or it >= maxit:
-            return -2
-        best = size
-        for i in range(s):
-            rk_jacobian(Y[i], P, J)
-            for a in range(n):
-                for j in range(s):
-                    for c in range(n):
-                        M[i * n + a, j * n + c] = (1.0 if (i == j and a == c) else 0.0) - h * A[c, i, j] * J[a, c]
-        if not rk_solve(M, r, m):
-            return -1
-        for i in range(s):
-            for k in range(n):
-                K[i, k] -= r[i * n + k]
-        it += 1
-
-
-def rk_explicit(x, h, P, A, K, Y):
-    """The stages of an explicit method in order: K_i = f(x + h sum_{j<i} a_ij K_j)."""
-    s = K.shape[0]
-    n = x.shape[0]
+#: The stages ``K_i = f(x + h sum_q a_iq K_q)`` by Newton's method on the ``m = s n`` unknowns, from ``K_i = f(x)``,
+#: until the residual no longer shrinks (round-off): ``it`` the iterations used, -1 when the Newton matrix is
+#: singular, -2 when the residual did not reach ``tol (1 + max|K|)`` within ``maxit`` iterations.  ``A[k]`` is the
+#: tableau of component ``k`` (one tableau for all, or a partitioned pair's two).
+_RK_NEWTON = """\
+rk_field(x, P, F[0])
+for i in range(s):
+    for k in range(n):
+        K[i, k] = F[0, k]
+best = _INF
+it = 0
+while True:
     for i in range(s):
         for k in range(n):
             acc = 0.0
-            for j in range(i):
-                acc += A[k, i, j] * K[j, k]
+            for q in range(s):
+                acc += A[k, i, q] * K[q, k]
             Y[i, k] = x[k] + h * acc
-        rk_field(Y[i], P, K[i])
+        rk_field(Y[i], P, F[i])
+    size = 0.0
+    scale = 0.0
+    for i in range(s):
+        for k in range(n):
+            d = K[i, k] - F[i, k]
+            r[i * n + k] = d
+            if abs(d) > size:
+                size = abs(d)
+            if abs(K[i, k]) > scale:
+                scale = abs(K[i, k])
+    if not (size < _INF):
+        it = -2
+        break
+    if size <= 4.0 * 2.220446049250313e-16 * scale or (size >= best and best <= tol * (1.0 + scale)):
+        break
+    if size >= best or it >= maxit:
+        it = -2
+        break
+    best = size
+    for i in range(s):
+        rk_jacobian(Y[i], P, J)
+        for a in range(n):
+            for q in range(s):
+                for e in range(n):
+                    M[i * n + a, q * n + e] = (1.0 if (i == q and a == e) else 0.0) - h * A[e, i, q] * J[a, e]
+{solve}
+    if not ok:
+        it = -1
+        break
+    for i in range(s):
+        for k in range(n):
+            K[i, k] -= r[i * n + k]
+    it += 1"""
 
+#: The run loop every entry point shares: ``{stages}`` computes the increment ``inc`` of one step (or returns
+#: ``step - 1`` with ``info[1]`` set); the update (compensated or not), the range check and the sampling are common.
+_RK_RUN = """
 
-def rk_run(x, c, compensated, mode, h, P, A, b, steps, every, out, maxit, tol, info):
-    """steps steps from x (updated in place); out[j] gets the state after step j*every (and the last step).
-    mode: 1 -- Kahan's step x' = x + h (I - h/2 f'(x))^-1 f(x), one linear solve; 2 -- an explicit method,
-    its stages in order; 0 -- the Runge--Kutta step with Newton's method.  info[0] += Newton iterations
-    (mode 1: solves); on failure info[1] = 1 (singular), 2 (no convergence) or 3 (not finite) and info[2] = the
-    step; returns the steps done.  A[k] (s x s) and b[k] (s) are the tableau of component k."""
-    s = b.shape[1]
+def {name}(x, c, compensated, h, P, A, b, steps, every, out, maxit, tol, info):
+    \"\"\"{what}.
+    steps steps from x (updated in place); out[j] gets the state after step j*every (and the last step);
+    {work}.  On failure info[1] = 1 (singular), 2 (no convergence) or 3 (not finite),
+    info[2] = the step.  Returns the steps done.  A[k] (s x s) and b[k] (s) are the tableau of component k.\"\"\"
     n = x.shape[0]
-    m = s * n
-    K = np.zeros((s, n))
-    Y = np.zeros((s, n))
-    F = np.zeros((s, n))
-    J = np.zeros((n, n))
-    M = np.zeros((m, m))
-    r = np.zeros(m)
+{arrays}
     inc = np.zeros(n)
     j = 1
     for step in range(1, steps + 1):
-        if mode == 2:
-            rk_explicit(x, h, P, A, K, Y)
-            for k in range(n):
-                acc = 0.0
-                for i in range(s):
-                    acc += b[k, i] * K[i, k]
-                inc[k] = h * acc
-        elif mode == 1:
-            rk_field(x, P, r)
-            rk_jacobian(x, P, J)
-            for a in range(n):
-                for e in range(n):
-                    M[a, e] = (1.0 if a == e else 0.0) - 0.5 * h * J[a, e]
-            if not rk_solve(M, r, n):
-                info[1] = 1
-                info[2] = step
-                return step - 1
-            info[0] += 1
-            for k in range(n):
-                inc[k] = h * r[k]
-        else:
-            it = rk_newton(x, h, P, A, K, Y, F, J, M, r, maxit, tol)
-            if it < 0:
-                info[1] = 1 if it == -1 else 2
-                info[2] = step
-                return step - 1
-            info[0] += it
-            for k in range(n):
-                acc = 0.0
-                for i in range(s):
-                    acc += b[k, i] * K[i, k]
-                inc[k] = h * acc
+{stages}
         finite = True
         for k in range(n):
             if compensated:
@@ -1176,13 +1136,76 @@ def rk_run(x, c, compensated, mode, h, P, A, b, steps, every, out, maxit, tol, i
                 out[j, k] = x[k]
             j += 1
     return steps
-'''
+"""
+
+#: inc = h sum_i b_i K_i, per component.
+_RK_INCREMENT = """\
+for k in range(n):
+    acc = 0.0
+    for i in range(s):
+        acc += b[k, i] * K[i, k]
+    inc[k] = h * acc"""
+
+#: The stages of an explicit method in order: K_i = f(x + h sum_{q<i} a_iq K_q).
+_RK_EXPLICIT = """\
+for i in range(s):
+    for k in range(n):
+        acc = 0.0
+        for q in range(i):
+            acc += A[k, i, q] * K[q, k]
+        Y[i, k] = x[k] + h * acc
+    rk_field(Y[i], P, K[i])"""
+
+#: Kahan's step on a quadratic field: x' = x + h (I - h/2 f'(x))^-1 f(x).
+_RK_KAHAN = """\
+rk_field(x, P, r)
+rk_jacobian(x, P, J)
+for a in range(n):
+    for e in range(n):
+        M[a, e] = (1.0 if a == e else 0.0) - 0.5 * h * J[a, e]
+{solve}
+if not ok:
+    info[1] = 1
+    info[2] = step
+    return step - 1
+info[0] += 1
+for k in range(n):
+    inc[k] = h * r[k]"""
+
+#: The failure of Newton's iteration reported, its iterations counted.
+_RK_NEWTON_DONE = """\
+if it < 0:
+    info[1] = 1 if it == -1 else 2
+    info[2] = step
+    return step - 1
+info[0] += it"""
+
+
+def _rk_runs() -> str:
+    """The three entry points (:func:`nambu_bch.numeric.runge_kutta.iterate_runge_kutta` calls the one its tableau
+    needs): ``rk_run_explicit``, ``rk_run_kahan`` and ``rk_run_newton``, written out from :data:`_RK_RUN`."""
+    def block(*fragments, depth=8):
+        return textwrap.indent("\n".join(fragments), " " * depth)
+
+    newton = _RK_NEWTON.format(solve=block(_RK_SOLVE.format(m="m"), depth=4))
+    runs = (
+        ("rk_run_explicit", "An explicit method, its stages in order", "info[0] is left as it is",
+         ("s = b.shape[1]", "K = np.zeros((s, n))", "Y = np.zeros((s, n))"), (_RK_EXPLICIT, _RK_INCREMENT)),
+        ("rk_run_kahan", "Kahan's method: one linear solve a step (A, b unused)", "info[0] += 1 per solve",
+         ("J = np.zeros((n, n))", "M = np.zeros((n, n))", "r = np.zeros(n)"),
+         (_RK_KAHAN.format(solve=_RK_SOLVE.format(m="n")),)),
+        ("rk_run_newton", "The Runge--Kutta step, its stages by Newton's method", "info[0] += the Newton iterations",
+         ("s = b.shape[1]", "m = s * n", "K = np.zeros((s, n))", "Y = np.zeros((s, n))", "F = np.zeros((s, n))",
+          "J = np.zeros((n, n))", "M = np.zeros((m, m))", "r = np.zeros(m)"), (newton, _RK_NEWTON_DONE, _RK_INCREMENT)),
+    )
+    return "".join(_RK_RUN.format(name=name, what=what, work=work, arrays=block(*arrays, depth=4),
+                                  stages=block(*stages)) for name, what, work, arrays, stages in runs)
 
 
 def runge_kutta_source(system) -> str:
     """The generated module of the Runge--Kutta steps on ``system``: ``rk_field(y, P, out)`` and
     ``rk_jacobian(y, P, J)`` printed from the system's (validated) vector field, then the fixed Newton and
-    linear-solve loops (:data:`_RK_TEMPLATE`).  Coordinates enter as ``y[i]``, parameters as ``P[i]``: no name a
+    linear-solve loops (:func:`_rk_runs`).  Coordinates enter as ``y[i]``, parameters as ``P[i]``: no name a
     user chose reaches the source; the field may use only them and :data:`ALLOWED_FUNCTIONS`, and must be finite.
     """
     coords, params = list(system.coordinates), list(system.parameters)
@@ -1203,4 +1226,4 @@ def runge_kutta_source(system) -> str:
     lines += [f"    out[{i}] = {checked(e, 'the vector field')}" for i, e in enumerate(field)]
     lines += ["", "", "def rk_jacobian(y, P, J):", *load]
     lines += [f"    J[{i}, {k}] = {checked(jac[i, k], 'the Jacobian')}" for i in range(len(s)) for k in range(len(s))]
-    return "\n".join(lines) + "\n" + _RK_TEMPLATE
+    return "\n".join(lines) + "\n" + _rk_runs()

@@ -125,7 +125,10 @@ def is_linearly_implicit(tableau) -> bool:
 
 
 #: The functions of the generated Runge--Kutta module, callees first.
-_RK_FUNCTIONS = ("rk_field", "rk_jacobian", "rk_solve", "rk_newton", "rk_explicit", "rk_run")
+_RK_FUNCTIONS = ("rk_field", "rk_jacobian", "rk_run_explicit", "rk_run_kahan", "rk_run_newton")
+#: The entry point of each kind of step, its loops inline (numba compiles a function on its first call, with the
+#: callees it reaches: an explicit run compiles the field and its own loop, never Newton's iteration or the solve).
+_RK_ENTRIES = {"explicit": "rk_run_explicit", "kahan": "rk_run_kahan", "newton": "rk_run_newton"}
 
 
 def _method(method):
@@ -177,7 +180,7 @@ def _module(system, backend):
 
         sys.modules[name] = module  # numba's cache locates the functions through their module (not the numpy twin)
 
-        # callees first: the compiled callers find them as globals of the module
+        # callees first: the compiled callers find them as globals of the module; each is compiled on its first call
         for fn in _RK_FUNCTIONS:
             jitted = numba.njit(nogil=True, error_model="numpy")(module.__dict__[fn])
             if path.is_file():
@@ -185,6 +188,12 @@ def _module(system, backend):
             module.__dict__[fn] = jitted
     _MODULES[key] = module
     return module
+
+
+def _compiled(system, entry) -> bool:
+    """Whether this process has compiled (or loaded from numba's cache) the entry point ``entry`` for ``system``."""
+    module = _MODULES.get((system, "numba"))
+    return module is not None and bool(getattr(module, entry).signatures)
 
 
 def iterate_runge_kutta(system, method, h, steps, x0=None, params=None, every=1, *, kahan=False, backend="auto",
@@ -200,8 +209,8 @@ def iterate_runge_kutta(system, method, h, steps, x0=None, params=None, every=1,
         coordinates use its first tableau, those of ``p`` its second, in the same Newton iteration (HLW Sect. II.2)
     kahan : bool -- compensated summation of the increments
     backend : ``"auto"`` | ``"numba"`` | ``"numpy"`` -- compiled, or the same generated source interpreted (the same
-        bits); ``"auto"``: compiled, except runs of at most :data:`INTERPRET_STEPS` trajectory-steps before the module
-        is compiled in this process
+        bits); ``"auto"``: compiled, except runs of at most :data:`INTERPRET_STEPS` trajectory-steps before the
+        entry point of the method's kind of step (explicit, Kahan's, Newton's) is compiled in this process
     max_newton : int -- Newton iterations allowed per step
     compensation : float64 array of shape (N,), optional -- the compensated summation's carry, updated in place
         (a run continued block by block: :func:`nambu_bch.numeric.iterate_chunks`); one trajectory only
@@ -247,10 +256,10 @@ def iterate_runge_kutta(system, method, h, steps, x0=None, params=None, every=1,
         from ..bseries.modified import _polynomial_field
 
         _polynomial_field(system, tableau)  # Kahan's formula is the method only on quadratic fields: refuse others
-    mode = 1 if linear else 2 if tableau.is_explicit else 0
-    if backend == "numba" and auto and (system, "numba") not in _MODULES and work <= INTERPRET_STEPS:
+    entry = _RK_ENTRIES["kahan" if linear else "explicit" if tableau.is_explicit else "newton"]
+    if backend == "numba" and auto and work <= INTERPRET_STEPS and not _compiled(system, entry):
         backend = "numpy"  # compiling costs seconds; a short run is done sooner by the interpreter (the same bits)
-    module = _module(system, backend)
+    run = getattr(_module(system, backend), entry)
     P = np.array([float(values[p]) for p in system.parameters], dtype=np.float64)
     A = np.array([[[float(a) for a in row] for row in t.A] for t in per_coordinate], dtype=np.float64)
     b = np.array([[float(x) for x in t.b] for t in per_coordinate], dtype=np.float64)
@@ -268,7 +277,12 @@ def iterate_runge_kutta(system, method, h, steps, x0=None, params=None, every=1,
         c = compensation if compensation is not None and single else np.zeros(system.N)
         info = np.zeros(3, dtype=np.int64)
         with np.errstate(all="ignore"):
-            done = module.rk_run(x, c, kahan, mode, h, P, A, b, steps, every, samples, max_newton, NEWTON_TOL, info)
+            try:
+                done = run(x, c, kahan, h, P, A, b, steps, every, samples, max_newton, NEWTON_TOL, info)
+            except (OverflowError, ValueError, ZeroDivisionError):  # the interpreter's math.sin(inf), math.exp(1e3),
+                # 1/0 raise where the compiled loop gets nan or inf and stops at the step (reported below)
+                raise NumericalRangeError(f"{tableau.name} on {what}: the state left the float64 range (h = {h:g}); "
+                                          "lower h") from None
         total += int(info[0])
         if done < steps:
             why = {1: "the Newton matrix is singular", 2: f"Newton's method did not converge in {max_newton} iterations",
