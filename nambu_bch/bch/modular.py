@@ -120,10 +120,11 @@ def _lyndon_table_kernel(words, table, g):
     (``left``, ``right``; -1 for a letter), and the chains ``K, core, lead, span`` of :func:`_solve`.
 
     Duval's step: the word after ``w`` is ``w`` repeated to length ``n``, its trailing largest letters dropped and
-    its last letter incremented (Duval 1983).  The standard factorisation of a Lyndon word ``w = u v`` has ``v``
-    the longest proper Lyndon suffix, which is the lexicographically smallest proper suffix (a longer Lyndon suffix
-    would be smaller than ``v``, its own suffix), and ``u`` Lyndon (Reutenauer, Prop. 5.1.3 / Lothaire, Combinatorics
-    on Words, Prop. 5.1.3); both are found by binary search, Duval order being lexicographic order (a prefix first).
+    its last letter incremented.  The standard factorisation ``w = u v`` of a Lyndon word has ``v`` the longest
+    proper Lyndon suffix and ``u`` Lyndon (Reutenauer, Sect. 5.1).  That suffix is the lexicographically smallest
+    proper suffix ``s``: ``s`` is Lyndon (its proper suffixes are proper suffixes of ``w``, so larger than ``s``), and
+    a longer Lyndon suffix would be smaller than ``s``, a proper suffix of it.  Both factors are found by binary
+    search, Duval order being lexicographic order (a prefix first).
 
     Chains: ``v = a^K u`` with ``P_v = ad_a^K P_u`` (the standard factorisation's left factor is the letter ``a``,
     the first of ``v``, ``K`` times in a row); ``u`` is the core; ``lead`` counts the leading ``a``'s; ``span`` is
