@@ -128,6 +128,20 @@ def test_sparse_engine_equals_dense_engine(spec, degree):
     assert len(A) == len(B) > 0
 
 
+def test_a_program_outgrowing_its_workspace_resumes_at_its_class(monkeypatch):
+    """The solve's program table is allocated in Python (``modular._engine``; compiled code allocates nothing): with
+    room for one inner node, each class whose program needs more comes back before it is touched and is solved again,
+    from its start, in a larger table; the numerators are those of a table large enough from the start."""
+    dens = [factorial(d) * lcm(*range(1, 8)) for d in range(8)]
+    args = ([0, 1, 2], [1, 1, 1], 1, 3, 7, dens)
+    expected = modular.lyndon_numerators(*args)
+    starts, solve = [], modular._solve
+    monkeypatch.setattr(modular, "_PROGRAM_CAPACITY", 1)
+    monkeypatch.setattr(modular, "_solve", lambda *a: starts.append(int(a[15])) or solve(*a))
+    assert modular.lyndon_numerators(*args) == expected
+    assert len(starts) > 2 and starts[0] == 0 and starts == sorted(starts)
+
+
 def test_algebraic_coefficients_use_the_dense_engine():
     """Triple jump (2^(1/3)): not rational, so the series comes from the dense engine with field elements."""
     B = formal_bch("yoshida:121", 5)
@@ -253,8 +267,9 @@ def test_chain_entries_are_the_core_entries(g, n):
     words ``v < w``, against the full expansion of ``P_v`` (Reutenauer Thm. 5.1), and ``P_v = ad_a^K P_core``."""
     from nambu_bch.bch.lyndon import lyndon_expansion, word_index
 
-    words, lengths, left, right = modular.lyndon_table(g, n)
-    K, core, lead, span = modular._chains(words, lengths, left, right)
+    table = modular.lyndon_table(g, n)
+    words, lengths, left, right = table
+    K, core, lead, span = table.chains
     word = [tuple(int(a) for a in words[i, : lengths[i]]) for i in range(len(lengths))]
     checked = 0
     for v in range(len(lengths)):
@@ -351,26 +366,27 @@ def test_the_solve_compiles_each_helper_for_one_signature():
     callee again for ``int64``: the class loop's start must not be a literal (five helpers compiled twice cost
     ~3 s of a cold start).  Checked where the engine was compiled in this process (a cold cache)."""
     formal_bch("123", 5)
-    for helper in (modular._class_chains, modular._add_earlier, modular._finish_group, modular._reduce):
+    for helper in (modular._class_program, modular._run_program, modular._add_earlier, modular._finish_group,
+                   modular._reduce):
         assert len(helper.signatures) <= 1, (helper, helper.signatures)
 
 
 def test_the_engine_compiles_only_what_a_series_needs():
     """Each compiled function, each numpy call numba specialises and each CPython wrapper is a separate compile on a
-    cold start: Eq. (3) (two letters, even degree) and the chains are entry points of their own (a three-letter series
-    never compiles Eq. (3)), the helpers called only from compiled code have no CPython wrapper, and the kernels call
-    no ``min``/``max``/``astype`` (one more compile each).  Read from the source and the
-    options, so nothing is compiled here."""
+    cold start: Eq. (3) (two letters, even degree) is an entry point of its own (a three-letter series never compiles
+    it), the chains come with the Lyndon table (one kernel) and are walked where they are used (no compiled function
+    tabulates them), the helpers called only from compiled code have no CPython wrapper, and the kernels call no
+    ``min``/``max``/``astype`` (one more compile each).  Read from the source and the options, so nothing is
+    compiled here."""
     solve = set(modular._solve.py_func.__code__.co_names)
-    assert not {"_even_top", "_chains"} & solve
-    kernels = [modular._lyndon_table_kernel, modular._chains, modular._class_chains, modular._add_earlier,
-               modular._finish_group, modular._solve, modular._word_coefficients, modular._even_top,
-               modular._class_program, modular._run_program]
+    assert "_even_top" not in solve
+    assert not hasattr(modular, "_chains") and not hasattr(modular, "_class_chains")
+    kernels = [modular._lyndon_table_kernel, modular._add_earlier, modular._finish_group, modular._solve,
+               modular._word_coefficients, modular._even_top, modular._class_program, modular._run_program]
     for kernel in kernels:
         names = set(kernel.py_func.__code__.co_names)
         assert not {"min", "max", "astype"} & names, (kernel, names)
-    for helper in (modular._class_chains, modular._add_earlier, modular._finish_group, modular._class_program,
-                   modular._run_program):
+    for helper in (modular._add_earlier, modular._finish_group, modular._class_program, modular._run_program):
         options = getattr(helper, "targetoptions", None) or helper.options  # a numba dispatcher once made
         assert options.get("no_cpython_wrapper"), helper
 
@@ -400,7 +416,7 @@ def test_importing_the_compiled_modules_does_not_import_numba(tmp_path):
 
     code = ("import sys\nimport nambu_bch.bch.modular as m, nambu_bch.numeric.scan\n"
             "print('numba' in sys.modules)\n"
-            "print(m._solve.signatures, 'numba' in sys.modules, type(m._chains).__name__)\n")
+            "print(m._solve.signatures, 'numba' in sys.modules, type(m._even_top).__name__)\n")
     env = {**os.environ, "PYTHONPATH": str(Path(__file__).resolve().parents[1]), "NAMBU_BCH_CACHE": str(tmp_path)}
     done = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True, timeout=300)
     assert done.returncode == 0, done.stderr

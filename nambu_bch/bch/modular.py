@@ -106,179 +106,115 @@ def _reduce(x, p, inv):
 
 
 # -- allocation ----------------------------------------------------------------------------------------------------
-# numba compiles np.zeros / np.full / np.empty / np.arange once per (number of dimensions, dtype), with the
-# np.empty and the zero fill beneath it: 0.1-0.3 s each on a cold start.  Every array here is allocated as a
-# zeroed one-dimensional int64 array (one compilation), seen as int32 through ``view`` where narrower entries are
-# wanted (one more), filled by a loop and reshaped (a view: no compilation); the Lyndon table's int8 rows are
-# allocated by numpy (:func:`lyndon_table`).  The helpers are inlined into their callers (no compilation of their
-# own either).
-
-@njit(inline="always")
-def _zeros2(rows, cols):
-    """A zeroed C-contiguous int64 ``(rows, cols)`` array."""
-    return np.zeros(rows * cols, dtype=np.int64).reshape((rows, cols))
-
-
-@njit(inline="always")
-def _zeros_int32(size):
-    """A zeroed int32 array of ``size`` entries (the first half of an int64 array's bytes, seen as int32)."""
-    return np.zeros((size + 1) // 2, dtype=np.int64).view(np.int32)[:size]
-
-
-@njit(inline="always")
-def _filled(size, value):
-    """An int64 array of ``size`` entries equal to ``value``."""
-    a = np.zeros(size, dtype=np.int64)
-    for i in range(size):
-        a[i] = value
-    return a
+# The compiled functions allocate nothing: every array, workspaces included, is allocated by numpy in Python and
+# passed in.  numba compiles its own np.zeros, reshape and view (with np.empty and the fill beneath them) on a cold
+# start, about a second of CPU for the three; passing arrays costs their unboxing only.
 
 
 # -- Lyndon table -------------------------------------------------------------------------------------------------
 
-@njit(inline="always")
-def _duval_next(w, length, n, g):
-    """Duval's step after the Lyndon word ``w[:length]`` has been used: extend periodically to length ``n``, drop
-    trailing maximal letters; returns the new length (0: done).  The caller increments ``w[length - 1]``."""
-    m = length
-    while length < n:
-        w[length] = w[length - m]
-        length += 1
-    while length > 0 and w[length - 1] == g - 1:
-        length -= 1
-    return length
-
-
-@njit(inline="always")
-def _find(codes, by_length, start, L, code):
-    """Duval index of the Lyndon word of length ``L`` with base-``g`` code ``code``, or -1 (binary search:
-    within one length Duval order is numeric order of codes)."""
-    lo, hi = start[L], start[L + 1]
-    while lo < hi:
-        mid = (lo + hi) // 2
-        if codes[mid] < code:
-            lo = mid + 1
-        else:
-            hi = mid
-    if lo < start[L + 1] and codes[lo] == code:
-        return by_length[lo]
-    return -1
-
-
 @njit()
-def _lyndon_table_kernel(words, g, n):
-    """Lyndon words of length <= n in Duval (lexicographic) order into ``words`` (zeroed, one row per word), their
-    lengths, and standard factors."""
-    count = words.shape[0]
-    lengths = np.zeros(count, dtype=np.int64)
-    code_of = np.zeros(count, dtype=np.int64)
-    left = _filled(count, -1)
-    right = _filled(count, -1)
-    w = _filled(n + 1, -1)
-    length, k = np.int64(1), 0
-    while length > 0:
-        w[length - 1] += 1
-        code = 0
-        for i in range(length):
-            code = code * g + w[i]
-            words[k, i] = w[i]
-        lengths[k] = length
-        code_of[k] = code
-        k += 1
-        length = _duval_next(w, length, n, g)
-    start = np.zeros(n + 2, dtype=np.int64)  # words grouped by length (a stable counting sort)
-    for k in range(count):
-        start[lengths[k] + 1] += 1
-    for L in range(1, n + 2):
-        start[L] += start[L - 1]
-    fill = start.copy()
-    by_length = np.zeros(count, dtype=np.int64)
-    codes = np.zeros(count, dtype=np.int64)
-    for k in range(count):
-        by_length[fill[lengths[k]]] = k
-        codes[fill[lengths[k]]] = code_of[k]
-        fill[lengths[k]] += 1
-    for k in range(count):  # the longest proper Lyndon suffix
+def _lyndon_table_kernel(words, table, g):
+    """The Lyndon words of length ``<= n`` (``words``: zeroed, Witt's count of rows of ``n`` columns) in Duval
+    (lexicographic) order, and per word ``k`` into the columns of ``table[:, k]`` (zeroed): length, standard factors
+    (``left``, ``right``; -1 for a letter), and the chains ``K, core, lead, span`` of :func:`_solve`.
+
+    Duval's step: the word after ``w`` is ``w`` repeated to length ``n``, its trailing largest letters dropped and
+    its last letter incremented.  The standard factorisation ``w = u v`` of a Lyndon word has ``v`` the longest
+    proper Lyndon suffix and ``u`` Lyndon (Reutenauer, Sect. 5.1).  That suffix is the lexicographically smallest
+    proper suffix ``s``: ``s`` is Lyndon (its proper suffixes are proper suffixes of ``w``, so larger than ``s``), and
+    a longer Lyndon suffix would be smaller than ``s``, a proper suffix of it.  Both factors are found by binary
+    search, Duval order being lexicographic order (a prefix first).
+
+    Chains: ``v = a^K u`` with ``P_v = ad_a^K P_u`` (the standard factorisation's left factor is the letter ``a``,
+    the first of ``v``, ``K`` times in a row); ``u`` is the core; ``lead`` counts the leading ``a``'s; ``span`` is
+    the last ``j`` with ``v[j:]`` still starting with ``a`` (``K``, or ``K - 1`` when the core starts with a larger
+    letter).  A factor and the core are later words (a proper suffix of a Lyndon word is larger), so the words are
+    factorised last to first."""
+    lengths, left, right, K, core, lead, span = table[0], table[1], table[2], table[3], table[4], table[5], table[6]
+    count, n = words.shape[0], words.shape[1]
+    lengths[0] = 1  # the letter 0
+    for k in range(1, count):
+        m = lengths[k - 1]
+        L = n
+        while words[k - 1, (L - 1) % m] == g - 1:
+            L -= 1
+        for i in range(L):
+            words[k, i] = words[k - 1, i % m]
+        words[k, L - 1] += 1
+        lengths[k] = L
+    for k in range(count - 1, -1, -1):
         L = lengths[k]
-        for first in range(1, L):
-            code = np.int64(0)  # not a literal 0: one compiled _find, not two
-            for i in range(first, L):
-                code = code * g + words[k, i]
-            j = _find(codes, by_length, start, L - first, code)
-            if j >= 0:
-                right[k] = j
-                code = np.int64(0)
-                for i in range(first):
-                    code = code * g + words[k, i]
-                left[k] = _find(codes, by_length, start, first, code)
-                break
-    return lengths, left, right
+        left[k], right[k] = -1, -1
+        if L > 1:
+            best = 1  # the smallest proper suffix w[best:]
+            for s in range(2, L):
+                i = 0
+                while s + i < L and words[k, s + i] == words[k, best + i]:
+                    i += 1
+                if s + i == L or words[k, s + i] < words[k, best + i]:
+                    best = s
+            for part in range(2):  # the index of w[:best], then of w[best:]
+                a0 = 0 if part == 0 else best
+                size = best if part == 0 else L - best
+                lo, hi = 0, count
+                while lo < hi:
+                    mid = (lo + hi) >> 1
+                    m = lengths[mid]
+                    i = 0
+                    while i < m and i < size and words[mid, i] == words[k, a0 + i]:
+                        i += 1
+                    if (i < m and i < size and words[mid, i] < words[k, a0 + i]) or (i == m and m < size):
+                        lo = mid + 1
+                    else:
+                        hi = mid
+                if part == 0:
+                    left[k] = lo
+                else:
+                    right[k] = lo
+        a = words[k, 0]
+        j = 0
+        while j < L and words[k, j] == a:
+            j += 1
+        lead[k] = j
+        c, kk = k, 0
+        while lengths[c] > 1 and lengths[left[c]] == 1 and words[left[c], 0] == a:
+            c = right[c]
+            kk += 1
+        K[k], core[k] = kk, c
+        span[k] = kk if words[c, 0] == a else kk - 1
+
+
+class _Table(tuple):
+    """``(words, lengths, left, right)`` of :func:`lyndon_table`, with the chains ``(K, core, lead, span)`` of
+    :func:`_solve` as ``.chains`` (computed with the table, by the same compiled kernel)."""
+
+    chains: tuple
 
 
 @lru_cache(maxsize=16)
 def lyndon_table(g: int, n: int):
     """``(words, lengths, left, right)`` for all Lyndon words of length ``<= n`` over ``0..g-1``, Duval order.
 
-    The table's size is Witt's count (Reutenauer, Cor. 4.14), so the int8 rows are allocated here, by numpy: the
-    compiled kernel needs no int8 allocation of its own (one compile fewer) and no counting pass."""
+    The table's size is Witt's count (Reutenauer, Cor. 4.14), so every array is allocated here, by numpy: the
+    compiled kernel allocates nothing (no compile of numba's allocation code) and needs no counting pass.  The
+    result also carries the chains of :func:`_solve` (``.chains``, see :func:`_lyndon_table_kernel`): one compiled
+    entry point for both on a cold start, computed once per table."""
     count = sum(witt_dimension(g, length) for length in range(1, n + 1))
     words = np.zeros((count, n), dtype=np.int8)
-    return (words, *_lyndon_table_kernel(words, g, n))
+    table = np.zeros((7, count), dtype=np.int64)
+    _lyndon_table_kernel(words, table, g)
+    out = _Table((words, table[0], table[1], table[2]))
+    out.chains = (table[3], table[4], table[5], table[6])
+    return out
 
 
 # -- the Lyndon matrix <P_v, w>, through the chains v = a^k u -------------------------------------------------
 
 
-@njit()
-def _chains(words, lengths, left, right):
-    """Per Lyndon word ``v``: ``K`` (letters peeled as ``P_{a u} = [a, P_u]``, ``a`` the first letter), core, lead, span.
-
-    ``v = a^K u`` with ``P_v = ad_a^K P_u`` (the standard factorisation's left factor is the
-    letter ``a`` ``K`` times in a row); ``u`` is the core; ``lead`` counts the leading ``a``'s;
-    ``span`` is the last ``j`` with ``v[j:]`` still starting with ``a`` (``K``, or ``K - 1`` when
-    the core starts with a larger letter)."""
-    count = lengths.shape[0]
-    span = np.zeros(count, dtype=np.int64)
-    K = np.zeros(count, dtype=np.int64)
-    core = np.zeros(count, dtype=np.int64)
-    for i in range(count):
-        core[i] = i
-    lead = np.zeros(count, dtype=np.int64)
-    for i in range(count):
-        a = words[i, 0]
-        j = 0
-        while j < lengths[i] and words[i, j] == a:
-            j += 1
-        lead[i] = j
-        c, k = i, 0
-        while lengths[c] > 1 and lengths[left[c]] == 1 and words[left[c], 0] == a:
-            c = right[c]
-            k += 1
-        K[i], core[i] = k, c
-        span[i] = k if words[c, 0] == a else k - 1
-    return K, core, lead, span
-
-
 _LANES = 8  # words evaluated together by one program sweep (8 x int32: one AVX2 vector)
-
-
-@njit(no_cpython_wrapper=True)
-def _class_chains(z, members, span, right, r0, r1, d, k):
-    """``chain[r, j]``: the index of ``members[r0 + r][j:]`` (the suffixes still starting with the class's smallest
-    letter), and whether any of them has ``z != 0``."""
-    size = r1 - r0
-    chain = _filled(size * d, -1).reshape((size, d))
-    any_nonzero = False
-    for r in range(size):
-        c = members[r0 + r]
-        chain[r, 0] = c
-        for j in range(1, span[c] + 1):
-            chain[r, j] = right[chain[r, j - 1]]
-        for j in range(span[c] + 1):
-            for i in range(k):
-                if z[chain[r, j], i] != 0:
-                    any_nonzero = True
-    return chain, any_nonzero
+#: Inner nodes of a class's program the solve's first workspace holds (grown fourfold when a class needs more).
+_PROGRAM_CAPACITY = 1024
 
 
 @njit(inline="always")
@@ -293,8 +229,11 @@ def _group_stop(live, roots, r0, b0, b1):
 
 
 @njit(no_cpython_wrapper=True)
-def _add_earlier(acc, z, X, live, roots, chain, members, K, span, lane_span, lane_lead, primes, inv, r0, b0, nb, block):
+def _add_earlier(acc, z, X, live, roots, right, members, K, span, lane_span, lane_lead, primes, inv, r0, b0, nb, block):
     """``acc[lane, j] += c z`` over the members before the group (final): one row of ``X`` for all lanes.
+
+    ``z`` is read along each member's chain ``v, v[1:], ...`` (the suffixes still starting with the class's smallest
+    letter, ``right`` of each: :func:`_lyndon_table_kernel`), walked where it is used: no table of chains.
 
     The sum is kept in int64, reduced every ``block`` terms: ``|c| <= 2^(d-1)``, ``z < 2^28``, so
     ``block * 2^(d+27) <= 2^62`` (no integer division in the inner loops)."""
@@ -310,10 +249,11 @@ def _add_earlier(acc, z, X, live, roots, chain, members, K, span, lane_span, lan
                     if c != 0:
                         hit = True
                         jt = sv if sv < lane_span[lane] else lane_span[lane]  # (min() is one more compile)
+                        v = members[q]
                         for j in range(jt + 1):
-                            v = chain[q - r0, j]
                             for i in range(k):
                                 acc[lane, j, i] += c * z[v, i]
+                            v = right[v]
             if hit:
                 terms += 1
                 if terms >= block - _LANES:  # the group's own members add at most _LANES - 1
@@ -325,7 +265,7 @@ def _add_earlier(acc, z, X, live, roots, chain, members, K, span, lane_span, lan
 
 
 @njit(no_cpython_wrapper=True)
-def _finish_group(acc, z, X, live, roots, chain, members, K, span, lane_span, lane_lead, primes, inv, r0, b0, b1,
+def _finish_group(acc, z, X, live, roots, right, members, K, span, lane_span, lane_lead, primes, inv, r0, b0, b1,
                   ran):
     """Each word ``w`` of the group in turn: add the group's members before it (final by now), subtract the sum from
     ``z`` along its chain (``ran``: the program ran, else nothing is subtracted), and mark it live if non-zero."""
@@ -339,24 +279,27 @@ def _finish_group(acc, z, X, live, roots, chain, members, K, span, lane_span, la
                     c = np.int64(X[roots[q - r0], lane])
                     if c != 0:
                         jt = span[members[q]] if span[members[q]] < kw else kw
+                        v = members[q]
                         for j in range(jt + 1):
-                            v = chain[q - r0, j]
                             for i in range(k):
                                 acc[lane, j, i] += c * z[v, i]
-            for j in range(kw + 1):
-                v = chain[r - r0, j]
+                            v = right[v]
+        v = members[r]
+        for j in range(kw + 1):
+            if ran:
                 for i in range(k):
                     z[v, i] = _reduce(z[v, i] - acc[lane, j, i], primes[i], inv[i])
-        for j in range(kw + 1):
             for i in range(k):
-                if z[chain[r - r0, j], i] != 0:
+                if z[v, i] != 0:
                     live[r] = 1
+            v = right[v]
 
 
 @njit()
-def _solve(z, primes, inv, words, lengths, left, right, K, core, lead, span, members, class_start, g, d):
+def _solve(z, primes, inv, words, lengths, left, right, K, core, lead, span, members, class_start, g, d, r0, live, memo,
+           x, acc, acc_flat, lanes, nodes, X, roots, stack):
     """Eq. (1) in place, all primes at once, for every degree ``<= d`` through the content classes of degree ``d``
-    (``inv = 1.0 / primes``; ``K, core, lead, span`` of :func:`_chains`).
+    (``inv = 1.0 / primes``; ``K, core, lead, span`` of :func:`_lyndon_table_kernel`).
 
     Chains.  Let ``a`` be the smallest letter of a class (every member starts with it) and
     ``v = a^k u`` with ``P_v = ad_a^k P_u`` (``k <= K_v``).  A Lyndon word ``w`` of length ``>= 2``
@@ -367,7 +310,7 @@ def _solve(z, primes, inv, words, lengths, left, right, K, core, lead, span, mem
 
     Hence for members ``v < w`` of a class of degree ``d`` the same number
     ``c = <P_{core v}, w[K_v:]>`` is the entry of every pair of suffixes ``(v[j:], w[j:])``,
-    ``j <= min(span_v, span_w)`` (suffixes still starting with ``a``, :func:`_chains`), and every
+    ``j <= min(span_v, span_w)`` (suffixes still starting with ``a``, :func:`_lyndon_table_kernel`), and every
     pair of equal-content Lyndon words of lower degree ``d - j`` and smallest letter ``a``
     (length ``>= 2``) is such a pair of suffixes of exactly one pair of degree ``d`` (prefix
     ``a^j``: ``a^j x`` is Lyndon with ``P = ad_a^j P_x``).  So only the classes of
@@ -378,34 +321,38 @@ def _solve(z, primes, inv, words, lengths, left, right, K, core, lead, span, mem
     ``c`` in one sweep, for :data:`_LANES` words ``w`` side by side (int32: ``|<P_u, x>| <=
     2^(|u|-1)``, exact for ``|u| <= 31``); the matrix is never stored, a class whose word
     coefficients all vanish is skipped, and ``c`` is used only when a suffix of ``v`` has
-    ``z != 0``.  Returns the number of program nodes run (times lanes)."""
+    ``z != 0``.
+
+    Starts at the class beginning at ``r0`` and returns ``(r, work)``: ``r`` the number of members done (all, or the
+    start of a class whose program outgrew ``nodes``: the caller grows ``nodes`` and ``X`` and calls again from
+    there, nothing of that class touched yet) and ``work`` the number of program nodes run (times lanes).
+    Workspaces (:func:`_engine`): ``live`` (members, 0 / 1, kept between calls), ``memo`` (``-1``, node numbers
+    of :func:`_class_program`), ``x`` (``_LANES`` words), ``acc`` (``_LANES, d, k``) and ``acc_flat`` (the same
+    memory, flat), ``lanes`` (span and lead per lane), ``nodes``, ``X``, ``roots``, ``stack`` (the programs)."""
     k = primes.shape[0]
     m = members.shape[0]
-    live = _zeros_int32(m)  # 0 / 1 (int32: the one narrow type numba compiles here, for X)
-    x = _zeros2(_LANES, 64)
-    acc_flat = np.zeros(_LANES * d * k, dtype=np.int64)
-    acc = acc_flat.reshape((_LANES, d, k))  # a view: lanes 0 .. nb - 1 are the first nb d k entries of acc_flat
-    lane_span = np.zeros(_LANES, dtype=np.int64)
-    memo = _zeros_int32(lengths.shape[0] * d)  # node numbers of _class_program
-    for i in range(memo.shape[0]):
-        memo[i] = -1
-    memo = memo.reshape((lengths.shape[0], d))
-    lane_lead = np.zeros(_LANES, dtype=np.int64)
+    lane_span, lane_lead = lanes[0], lanes[1]
     block = 1 << (35 - d if d < 35 else 0)
     work = 0
-    r0 = np.int64(0)  # not a literal 0: the helpers taking r0 would be compiled twice (Literal[int](0), int64)
     while r0 < m:
         r1 = r0
         while r1 < m and class_start[r1] == r0:
             r1 += 1
-        chain, any_nonzero = _class_chains(z, members, span, right, r0, r1, d, k)
+        any_nonzero = False  # any z != 0 along the class's chains
+        for r in range(r0, r1):
+            v = members[r]
+            for j in range(span[members[r]] + 1):
+                for i in range(k):
+                    if z[v, i] != 0:
+                        any_nonzero = True
+                v = right[v]
         if not any_nonzero or r1 - r0 == 1:  # left as it is: a lone member is live if a suffix is non-zero
             if any_nonzero:
                 live[r0] = 1
             r0 = r1
             continue
-        kids, roots = _class_program(members[r0:r1], core, K, words, lengths, left, right, g, d, memo)
-        X = _zeros_int32((g * d + kids.shape[0]) * _LANES).reshape((g * d + kids.shape[0], _LANES))
+        if _class_program(members[r0:r1], core, K, words, lengths, left, right, g, d, memo, nodes, roots, stack) < 0:
+            return r0, work
         for b0 in range(r0, r1, _LANES):
             b1 = b0 + _LANES if b0 + _LANES < r1 else r1
             stop = _group_stop(live, roots, r0, b0, b1)
@@ -413,7 +360,7 @@ def _solve(z, primes, inv, words, lengths, left, right, K, core, lead, span, mem
                 for r in range(b0, b1):
                     for i in range(d):
                         x[r - b0, i] = words[members[r], i]
-                _run_program(kids, x, g, d, stop, X)
+                _run_program(nodes, x, g, d, stop, X)
                 if stop + 1 > g * d:
                     work += (stop + 1 - g * d) * _LANES
             nb = b1 - b0
@@ -422,19 +369,21 @@ def _solve(z, primes, inv, words, lengths, left, right, K, core, lead, span, mem
             if stop >= 0:
                 for i in range(nb * d * k):  # (one loop, not three: each loop nest is compiled code of its own)
                     acc_flat[i] = 0
-                _add_earlier(acc, z, X, live, roots, chain, members, K, span, lane_span, lane_lead, primes, inv,
+                _add_earlier(acc, z, X, live, roots, right, members, K, span, lane_span, lane_lead, primes, inv,
                              r0, b0, nb, block)
-            _finish_group(acc, z, X, live, roots, chain, members, K, span, lane_span, lane_lead, primes, inv,
+            _finish_group(acc, z, X, live, roots, right, members, K, span, lane_span, lane_lead, primes, inv,
                           r0, b0, b1, stop >= 0)
         r0 = r1
-    return work
+    return r0, work
 
 
 @njit()
-def _word_coefficients(letters, cpow, logk, primes, inv, g, n, count, top):
-    """``<log Phi, w> mod p`` for the Lyndon words ``w`` of length ``<= n`` in Duval order, every prime in turn.
+def _word_coefficients(letters, cpow, logk, primes, inv, g, n, top, out, F, A, walk):
+    """``out[w, i] = <log Phi, w> mod primes[i]`` for the Lyndon words ``w`` of length ``<= n`` in Duval order, every
+    prime in turn.
 
-    Words longer than ``top`` are skipped (left 0).
+    Words longer than ``top`` are skipped (left 0).  ``out`` (``count, k``), ``F`` (``n + 1, n + 1, s + 1``), ``A``
+    (``n + 1, n + 1``) and ``walk`` (``2, n + 1``) arrive zeroed.
 
     ``cpow[i, t, r] = c_t^r / r!`` and ``logk[i, k] = (-1)^(k+1) / k`` modulo ``primes[i]``; ``inv = 1.0 / primes``.
     The walk of the Lyndon words is repeated per prime, so the recurrences are scalar: a loop over the primes
@@ -442,16 +391,12 @@ def _word_coefficients(letters, cpow, logk, primes, inv, g, n, count, top):
     walk itself is bookkeeping, a small part of a row's arithmetic)."""
     s = letters.shape[0]
     k = primes.shape[0]
-    out = _zeros2(count, k)
     # F[m, j, t] = <E_1..E_t, w[j:m]>, A[m, kk] = <(Phi - 1)^kk, w[:m]> (one prime)
-    F = np.zeros((n + 1) * (n + 1) * (s + 1), dtype=np.int64).reshape((n + 1, n + 1, s + 1))
-    A = _zeros2(n + 1, n + 1)
     for m in range(n + 1):  # (loops, not slice assignments: numba compiles a broadcast for those); never overwritten
         for t in range(s + 1):
             F[m, m, t] = 1
     A[0, 0] = 1
-    w = _filled(n + 1, -1)
-    run = np.zeros(n + 1, dtype=np.int64)  # run[m]: length of the trailing run of equal letters of w[:m]
+    w, run = walk[0], walk[1]  # the word; run[m]: length of the trailing run of equal letters of w[:m]
     for i in range(k):
         p, pinv = primes[i], inv[i]
         for m in range(n + 1):
@@ -508,7 +453,6 @@ def _word_coefficients(letters, cpow, logk, primes, inv, g, n, count, top):
             while length > 0 and w[length - 1] == g - 1:
                 length -= 1
             extend = False
-    return out
 
 
 # -- driver -------------------------------------------------------------------------------------------------
@@ -563,7 +507,8 @@ def lyndon_numerators(letters, values, q, g, n, denominators, stats=None):
     if product <= need or len(moduli) > MAX_PRIMES:
         return None
     clock = [process_time()]
-    words, lengths, left, right = lyndon_table(g, n)
+    table = lyndon_table(g, n)
+    words, lengths, left, right = table
     count = len(lengths)
     eriksen = _eriksen_sign(letters, g, n)
     top = n - 1 if eriksen else n  # Eq. (3): the even top degree of log(e^A e^B) follows from the odd ones
@@ -580,7 +525,7 @@ def lyndon_numerators(letters, values, q, g, n, denominators, stats=None):
                 beta[i, kk] = value.numerator % p * pow(value.denominator % p, p - 2, p) % p
     clock.append(process_time())
     z, work = _engine(np.asarray(letters, dtype=np.int64), cpow, logk, primes, beta, g, n, top,
-                      words, lengths, left, right, members, class_start, clock)
+                      words, lengths, left, right, table.chains, members, class_start, clock)
     global runs
     runs += 1
     scale = np.array([[denominators[d] % p for p in moduli] for d in range(n + 1)], dtype=np.int64)
@@ -663,26 +608,22 @@ def _even_top(z, primes, inv, lengths, right, K, beta, n):
 
         ``z_w = sum_{k odd, k <= K_w} beta_k z_{w[k:]}``,  ``beta_k = +-[x^k] tanh(x/2) a^k``.    (3)
 
-    (``inv = 1.0 / primes``, ``K`` of :func:`_chains`.)
+    (``inv = 1.0 / primes``, ``K`` of :func:`_lyndon_table_kernel`.)
     """
-    k = primes.shape[0]
-    acc = np.zeros(k, dtype=np.int64)
     for w in range(lengths.shape[0]):
         if lengths[w] != n:
             continue
-        for i in range(k):
-            acc[i] = 0
-        c = w
-        for j in range(1, K[w] + 1):
-            c = right[c]
-            if j % 2 == 1:
-                for i in range(k):
-                    acc[i] = _reduce(acc[i] + beta[i, j] * z[c, i], primes[i], inv[i])
-        for i in range(k):
-            z[w, i] = acc[i]
+        for i in range(primes.shape[0]):
+            acc = np.int64(0)
+            c = w
+            for j in range(1, K[w] + 1):
+                c = right[c]
+                if j % 2 == 1:
+                    acc = _reduce(acc + beta[i, j] * z[c, i], primes[i], inv[i])
+            z[w, i] = acc
 
 
-def _engine(letters, cpow, logk, primes, beta, g, n, top, words, lengths, left, right, members, class_start,
+def _engine(letters, cpow, logk, primes, beta, g, n, top, words, lengths, left, right, chains, members, class_start,
             clock=None):
     """Word coefficients, then the chained solve of degree ``top`` and Eq. (3) when ``top < n``.
 
@@ -691,14 +632,32 @@ def _engine(letters, cpow, logk, primes, beta, g, n, top, words, lengths, left, 
     Compiled entry points called from Python, not one compiled driver calling them: numba links a
     callee's code into its caller and optimises the linked module again, so a driver would cost the
     optimisation of both twice on a cold start (1.2 s of 6.5 s measured); an entry point costs a
-    cache load (a few ms) in a fresh process.  For the same reason the chains and Eq. (3) are entry
-    points of their own: Eq. (3) is compiled only by a series that needs it (two letters, even degree)."""
+    cache load (a few ms) in a fresh process.  For the same reason Eq. (3) is an entry point of its own,
+    compiled only by a series that needs it (two letters, even degree); the chains ``K, core, lead, span``
+    (:func:`_lyndon_table_kernel`) come with the table."""
     inv = 1.0 / primes.astype(np.float64)
-    z = _word_coefficients(letters, cpow, logk, primes, inv, g, n, lengths.shape[0], top)
+    k, count, s = len(primes), len(lengths), len(letters)
+    z = np.zeros((count, k), dtype=np.int64)
+    _word_coefficients(letters, cpow, logk, primes, inv, g, n, top, z, np.zeros((n + 1, n + 1, s + 1), dtype=np.int64),
+                       np.zeros((n + 1, n + 1), dtype=np.int64), np.zeros((2, n + 1), dtype=np.int64))
     if clock is not None:
         clock.append(process_time())
-    K, core, lead, span = _chains(words, lengths, left, right)
-    work = _solve(z, primes, inv, words, lengths, left, right, K, core, lead, span, members, class_start, g, top)
+    K, core, lead, span = chains
+    m, d = len(members), top
+    live = np.zeros(m, dtype=np.int32)
+    memo = np.full((count, d), -1, dtype=np.int32)
+    acc = np.zeros((_LANES, d, k), dtype=np.int64)
+    workspaces = (live, memo, np.zeros((_LANES, 64), dtype=np.int64), acc, acc.reshape(-1),
+                  np.zeros((2, _LANES), dtype=np.int64))
+    roots, stack = np.zeros(m, dtype=np.int64), np.zeros((4 * d * d + 8, 2), dtype=np.int64)
+    start, work, capacity = 0, 0, _PROGRAM_CAPACITY
+    while start < m:  # a class whose program outgrows ``nodes`` comes back: grow it, carry on from that class
+        nodes = np.zeros((capacity, 6), dtype=np.int64)
+        X = np.zeros((g * d + capacity, _LANES), dtype=np.int32)
+        start, done = _solve(z, primes, inv, words, lengths, left, right, K, core, lead, span, members, class_start,
+                             g, d, start, *workspaces, nodes, X, roots, stack)
+        work += done
+        capacity *= 4
     if top < n:
         _even_top(z, primes, inv, lengths, right, K, beta, n)
     if clock is not None:
@@ -757,7 +716,7 @@ def _garner(residues, moduli) -> list:
 
 
 @njit(no_cpython_wrapper=True)
-def _class_program(members, core, K, words, lengths, left, right, g, d, memo):
+def _class_program(members, core, K, words, lengths, left, right, g, d, memo, nodes, roots, stack):
     """A straight-line program for ``<P_u, x[K_v:]>``, ``u`` the core of ``v``, every ``v`` in ``members``.
 
     ``members`` is one content class of degree ``d`` (:func:`_solve`, Eq. (2)).  Node ``(u, l)``
@@ -765,14 +724,15 @@ def _class_program(members, core, K, words, lengths, left, right, g, d, memo):
     ``X[c1] X[c2] - X[c3] X[c4]`` with children ``(u1, l), (u2, l+|u1|), (u2, l), (u1, l+|u2|)`` for
     ``P_u = [P_u1, P_u2]``.  Nodes are numbered children first, roots in member order, so
     evaluating up to the root of a member evaluates all it needs; a core that is a letter has a
-    leaf as its root.  ``memo[u, l]`` (all ``-1`` on entry and again on return) numbers the nodes."""
-    cap = 64
-    kids = _zeros2(cap, 4)
-    keys = _zeros2(cap, 2)
-    count = g * d
-    roots = np.zeros(members.shape[0], dtype=np.int64)
-    stack = _zeros2(4 * d * d + 8, 2)
-    ks = np.zeros(4, dtype=np.int64)
+    leaf as its root.  ``memo[u, l]`` (all ``-1`` on entry and again on return) numbers the nodes.
+
+    Inner node ``g d + i`` gets the children ``nodes[i, :4]`` and the key ``(u, l) = nodes[i, 4:6]``, member ``r``
+    its root ``roots[r]``; ``stack`` (``4 d^2 + 8`` rows) is the depth-first walk's.  Returns the number of inner
+    nodes, or -1 when they would not fit in ``nodes`` (the caller grows it)."""
+    cap = nodes.shape[0]
+    leaves = g * d
+    size = 0
+    full = False
     for r in range(members.shape[0]):
         u0, l0 = core[members[r]], K[members[r]]
         if lengths[u0] == 1:
@@ -780,14 +740,17 @@ def _class_program(members, core, K, words, lengths, left, right, g, d, memo):
             continue
         top = 0
         stack[0, 0], stack[0, 1] = u0, l0
-        while top >= 0:
+        while top >= 0 and not full:
             u, l = stack[top, 0], stack[top, 1]
             if memo[u, l] >= 0:
                 top -= 1
                 continue
+            if size == cap:
+                full = True
+                continue
             u1, u2 = left[u], right[u]
             missing = False
-            for c in range(4):
+            for c in range(4):  # the children, written into the new node's row (kept only when none is missing)
                 cu = u1 if c == 0 or c == 3 else u2
                 if c == 0 or c == 2:
                     cl = l
@@ -796,39 +759,26 @@ def _class_program(members, core, K, words, lengths, left, right, g, d, memo):
                 else:
                     cl = l + lengths[u2]
                 if lengths[cu] == 1:
-                    ks[c] = words[cu, 0] * d + cl
+                    nodes[size, c] = words[cu, 0] * d + cl
                 else:
                     node = memo[cu, cl]
                     if node < 0:
                         missing = True
                         top += 1
                         stack[top, 0], stack[top, 1] = cu, cl
-                    ks[c] = node
+                    nodes[size, c] = node
             if missing:
                 continue
-            inner = count - g * d
-            if inner == cap:
-                cap *= 2
-                # element loops, not slice assignments: a slice assignment makes numba compile its
-                # broadcasting error path with the unicode machinery (seconds of cold compile time)
-                grown = _zeros2(cap, 4)
-                grown_keys = _zeros2(cap, 2)
-                for i in range(inner):
-                    for c in range(4):
-                        grown[i, c] = kids[i, c]
-                    grown_keys[i, 0], grown_keys[i, 1] = keys[i, 0], keys[i, 1]
-                kids = grown
-                keys = grown_keys
-            for c in range(4):
-                kids[inner, c] = ks[c]
-            keys[inner, 0], keys[inner, 1] = u, l
-            memo[u, l] = count
-            count += 1
+            nodes[size, 4], nodes[size, 5] = u, l
+            memo[u, l] = leaves + size
+            size += 1
             top -= 1
+        if full:
+            break
         roots[r] = memo[u0, l0]
-    for i in range(count - g * d):
-        memo[keys[i, 0], keys[i, 1]] = -1
-    return kids[: count - g * d].copy(), roots
+    for i in range(size):
+        memo[nodes[i, 4], nodes[i, 5]] = -1
+    return -1 if full else size
 
 
 @njit(no_cpython_wrapper=True)
