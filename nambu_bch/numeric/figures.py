@@ -162,7 +162,8 @@ def paper_figures(outdir=None, *, word="32123", h=0.1, x0=None, params=None, t_s
     t_short : float -- time span of Figs. 1-2 (every step plotted)
     t_long : float -- time span of Figs. 3-4 (long enough for the beat)
     every_long : int -- sampling of Figs. 3-4 (the paper plots every 100 steps)
-    dpi : int, 1 to :data:`MAX_DPI`; fmt : ``"png"``, ``"pdf"`` or ``"svg"``
+    dpi : int, 1 to :data:`MAX_DPI` -- the figures are created, laid out and written at it; fmt : ``"png"``, ``"pdf"``
+        or ``"svg"``
 
     Returns
     -------
