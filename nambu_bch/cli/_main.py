@@ -76,8 +76,8 @@ SUBCOMMANDS = ("models", "bch", "fi", "shadow", "conserved", "exact", "check", "
 
 
 class _Version(argparse.Action):
-    """``--version``: the version is looked up only when asked (``importlib.metadata`` costs every other run of the
-    command ~50 ms)."""
+    """``--version``: the installed version is looked up only when asked (importing ``importlib.metadata`` would
+    otherwise cost every run of the command, ``--help`` and errors included)."""
 
     def __call__(self, parser, namespace, values, option_string=None):
         from .. import __version__
