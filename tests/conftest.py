@@ -52,6 +52,7 @@ LONG = (
     ("test_docs.py", "test_api_reference_builds_without_warnings"),         # a Sphinx build in a subprocess
     ("test_bch_modular.py", "test_sparse_engine_equals_dense_engine"),      # 9 s at [12-12], cold: numba compile
     ("test_pickle.py", "test_results_come_back_from_loky_workers"),         # two spawned workers import and compute
+    ("test_parallel.py", "test_loky_equals_serial_in_task_order"),          # ... and the same pool, right after
     ("test_cli.py", "test_every_subcommand_runs_as_a_subprocess"),          # 1-2 s each: a subprocess per subcommand
     ("test_packaging.py", "test_"),                                         # wheel and sdist built, installed, run
     ("test_fuzz_cli.py", "test_"),

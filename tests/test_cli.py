@@ -358,6 +358,32 @@ def test_bad_input_as_subprocess(tmp_path):
     bad(cli("bch", "--frobnicate"), "--frobnicate")
 
 
+def test_bad_input_is_refused_before_the_subcommands_own_imports(monkeypatch):
+    """A subcommand reads its flags before it imports its machinery (``nambu_bch.exact``, ``nambu_bch.shadow``, the
+    numeric diagnostics: about 0.5 s of a cold process), so a bad flag is answered without them; here they cannot be
+    imported at all."""
+    for name in ("nambu_bch.exact", "nambu_bch.shadow", "nambu_bch.shadow.fi_route", "nambu_bch.numeric.diagnostics",
+                 "nambu_bch.numeric.hmc"):
+        monkeypatch.setitem(sys.modules, name, None)  # importing it raises ImportError
+    for sub in ("conserved", "exact", "fi", "shadow", "check", "sample"):
+        bad(cli(sub, "--model", "hoo"), "unknown model 'hoo'")
+    bad(cli("shadow", "--integrator", "12x"), "unknown composition '12x'")
+
+
+def test_the_version_is_looked_up_only_for_version(monkeypatch):
+    """Building the parser does not read the installed version (``importlib.metadata``: ~50 ms of every run)."""
+    import nambu_bch
+    from nambu_bch.cli._main import build_parser
+
+    monkeypatch.setitem(vars(nambu_bch), "__version__", None)  # restored (or removed) afterwards
+    del vars(nambu_bch)["__version__"]
+    looked_up = []
+    monkeypatch.setattr(nambu_bch, "_version", lambda: looked_up.append(1) or "9.9")
+    build_parser()
+    assert looked_up == []
+    assert ok(cli("--version")) == "nambu-bch 9.9\n" and looked_up == [1]
+
+
 def _toml(tmp_path, name, text):
     path = tmp_path / name
     path.write_text(text) if isinstance(text, str) else path.write_bytes(text)

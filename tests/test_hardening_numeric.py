@@ -451,6 +451,12 @@ def test_paper_figures_returns_figures_with_parameters(tmp_path):
     assert all(isinstance(f, Figure) for f in fs.figures.values()) and all(p.is_file() for p in fs.values())
     title = fs.figures["fig1"].axes[0].get_title()
     assert "h = 0.1" in title and r"\omega = 0.5" in title and "x(0) = (1, 1, 1)" in title
+    # each title names the system (a loop variable once shadowed its name: the titles read fig1, fig2, fig2, fig2)
+    titles = {n: f.axes[0].get_title() for n, f in fs.figures.items()}
+    assert [titles[n].split(", ")[0] for n in ("fig1", "fig2", "fig4")] == ["ho3"] * 3, titles
+    assert titles["fig3"].startswith("the beat, ho3, "), titles
+    # drawn at the resolution it is written at: laid out and rendered once per figure at one dpi
+    assert all(f.dpi == 40 for f in fs.figures.values())
     drawn = paper_figures(None, t_short=5.0, t_long=200.0, every_long=10)
     assert dict(drawn) == {} and len(drawn.figures) == 4
 

@@ -75,6 +75,17 @@ from ._output import say, stdout_closed
 SUBCOMMANDS = ("models", "bch", "fi", "shadow", "conserved", "exact", "check", "plot", "compare", "sample")
 
 
+class _Version(argparse.Action):
+    """``--version``: the installed version is looked up only when asked (importing ``importlib.metadata`` would
+    otherwise cost every run of the command, ``--help`` and errors included)."""
+
+    def __call__(self, parser, namespace, values, option_string=None):
+        from .. import __version__
+
+        parser._print_message(f"{parser.prog} {__version__}\n", sys.stdout)
+        parser.exit()
+
+
 def build_parser() -> argparse.ArgumentParser:
     """The ``argparse`` parser of ``nambu-bch`` with every subcommand registered."""
     parser = _Parser(
@@ -88,9 +99,7 @@ def build_parser() -> argparse.ArgumentParser:
                "  nambu-bch shadow --integrator 32123 --format json\n"
                "  nambu-bch models\n  nambu-bch SUBCOMMAND --help",
     )
-    from .. import __version__
-
-    parser.add_argument("--version", action="version", version=f"%(prog)s {__version__}")
+    parser.add_argument("--version", action=_Version, nargs=0, help="show program's version number and exit")
     sub = parser.add_subparsers(dest="command", metavar="SUBCOMMAND", parser_class=_Parser)
     sub.required = True
     for name in SUBCOMMANDS:

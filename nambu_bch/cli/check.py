@@ -31,7 +31,6 @@ def register(sub) -> None:
 
 def run(args):
     from ..checks import finite_float
-    from ..numeric.diagnostics import check
 
     system, values = system_from_args(args)
     if _gradient_method(args):
@@ -43,6 +42,8 @@ def run(args):
     alpha = finite_float(number(args.alpha, "--alpha"), "--alpha") if args.alpha is not None else 0.5
     method = comp if args.tableau else word  # a tableau file's method is its tableau, not a name
     shadow_order = _numerical_shadow_order(args, system)
+    from ..numeric.diagnostics import check  # once the flags are read: bad input is refused without it
+
     report = check(system, method, args.h, args.steps, x0, params=params, every=args.every, order=order, alpha=alpha)
     if shadow_order is None:
         emit(args, text=lambda: str(report), data=report.to_dict, system=system)

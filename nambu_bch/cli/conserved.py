@@ -21,10 +21,10 @@ def register(sub) -> None:
 
 
 def run(args):
-    from ..exact import conserved_quantities
-
     system = symbolic_system(args)
     word, comp = integrator_from_args(args, system)
+    from ..exact import conserved_quantities  # once the flags are read: bad input is refused without it
+
     result = conserved_quantities(system, comp, **({"degree": args.degree} if args.degree is not None else {}))
 
     emit(args, latex=result.to_latex, text=result.to_text, data=result.to_dict, system=system)

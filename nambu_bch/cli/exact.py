@@ -20,10 +20,10 @@ def register(sub) -> None:
 
 
 def run(args):
-    from ..exact import exact_shadow_hamiltonians
-
     system = symbolic_system(args)
     word, comp = integrator_from_args(args, system)
+    from ..exact import exact_shadow_hamiltonians  # once the flags are read: bad input is refused without it
+
     result = exact_shadow_hamiltonians(system, comp)
 
     def data():

@@ -28,8 +28,6 @@ def _system_chosen(args) -> bool:
 
 
 def run(args):
-    from ..shadow.fi_route import FIForms, fi_forms
-
     system = symbolic_system(args)
     word, comp = integrator_from_args(args, system)
     if args.order is not None and args.order < 2:
@@ -41,6 +39,8 @@ def run(args):
                             f"for {word}, not to the h^2 brackets (all shown); add e.g. --order 4 or drop --limit")
     if nested:
         return _nested(args, system, word, comp)
+    from ..shadow.fi_route import FIForms, fi_forms  # once the flags are read: bad input is refused without it
+
     result = fi_forms(system, comp) if _system_chosen(args) else FIForms(system, comp)
     emit(args, latex=result.to_latex, text=result.to_text, data=result.to_dict, system=system if _system_chosen(args) else None)
 

@@ -42,7 +42,6 @@ def register(sub) -> None:
 def run(args):
     from ..checks import finite_float
     from ..errors import NambuBCHError
-    from ..numeric.hmc import hybrid_monte_carlo
 
     for flag, value in (("--alpha", args.alpha), ("--order", args.order)):
         if value is not None and args.target != "H_S":
@@ -58,6 +57,8 @@ def run(args):
     burn = order_value(args.burn, "--burn", MAX_ITERATIONS) if args.burn is not None else 10
     seed = order_value(args.seed, "--seed", 2**63 - 1) if args.seed is not None else None
     observables = _observables(args.observable, system, params)
+    from ..numeric.hmc import hybrid_monte_carlo  # once the flags are read: bad input is refused without it
+
     result = hybrid_monte_carlo(system, comp, args.h, steps, refresh=_names(args.refresh), flip=_names(args.flip),
                                 target=args.target, order=order, alpha=alpha, chains=chains, iterations=iterations,
                                 burn=burn, x0=x0, params=params, seed=seed)

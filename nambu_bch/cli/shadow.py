@@ -78,8 +78,6 @@ def run_density(args, system, method, order) -> None:
 
 
 def run(args):
-    from ..shadow import shadow_hamiltonians
-
     if args.generic_separable:
         return run_generic_separable(args)
     if args.dim is not None:
@@ -95,6 +93,8 @@ def run(args):
     kwargs = {"order": order, "route": args.route, "existence": args.existence}
     if args.degree is not None:
         kwargs["degree"] = args.degree
+    from ..shadow import shadow_hamiltonians  # once the flags are read: bad input is refused without it
+
     family = shadow_hamiltonians(system, comp, **kwargs)
 
     def text():

@@ -62,11 +62,13 @@ class FigureSet(dict):
         return None
 
 
-def _figure(width=6.4, height=3.84, ncols=1):
+def _figure(dpi, width=6.4, height=3.84, ncols=1):
+    """A figure at the resolution it is saved at: laid out (``tight_layout``) and drawn at one dpi, its text
+    is measured once per string (matplotlib caches the mathtext layout per resolution)."""
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
 
-    fig = Figure(figsize=(width * (1 if ncols == 1 else 1.55), height))
+    fig = Figure(figsize=(width * (1 if ncols == 1 else 1.55), height), dpi=dpi)
     FigureCanvasAgg(fig)
     axes = [fig.add_subplot(1, ncols, k + 1) for k in range(ncols)]
     return fig, axes
@@ -160,7 +162,8 @@ def paper_figures(outdir=None, *, word="32123", h=0.1, x0=None, params=None, t_s
     t_short : float -- time span of Figs. 1-2 (every step plotted)
     t_long : float -- time span of Figs. 3-4 (long enough for the beat)
     every_long : int -- sampling of Figs. 3-4 (the paper plots every 100 steps)
-    dpi : int, 1 to :data:`MAX_DPI`; fmt : ``"png"``, ``"pdf"`` or ``"svg"``
+    dpi : int, 1 to :data:`MAX_DPI` -- the figures are created, laid out and written at it; fmt : ``"png"``, ``"pdf"``
+        or ``"svg"``
 
     Returns
     -------
@@ -199,10 +202,10 @@ def paper_figures(outdir=None, *, word="32123", h=0.1, x0=None, params=None, t_s
     figures = {}
 
     env, _ = _stream(system, word, h, n_short, 1, x0, params, names=("H", "G", "H_c", "G_c"))
-    for name, (a, b) in {"fig1": ("H", "H_c"), "fig2": ("G", "G_c")}.items():
+    for fig_name, (a, b) in {"fig1": ("H", "H_c"), "fig2": ("G", "G_c")}.items():
         if a not in env:
             continue
-        fig, (ax,) = _figure()
+        fig, (ax,) = _figure(dpi)
         t, y = env[a].arrays()
         ax.plot(t, y, "-", lw=1.0, color="C0", label=f"${a}(t) - {a}(0)$")
         if b in env:
@@ -216,7 +219,7 @@ def paper_figures(outdir=None, *, word="32123", h=0.1, x0=None, params=None, t_s
         _headroom(ax)
         ax.legend(loc="upper right", fontsize=9, ncol=2)
         ax.set_xlim(t[0], t[-1])
-        figures[name] = fig
+        figures[fig_name] = fig
 
     env, size = _stream(system, word, h, n_long, every_long, x0, params, kinds="ocs")
     last = system.coordinates[-1]
@@ -224,7 +227,7 @@ def paper_figures(outdir=None, *, word="32123", h=0.1, x0=None, params=None, t_s
     run = rf"{tex}^{{{_tex_word(word)}}}(t)"
     drawn = f"every {every_long} steps" + (f", min/max of {size} samples" if size > 1 else "")
     if "o" in env:
-        fig, (ax,) = _figure()
+        fig, (ax,) = _figure(dpi)
         t, y = env["o"].arrays()
         ax.plot(t, y, "-", lw=0.4, color="C0", label=f"${tex}^{{\\rm o}}(t) - {run}$ ({drawn})")
         ax.set_xlabel("$t$")
@@ -235,7 +238,7 @@ def paper_figures(outdir=None, *, word="32123", h=0.1, x0=None, params=None, t_s
         ax.set_xlim(t[0], t[-1])
         figures["fig3"] = fig
     if "c" in env and "s" in env:
-        fig, (ax, zoom) = _figure(ncols=2)
+        fig, (ax, zoom) = _figure(dpi, ncols=2)
         tc, yc = env["c"].arrays()
         ts, ys = env["s"].arrays()
         ax.plot(tc, yc, "-", lw=0.4, color="C0", label=f"${tex}^{{\\rm c}}(t) - {run}$")
@@ -253,9 +256,10 @@ def paper_figures(outdir=None, *, word="32123", h=0.1, x0=None, params=None, t_s
         zoom.legend(loc="upper left", fontsize=8)
         zoom.set_xlim(ts[0], ts[-1])
         zoom.ticklabel_format(axis="y", style="sci", scilimits=(0, 0))
-        fig.tight_layout()
+        fig.tight_layout()  # the two panels' labels would overlap in a figure shown without being written
         figures["fig4"] = fig
-    paths = _write_set(outdir, figures, fmt, dpi) if outdir is not None else {}
+    laid_out = {"fig4"}
+    paths = _write_set(outdir, figures, fmt, dpi, laid_out) if outdir is not None else {}
     return FigureSet(paths, figures)
 
 
@@ -284,17 +288,19 @@ def _headroom(ax, frac=0.35):
     ax.set_ylim(lo, hi + frac * (hi - lo))
 
 
-def _render(fig, fmt, dpi):
+def _render(fig, fmt, dpi, layout=True):
+    """The file's bytes; ``layout``: ``tight_layout`` first (once per figure: a second pass only moves the
+    axes by round-off, at the cost of measuring every text again)."""
     import io
 
-    if not fig.get_tight_layout():
+    if layout:
         fig.tight_layout()
     buffer = io.BytesIO()
     fig.savefig(buffer, format=fmt, dpi=dpi, metadata={"Software": None} if fmt == "png" else None)
     return buffer.getvalue()
 
 
-def _write_set(outdir, figures, fmt, dpi) -> dict:
+def _write_set(outdir, figures, fmt, dpi, laid_out=frozenset()) -> dict:
     """Write every figure or none.
 
     Render all; stage each in a temp file in ``outdir``; keep a hard-linked backup of every file
@@ -302,7 +308,7 @@ def _write_set(outdir, figures, fmt, dpi) -> dict:
     backups and remove the files this call created.  One :class:`NambuBCHError` line on failure.
     """
     outdir = Path(outdir)
-    data = {name: _render(fig, fmt, dpi) for name, fig in figures.items()}
+    data = {name: _render(fig, fmt, dpi, layout=name not in laid_out) for name, fig in figures.items()}
     staged, backups, done = {}, {}, []
     try:
         outdir.mkdir(parents=True, exist_ok=True)
