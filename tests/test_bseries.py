@@ -328,3 +328,28 @@ def test_results_pickle():
     back = pickle.loads(pickle.dumps(M))
     assert all(a == b for a, b in zip(M.coefficients, back.coefficients)) and back.tree_coefficients == M.tree_coefficients
     assert pickle.loads(pickle.dumps(TABLEAUX["gauss4"])) == TABLEAUX["gauss4"]
+
+
+def test_taylor_route_truncated_composition_equals_compose_then_cut():
+    """The Taylor route's truncated substitution gives the polynomials of ``compose`` followed by the cut, over
+    QQ(sqrt(3)) (Gauss4's coefficients) too; the shared stage values give each tree's elementary weight."""
+    from nambu_bch.bseries import rooted_trees as T
+    from nambu_bch.bseries.modified import _compose_cut, _polynomial_field
+    from nambu_bch.integrators.runge_kutta import TABLEAUX
+
+    f = _polynomial_field(model("lotka-volterra"), TABLEAUX["gauss4"])
+    alg = f.algebra.with_constants(extension=[sympy.sqrt(3)])
+    gens, n = alg.ring.gens, alg.n
+    hi = n + alg.constants.index(h)
+    top = 3
+    fields = [alg.convert(f.algebra.to_sympy(c)) for c in f.components]
+    s3 = alg.domain.from_sympy(sympy.sqrt(3))
+    values = [gens[0] + s3 * gens[hi] * gens[1] + gens[hi] ** 4, gens[1] - gens[hi] ** 2 * gens[0] ** 2]
+
+    def cut(p):
+        return alg.ring.from_dict({m: c for m, c in p.items() if m[hi] <= top})
+
+    want = [cut(fk.compose(list(zip(gens[:n], values)))) for fk in fields]
+    assert _compose_cut(fields, values, hi, top, alg.ring) == want
+    weights = T.rk_coefficients(TABLEAUX["gauss4"], 5)
+    assert all(weights[t] == T.elementary_weight(t, TABLEAUX["gauss4"]) for t in weights)

@@ -518,3 +518,23 @@ def test_catalog_names_match_the_alias_hook():
     from nambu_bch.integrators.composition import _CATALOG
 
     assert tuple(NAMES) == tuple(_CATALOG)
+
+
+def test_exact_critical_point_helpers_agree_with_sympy_expressions():
+    """The Lagrange minors as Poly determinants and the CRootOf values built term by term are the expressions the
+    sympy-expression route gives (Matrix.det then expand; expand of the substituted polynomial)."""
+    from nambu_bch.design.optimize import _algebraic_values, _poly_det
+
+    a, b, c = sympy.symbols("a b c")
+    rows = [[a**2 + b, a * c, 3], [b - c, 2 * a, b**2], [1, c, a * b - 1]]
+    P = [[sympy.Poly(e, a, b, c) for e in row] for row in rows]
+    assert _poly_det(P).as_expr() == sympy.expand(sympy.Matrix(rows).det())
+    minor = sympy.Matrix(rows).extract([0, 1], [0, 1]).det()
+    assert _poly_det([row[:2] for row in P[:2]]).as_expr() == sympy.expand(minor)
+    t = sympy.Dummy("t")
+    g = sympy.Poly(t**5 - 3 * t - 1, t)                                  # not solvable in radicals
+    root = sympy.CRootOf(g.as_expr(), 0)
+    rem = {a: sympy.Poly(sympy.Rational(2, 3) * t**4 - t + 5, t), b: sympy.Poly(0, t, domain="QQ")}
+    values, radical = _algebraic_values(g, root, rem, [a, b], t)
+    assert radical is False
+    assert [v for _, v in values] == [sympy.expand(rem[v].as_expr().subs(t, root)) for v in (a, b)]

@@ -93,16 +93,27 @@ def graft(t, s) -> list:
     return out
 
 
-def elementary_weight(t, tableau):
-    """``Phi(t) = sum_i b_i Phi_i(t)``, ``Phi_i(t) = prod_children sum_j a_ij Phi_j(child)`` (HLW Sect. III.1), exact."""
+def elementary_weight(t, tableau, _stages=None):
+    """``Phi(t) = sum_i b_i Phi_i(t)``, ``Phi_i(t) = prod_children sum_j a_ij Phi_j(child)`` (HLW Sect. III.1), exact.
+
+    ``_stages`` (internal): a dict shared by the calls of one tableau, ``{tree: (Phi_1(tree), ..)}``, so that the
+    stage values of a subtree are computed once for all the trees that contain it.
+    """
     A, b = tableau.A, tableau.b
     s = len(b)
+    memo = {} if _stages is None else _stages
 
     def stage(tree):
-        values = [sympy.Integer(1)] * s
-        for child in tree:
-            inner = stage(child)
-            values = [v * sum(A[i][j] * inner[j] for j in range(s)) for i, v in enumerate(values)]
+        values = memo.get(tree)
+        if values is None:
+            values = [sympy.Integer(1)] * s
+            for child in tree:
+                inner = stage(child)
+                # expanded at every level: the stage values stay short sums (a + b sqrt(3) for Gauss4) instead of
+                # products nested |t| deep that one final expand has to multiply out; expand is canonical on
+                # these sums, so the result is the expression the final expand alone gives
+                values = [sympy.expand(v * sum(A[i][j] * inner[j] for j in range(s))) for i, v in enumerate(values)]
+            memo[tree] = values
         return values
 
     return sympy.radsimp(sympy.expand(sum(bi * v for bi, v in zip(b, stage(t)))))
@@ -110,7 +121,8 @@ def elementary_weight(t, tableau):
 
 def rk_coefficients(tableau, upto: int) -> dict:
     """``{t: Phi(t)}`` for every tree with at most ``upto`` vertices."""
-    return {t: elementary_weight(t, tableau) for n in range(1, upto + 1) for t in trees(n)}
+    stages: dict = {}
+    return {t: elementary_weight(t, tableau, stages) for n in range(1, upto + 1) for t in trees(n)}
 
 
 def error_coefficients(tableau, n: int) -> dict:
@@ -122,7 +134,8 @@ def error_coefficients(tableau, n: int) -> dict:
     NodePy's ``error_coefficient``).  Hairer, Norsett, Wanner I, Sect. II.3 write them as ``alpha(t) e(t)/(p+1)!``
     with ``e(t) = 1 - gamma(t) Phi(t)`` and ``alpha(t) = (p+1)!/(sigma(t) gamma(t))``: the same up to sign.
     """
-    return {t: sympy.radsimp(sympy.expand((elementary_weight(t, tableau) - sympy.Rational(1, density(t)))
+    stages: dict = {}
+    return {t: sympy.radsimp(sympy.expand((elementary_weight(t, tableau, stages) - sympy.Rational(1, density(t)))
                                           / symmetry(t))) for t in trees(n)}
 
 

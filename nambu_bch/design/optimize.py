@@ -459,14 +459,16 @@ def _exact_critical_point(objective, selected, x, best, dps):
     (:data:`MAX_CRITICAL_BEZOUT`, :data:`MAX_CRITICAL_DEGREE`) or not in shape position.
     """
     n, r = len(x), len(selected)
-    f = objective.as_expr()
     F = [sympy.Poly(e, *x) for e in selected]
-    M = sympy.Matrix([[sympy.diff(g, v) for v in x] for g in [f, *selected]])
     minor_degree = (objective.total_degree() - 1) + sum(P.total_degree() - 1 for P in F)
     if np.prod([P.total_degree() for P in F]) * minor_degree ** (n - r) > MAX_CRITICAL_BEZOUT:
         return None
-    minors = [sympy.expand(M.extract(list(range(r + 1)), list(cols)).det()) for cols in combinations(range(n), r + 1)]
-    system = [P.as_expr() for P in F] + [m for m in minors if m != 0]
+    # the Jacobian and its minors in QQ[x] (sparse polynomial arithmetic): through sympy expressions, the
+    # derivatives of the objective (a sum of squares of the defects) and the expanded determinants were
+    # most of the cost of the exact step
+    M = [[P.diff(v) for v in x] for P in [objective, *F]]
+    minors = [_poly_det([[row[j] for j in cols] for row in M]) for cols in combinations(range(n), r + 1)]
+    system = [P.as_expr() for P in F] + [m.as_expr() for m in minors if not m.is_zero]
     G = sympy.groebner(system, *x, order="grevlex")
     if G.exprs == [1] or not G.is_zero_dimensional or _quotient_dimension(G, MAX_CRITICAL_DEGREE) > MAX_CRITICAL_DEGREE:
         return None
@@ -498,6 +500,21 @@ def _exact_critical_point(objective, selected, x, best, dps):
     return None
 
 
+def _poly_det(rows):
+    """The determinant of a small square matrix of :class:`sympy.Poly` (same generators), by Laplace expansion
+    along the first row; exact, and no expression is built."""
+    if len(rows) == 1:
+        return rows[0][0]
+    total = None
+    for j, a in enumerate(rows[0]):
+        if a.is_zero:
+            continue
+        term = a * _poly_det([row[:j] + row[j + 1:] for row in rows[1:]])
+        term = -term if j % 2 else term
+        total = term if total is None else total + term
+    return total if total is not None else rows[0][0]
+
+
 def _vanishes_at(e, x, rem, g) -> bool:
     """Exact certificate: ``e(r_1(t), ..., r_n(t)) = 0`` in ``QQ[t]/(g)``, every product reduced modulo ``g``."""
     powers = {v: [rem[v].one] for v in x}
@@ -518,7 +535,9 @@ def _algebraic_values(g, root, rem, x, t):
         for candidate in sympy.roots(g, t):
             if _is_real_radical(candidate) and abs(sympy.N(candidate - root, 50)) < sympy.Float(10) ** -40:
                 return tuple((v, sympy.radsimp(sympy.expand(rem[v].as_expr().subs(t, candidate)))) for v in x), True
-    return tuple((v, sympy.expand(rem[v].as_expr().subs(t, root))) for v in x), False
+    # sum c_k root^k built term by term: the same expression as expanding ``rem[v](root)`` (an expanded
+    # polynomial with one atom substituted), without expand's walk over the CRootOf powers
+    return tuple((v, sympy.Add(*(c * root**k for (k,), c in rem[v].terms()))) for v in x), False
 
 
 def _is_real_radical(v) -> bool:
