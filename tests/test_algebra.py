@@ -126,6 +126,26 @@ class TestPoissonBracket:
 
 
 # --------------------------------------------------------------------------------------------------
+# the zero test on jets of undefined functions
+# --------------------------------------------------------------------------------------------------
+def test_polynomials_in_jets_of_undefined_functions_are_decided_without_simplify(monkeypatch):
+    """A rational function of ``x`` and the jets ``T(x), T'(x), ...`` of an undefined ``T`` is decided by ``cancel``
+    with the jets as symbols (they are algebraically independent, Olver Sect. 2.3); ``simplify`` is not reached."""
+    from nambu_bch.algebra.zero import _jets_as_symbols, is_zero
+
+    x, y = sympy.symbols("x y")
+    T, V = sympy.Function("T"), sympy.Function("V")
+    d1, d2 = T(x).diff(x), T(x).diff(x, 2)
+    monkeypatch.setattr(sympy, "simplify", lambda *a, **k: pytest.fail("simplify reached"))
+    assert is_zero((d1 + V(y)) ** 2 - d1**2 - 2 * d1 * V(y) - V(y) ** 2)
+    assert is_zero(d2 * x / (x + d1) - d2 + d2 * d1 / (x + d1))
+    assert not is_zero(d1**2 * V(y).diff(y) / 12 - d2 * V(y) / 24)
+    # outside the jets of one-argument functions: not rewritten (the other tiers decide)
+    f = sympy.Function("f")
+    assert _jets_as_symbols(f(x, y) - 1) is None and _jets_as_symbols(T(x**2)) is None
+
+
+# --------------------------------------------------------------------------------------------------
 # Nambu bracket, Eq. (NB)
 # --------------------------------------------------------------------------------------------------
 class TestNambuBracket:
