@@ -125,6 +125,27 @@ class TestPoissonBracket:
         assert sympy.simplify(ALG2.to_sympy(got) - sympy.cos(x1) * x2 * sympy.exp(x2)) == 0
 
 
+def test_diff_of_a_ring_element_is_the_rings_diff_with_memoised_coefficient_products(monkeypatch):
+    """``PolynomialAlgebra.diff`` of an element of its ring gives the ring's ``diff`` (the same terms, in order)
+    without ``PolyElement.diff`` (a generator search by comparison) and multiplies a ``QQ(parameters)`` coefficient
+    by a brought-down exponent once: a second derivative of the same polynomial computes no product."""
+    from sympy.polys.rings import PolyElement
+
+    from nambu_bch.algebra import polynomial
+
+    x1, x2, I1 = sympy.symbols("x1 x2 I1")
+    alg = PolynomialAlgebra([x1, x2], parameters=[I1])
+    p = alg.convert(x1**3 / (2 * I1 + 1) + x1 * x2**2 / I1 - 7 * x2)
+    expected = [p.diff(alg.gens[i]) for i in range(2)]
+    monkeypatch.setattr(PolyElement, "diff", lambda *a: pytest.fail("PolyElement.diff called"))
+    polynomial._times.cache_clear()
+    first = [alg.diff(p, i) for i in range(2)]
+    assert [list(d.items()) for d in first] == [list(d.items()) for d in expected]
+    misses = polynomial._times.cache_info().misses
+    assert misses == 2 and [alg.diff(p, i) for i in range(2)] == first
+    assert polynomial._times.cache_info().misses == misses
+
+
 # --------------------------------------------------------------------------------------------------
 # the zero test on jets of undefined functions
 # --------------------------------------------------------------------------------------------------

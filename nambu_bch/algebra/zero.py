@@ -1,6 +1,7 @@
 """The package's one exact zero test of a sympy expression (cheap structural tests first).
 
-Rational functions are decided by ``cancel``.  Otherwise an expression is zero when its
+Rational functions are decided by ``cancel``, also those in the jets ``F(x), F'(x), ...`` of undefined
+one-argument functions (algebraically independent, so they count as symbols).  Otherwise an expression is zero when its
 expansion is ``0``; else, when it holds algebraic numbers such as ``2**(1/3)`` (the
 triple-jump coefficients of Yoshida, Phys. Lett. A 150 (1990) 262, Eq. 5.5), when
 rationalising the denominators (``radsimp``) brings the expansion to ``0``; else, with
