@@ -32,6 +32,7 @@ CACHES = (
     ("nambu_bch.algebra._flint", "_QQ_IS_FMPQ"),
     ("nambu_bch.algebra.fields", "_number_field"),
     ("nambu_bch.algebra.polynomial", "_converted"),
+    ("nambu_bch.algebra.polynomial", "_times"),
     ("nambu_bch.bch.concrete", "clear_cache"),          # _EVALUATORS
     ("nambu_bch.compiled", "_NUMBA_DIRS"),
     ("nambu_bch.bch.formal", "clear_cache"),            # _PATTERN_CACHE

@@ -125,6 +125,47 @@ class TestPoissonBracket:
         assert sympy.simplify(ALG2.to_sympy(got) - sympy.cos(x1) * x2 * sympy.exp(x2)) == 0
 
 
+def test_diff_of_a_ring_element_is_the_rings_diff_with_memoised_coefficient_products(monkeypatch):
+    """``PolynomialAlgebra.diff`` of an element of its ring gives the ring's ``diff`` (the same terms, in order)
+    without ``PolyElement.diff`` (a generator search by comparison) and multiplies a ``QQ(parameters)`` coefficient
+    by a brought-down exponent once: a second derivative of the same polynomial computes no product."""
+    from sympy.polys.rings import PolyElement
+
+    from nambu_bch.algebra import polynomial
+
+    x1, x2, I1 = sympy.symbols("x1 x2 I1")
+    alg = PolynomialAlgebra([x1, x2], parameters=[I1])
+    p = alg.convert(x1**3 / (2 * I1 + 1) + x1 * x2**2 / I1 - 7 * x2)
+    expected = [p.diff(alg.gens[i]) for i in range(2)]
+    monkeypatch.setattr(PolyElement, "diff", lambda *a: pytest.fail("PolyElement.diff called"))
+    polynomial._times.cache_clear()
+    first = [alg.diff(p, i) for i in range(2)]
+    assert [list(d.items()) for d in first] == [list(d.items()) for d in expected]
+    misses = polynomial._times.cache_info().misses
+    assert misses == 2 and [alg.diff(p, i) for i in range(2)] == first
+    assert polynomial._times.cache_info().misses == misses
+
+
+# --------------------------------------------------------------------------------------------------
+# the zero test on jets of undefined functions
+# --------------------------------------------------------------------------------------------------
+def test_polynomials_in_jets_of_undefined_functions_are_decided_without_simplify(monkeypatch):
+    """A rational function of ``x`` and the jets ``T(x), T'(x), ...`` of an undefined ``T`` is decided by ``cancel``
+    with the jets as symbols (they are algebraically independent, Olver Sect. 2.3); ``simplify`` is not reached."""
+    from nambu_bch.algebra.zero import _jets_as_symbols, is_zero
+
+    x, y = sympy.symbols("x y")
+    T, V = sympy.Function("T"), sympy.Function("V")
+    d1, d2 = T(x).diff(x), T(x).diff(x, 2)
+    monkeypatch.setattr(sympy, "simplify", lambda *a, **k: pytest.fail("simplify reached"))
+    assert is_zero((d1 + V(y)) ** 2 - d1**2 - 2 * d1 * V(y) - V(y) ** 2)
+    assert is_zero(d2 * x / (x + d1) - d2 + d2 * d1 / (x + d1))
+    assert not is_zero(d1**2 * V(y).diff(y) / 12 - d2 * V(y) / 24)
+    # outside the jets of one-argument functions: not rewritten (the other tiers decide)
+    f = sympy.Function("f")
+    assert _jets_as_symbols(f(x, y) - 1) is None and _jets_as_symbols(T(x**2)) is None
+
+
 # --------------------------------------------------------------------------------------------------
 # Nambu bracket, Eq. (NB)
 # --------------------------------------------------------------------------------------------------

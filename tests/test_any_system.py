@@ -474,6 +474,29 @@ def test_generic_nambu_no_universal_shadow_pair_at_h2(word):
     assert ell(Z2) != 0
 
 
+def test_jet_total_derivative_is_the_chain_rule_in_one_pass(monkeypatch):
+    """``JetRing.D`` is ``sum_k d p / d f_j^{(k)} f_j^{(k+1)}`` (the same dict, term order included) without the ring's
+    ``diff`` and generator ``index`` per jet (each a comparison of ring elements, most of ``generic_nambu_h2``'s time)."""
+    from sympy.polys.rings import PolyElement, PolyRing
+
+    from nambu_bch.shadow.generic_nambu import JetRing
+
+    J = JetRing(3)
+    h1, h2, g1, g2 = (J.jet[k] for k in (("h", 1, 0), ("h", 1, 1), ("g", 1, 0), ("g", 1, 2)))
+    p = 3 * h1**2 * g2 - h2 * g1 + 5 * h1 * h2 * J.jet[("g", 2, 1)] + 7
+    expected = [J.R.zero for _ in (1, 2, 3)]
+    for j in (1, 2, 3):
+        for f in "hg":
+            for k in range(3):
+                expected[j - 1] += p.diff(J.jet[(f, j, k)]) * J.jet[(f, j, k + 1)]
+    monkeypatch.setattr(PolyElement, "diff", lambda *a: pytest.fail("D called PolyElement.diff"))
+    monkeypatch.setattr(PolyRing, "index", lambda *a: pytest.fail("D called PolyRing.index"))
+    for j in (1, 2, 3):
+        assert list(J.D(p, j).items()) == list(expected[j - 1].items())
+    with pytest.raises(NambuBCHError, match="jet order 3 too small"):
+        J.D(J.jet[("h", 1, 3)], 1)
+
+
 # ---------------------------------------------------------------------------------------------
 # every new system: X_{H_S(,G_S)} = X_eff by both routes; truncated H_S drifts like h^4; the map has order 2
 # ---------------------------------------------------------------------------------------------

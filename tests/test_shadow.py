@@ -561,3 +561,23 @@ def test_symmetric_word_below_its_first_correction_is_a_polynomial_pair():
     pair, reported as such (it was polynomial=None)."""
     fam = shadow_hamiltonians(model("ho3"), "12321", order=1, route="fi")
     assert fam.exists is True and fam.polynomial is True and fam.H_S == sympy.expand(model("ho3").H)
+
+
+def test_exact_average_multiplies_the_hamiltonians_in_the_ring(monkeypatch):
+    """``exact_average``'s columns ``H^k G^l`` are products in the polynomial ring, not sympy expansions of
+    ``Mul(H**k, ..)`` (most of its time for quartic pairs); the answer is unchanged: ``<x1^4> = 3 H^2 / 2`` on the
+    circles of ``H = (x1^2 + x2^2) / 2``."""
+    from nambu_bch.shadow import existence
+
+    S = System("x1 x2", ["x1**2/2 + x2**2/2"])
+    x1, _ = S.coordinates
+    H = sympy.expand(S.hamiltonians[0])
+    expanded, expand = [], sympy.expand
+
+    def spy(e, *a, **k):
+        expanded.append(e)
+        return expand(e, *a, **k)
+
+    monkeypatch.setattr(existence.sympy, "expand", spy)
+    assert existence.exact_average(S, x1**4) == 3 * sympy.Symbol("H") ** 2 / 2
+    assert not [e for e in expanded if any(p.base == H for p in sympy.sympify(e).atoms(sympy.Pow))]

@@ -1,6 +1,7 @@
 """The package's one exact zero test of a sympy expression (cheap structural tests first).
 
-Rational functions are decided by ``cancel``.  Otherwise an expression is zero when its
+Rational functions are decided by ``cancel``, also those in the jets ``F(x), F'(x), ...`` of undefined
+one-argument functions (algebraically independent, so they count as symbols).  Otherwise an expression is zero when its
 expansion is ``0``; else, when it holds algebraic numbers such as ``2**(1/3)`` (the
 triple-jump coefficients of Yoshida, Phys. Lett. A 150 (1990) 262, Eq. 5.5), when
 rationalising the denominators (``radsimp``) brings the expansion to ``0``; else, with
@@ -64,11 +65,39 @@ def _nonzero_at_a_point(e) -> bool:
     return witness(e) is not None
 
 
+def _jets_as_symbols(expr):
+    """``expr`` with each ``F(x)`` and ``Derivative(F(x), (x, k))`` (``F`` undefined, one symbol argument) replaced by
+    a symbol of its own, or ``None`` when ``expr`` has no such atom or another applied undefined function.
+
+    For an undefined (generic) ``F`` the jets ``F(x), F'(x), F''(x), ...`` are algebraically independent over the
+    rational functions of the coordinates (Olver, *Applications of Lie Groups to Differential Equations*,
+    Sect. 2.3), so a rational function of them is zero exactly when it is zero with the jets as free symbols.
+
+    >>> x = sympy.Symbol("x"); T = sympy.Function("T")
+    >>> _jets_as_symbols(T(x).diff(x)**2 - T(x)).free_symbols.isdisjoint({x})
+    True
+    """
+    from sympy.core.function import AppliedUndef
+
+    undefined = expr.atoms(AppliedUndef)
+    if not undefined or not all(len(f.args) == 1 and f.args[0].is_Symbol for f in undefined):
+        return None
+    jets = set(undefined)
+    for d in expr.atoms(sympy.Derivative):
+        if not (isinstance(d.expr, AppliedUndef) and len(d.variable_count) == 1
+                and d.variable_count[0][0] == d.expr.args[0]):
+            return None
+        jets.add(d)
+    # xreplace matches the largest subtree first: a derivative is replaced whole, before the F(x) inside it
+    return expr.xreplace({jet: sympy.Dummy() for jet in sorted(jets, key=sympy.default_sort_key)})
+
+
 def is_zero(expr) -> bool:
     """Exact zero test, cheapest decisive tier first.
 
     1. A rational function of its symbols with rational coefficients is zero exactly when
-       ``cancel`` gives ``0`` (decisive both ways: ``QQ(symbols)`` is a field).
+       ``cancel`` gives ``0`` (decisive both ways: ``QQ(symbols)`` is a field); so is a rational function of the
+       symbols and of the jets ``F(x), F'(x), ...`` of undefined one-argument functions (:func:`_jets_as_symbols`).
     2. Otherwise the expansion; then a witness of non-zero-ness (a rational point where the value,
        at 30 digits, is clearly not zero: :func:`_nonzero_at_a_point`) answers ``False`` before the
        expensive tiers; with algebraic numbers, the expansion after rationalising the denominators (``radsimp``).
@@ -86,6 +115,9 @@ def is_zero(expr) -> bool:
     radicals = has_radicals(expr)
     if not radicals and expr.is_rational_function(*sorted(expr.free_symbols, key=str)):
         return sympy.cancel(sympy.together(expr)) == 0
+    jets = None if radicals else _jets_as_symbols(expr)
+    if jets is not None and jets.is_rational_function(*sorted(jets.free_symbols, key=str)):
+        return sympy.cancel(sympy.together(jets)) == 0
     e = sympy.expand(expr)
     if e == 0:
         return True

@@ -65,8 +65,9 @@ Horikoshi, Eqs. (L2), (Xeff3).
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from functools import cached_property
+from functools import cached_property, reduce
 from itertools import combinations, product
+from operator import mul
 
 import numpy as np
 import sympy
@@ -238,7 +239,14 @@ def exact_average(system, g, max_unknowns: int = MAX_EXACT_UNKNOWNS):
         return rows.vector(expr if hasattr(expr, "ring") else alg.convert(sympy.expand(expr)))
 
     cols = [vec(X.apply(alg.convert(sympy.Mul(*(x**k for x, k in zip(coords, e)))))) for e in pmonos]
-    ccols = [vec(sympy.Mul(*(H**k for H, k in zip(hams, e)))) for e in cmonos]
+    # the products of powers of the Hamiltonians in the ring (sympy's expansion of each product cost most of this
+    # function for the quartic pairs); the solution does not depend on the order in which rows first appear
+    ring_hams = [alg.convert(H) for H in hams]
+    if all(hasattr(H, "ring") for H in ring_hams):
+        ccols = [vec(reduce(mul, (H**k for H, k in zip(ring_hams, e)), alg.convert(1)))
+                 for e in cmonos]
+    else:
+        ccols = [vec(sympy.Mul(*(H**k for H, k in zip(hams, e)))) for e in cmonos]
     b = vec(g)
     solution = solve_affine(SparseMatrix.from_columns(cols + ccols, len(rows), alg.domain), [b], certificate=False)
     if not solution.consistent:

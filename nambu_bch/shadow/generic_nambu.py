@@ -67,18 +67,36 @@ class JetRing:
         self.ring = self.R
         self.jet = {(f, i, k): gens[self.names.index(f"{f}{i}_{k}")] for f in "hg" for i in (1, 2, 3)
                     for k in range(max_order + 1)}
+        # each jet's position among the generators (the ring's own ``index`` compares elements one by one)
+        self._pos = {key: self.names.index(f"{key[0]}{key[1]}_{key[2]}") for key in self.jet}
         self.backend = PolynomialBackend.on_ring(self)
 
     def D(self, p, j):
-        """Total derivative ``d/dx_j``."""
-        out = self.R.zero
+        """Total derivative ``d/dx_j``: ``sum_k d p / d f_j^{(k)} * f_j^{(k+1)}`` over ``f = h, g``.
+
+        One pass over the terms of ``p`` per jet (the chain rule term by term) instead of a ring ``diff``, a product
+        and a sum per jet; the terms are accumulated in the same order, so the result is the same dict.
+        """
+        R, K, pos = self.R, self.K, self._pos
+        if any(m[pos[(f, j, K)]] for f in "hg" for m in p):
+            raise InvalidOrderError(f"jet order {K} too small for this computation")
+        out, zero = R.zero, R.domain.zero
+        get = out.get
         for f in "hg":
-            if p.diff(self.jet[(f, j, self.K)]):
-                raise InvalidOrderError(f"jet order {self.K} too small for this computation")
-            for k in range(self.K):
-                c = p.diff(self.jet[(f, j, k)])
-                if c:
-                    out += c * self.jet[(f, j, k + 1)]
+            for k in range(K):
+                a, b = pos[(f, j, k)], pos[(f, j, k + 1)]
+                for m, c in p.items():
+                    e = m[a]
+                    if e:
+                        n = list(m)
+                        n[a] -= 1
+                        n[b] += 1
+                        n = tuple(n)
+                        v = get(n, zero) + c * e
+                        if v:
+                            out[n] = v
+                        else:
+                            del out[n]
         return out
 
     def diff(self, p, index: int):
@@ -140,19 +158,30 @@ def generic_nambu_h2(word: str = "12321", max_order: int = 6) -> GenericNambuRes
             Z2 = tuple(a + R.domain.convert(sympy.Rational(c)) * b for a, b in zip(Z2, B.values(X)))
 
     def monomials(nh, ng):
+        # products of nh h-jets and ng g-jets whose derivative counts per coordinate are (2, 2, 2), in the order of
+        # the nested enumeration (h-part, then g-part); the g-parts are grouped by their multidegree once
         jh = [("h", i, k) for i in (1, 2, 3) for k in range(max_order)]
         jg = [("g", i, k) for i in (1, 2, 3) for k in range(max_order)]
+
+        def multidegree(keys):
+            md = [0, 0, 0]
+            for _, i, k in keys:
+                md[i - 1] += k
+            return tuple(md)
+
+        by_md: dict = {}
+        for gs in combinations_with_replacement(jg, ng):
+            md = multidegree(gs)
+            if max(md) <= 2:
+                by_md.setdefault(md, []).append(gs)
         out = []
         for hs in combinations_with_replacement(jh, nh):
-            for gs in combinations_with_replacement(jg, ng):
-                md = [0, 0, 0]
-                for _, i, k in hs + gs:
-                    md[i - 1] += k
-                if md == [2, 2, 2]:
-                    m = R.one
-                    for key in hs + gs:
-                        m *= J.jet[key]
-                    out.append(m)
+            md = multidegree(hs)
+            for gs in by_md.get(tuple(2 - d for d in md), ()):
+                m = R.one
+                for key in hs + gs:
+                    m *= J.jet[key]
+                out.append(m)
         return out
 
     cols = [("H", m) for m in monomials(3, 2)] + [("G", m) for m in monomials(2, 3)]
