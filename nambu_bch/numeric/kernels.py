@@ -76,8 +76,8 @@ from ..atomic import write_atomic
 from ..private_dirs import cache_root, private_directory, read_private, untrusted
 from ..integrators.composition import composition_for
 from ..integrators.step import parameter_values
-from .codegen import (FMA_FUNCTION, PAIR_FUNCTION, SCAN_FUNCTION, TEMPLATE_VERSION, python_source, source_hash,
-                      step_program)
+from .codegen import (COPY_FUNCTION, FMA_FUNCTION, PAIR_FUNCTION, SCAN_FUNCTION, SELECT_FUNCTION, TEMPLATE_VERSION,
+                      python_source, source_hash, step_program)
 
 from .guards import BACKENDS, linear_part  # the accepted names live with the other checks of a run's inputs
 #: numba's fast-math flags of a run with ``fma=True``: contraction of ``a*b + c`` into one fused
@@ -346,9 +346,14 @@ class Kernel:
         if fn is None:
             import numba
 
+            select = None
             if name.startswith("run_batch") and hasattr(self.module, PAIR_FUNCTION):
                 # the batch loops' redo calls the shared-exponential function: compiled, it is a global of theirs
                 self.module.__dict__[PAIR_FUNCTION] = self.function(PAIR_FUNCTION)
+                # and their branch-free pass the select function, compiled with the loop's own flags: a
+                # contracted loop's inline statements were contracted too (codegen.SELECT_FUNCTION)
+                select = self.function(SELECT_FUNCTION + cache_variant(CONTRACT if fma else None))
+                self.module.__dict__[COPY_FUNCTION] = self.function(COPY_FUNCTION)
             if name.startswith("run_batch"):  # the guards' scan they extend as they load the states
                 from .scan import scan_into
 
@@ -359,6 +364,11 @@ class Kernel:
                 self.module.__dict__[FMA_FUNCTION] = fused_multiply_add()
             py = getattr(self.module, source)
             py = getattr(py, "py_func", py)  # the compiled pair function stands in the module once bound
+            if select is not None and fma:  # its own globals: the module keeps the uncontracted select function
+                py = types.FunctionType(py.__code__, {**self.module.__dict__, SELECT_FUNCTION: select}, py.__name__,
+                                        py.__defaults__, py.__closure__)
+            elif select is not None:
+                self.module.__dict__[SELECT_FUNCTION] = select
             fn = numba.njit(nogil=True, fastmath=set(CONTRACT) if fma else False, error_model="numpy")(py)
             if self.path.is_file():  # numba caches next to a source file; without one, compile in memory
                 enable_private_cache(fn, self.directory / "__pycache__", name)
