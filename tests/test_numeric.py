@@ -139,13 +139,17 @@ def test_exponential_flows_use_expm1():
     assert all("expm1" in str(d) for u in prog.updates for _, d in u.expanded())
     # one expm1 per sub-flow: each Lotka-Volterra piece scales one coordinate by e^u, another by e^-u
     assert all(len(u.pairs) == 1 and len(u.increments) == 2 for u in prog.updates)
-    # run, run_fma and run_kahan: one library call per sub-flow, only above the series range; the batch loops'
-    # redo (and only it) calls the one generated pair function, which holds the last library call
-    from nambu_bch.numeric.codegen import PAIR_FUNCTION
+    # one library call, only above the series range, in the one generated pair function: run, run_fma, run_kahan
+    # and the batch loops' redo call it once per sub-flow (compiled, LLVM inlines it), the batch loops' branch-free
+    # pass calls the select function once per sub-flow
+    from nambu_bch.numeric.codegen import PAIR_FUNCTION, SELECT_FUNCTION
 
     src = python_source(prog)
-    assert src.count("    e0 = _expm1(_au0)") == 4 and src.count("= _expm1(") == 3 * len(prog.updates) + 1
-    assert src.count(f"def {PAIR_FUNCTION}(") == 1 and src.count(f" = {PAIR_FUNCTION}(") == 2 * len(prog.updates)
+    assert src.count("    e0 = _expm1(_au0)") == 1 and src.count("= _expm1(") == 1
+    assert src.count(f"def {PAIR_FUNCTION}(") == 1 and src.count(f" = {PAIR_FUNCTION}(") == 5 * len(prog.updates)
+    assert src.count(f"def {SELECT_FUNCTION}(") == 1 and src.count(f" = {SELECT_FUNCTION}(") == 2 * len(prog.updates)
+    compiled = [f for f in src.split("\ndef ")[1:] if not f.startswith("run_numpy")]  # numpy twins stay inline
+    assert sum("_zu0 = " in f for f in compiled) == 2 and not any("_zu1" in f for f in compiled)
     assert src.count("_np_expm1(") == 2 * len(prog.updates)        # run_numpy and its Kahan form
 
 

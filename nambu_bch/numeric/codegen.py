@@ -694,11 +694,14 @@ def python_source(program: StepProgram) -> str:
     src = [_HEADER.format(version=TEMPLATE_VERSION), f"{SCAN_FUNCTION} = None\n", constants_source(program)]
     if any(u.pairs for u in program.updates):
         src.append(pair_function_source())
+    # the single loops call the compiled pair function (LLVM inlines it) rather than repeat its statements per
+    # sub-flow: numba's compile grows with the statements it types and lowers
+    pair_call = PAIR_FUNCTION if any(u.pairs for u in program.updates) else None
     for kahan in (False, True):
         body = body_lines(program, scalar, kahan)
-        src.append(_run_source(program, body, consts, kahan))
+        src.append(_run_source(program, body_lines(program, scalar, kahan, pair_call=pair_call), consts, kahan))
         if not kahan:
-            src.append(_run_fma_source(program, scalar, consts))
+            src.append(_run_fma_source(program, scalar, consts, pair_call))
         src.append(_run_batch_source(program, body, scalar, consts, kahan))
         src.append(_run_numpy_source(program, consts, kahan))
     return "\n".join(src)
@@ -728,7 +731,7 @@ def {name}({args}):
 """
 
 
-def _run_fma_source(program: StepProgram, scalar, consts) -> str:
+def _run_fma_source(program: StepProgram, scalar, consts, pair_call=None) -> str:
     """``run_fma``: ``run`` with the fused multiply-adds written out, the loop of ``fma=True`` for one trajectory.
 
     Contraction alone (fastmath "contract") left LLVM free to compute a product shared by two consecutive steps
@@ -744,7 +747,8 @@ def _run_fma_source(program: StepProgram, scalar, consts) -> str:
 def run_fma(x, K, steps, every, out):
 {_indent(consts, 4)}
     {load}
-{_indent(_sampling_loop(body_lines(program, scalar, fused=True), [sample], [f"if not ({finite}):", "    break"]), 4)}
+{_indent(_sampling_loop(body_lines(program, scalar, fused=True, pair_call=pair_call), [sample],
+                         [f"if not ({finite}):", "    break"]), 4)}
     {store}
     return n
 """
