@@ -153,6 +153,24 @@ def test_exponential_flows_use_expm1():
     assert src.count("_np_expm1(") == 2 * len(prog.updates)        # run_numpy and its Kahan form
 
 
+@numba_only
+def test_exponential_helpers_are_compiled_with_each_loops_flags():
+    """A loop compiled with contraction calls helpers compiled with contraction (its inline statements were
+    contracted: the same bits), the others and the interpreter the plain ones; the batch redo always the plain pair.
+    Only dispatchers are made here, nothing is compiled."""
+    from nambu_bch.numeric.codegen import PAIR_FUNCTION, SELECT_FUNCTION
+
+    k = kernel(model("lotka-volterra"), "12321")
+    flags = lambda f: set(f.targetoptions.get("fastmath") or ())  # noqa: E731
+    for name in ("run", "run_kahan", "run_batch", "run_batch_kahan"):
+        for fma in (False, True):
+            scope = k.function(name + ("+contract" if fma else "")).py_func.__globals__
+            helper = scope[SELECT_FUNCTION if name.startswith("run_batch") else PAIR_FUNCTION]
+            assert flags(helper) == ({"contract"} if fma else set()), (name, fma)
+            assert flags(scope[PAIR_FUNCTION]) == ({"contract"} if fma and "batch" not in name else set())
+    assert flags(k.module.__dict__[SELECT_FUNCTION]) == flags(k.module.__dict__[PAIR_FUNCTION]) == set()
+
+
 @pytest.mark.parametrize("name,word", [("ho3", "32123"), ("lotka-volterra", "12321")])
 def test_numba_loops_copy_rows_element_by_element(name, word):
     """The compiled loops move states between arrays only by element loops, never by a slice assignment
