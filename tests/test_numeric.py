@@ -139,14 +139,36 @@ def test_exponential_flows_use_expm1():
     assert all("expm1" in str(d) for u in prog.updates for _, d in u.expanded())
     # one expm1 per sub-flow: each Lotka-Volterra piece scales one coordinate by e^u, another by e^-u
     assert all(len(u.pairs) == 1 and len(u.increments) == 2 for u in prog.updates)
-    # run, run_fma and run_kahan: one library call per sub-flow, only above the series range; the batch loops'
-    # redo (and only it) calls the one generated pair function, which holds the last library call
-    from nambu_bch.numeric.codegen import PAIR_FUNCTION
+    # one library call, only above the series range, in the one generated pair function: run, run_fma, run_kahan
+    # and the batch loops' redo call it once per sub-flow (compiled, LLVM inlines it), the batch loops' branch-free
+    # pass calls the select function once per sub-flow
+    from nambu_bch.numeric.codegen import PAIR_FUNCTION, SELECT_FUNCTION
 
     src = python_source(prog)
-    assert src.count("    e0 = _expm1(_au0)") == 4 and src.count("= _expm1(") == 3 * len(prog.updates) + 1
-    assert src.count(f"def {PAIR_FUNCTION}(") == 1 and src.count(f" = {PAIR_FUNCTION}(") == 2 * len(prog.updates)
+    assert src.count("    e0 = _expm1(_au0)") == 1 and src.count("= _expm1(") == 1
+    assert src.count(f"def {PAIR_FUNCTION}(") == 1 and src.count(f" = {PAIR_FUNCTION}(") == 5 * len(prog.updates)
+    assert src.count(f"def {SELECT_FUNCTION}(") == 1 and src.count(f" = {SELECT_FUNCTION}(") == 2 * len(prog.updates)
+    compiled = [f for f in src.split("\ndef ")[1:] if not f.startswith("run_numpy")]  # numpy twins stay inline
+    assert sum("_zu0 = " in f for f in compiled) == 2 and not any("_zu1" in f for f in compiled)
     assert src.count("_np_expm1(") == 2 * len(prog.updates)        # run_numpy and its Kahan form
+
+
+@numba_only
+def test_exponential_helpers_are_compiled_with_each_loops_flags():
+    """A loop compiled with contraction calls helpers compiled with contraction (its inline statements were
+    contracted: the same bits), the others and the interpreter the plain ones; the batch redo always the plain pair.
+    Only dispatchers are made here, nothing is compiled."""
+    from nambu_bch.numeric.codegen import PAIR_FUNCTION, SELECT_FUNCTION
+
+    k = kernel(model("lotka-volterra"), "12321")
+    flags = lambda f: set(f.targetoptions.get("fastmath") or ())  # noqa: E731
+    for name in ("run", "run_kahan", "run_batch", "run_batch_kahan"):
+        for fma in (False, True):
+            scope = k.function(name + ("+contract" if fma else "")).py_func.__globals__
+            helper = scope[SELECT_FUNCTION if name.startswith("run_batch") else PAIR_FUNCTION]
+            assert flags(helper) == ({"contract"} if fma else set()), (name, fma)
+            assert flags(scope[PAIR_FUNCTION]) == ({"contract"} if fma and "batch" not in name else set())
+    assert flags(k.module.__dict__[SELECT_FUNCTION]) == flags(k.module.__dict__[PAIR_FUNCTION]) == set()
 
 
 @pytest.mark.parametrize("name,word", [("ho3", "32123"), ("lotka-volterra", "12321")])
@@ -161,7 +183,8 @@ def test_numba_loops_copy_rows_element_by_element(name, word):
 
     tree = ast.parse(python_source(step_program(model(name), word)))
     compiled = [f for f in tree.body if isinstance(f, ast.FunctionDef) and not f.name.startswith(("run_numpy", "constants"))]
-    pairs = {"_expm1_pair"} if name == "lotka-volterra" else set()  # the shared-exponential function (compiled too)
+    # the shared-exponential functions and the row copy of the batch loops with shared exponentials (compiled too)
+    pairs = {"_expm1_pair", "_expm1_select", "_copy"} if name == "lotka-volterra" else set()
     assert {f.name for f in compiled} == {"run", "run_fma", "run_kahan", "run_batch", "run_batch_kahan"} | pairs
     compiled += [f for f in ast.parse(Path(scan_module.__file__).read_text()).body if isinstance(f, ast.FunctionDef)]
     assert [f.name for f in compiled][-1:] == ["scan"]
@@ -172,6 +195,12 @@ def test_numba_loops_copy_rows_element_by_element(name, word):
     # the copies are there: each state row is gathered from X into the chunk and scattered back (per row)
     batch = ast.unparse(next(f for f in compiled if f.name == "run_batch"))
     N = model(name).N
+    if pairs:  # one call of the compiled element loop per row (what numba compiles once, LLVM inlines)
+        copy = ast.unparse(next(f for f in compiled if f.name == "_copy"))
+        assert "_dst[b] = _src[b]" in copy and "for b in range(nb)" in copy
+        assert all(f"_copy(S{i}, X[{i}, b0:b0 + nb], nb)" in batch and f"_copy(X[{i}, b0:b0 + nb], S{i}, nb)" in batch
+                   for i in range(N))
+        return
     assert all(f"row = X[{i}, b0:b0 + nb]" in batch and f"S{i}[b] = row[b]" in batch and f"row[b] = S{i}[b]" in batch
                for i in range(N))
 

@@ -59,7 +59,7 @@ from ..integrators.flows import TIME, exact_flow
 STEP = sympy.Symbol("h")
 
 #: Bump when the generated source changes meaning (part of the cache key).
-TEMPLATE_VERSION = "10"
+TEMPLATE_VERSION = "11"
 #: Steps a batch kernel takes for each state of a chunk before moving to the next state (:func:`_chunk_step`).
 JAM_STEPS = 2
 
@@ -452,14 +452,41 @@ def pair_lines(u, e, f, value, prefix="_", style="python"):
 PAIR_FUNCTION = "_expm1_pair"
 
 
+#: The generated function ``e, f, o = _expm1_select(u)`` (:func:`pair_lines` style ``"select"`` as a function,
+#: ``o`` = 1 when ``|u|`` is beyond the series), called by the batch loops' branch-free pass.  One compiled copy of
+#: the series instead of one per sub-flow: numba types and lowers each statement of a function once, and its cost
+#: grows with the statements (five inline copies in a Lotka-Volterra 12321 step, twice: plain and Kahan); LLVM
+#: inlines the small callee, so the machine code and its vectorisation are those of the inline statements.  A loop
+#: compiled with contraction calls a copy compiled with contraction (fast-math flags are per instruction, kept
+#: through inlining): the same bits as the statements inline (:meth:`~nambu_bch.numeric.kernels.Kernel.function`).
+SELECT_FUNCTION = "_expm1_select"
+
+
+#: The generated function ``_copy(_dst, _src, nb)``: ``_dst[b] = _src[b]`` for ``b < nb`` -- the memory passes of
+#: the batch loops with shared exponentials (:func:`_run_batch_source`), inlined by LLVM like the select function.
+COPY_FUNCTION = "_copy"
+
+
 def pair_function_source() -> str:
-    """``def _expm1_pair(x): ... return e0, f0`` -- the statements of :func:`pair_lines` (style ``"python"``)."""
+    """``def _expm1_pair(x): ... return e0, f0`` -- the statements of :func:`pair_lines` (style ``"python"``) --
+    and ``def _expm1_select(x): ... return e0, f0, over`` (style ``"select"``, ``over`` 0 or 1)."""
     body = pair_lines("u0", "e0", "f0", "x")
+    select = [line.replace("over += ", "over = ", 1) for line in pair_lines("u0", "e0", "f0", "x", style="select")]
     return f"""
 
 def {PAIR_FUNCTION}(x):
 {_indent(body, 4)}
     return e0, f0
+
+
+def {SELECT_FUNCTION}(x):
+{_indent(select, 4)}
+    return e0, f0, over
+
+
+def {COPY_FUNCTION}(_dst, _src, nb):
+    for b in range(nb):
+        _dst[b] = _src[b]
 """
 
 
@@ -479,15 +506,16 @@ def expm1_pair(u: float) -> tuple:
 
 
 def body_lines(program: StepProgram, printer, kahan=False, c_syntax=False, vector=False, prefix="_", select=False,
-               pair_call=None, fused=False):
+               pair_call=None, fused=False, select_call=None):
     """Statements of one step, ``s_i`` / ``k_j`` / ``d_j`` / ``c_i`` named as in the generated kernels.
 
     ``vector``: numpy arrays (the shared-exponential swap is a ``np.where``); ``prefix``: of the
     function names (``_``, ``_np_``, ``_mp_``); ``c_syntax``: C99; ``select``: shared exponentials
     without branches (:func:`pair_lines` style ``"select"``, for the vectorised batch loop);
     ``pair_call``: the name of a function computing a shared pair (``e_j, f_j = pair_call(u_j)``,
-    :data:`PAIR_FUNCTION`) instead of its statements inline; ``fused``: each increment that is a product
-    ``p*q`` is added by one fused multiply-add ``s_i = _fma(p, q, s_i)`` (:func:`fused_product`), the
+    :data:`PAIR_FUNCTION`) instead of its statements inline; ``select_call``: likewise for ``select``
+    (``e_j, f_j, _o = select_call(u_j)``, ``over += _o``; :data:`SELECT_FUNCTION`); ``fused``: each increment
+    that is a product ``p*q`` is added by one fused multiply-add ``s_i = _fma(p, q, s_i)`` (:func:`fused_product`), the
     operands of an update taken before any of its coordinates moves (Python syntax, no Kahan).
     """
     end = ";" if c_syntax else ""
@@ -497,6 +525,9 @@ def body_lines(program: StepProgram, printer, kahan=False, c_syntax=False, vecto
         for us, es, fs, ue in u.pairs:
             if pair_call:
                 lines += [f"{us} = {printer(ue)}", f"{es}, {fs} = {pair_call}({us})"]
+                continue
+            if select_call:
+                lines += [f"{us} = {printer(ue)}", f"{es}, {fs}, _o{us} = {select_call}({us})", f"over += _o{us}"]
                 continue
             style = ("cselect" if select else "c") if c_syntax else "numpy" if vector else "select" if select else "python"
             lines += pair_lines(str(us), str(es), str(fs), printer(ue), prefix, style)
@@ -595,8 +626,11 @@ def _indent(lines, n):
     return "\n".join(pad + line for line in lines)
 
 
-def _row_copy(dst, src):
-    """Lines copying the first ``nb`` entries of ``src`` into ``dst`` (chunk arrays; at most one of them a row slice)."""
+def _row_copy(dst, src, call=False):
+    """Lines copying the first ``nb`` entries of ``src`` into ``dst`` (chunk arrays; at most one of them a row slice);
+    ``call``: one call of the compiled :data:`COPY_FUNCTION` instead of the loop."""
+    if call:
+        return [f"{COPY_FUNCTION}({dst}, {src}, nb)"]
     if "[" in src:
         return [f"row = {src}", "for b in range(nb):", f"    {dst}[b] = row[b]"]
     if "[" in dst:
@@ -662,11 +696,14 @@ def python_source(program: StepProgram) -> str:
     src = [_HEADER.format(version=TEMPLATE_VERSION), f"{SCAN_FUNCTION} = None\n", constants_source(program)]
     if any(u.pairs for u in program.updates):
         src.append(pair_function_source())
+    # the single loops call the compiled pair function (LLVM inlines it) rather than repeat its statements per
+    # sub-flow: numba's compile grows with the statements it types and lowers
+    pair_call = PAIR_FUNCTION if any(u.pairs for u in program.updates) else None
     for kahan in (False, True):
         body = body_lines(program, scalar, kahan)
-        src.append(_run_source(program, body, consts, kahan))
+        src.append(_run_source(program, body_lines(program, scalar, kahan, pair_call=pair_call), consts, kahan))
         if not kahan:
-            src.append(_run_fma_source(program, scalar, consts))
+            src.append(_run_fma_source(program, scalar, consts, pair_call))
         src.append(_run_batch_source(program, body, scalar, consts, kahan))
         src.append(_run_numpy_source(program, consts, kahan))
     return "\n".join(src)
@@ -696,7 +733,7 @@ def {name}({args}):
 """
 
 
-def _run_fma_source(program: StepProgram, scalar, consts) -> str:
+def _run_fma_source(program: StepProgram, scalar, consts, pair_call=None) -> str:
     """``run_fma``: ``run`` with the fused multiply-adds written out, the loop of ``fma=True`` for one trajectory.
 
     Contraction alone (fastmath "contract") left LLVM free to compute a product shared by two consecutive steps
@@ -712,7 +749,8 @@ def _run_fma_source(program: StepProgram, scalar, consts) -> str:
 def run_fma(x, K, steps, every, out):
 {_indent(consts, 4)}
     {load}
-{_indent(_sampling_loop(body_lines(program, scalar, fused=True), [sample], [f"if not ({finite}):", "    break"]), 4)}
+{_indent(_sampling_loop(body_lines(program, scalar, fused=True, pair_call=pair_call), [sample],
+                         [f"if not ({finite}):", "    break"]), 4)}
     {store}
     return n
 """
@@ -729,19 +767,22 @@ def _run_batch_source(program: StepProgram, body, scalar, consts, kahan) -> str:
     # the chunk's rows in one buffer, each row 64-byte aligned: an allocation only 16- or 32-byte aligned
     # splits every 8-wide (AVX-512) load across two cache lines, measured 1.8x slower
     rows = [f"S{i}" for i in range(N)] + ([f"Q{i}" for i in range(N)] if kahan else [])
-    spare = [f"R{q}" for q in range(len(rows))] if any(u.pairs for u in program.updates) else []
+    pairs = any(u.pairs for u in program.updates)
+    spare = [f"R{q}" for q in range(len(rows))] if pairs else []
     alloc = ["W = (chunk + 7) // 8 * 8", f"buf = np.empty({len(rows) + len(spare)} * W + 8)",
              "off = (8 - (buf.ctypes.data // 8) % 8) % 8"]
     alloc += [f"{r} = buf[off + {q} * W:off + {q} * W + chunk]" for q, r in enumerate(rows + spare)]
     alloc += ["scanning = res.shape[0] > 0", "acc = np.empty((2, 3, chunk if scanning else 1))"]
     # the memory passes as one element loop per row (numba vectorises each; a slice assignment
     # ``S0[:nb] = X[0, b0:b0 + nb]`` runs as fast but makes numba compile its broadcasting error
-    # path, which doubled the kernel's compile time; one loop over all rows at once measured 3-4x slower)
-    gather = [line for i in range(N) for line in _row_copy(f"S{i}", f"X[{i}, b0:b0 + nb]")]
-    gather += [line for i in range(N) for line in _row_copy(f"Q{i}", f"C[{i}, b0:b0 + nb]")] if kahan else []
-    first = [line for i in range(N) for line in _row_copy(f"out[0, {i}, b0:b0 + nb]", f"S{i}")]
-    scatter = [line for i in range(N) for line in _row_copy(f"X[{i}, b0:b0 + nb]", f"S{i}")]
-    comp_back = [line for i in range(N) for line in _row_copy(f"C[{i}, b0:b0 + nb]", f"Q{i}")] if kahan else []
+    # path, which doubled the kernel's compile time; one loop over all rows at once measured 3-4x slower).
+    # With shared exponentials (a dozen to thirty such loops with the redo's save and restore) each is a call
+    # of the one compiled COPY_FUNCTION, which LLVM inlines: the same machine code, compiled by numba once
+    gather = [line for i in range(N) for line in _row_copy(f"S{i}", f"X[{i}, b0:b0 + nb]", pairs)]
+    gather += [line for i in range(N) for line in _row_copy(f"Q{i}", f"C[{i}, b0:b0 + nb]", pairs)] if kahan else []
+    first = [line for i in range(N) for line in _row_copy(f"out[0, {i}, b0:b0 + nb]", f"S{i}", pairs)]
+    scatter = [line for i in range(N) for line in _row_copy(f"X[{i}, b0:b0 + nb]", f"S{i}", pairs)]
+    comp_back = [line for i in range(N) for line in _row_copy(f"C[{i}, b0:b0 + nb]", f"Q{i}", pairs)] if kahan else []
     # ``res`` non-empty: the guards' scan of the start states (:func:`nambu_bch.numeric.scan.scan_into`, bound
     # to SCAN_FUNCTION when the loop is compiled) extended by each chunk just before it is loaded -- the batch
     # is read from memory once; a non-finite or subnormal start state stops the loop (-1) before any step
@@ -789,12 +830,12 @@ def _chunk_step(program: StepProgram, body, scalar, kahan, rows, steps=1) -> lis
         return None
     # shared exponentials: one branch-free pass over the chunk (vectorised); if some |u| left the
     # series range, the chunk's step is undone and redone with the library branch -- the same bits
-    # as the branchy loop either way.  The redo (scalar, rare) calls the pair function instead of
-    # repeating its statements per sub-flow: half the source numba compiles
-    fast = body_lines(program, scalar, kahan, select=True)
+    # as the branchy loop either way.  The pass and the redo (scalar, rare) call the select and the pair
+    # function instead of repeating their statements per sub-flow: a fraction of the source numba compiles
+    fast = body_lines(program, scalar, kahan, select_call=SELECT_FUNCTION)
     redo = body_lines(program, scalar, kahan, pair_call=PAIR_FUNCTION)
-    saved = [line for q, r in enumerate(rows) for line in _row_copy(f"R{q}", r)]
-    restore = [line for q, r in enumerate(rows) for line in _row_copy(r, f"R{q}")]
+    saved = [line for q, r in enumerate(rows) for line in _row_copy(f"R{q}", r, call=True)]
+    restore = [line for q, r in enumerate(rows) for line in _row_copy(r, f"R{q}", call=True)]
     return [*saved, "over = 0", "for b in range(nb):",
             *("    " + line for line in inner_load + fast + inner_store),
             "if over:", *("    " + line for line in restore),

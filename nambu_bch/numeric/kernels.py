@@ -76,8 +76,8 @@ from ..atomic import write_atomic
 from ..private_dirs import cache_root, private_directory, read_private, untrusted
 from ..integrators.composition import composition_for
 from ..integrators.step import parameter_values
-from .codegen import (FMA_FUNCTION, PAIR_FUNCTION, SCAN_FUNCTION, TEMPLATE_VERSION, python_source, source_hash,
-                      step_program)
+from .codegen import (COPY_FUNCTION, FMA_FUNCTION, PAIR_FUNCTION, SCAN_FUNCTION, SELECT_FUNCTION, TEMPLATE_VERSION,
+                      python_source, source_hash, step_program)
 
 from .guards import BACKENDS, linear_part  # the accepted names live with the other checks of a run's inputs
 #: numba's fast-math flags of a run with ``fma=True``: contraction of ``a*b + c`` into one fused
@@ -346,9 +346,19 @@ class Kernel:
         if fn is None:
             import numba
 
-            if name.startswith("run_batch") and hasattr(self.module, PAIR_FUNCTION):
-                # the batch loops' redo calls the shared-exponential function: compiled, it is a global of theirs
+            flagged = {}  # the helpers compiled with the loop's own flags (codegen.SELECT_FUNCTION)
+            if name.startswith("run") and hasattr(self.module, PAIR_FUNCTION):
+                # the loops call the shared-exponential functions: compiled, they are globals of theirs.  The
+                # batch loops' redo calls the uncontracted pair function whatever the loop's flags; their
+                # branch-free pass, and the single loops, call a copy compiled with the loop's flags (the
+                # statements a contracted loop used to hold inline were contracted too)
                 self.module.__dict__[PAIR_FUNCTION] = self.function(PAIR_FUNCTION)
+                variant = cache_variant(CONTRACT if fma else None)
+                if name.startswith("run_batch"):
+                    self.module.__dict__[COPY_FUNCTION] = self.function(COPY_FUNCTION)
+                    flagged[SELECT_FUNCTION] = self.function(SELECT_FUNCTION + variant)
+                elif fma:
+                    flagged[PAIR_FUNCTION] = self.function(PAIR_FUNCTION + variant)
             if name.startswith("run_batch"):  # the guards' scan they extend as they load the states
                 from .scan import scan_into
 
@@ -359,6 +369,11 @@ class Kernel:
                 self.module.__dict__[FMA_FUNCTION] = fused_multiply_add()
             py = getattr(self.module, source)
             py = getattr(py, "py_func", py)  # the compiled pair function stands in the module once bound
+            if flagged and fma:  # its own globals: the module (and the interpreter) keep the uncontracted helpers
+                py = types.FunctionType(py.__code__, {**self.module.__dict__, **flagged}, py.__name__,
+                                        py.__defaults__, py.__closure__)
+            else:
+                self.module.__dict__.update(flagged)
             fn = numba.njit(nogil=True, fastmath=set(CONTRACT) if fma else False, error_model="numpy")(py)
             if self.path.is_file():  # numba caches next to a source file; without one, compile in memory
                 enable_private_cache(fn, self.directory / "__pycache__", name)
