@@ -114,6 +114,18 @@ print(json.dumps({"numba_import": numba_import, "first": first_cpu, "compiles": 
 '''
 
 #: name -> source defining ``first()`` and ``warm()`` (the same calls on every tree).
+def _rk_case(method, h_warm, steps_warm):
+    """The child's source for a Runge-Kutta method on the rigid body: a short first run (the compile), a long warm one."""
+    return f'''
+from nambu_bch.numeric.runge_kutta import iterate_runge_kutta
+P = {{"I1": 1.0, "I2": 2.0, "I3": 3.0}}
+def first():
+    iterate_runge_kutta("rigid-body", "{method}", 0.1, 50, [1.0, 0.5, 0.2], P, every=10, backend="numba")
+def warm():
+    iterate_runge_kutta("rigid-body", "{method}", {h_warm}, {steps_warm}, [1.0, 0.5, 0.2], P, every=10, backend="numba")
+'''
+
+
 CASES = {
     "bch 12321 deg 9 (sparse engine)": '''
 from nambu_bch.bch import formal as F, formal_bch
@@ -163,30 +175,9 @@ def first():
 def warm():
     iterate("ho3", "32123", 0.1, 400, X, every=100, backend="numba")
 ''',
-    "rigid-body gauss4 (Runge-Kutta, Newton's method)": '''
-from nambu_bch.numeric.runge_kutta import iterate_runge_kutta
-P = {"I1": 1.0, "I2": 2.0, "I3": 3.0}
-def first():
-    iterate_runge_kutta("rigid-body", "gauss4", 0.1, 50, [1.0, 0.5, 0.2], P, every=10, backend="numba")
-def warm():
-    iterate_runge_kutta("rigid-body", "gauss4", 0.01, 200000, [1.0, 0.5, 0.2], P, every=10, backend="numba")
-''',
-    "rigid-body rk4 (Runge-Kutta, explicit)": '''
-from nambu_bch.numeric.runge_kutta import iterate_runge_kutta
-P = {"I1": 1.0, "I2": 2.0, "I3": 3.0}
-def first():
-    iterate_runge_kutta("rigid-body", "rk4", 0.1, 50, [1.0, 0.5, 0.2], P, every=10, backend="numba")
-def warm():
-    iterate_runge_kutta("rigid-body", "rk4", 0.001, 2000000, [1.0, 0.5, 0.2], P, every=10, backend="numba")
-''',
-    "rigid-body kahan (Runge-Kutta, one linear solve)": '''
-from nambu_bch.numeric.runge_kutta import iterate_runge_kutta
-P = {"I1": 1.0, "I2": 2.0, "I3": 3.0}
-def first():
-    iterate_runge_kutta("rigid-body", "kahan", 0.1, 50, [1.0, 0.5, 0.2], P, every=10, backend="numba")
-def warm():
-    iterate_runge_kutta("rigid-body", "kahan", 0.001, 2000000, [1.0, 0.5, 0.2], P, every=10, backend="numba")
-''',
+    **{f"rigid-body {method} (Runge-Kutta, {kind})": _rk_case(method, h, steps)
+       for method, kind, h, steps in (("gauss4", "Newton's method", 0.01, 200000), ("rk4", "explicit", 0.001, 2000000),
+                                       ("kahan", "one linear solve", 0.001, 2000000))},
 }
 
 
