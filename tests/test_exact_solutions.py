@@ -232,3 +232,16 @@ def test_closed_form_takes_sympys_route_outside_the_rationals():
     assert solutions._exact_parts(data, 0, (0, 1), (), (sympy.S(1),) * 5) is None
     assert solutions._exact_parts([sympy.Integer(0), 1 / m, -m * omega**2, sympy.Integer(0), omega**2, x10, x20], 0,
                                   (0, 1), (), (sympy.cos(t), sympy.sin(t), 2, 3, t)) is not None
+
+
+def test_composed_map_is_composed_once_per_word():
+    """The composed map (an immutable tuple) is memoised per (splitting, composition, step): the conserved
+    quantities, ``is_invariant`` and the modified solutions ask for the same map; ``clear_caches`` forgets it."""
+    from nambu_bch import clear_caches
+
+    splitting = model("ho").splitting
+    phi = composed_map(splitting, "121")
+    assert composed_map(splitting, "121") is phi
+    assert composed_map(splitting, "121", h=sympy.Rational(1, 10)) == tuple(e.subs(h, sympy.Rational(1, 10)) for e in phi)
+    clear_caches()
+    assert composed_map(splitting, "121") == phi and composed_map(splitting, "121") is not phi
