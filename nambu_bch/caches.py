@@ -64,6 +64,7 @@ CACHES = (
     ("nambu_bch.exact.solutions", "_lambdify"),
     ("nambu_bch.exact.solutions", "_solution"),
     ("nambu_bch.integrators.composition", "_composition_from_text"),
+    ("nambu_bch.integrators.compose", "_composed_map"),
     ("nambu_bch.systems.piece_flows", "piece_flow"),
     ("nambu_bch.integrators.composition", "_catalog_build"),
     ("nambu_bch.numeric.codegen", "_step_program"),

@@ -200,3 +200,45 @@ def test_shadow_solution_stretches_the_conserved_one_without_solving_again(monke
     factor = solutions.exact_shadow_hamiltonians(system, "TVT").factor
     assert shadow.expressions == tuple(e.subs(solutions.TIME, factor * solutions.TIME) for e in base)
     assert shadow.initial_symbols == x0 == conserved.initial_symbols and shadow.frequency == factor * Omega
+
+
+@pytest.mark.parametrize("name,word,kind", [("ho3", "32123", "o"), ("ho", "121", "c")])
+def test_closed_form_in_the_exact_field_is_sympys_closed_form(name, word, kind):
+    """The coefficients computed in ``Q(parameters, h, x_0)`` (``W**2 = det`` as field arithmetic) give the very
+    expressions -- same sympy structure, same printed form -- that expanding and collecting in sympy gives
+    (Eqs. OHsol, CQsol)."""
+    from nambu_bch.exact import solutions
+
+    system = model(name)
+    eqs = modified_equations(system, word, kind)
+    exact, x0, Omega = solutions._closed_form(system, eqs, solutions.TIME)
+    rhs = [sympy.expand(r) for r in eqs]
+    lc = solutions.linear_core(system.coordinates, rhs, system.name)
+    W = sympy.Dummy("Omega", positive=True)
+    trig = (sympy.cos(W * t), sympy.sin(W * t), sympy.cos(2 * W * t), sympy.sin(2 * W * t))
+    y = tuple(system.coordinates[i] for i in lc.core)
+    collected, _, _ = solutions._closed_form_sympy(system.coordinates, rhs, x0, lc, W, trig, y, solutions.TIME)
+    assert exact == collected
+    assert [sympy.srepr(e) for e in exact] == [sympy.srepr(e) for e in collected]
+
+
+def test_closed_form_takes_sympys_route_outside_the_rationals():
+    """An algebraic coefficient (``2**(1/3)``, a Yoshida weight) is not in ``Q(symbols)``: the exact route declines
+    and sympy's expansion is used (the field would treat the radical as an independent symbol)."""
+    from nambu_bch.exact import solutions
+
+    data = [sympy.Integer(0), sympy.Integer(1), -sympy.cbrt(2) * omega**2, sympy.Integer(0), sympy.cbrt(2) * omega**2,
+            x10, x20]
+    assert solutions._exact_parts(data, 0, (0, 1), (), (sympy.S(1),) * 5) is None
+    assert solutions._exact_parts([sympy.Integer(0), 1 / m, -m * omega**2, sympy.Integer(0), omega**2, x10, x20], 0,
+                                  (0, 1), (), (sympy.cos(t), sympy.sin(t), 2, 3, t)) is not None
+
+
+def test_composed_map_is_composed_once_per_word():
+    """The composed map (an immutable tuple) is memoised per (splitting, composition, step): the conserved
+    quantities, ``is_invariant`` and the testing helpers ask for the same map (``clear_caches`` forgets it:
+    tests/test_public_api.py checks that every ``lru_cache`` is listed in ``CACHES``)."""
+    splitting = model("ho").splitting
+    phi = composed_map(splitting, "121")
+    assert composed_map(splitting, "121") is phi
+    assert composed_map(splitting, "121", h=sympy.Rational(1, 10)) == tuple(e.subs(h, sympy.Rational(1, 10)) for e in phi)

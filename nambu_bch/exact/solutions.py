@@ -127,7 +127,13 @@ def _tidy(expr, atoms, W, det):
 
 
 def _closed_form(system, rhs, t):
-    """Closed-form solution of ``x' = rhs(x)`` with a 2-d linear core and driven coordinates."""
+    """Closed-form solution of ``x' = rhs(x)`` with a 2-d linear core and driven coordinates.
+
+    The coefficients are computed as exact rational functions (:func:`_exact_parts`) and turned into sympy
+    expressions once, each factored; the result is the expression that expanding and collecting the sympy
+    sum gives (:func:`_closed_form_sympy`, still the route for coefficients outside ``Q(symbols)``), without
+    the cost of ``expand``/``collect``/``cancel`` on the whole sum.
+    """
     coords = system.coordinates
     x0 = tuple(sympy.Symbol(f"{c.name}_0") for c in coords)
     rhs = [sympy.expand(r) for r in rhs]
@@ -136,10 +142,76 @@ def _closed_form(system, rhs, t):
     y = (coords[i1], coords[i2])
     # work with a placeholder W for Omega so that coefficients factor cleanly, substitute at the end
     W = sympy.Dummy("Omega", positive=True)
-    C = sympy.Matrix([x0[i1], x0[i2]])
-    S = A * C / W
     c1, s1 = sympy.cos(W * t), sympy.sin(W * t)
     c2, s2 = sympy.cos(2 * W * t), sympy.sin(2 * W * t)
+    polys = [sympy.Poly(rhs[k], *y) for k in driven]
+    data = [A[i, j] for i in range(2) for j in range(2)] + [det]
+    data += [q.coeff_monomial(m) for q in polys for m in (y[0] ** 2, y[1] ** 2, y[0] * y[1], y[0], y[1], 1)]
+    data += list(x0)
+    parts = _exact_parts(data, len(polys), (i1, i2), driven, (c1, s1, c2, s2, t))
+    if parts is None:  # coefficients outside Q(symbols) (e.g. 2**(1/3)): sympy's route below
+        return _closed_form_sympy(coords, rhs, x0, lc, W, (c1, s1, c2, s2), y, t)
+    out = [sympy.Add(*[(sympy.factor(a) + sympy.factor(b) * W) * key for key, (a, b) in coeffs.items()])
+           for coeffs in parts]
+    return tuple(e.subs(W, Omega) for e in out), x0, Omega
+
+
+def _exact_parts(data, ndriven, core, driven, keys):
+    """The coefficients of the closed form, exactly in ``Q(parameters, h, x_0)``, as ``{key: (a, b)}`` per coordinate.
+
+    With ``W = Omega`` (``W**2 = det``), ``S = A C / W = W (A C)/det`` and ``1/W = W/det``, so every
+    coefficient of ``1, t, cos(W t), sin(W t), cos(2 W t), sin(2 W t)`` is ``a + b W`` with ``a, b`` in
+    the field, read off without expanding or collecting (Eqs. OHsol, CQsol):
+
+    * core ``y(t) = C cos(W t) + (A C)/det * W sin(W t)``;
+    * driven ``x_k' = y^T Q y + l y + c0``: with ``cqc = C^T Q C``, ``sqs = (AC)^T Q (AC)/det``,
+      ``cqs = C^T Q (A C)/det``, the integral is
+      ``((cqc + sqs)/2 + c0) t + (cqc - sqs)/(4 det) W sin(2Wt) - cqs/2 cos(2Wt) + cqs/2
+      + (l C)/det W sin(Wt) - (l A C)/det cos(Wt) + (l A C)/det``.
+
+    Returns ``None`` when the data are not rational functions over ``QQ`` (sympy's route is taken then).
+    A key whose coefficient is zero is left out, as ``sympy.collect`` leaves it out of an expanded sum.
+    """
+    from sympy.polys.polyerrors import PolynomialError
+
+    try:
+        K, vals = sympy.sfield(data, domain=sympy.QQ)
+    except (PolynomialError, sympy.CoercionFailed, ValueError, TypeError):
+        return None
+    if not all(isinstance(g, sympy.Symbol) for g in K.symbols):  # a radical taken as a generator: not a field of Q
+        return None
+    a11, a12, a21, a22, det = vals[:5]
+    qs = vals[5:5 + 6 * ndriven]
+    x0 = vals[5 + 6 * ndriven:]
+    if det == 0:
+        return None
+    c1, s1, c2, s2, t = keys
+    C = (x0[core[0]], x0[core[1]])
+    AC = (a11 * C[0] + a12 * C[1], a21 * C[0] + a22 * C[1])
+    zero = K.zero
+    out = [None] * len(x0)
+    out[core[0]] = {c1: (C[0], zero), s1: (zero, AC[0] / det)}
+    out[core[1]] = {c1: (C[1], zero), s1: (zero, AC[1] / det)}
+
+    def form(u, v, q11, q22, q12):
+        return q11 * u[0] * v[0] + q22 * u[1] * v[1] + q12 * (u[0] * v[1] + u[1] * v[0]) / 2
+
+    for n, k in enumerate(driven):
+        q11, q22, q12, l1, l2, c0 = qs[6 * n: 6 * n + 6]
+        cqc, sqs, cqs = form(C, C, q11, q22, q12), form(AC, AC, q11, q22, q12) / det, form(C, AC, q11, q22, q12) / det
+        lC, lAC = l1 * C[0] + l2 * C[1], (l1 * AC[0] + l2 * AC[1]) / det
+        out[k] = {sympy.S.One: (x0[k] + cqs / 2 + lAC, zero), t: ((cqc + sqs) / 2 + c0, zero),
+                  s2: (zero, (cqc - sqs) / (4 * det)), c2: (-cqs / 2, zero),
+                  s1: (zero, lC / det), c1: (-lAC, zero)}
+    return [{key: (a.as_expr(), b.as_expr()) for key, (a, b) in coeffs.items() if a != 0 or b != 0} for coeffs in out]
+
+
+def _closed_form_sympy(coords, rhs, x0, lc, W, trig, y, t):
+    """The closed form by sympy expansion and collection (coefficients outside ``Q(symbols)``)."""
+    (i1, i2), driven, A, det, Omega = lc.core, lc.driven, lc.A, lc.det, lc.Omega
+    c1, s1, c2, s2 = trig
+    C = sympy.Matrix([x0[i1], x0[i2]])
+    S = A * C / W
     out = [None] * len(coords)
     yt = C * c1 + S * s1
     out[i1], out[i2] = yt[0], yt[1]

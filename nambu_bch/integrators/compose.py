@@ -8,6 +8,8 @@ sympy substitution.
 
 from __future__ import annotations
 
+from functools import lru_cache
+
 import sympy
 
 from ..parsing import as_expression
@@ -27,8 +29,17 @@ def composed_map(splitting, comp, h=STEP) -> tuple:
     -h**2*omega**2*x2/2 - h*m*omega**2*x1 + x2
     """
     comp = composition_for(comp, splitting)
+    h = as_expression(h, splitting.system.symbols(), "h")
+    return _composed_map(splitting, comp, h)
+
+
+@lru_cache(maxsize=128)
+def _composed_map(splitting, comp, h) -> tuple:
+    """The map of :func:`composed_map` per (splitting, composition, step): an immutable tuple, composed once.
+
+    The invariant search, :func:`~nambu_bch.exact.is_invariant` and the testing helpers ask for the same map of
+    the same word; composing it again costs the same substitutions each time."""
     system = splitting.system
-    h = as_expression(h, system.symbols(), "h")
     coords = system.coordinates
     flows = [(exact_flow(splitting[k], coords), c) for k, c in comp.factors()]
     # the ring route takes the step as a generator: a symbol (h = -h or 0.1 compose by substitution)
