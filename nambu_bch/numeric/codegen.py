@@ -602,7 +602,6 @@ Every name below is internal (s_i state, k_j constants, P[i] parameters); the ca
 verifies this file against the digest recorded when it was generated.
 """
 import math
-import textwrap
 import numpy as np
 
 _exp, _expm1, _log, _sqrt = math.exp, math.expm1, math.log, math.sqrt
