@@ -100,3 +100,19 @@ def test_compile_cost_takes_triples_and_says_how_otherwise(capsys):
     for argv in ([], ["ho3", "32123"], ["ho3", "32123", "run", "ho"]):
         assert tool.main(argv) == 2
         assert capsys.readouterr().err.startswith("usage: compile_cost.py SYSTEM WORD LOOP")
+
+
+def test_report_gives_the_runs_wall_time_each_collection_and_the_exit(tmp_path):
+    records = {
+        "main": [{"k": "start", "cpu": 0.5, "t": 100.0}, {"k": "end", "cpu": 9.0, "t": 160.0}],
+        "gw0": [{"k": "start", "cpu": 0.5, "t": 101.0}, {"k": "collected", "cpu": 8.0, "t": 109.5},
+                {"k": "end", "cpu": 50.0, "t": 158.0}],
+        "gw1": [{"k": "start", "cpu": 0.5, "t": 101.5}, {"k": "collected", "cpu": 8.0, "t": 110.0},
+                {"k": "end", "cpu": 49.0, "t": 159.5}],
+    }
+    for worker, lines in records.items():
+        (tmp_path / f"{worker}.jsonl").write_text("".join(json.dumps(r) + "\n" for r in lines))
+    text = _tool().report(tmp_path)
+    assert "  wall: the run 60.0 s" in text
+    assert "  wall: gw0 collection 8.5 s" in text and "  wall: gw1 collection 8.5 s" in text
+    assert "  wall: the last worker's end -> the run's end 0.5 s" in text

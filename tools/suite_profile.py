@@ -147,6 +147,7 @@ def report(directory, n_tests: int = 60, n_files: int = 30) -> str:
     lines += [f"  {w}: {v:.1f} s" for w, v in sorted(by_worker.items())]
     lines += [f"  {m['worker']} {m['k']}: CPU {m['cpu']:.1f} s" + (f", load {m['load'][0]:.1f}" if "load" in m else "")
               for m in marks]
+    lines += _timeline(marks)
     by_file = collections.Counter()
     for t in tests:
         by_file[t["test"].split("::")[0]] += cost(t)
@@ -159,6 +160,22 @@ def report(directory, n_tests: int = 60, n_files: int = 30) -> str:
               for c in sorted(compiles, key=lambda c: -c["cpu"])]
     lines += _repeated(compiles)
     return "\n".join(lines)
+
+
+def _timeline(marks) -> list:
+    """Wall seconds from the time stamps: the whole run (the controller's start to its end), each worker's
+    collection, and the last worker's end (its session over) to the run's end -- the workers' exit."""
+    t = {(m["worker"], m["k"]): m["t"] for m in marks if "t" in m}
+    if ("main", "start") not in t or ("main", "end") not in t:
+        return []
+    lines = [f"  wall: the run {t['main', 'end'] - t['main', 'start']:.1f} s"]
+    workers = sorted({w for w, _ in t if w != "main"})
+    lines += [f"  wall: {w} collection {t[w, 'collected'] - t[w, 'start']:.1f} s"
+              for w in workers if (w, "start") in t and (w, "collected") in t]
+    ends = [t[w, "end"] for w in workers if (w, "end") in t]
+    if ends:
+        lines.append(f"  wall: the last worker's end -> the run's end {t['main', 'end'] - max(ends):.1f} s")
+    return lines
 
 
 def _repeated(compiles) -> list:
